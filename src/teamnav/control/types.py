@@ -1,0 +1,194 @@
+"""What a robot's brain receives and returns: the belief side of the truth/belief rule.
+
+Everything here is in the robot's *own* frame: its odometry frame (which drifts away from
+the world) or its body frame (x forward, y left). Nothing here carries a true pose. The
+simulator (``teamnav.sim``) builds these from the truth through the sensor, odometry and
+radio models; brains (``teamnav.control``, ``teamnav.localization``) read only these.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+
+def payload_size_bytes(value: Any) -> int:
+    """Bytes a value would take on the wire, for bandwidth accounting.
+
+    float/int: 8 bytes, bool: 1, str: its UTF-8 length, ndarray: ``nbytes``, None: 0,
+    sequences and mappings: the sum of their items, dataclasses: the sum of their fields.
+    """
+    if value is None:
+        return 0
+    if isinstance(value, (bool, np.bool_)):
+        return 1
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        return 8
+    if isinstance(value, str):
+        return len(value.encode())
+    if isinstance(value, bytes):
+        return len(value)
+    if isinstance(value, np.ndarray):
+        return int(value.nbytes)
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return sum(payload_size_bytes(getattr(value, f.name)) for f in dataclasses.fields(value))
+    if isinstance(value, dict):
+        return sum(payload_size_bytes(k) + payload_size_bytes(v) for k, v in value.items())
+    if isinstance(value, (list, tuple, set, frozenset)):
+        return sum(payload_size_bytes(v) for v in value)
+    raise TypeError(f"cannot size a message field of type {type(value).__name__}; use plain data")
+
+
+@dataclass(frozen=True, slots=True)
+class Message:
+    """A radio message: plain data, sized so bandwidth can be counted.
+
+    Parameters
+    ----------
+    sender : int
+        Id of the sending robot (a robot knows its own id).
+    stamp_s : float
+        Sender's clock when sent [s].
+    body : Any
+        Plain data: a frozen dataclass, numbers, strings, arrays, tuples, dicts.
+    to : int or None
+        Addressee id, or None to broadcast. The radio model still decides who hears it.
+    kind : str
+        A short label for logs and per-kind message counts.
+    """
+
+    sender: int
+    stamp_s: float
+    body: Any
+    to: int | None = None
+    kind: str = "msg"
+
+    def size_bytes(self) -> int:
+        """Header (sender, stamp, to: 8 bytes each) plus the body's size."""
+        return 24 + payload_size_bytes(self.body)
+
+
+@dataclass(frozen=True, slots=True)
+class Detection:
+    """One robot seen by the robot detector, in the observer's body frame.
+
+    ``robot_id`` is None when the detector does not report identities, and for false
+    positives it is whatever the detector model reports (possibly a wrong id or None).
+    """
+
+    range_m: float
+    bearing_rad: float
+    robot_id: int | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class RangeScan:
+    """One range sensor's reading.
+
+    ``angles_rad[i]`` is beam i's direction in the body frame; ``ranges_m[i]`` its range,
+    equal to ``max_range_m`` for "no return".
+    """
+
+    ranges_m: np.ndarray
+    angles_rad: np.ndarray
+    max_range_m: float
+
+
+@dataclass(frozen=True, slots=True)
+class Observation:
+    """Everything a robot knows at one step, built fresh by the simulator each step.
+
+    Attributes
+    ----------
+    robot_id : int
+        This robot's id.
+    step : int
+        Step index (0 at start).
+    time_s : float
+        Time since start [s] (robots' clocks agree).
+    odom_pose : ndarray of shape (3,)
+        (x [m], y [m], theta [rad]) believed from odometry, in this robot's own odometry
+        frame (the pose it started at is (0, 0, 0) unless the scenario aligns frames).
+    odom_delta : ndarray of shape (3,)
+        Odometry motion since the previous step, as (dx, dy, dtheta) in the previous
+        body frame (what MCL's odometry motion model consumes).
+    scans : dict of str to RangeScan
+        Range sensors by name ("laser", "sonar", ...).
+    detections : tuple of Detection
+        Teammates (and false positives) seen by the robot detector this step.
+    stalled : bool
+        Bumper/stall flag: the last commanded motion was blocked (wall or robot).
+    inbox : tuple of Message
+        Messages the radio delivered this step.
+    events : tuple of str
+        Task events fired for this robot this step (e.g. "given_resource", "took_resource").
+    """
+
+    robot_id: int
+    step: int
+    time_s: float
+    odom_pose: np.ndarray
+    odom_delta: np.ndarray
+    scans: dict[str, RangeScan] = field(default_factory=dict)
+    detections: tuple[Detection, ...] = ()
+    stalled: bool = False
+    inbox: tuple[Message, ...] = ()
+    events: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class Action:
+    """A motion command.
+
+    Unicycle robots use ``v_mps`` (forward speed) and ``omega_radps`` (turn rate); the
+    simulator clips both to the robot's limits. Holonomic fixed-step robots (Sgorbissa &
+    Arkin count motion steps) use ``direction_rad``: the body-frame direction of one step of
+    fixed length (the robot turns to face it and moves); None means stay.
+    """
+
+    v_mps: float = 0.0
+    omega_radps: float = 0.0
+    direction_rad: float | None = None
+
+    @staticmethod
+    def stop() -> "Action":
+        return Action()
+
+
+@dataclass(frozen=True, slots=True)
+class BatchObservation:
+    """Observations of every robot run by one batched controller, row by row.
+
+    The same truth/belief rule as :class:`Observation`: each row is one robot's own data.
+
+    Attributes
+    ----------
+    robot_ids : ndarray (n,) int64
+    step : int
+    time_s : float
+    odom_pose : ndarray (n, 3) float64 — own odometry frame
+    ranges_m : ndarray (n, B) float64 — the controller's chosen range sensor
+    angles_rad : ndarray (B,) float64 — beam directions in the body frame
+    max_range_m : float
+    stalled : ndarray (n,) bool
+    """
+
+    robot_ids: np.ndarray
+    step: int
+    time_s: float
+    odom_pose: np.ndarray
+    ranges_m: np.ndarray
+    angles_rad: np.ndarray
+    max_range_m: float
+    stalled: np.ndarray
+
+
+@dataclass(frozen=True, slots=True)
+class BatchAction:
+    """Commands for every robot of a batched controller: ``v_mps`` and ``omega_radps`` (n,)."""
+
+    v_mps: np.ndarray
+    omega_radps: np.ndarray

@@ -1,0 +1,1 @@
+"""Scenario files, runner, metrics, sweeps and reports."""

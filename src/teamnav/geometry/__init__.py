@@ -1,0 +1,1 @@
+"""SE(2) and similarity transforms, angles, frames from mutual bearings."""

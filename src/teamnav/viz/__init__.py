@@ -1,0 +1,1 @@
+"""Figures and replays: read recorded runs only."""
