@@ -49,6 +49,7 @@ class LaserConfig(Model):
     p_max: Prob = 0.0
     p_short: Prob = 0.0
     sees: tuple[str, ...] = DEFAULT_SEES["laser"]
+    sees_robots: bool = True
 
 
 class SonarConfig(Model):
@@ -71,6 +72,7 @@ class SonarConfig(Model):
     p_specular: Prob = 0.02
     p_short: Prob = 0.0
     sees: tuple[str, ...] = DEFAULT_SEES["sonar"]
+    sees_robots: bool = True
 
 
 class ProximityConfig(Model):
@@ -82,6 +84,7 @@ class ProximityConfig(Model):
     max_range_m: float = Field(0.14, gt=0.0, le=10.0)
     noise_std_m: NonNegFloat = 0.0
     sees: tuple[str, ...] = DEFAULT_SEES["proximity"]
+    sees_robots: bool = True
 
     @field_validator("angles_deg")
     @classmethod
@@ -243,6 +246,7 @@ class SimConfig(Model):
     dt_s: float = Field(0.1, gt=0.0, le=10.0)
     seed: int = Field(0, ge=0, le=2**63 - 1)
     robot_collisions: bool = True
+    record_every: int = Field(1, ge=1, le=1_000_000)
 
     @field_validator("robots")
     @classmethod
