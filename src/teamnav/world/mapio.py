@@ -1,0 +1,620 @@
+"""Map files: ROS map_server YAML + image, plain PNG/PGM images, and a material layer.
+
+teamnav reads and writes maps in the format of ROS ``map_server`` (ROS 1
+``map_server/src/image_loader.cpp``; ROS 2 ``nav2_map_server/src/map_io.cpp`` follows the
+same rules). A map is a YAML file next to an image::
+
+    image: depot.pgm          # relative to the YAML file's folder (or absolute)
+    resolution: 0.05          # metres per pixel, positive
+    origin: [0.0, 0.0, 0.0]   # x [m], y [m], yaw [rad] of the lower-left pixel; yaw must be 0
+    negate: 0                 # 0/1 or false/true                (default 0)
+    occupied_thresh: 0.65     # in [0, 1]                        (default 0.65)
+    free_thresh: 0.196        # in [0, 1], below occupied_thresh (default 0.196)
+    mode: trinary             # trinary | scale | raw            (default trinary)
+
+teamnav extension (ignored by ROS, which skips unknown keys)::
+
+    materials: depot_materials.png   # a second 8-bit greyscale image, same size as ``image``
+    material_values: {3: glass, 4: foam}
+
+Pixels of the material layer whose value is listed in ``material_values`` set that cell to
+the named material (any name: ``glass``, ``foam`` and ``unknown`` are built in, new names
+are appended to the grid's materials in increasing pixel value order; ``free`` carves free
+space). Pixels with unlisted values (conventionally 0) keep what the occupancy image says.
+The layer is applied after the occupancy image is thresholded.
+
+Pixel rule (map_server, per pixel)
+----------------------------------
+1. ``c`` = mean of the colour channels. Like map_server, *trinary* mode averages the alpha
+   channel in with the colours (map_server's "preserve existing behaviour" quirk); *scale*
+   and *raw* modes leave alpha out. Palette images are expanded to RGB(A) first and 1-bit
+   images to 0/255 greyscale.
+2. If ``negate``: ``c = 255 - c``.
+3. *trinary* and *scale*: ``p = (255 - c) / 255``; occupied (100) if ``p > occupied_thresh``,
+   free (0) if ``p < free_thresh``; otherwise unknown (-1) in trinary mode and, in scale
+   mode, a value in 1..99 (or -1 for a fully transparent pixel).
+4. *raw*: the occupancy value is ``c`` itself, truncated to an integer (map_server stores it
+   unchanged in the int8 ``OccupancyGrid.data``; 255 reads back as -1).
+
+teamnav's grid has no graded occupancy, so the occupancy value is reduced to materials the
+way ``amcl`` reads a map (``amcl_node.cpp``, ``convertMap``): exactly 0 is ``free``, exactly
+100 is ``wall`` and every other value (-1 and the graded 1..99) is ``unknown``. In trinary
+mode this is exactly the three-way threshold rule above; in scale mode the graded band
+between the two thresholds becomes ``unknown``; in raw mode only pixel values 0 and 100 are
+free and wall.
+
+The image's top row is the map's highest y, so the pixel array is flipped vertically
+(row 0 of :attr:`OccupancyGrid.cells` is the bottom of the image).
+
+A plain ``.png``/``.pgm`` file (no YAML) is read with map_server's default thresholds
+(``occupied_thresh=0.65``, ``free_thresh=0.196``, ``negate=0``, trinary) and needs
+``resolution_m``.
+
+Every malformed input raises :class:`MapError`, whose message names the file, the field,
+what was expected and what was found.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from PIL import Image, UnidentifiedImageError
+
+from teamnav.world.grid import DEFAULT_MATERIALS, OccupancyGrid
+
+__all__ = [
+    "MapError",
+    "MapMetadata",
+    "load_map",
+    "save_map",
+    "read_map_yaml",
+    "occupancy_values",
+    "occupancy_to_cells",
+    "DEFAULT_OCCUPIED_THRESH",
+    "DEFAULT_FREE_THRESH",
+    "IMAGE_SUFFIXES",
+    "YAML_SUFFIXES",
+]
+
+#: map_server's customary thresholds (the values ``map_saver`` writes).
+DEFAULT_OCCUPIED_THRESH: float = 0.65
+DEFAULT_FREE_THRESH: float = 0.196
+MODES: tuple[str, ...] = ("trinary", "scale", "raw")
+YAML_SUFFIXES: tuple[str, ...] = (".yaml", ".yml")
+IMAGE_SUFFIXES: tuple[str, ...] = (".png", ".pgm")
+YAML_FIELDS: tuple[str, ...] = (
+    "image",
+    "resolution",
+    "origin",
+    "negate",
+    "occupied_thresh",
+    "free_thresh",
+    "mode",
+    "materials",
+    "material_values",
+)
+
+#: Pixel values ``save_map`` writes (those of ROS ``map_saver``).
+PIXEL_OCCUPIED: int = 0
+PIXEL_UNKNOWN: int = 205
+PIXEL_FREE: int = 254
+
+#: occupancy values of ``nav_msgs/OccupancyGrid``
+OCC_FREE: int = 0
+OCC_OCCUPIED: int = 100
+OCC_UNKNOWN: int = -1
+
+
+class MapError(ValueError):
+    """A map file is missing or malformed.
+
+    Parameters
+    ----------
+    file : str or Path
+        The file at fault.
+    field : str
+        The YAML field (or ``"image"``, ``"<file>"``, ``"<yaml>"`` for the file itself).
+    expected : str
+        What a valid value looks like.
+    found : object
+        What was found (shown with ``repr`` unless already a string description).
+
+    Examples
+    --------
+    >>> str(MapError("m.yaml", "resolution", "a positive number", -1.0))
+    "m.yaml: field 'resolution': expected a positive number, found -1.0"
+    """
+
+    def __init__(self, file: str | os.PathLike, field: str, expected: str, found: Any) -> None:
+        self.file = str(file)
+        self.field = field
+        self.expected = expected
+        self.found = found
+        shown = found if isinstance(found, _Described) else repr(found)
+        super().__init__(f"{self.file}: field {field!r}: expected {expected}, found {shown}")
+
+
+class _Described(str):
+    """A description of what was found, printed without quotes."""
+
+
+@dataclass(frozen=True)
+class MapMetadata:
+    """Validated contents of a map YAML file.
+
+    Attributes
+    ----------
+    image : Path
+        Occupancy image, resolved against the YAML file's folder.
+    resolution_m : float
+        Cell side [m], positive and finite.
+    origin_xy_m : tuple of float
+        World (x, y) [m] of the lower-left corner of the lower-left pixel.
+    negate : bool
+        Swap the meaning of black and white.
+    occupied_thresh, free_thresh : float
+        map_server thresholds on ``p`` in [0, 1], ``free_thresh < occupied_thresh``.
+    mode : str
+        ``"trinary"``, ``"scale"`` or ``"raw"``.
+    materials_image : Path or None
+        teamnav material layer, same size as ``image``.
+    material_values : dict of int to str
+        Pixel value of the material layer -> material name.
+    """
+
+    image: Path
+    resolution_m: float
+    origin_xy_m: tuple[float, float]
+    negate: bool = False
+    occupied_thresh: float = DEFAULT_OCCUPIED_THRESH
+    free_thresh: float = DEFAULT_FREE_THRESH
+    mode: str = "trinary"
+    materials_image: Path | None = None
+    material_values: dict[int, str] | None = None
+
+
+# ---------------------------------------------------------------------------- public API
+def load_map(
+    path: str | os.PathLike,
+    *,
+    resolution_m: float | None = None,
+    origin_xy_m: tuple[float, float] | None = None,
+) -> OccupancyGrid:
+    """Load a map file into an :class:`OccupancyGrid`.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.yaml``/``.yml`` (ROS map_server YAML, see the module docstring) or a plain
+        ``.png``/``.pgm`` image.
+    resolution_m : float, optional
+        Cell side [m]. Required for a plain image; for a YAML file it replaces the file's
+        ``resolution``.
+    origin_xy_m : (float, float), optional
+        World (x, y) [m] of the lower-left corner. Default (0, 0) for a plain image; for a
+        YAML file it replaces the file's ``origin``.
+
+    Returns
+    -------
+    OccupancyGrid
+        ``cells`` of shape (image height, image width), row 0 = bottom of the image;
+        ``name`` is the path.
+
+    Raises
+    ------
+    MapError
+        Missing file, unreadable image, wrong field type or value (see the module docstring).
+
+    Examples
+    --------
+    >>> g = load_map("/work/shared/data/nav2/tb3_sandbox.yaml")  # doctest: +SKIP
+    >>> g.shape, g.resolution_m, g.origin_xy_m  # doctest: +SKIP
+    ((384, 384), 0.05, (-10.0, -10.0))
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in YAML_SUFFIXES + IMAGE_SUFFIXES:
+        raise MapError(path, "<file>", f"a file ending in one of {YAML_SUFFIXES + IMAGE_SUFFIXES}", _Described(repr(path.suffix)))
+    if not path.is_file():
+        raise MapError(path, "<file>", "an existing map file", _Described("no such file"))
+    if resolution_m is not None:
+        resolution_m = _check_resolution(path, "resolution_m", resolution_m)
+    if origin_xy_m is not None:
+        origin_xy_m = _check_origin_xy(path, "origin_xy_m", origin_xy_m)
+
+    if suffix in IMAGE_SUFFIXES:
+        if resolution_m is None:
+            raise MapError(path, "resolution_m", "a resolution in metres per pixel for a plain image (no YAML)", None)
+        meta = MapMetadata(image=path, resolution_m=resolution_m, origin_xy_m=origin_xy_m or (0.0, 0.0))
+    else:
+        meta = read_map_yaml(path)
+        if resolution_m is not None or origin_xy_m is not None:
+            meta = MapMetadata(
+                image=meta.image,
+                resolution_m=meta.resolution_m if resolution_m is None else resolution_m,
+                origin_xy_m=meta.origin_xy_m if origin_xy_m is None else origin_xy_m,
+                negate=meta.negate,
+                occupied_thresh=meta.occupied_thresh,
+                free_thresh=meta.free_thresh,
+                mode=meta.mode,
+                materials_image=meta.materials_image,
+                material_values=meta.material_values,
+            )
+
+    pixels = _read_image(meta.image, "image", source=path)
+    values = occupancy_values(pixels, meta.negate, meta.occupied_thresh, meta.free_thresh, meta.mode)
+    cells = occupancy_to_cells(values)
+    materials = DEFAULT_MATERIALS
+    if meta.materials_image is not None:
+        cells, materials = _apply_material_layer(path, meta, cells)
+    # image row 0 is the top (highest y); grid row 0 is the bottom
+    cells = np.ascontiguousarray(cells[::-1])
+    return OccupancyGrid(cells, meta.resolution_m, meta.origin_xy_m, materials, str(path))
+
+
+def read_map_yaml(path: str | os.PathLike) -> MapMetadata:
+    """Read and validate a map_server YAML file (without reading the images).
+
+    Parameters
+    ----------
+    path : str or Path
+        The YAML file.
+
+    Returns
+    -------
+    MapMetadata
+
+    Raises
+    ------
+    MapError
+        On a missing file, invalid YAML, a missing required field (``image``,
+        ``resolution``, ``origin``), a value of the wrong type or range, an unknown field.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise MapError(path, "<file>", "an existing map YAML file", _Described("no such file")) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MapError(path, "<file>", "a readable UTF-8 YAML file", _Described(f"{type(exc).__name__}: {exc}")) from None
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise MapError(path, "<yaml>", "valid YAML", _Described(f"a syntax error: {str(exc).splitlines()[0]}")) from None
+    if not isinstance(doc, dict):
+        raise MapError(path, "<yaml>", "a mapping of map fields (image, resolution, origin, ...)", _Described(type(doc).__name__))
+    for key in doc:
+        if key not in YAML_FIELDS:
+            close = difflib.get_close_matches(str(key), YAML_FIELDS, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise MapError(path, str(key), f"one of the known fields {YAML_FIELDS}{hint}", _Described("an unknown field"))
+    for key in ("image", "resolution", "origin"):
+        if key not in doc:
+            raise MapError(path, key, "a required field", _Described("nothing (field missing)"))
+
+    image = _check_relpath(path, "image", doc["image"])
+    resolution = _check_resolution(path, "resolution", doc["resolution"])
+    origin = _check_origin(path, doc["origin"])
+    negate = _check_negate(path, doc.get("negate", 0))
+    occ = _check_thresh(path, "occupied_thresh", doc.get("occupied_thresh", DEFAULT_OCCUPIED_THRESH))
+    free = _check_thresh(path, "free_thresh", doc.get("free_thresh", DEFAULT_FREE_THRESH))
+    if not occ > free:
+        raise MapError(path, "occupied_thresh", f"a value greater than free_thresh={free!r}", occ)
+    mode = doc.get("mode", "trinary")
+    if not isinstance(mode, str) or mode not in MODES:
+        raise MapError(path, "mode", f"one of {MODES}", mode)
+
+    materials_image = None
+    material_values = None
+    if "materials" in doc or "material_values" in doc:
+        if "materials" not in doc:
+            raise MapError(path, "materials", "an image path when 'material_values' is given", _Described("nothing (field missing)"))
+        if "material_values" not in doc:
+            raise MapError(path, "material_values", "a mapping {pixel value: material name} when 'materials' is given", _Described("nothing (field missing)"))
+        materials_image = _check_relpath(path, "materials", doc["materials"])
+        material_values = _check_material_values(path, doc["material_values"])
+
+    return MapMetadata(
+        image=image,
+        resolution_m=resolution,
+        origin_xy_m=origin,
+        negate=negate,
+        occupied_thresh=occ,
+        free_thresh=free,
+        mode=mode,
+        materials_image=materials_image,
+        material_values=material_values,
+    )
+
+
+def occupancy_values(
+    pixels: np.ndarray,
+    negate: bool = False,
+    occupied_thresh: float = DEFAULT_OCCUPIED_THRESH,
+    free_thresh: float = DEFAULT_FREE_THRESH,
+    mode: str = "trinary",
+) -> np.ndarray:
+    """map_server's per-pixel occupancy values (``nav_msgs/OccupancyGrid.data``).
+
+    Implements ``image_loader.cpp`` (ROS 1 map_server) step by step, see the module
+    docstring. The image is *not* flipped here.
+
+    Parameters
+    ----------
+    pixels : ndarray of shape (H, W) or (H, W, C), uint8
+        Image; C = 2 (grey + alpha), 3 (RGB) or 4 (RGBA). The last channel of a 2- or
+        4-channel image is alpha.
+    negate : bool, default False
+    occupied_thresh, free_thresh : float, defaults 0.65, 0.196
+    mode : {"trinary", "scale", "raw"}, default "trinary"
+
+    Returns
+    -------
+    ndarray of shape (H, W), int8
+        100 occupied, 0 free, -1 unknown; scale mode also 1..99; raw mode any int8.
+
+    Examples
+    --------
+    >>> occupancy_values(np.array([[0, 205, 254]], np.uint8)).tolist()
+    [[100, -1, 0]]
+    """
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
+    px = np.asarray(pixels)
+    if px.ndim == 2:
+        px = px[..., None]
+    n_channels = px.shape[-1]
+    has_alpha = n_channels in (2, 4)
+    # map_server: trinary averages alpha in with the colours; scale and raw leave it out
+    avg_channels = n_channels if (mode == "trinary" or not has_alpha) else n_channels - 1
+    color_avg = px[..., :avg_channels].astype(np.float64).sum(axis=-1) / avg_channels
+    if negate:
+        color_avg = 255.0 - color_avg
+    if mode == "raw":
+        # unsigned char value = color_avg (truncation), stored into int8 data
+        return np.trunc(color_avg).astype(np.uint8).view(np.int8)
+    occ = (255.0 - color_avg) / 255.0
+    out = np.full(occ.shape, OCC_UNKNOWN, dtype=np.int8)
+    if mode == "scale":
+        alpha = px[..., -1] if has_alpha else np.full(occ.shape, 255, np.uint8)
+        band = (alpha >= 1) & (occ <= occupied_thresh) & (occ >= free_thresh)
+        ratio = (occ[band] - free_thresh) / (occupied_thresh - free_thresh)
+        out[band] = (1.0 + 98.0 * ratio).astype(np.int8)  # map_server truncates to 1..99
+    out[occ > occupied_thresh] = OCC_OCCUPIED
+    out[occ < free_thresh] = OCC_FREE
+    return out
+
+
+def occupancy_to_cells(values: np.ndarray) -> np.ndarray:
+    """Reduce occupancy values to material ids as ``amcl`` reads a map.
+
+    Parameters
+    ----------
+    values : ndarray of int8
+        ``nav_msgs/OccupancyGrid`` values.
+
+    Returns
+    -------
+    ndarray of uint8, same shape
+        ``free`` (0) where the value is 0, ``wall`` (1) where it is 100, ``unknown`` (2)
+        elsewhere (amcl ``convertMap``: 0 free, 100 occupied, anything else unknown).
+
+    Examples
+    --------
+    >>> occupancy_to_cells(np.array([0, 100, -1, 50], np.int8)).tolist()
+    [0, 1, 2, 2]
+    """
+    values = np.asarray(values)
+    cells = np.full(values.shape, DEFAULT_MATERIALS.index("unknown"), dtype=np.uint8)
+    cells[values == OCC_FREE] = DEFAULT_MATERIALS.index("free")
+    cells[values == OCC_OCCUPIED] = DEFAULT_MATERIALS.index("wall")
+    return cells
+
+
+def save_map(grid: OccupancyGrid, yaml_path: str | os.PathLike) -> Path:
+    """Write ``grid`` as a map_server YAML + PGM (+ a material layer PGM if needed).
+
+    The occupancy image (``<stem>.pgm``) uses ``map_saver``'s pixel values: 254 free,
+    205 unknown, 0 for every other material (a ROS consumer sees glass and foam as
+    obstacles, as a robot bumps into them). Cells whose material is neither ``free``,
+    ``wall`` nor ``unknown`` also go to ``<stem>_materials.pgm``, pixel value = material id,
+    with ``material_values`` naming every id >= 3 of ``grid.materials``. All files are
+    written to temporary names in the target folder and moved in place with
+    :func:`os.replace`, the YAML last, so a reader never sees a half-written map.
+
+    ``load_map(save_map(g, p))`` gives the same cells as ``g`` (and the same materials
+    tuple when ``g.materials`` starts with :data:`DEFAULT_MATERIALS`), resolution and origin.
+
+    Parameters
+    ----------
+    grid : OccupancyGrid
+    yaml_path : str or Path
+        Target ``.yaml``/``.yml`` path; images go next to it.
+
+    Returns
+    -------
+    Path
+        ``yaml_path``.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> g = OccupancyGrid(np.array([[0, 1], [2, 3]], np.uint8), 0.1)
+    >>> d = tempfile.mkdtemp()
+    >>> g2 = load_map(save_map(g, os.path.join(d, "m.yaml")))
+    >>> g2.cells.tolist(), g2.resolution_m
+    ([[0, 1], [2, 3]], 0.1)
+    """
+    yaml_path = Path(yaml_path)
+    if yaml_path.suffix.lower() not in YAML_SUFFIXES:
+        raise MapError(yaml_path, "<file>", f"a path ending in one of {YAML_SUFFIXES}", _Described(repr(yaml_path.suffix)))
+    if not isinstance(grid, OccupancyGrid):
+        raise TypeError(f"save_map: grid must be an OccupancyGrid, got {type(grid).__name__}")
+    folder = yaml_path.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    names = np.asarray(grid.materials, dtype=object)
+    cell_names = names[grid.cells]
+    image = np.full(grid.shape, PIXEL_OCCUPIED, dtype=np.uint8)
+    image[cell_names == "free"] = PIXEL_FREE
+    image[cell_names == "unknown"] = PIXEL_UNKNOWN
+    special = ~np.isin(cell_names, ("free", "wall", "unknown"))
+
+    image_name = yaml_path.stem + ".pgm"
+    doc: dict[str, Any] = {
+        "image": image_name,
+        "mode": "trinary",
+        "resolution": float(grid.resolution_m),
+        "origin": [float(grid.origin_xy_m[0]), float(grid.origin_xy_m[1]), 0.0],
+        "negate": 0,
+        "occupied_thresh": DEFAULT_OCCUPIED_THRESH,
+        "free_thresh": DEFAULT_FREE_THRESH,
+    }
+    files: list[tuple[Path, Any]] = [(folder / image_name, image[::-1])]
+    if special.any():
+        layer = np.where(special, grid.cells, 0).astype(np.uint8)
+        layer_name = yaml_path.stem + "_materials.pgm"
+        doc["materials"] = layer_name
+        doc["material_values"] = {
+            k: name for k, name in enumerate(grid.materials) if name not in ("free", "wall", "unknown")
+        }
+        files.append((folder / layer_name, layer[::-1]))
+    files.append((yaml_path, yaml.safe_dump(doc, sort_keys=False)))
+
+    temps: list[tuple[str, Path]] = []
+    try:
+        for target, content in files:
+            fd, tmp = tempfile.mkstemp(prefix="." + target.name + ".", suffix=".tmp" + target.suffix, dir=folder)
+            os.close(fd)
+            temps.append((tmp, target))
+            if isinstance(content, str):
+                Path(tmp).write_text(content, encoding="utf-8")
+            else:
+                Image.fromarray(np.ascontiguousarray(content), mode="L").save(tmp, format="PPM")
+        for tmp, target in temps:
+            os.replace(tmp, target)
+    finally:
+        for tmp, _ in temps:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    return yaml_path
+
+
+# ---------------------------------------------------------------------------- helpers
+def _read_image(image_path: Path, field: str, *, source: Path) -> np.ndarray:
+    """Pixels of ``image_path`` as uint8 (H, W) or (H, W, C); errors name ``source``'s ``field``."""
+    where = source if source == image_path else f"{source} -> {image_path}"
+    if not image_path.is_file():
+        raise MapError(where, field, "an existing image file", _Described("no such file"))
+    try:
+        with Image.open(image_path) as im:
+            im.load()
+            if im.mode == "P":
+                im = im.convert("RGBA" if "transparency" in im.info else "RGB")
+            elif im.mode == "1":
+                im = im.convert("L")
+            elif im.mode == "PA":
+                im = im.convert("RGBA")
+            if im.mode not in ("L", "LA", "RGB", "RGBA"):
+                raise MapError(where, field, "an 8-bit greyscale, grey+alpha, RGB or RGBA image", _Described(f"image mode {im.mode!r}"))
+            pixels = np.array(im, dtype=np.uint8)
+    except MapError:
+        raise
+    except (UnidentifiedImageError, OSError, ValueError, SyntaxError, EOFError) as exc:
+        raise MapError(where, field, "a readable PNG or PGM image", _Described(f"{type(exc).__name__}: {exc}")) from None
+    if pixels.ndim < 2 or pixels.shape[0] < 1 or pixels.shape[1] < 1:
+        raise MapError(where, field, "a non-empty image", _Described(f"shape {pixels.shape}"))
+    return pixels
+
+
+def _apply_material_layer(path: Path, meta: MapMetadata, cells: np.ndarray) -> tuple[np.ndarray, tuple[str, ...]]:
+    assert meta.materials_image is not None and meta.material_values is not None
+    layer = _read_image(meta.materials_image, "materials", source=path)
+    if layer.ndim != 2:
+        raise MapError(path, "materials", "a single-channel 8-bit greyscale image", _Described(f"an image with {layer.shape[2]} channels"))
+    if layer.shape != cells.shape:
+        raise MapError(path, "materials", f"an image of the same size as 'image' ({cells.shape[1]}x{cells.shape[0]} px)", _Described(f"{layer.shape[1]}x{layer.shape[0]} px"))
+    materials = list(DEFAULT_MATERIALS)
+    for value in sorted(meta.material_values):
+        name = meta.material_values[value]
+        if name not in materials:
+            materials.append(name)
+    if len(materials) > 256:
+        raise MapError(path, "material_values", "at most 256 materials in all", len(materials))
+    out = cells.copy()
+    for value, name in meta.material_values.items():
+        out[layer == value] = materials.index(name)
+    return out, tuple(materials)
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _check_resolution(path: Path, field: str, v: Any) -> float:
+    if not _is_number(v) or not math.isfinite(v) or v <= 0:
+        raise MapError(path, field, "a positive finite number of metres per pixel", v)
+    return float(v)
+
+
+def _check_origin_xy(path: Path, field: str, v: Any) -> tuple[float, float]:
+    if (
+        not isinstance(v, (list, tuple))
+        or len(v) != 2
+        or not all(_is_number(x) and math.isfinite(x) for x in v)
+    ):
+        raise MapError(path, field, "a pair of finite numbers (x, y) in metres", v)
+    return (float(v[0]), float(v[1]))
+
+
+def _check_origin(path: Path, v: Any) -> tuple[float, float]:
+    if (
+        not isinstance(v, list)
+        or len(v) != 3
+        or not all(_is_number(x) and math.isfinite(x) for x in v)
+    ):
+        raise MapError(path, "origin", "a list of three finite numbers [x_m, y_m, yaw_rad]", v)
+    if v[2] != 0:
+        raise MapError(path, "origin", "yaw (third element) 0: rotated maps are not supported", v)
+    return (float(v[0]), float(v[1]))
+
+
+def _check_negate(path: Path, v: Any) -> bool:
+    if isinstance(v, bool):
+        return v
+    if isinstance(v, int) and v in (0, 1):
+        return bool(v)
+    raise MapError(path, "negate", "0, 1, true or false", v)
+
+
+def _check_thresh(path: Path, field: str, v: Any) -> float:
+    if not _is_number(v) or not math.isfinite(v) or not 0.0 <= v <= 1.0:
+        raise MapError(path, field, "a number in [0, 1]", v)
+    return float(v)
+
+
+def _check_relpath(path: Path, field: str, v: Any) -> Path:
+    if not isinstance(v, str) or not v.strip():
+        raise MapError(path, field, "an image file name (relative to the YAML's folder, or absolute)", v)
+    p = Path(v)
+    return p if p.is_absolute() else path.parent / p
+
+
+def _check_material_values(path: Path, v: Any) -> dict[int, str]:
+    if not isinstance(v, dict) or not v:
+        raise MapError(path, "material_values", "a non-empty mapping {pixel value 0..255: material name}", v)
+    out: dict[int, str] = {}
+    for key, name in v.items():
+        if isinstance(key, bool) or not isinstance(key, int) or not 0 <= key <= 255:
+            raise MapError(path, "material_values", "pixel values that are integers in 0..255", key)
+        if not isinstance(name, str) or not name:
+            raise MapError(path, f"material_values[{key}]", "a material name (non-empty string)", name)
+        out[key] = name
+    return out

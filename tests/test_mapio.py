@@ -1,0 +1,297 @@
+"""Map loading and saving: real ROS maps, map_server's pixel rule, round trips, errors."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from PIL import Image
+
+from teamnav.world.grid import DEFAULT_MATERIALS, OccupancyGrid
+from teamnav.world.mapio import MapError, load_map, occupancy_values, save_map
+
+DATA = Path("/work/shared/data")
+FREE, WALL, UNKNOWN, GLASS, FOAM = range(5)
+
+
+def _pixels(path: Path) -> np.ndarray:
+    return np.asarray(Image.open(path))
+
+
+# ---------------------------------------------------------------------------- real maps
+@pytest.mark.parametrize(
+    "yaml_name, image_name, shape, origin, free_values, unknown_values",
+    [
+        # basement: 0 occupied, 205 unknown (p = 50/255 > 0.196), 254/255 free
+        ("mit/basement_hallways_5cm.yaml", "mit/basement_hallways_5cm.png", (1200, 1200), (0.0, 0.0), (254, 255), (205,)),
+        # depot has free_thresh 0.25, so its grey 205 (p = 0.196) is *free* under map_server's rule
+        ("nav2/depot.yaml", "nav2/depot.pgm", (307, 604), (0.0, 0.0), (205, 254), ()),
+        ("nav2/tb3_sandbox.yaml", "nav2/tb3_sandbox.pgm", (384, 384), (-10.0, -10.0), (254,), (205,)),
+    ],
+)
+def test_real_maps_load_with_expected_geometry_and_cell_counts(yaml_name, image_name, shape, origin, free_values, unknown_values):
+    g = load_map(DATA / yaml_name)
+    px = _pixels(DATA / image_name)
+    assert g.shape == shape == px.shape
+    assert g.resolution_m == pytest.approx(0.05)
+    assert g.origin_xy_m == origin
+    assert g.materials == DEFAULT_MATERIALS
+    assert g.name == str(DATA / yaml_name)
+    n_free = int(np.isin(px, free_values).sum())
+    n_unknown = int(np.isin(px, unknown_values).sum())
+    n_occ = int((px == 0).sum())
+    assert n_free + n_unknown + n_occ == px.size  # every pixel value accounted for
+    counts = np.bincount(g.cells.ravel(), minlength=3)
+    assert counts[FREE] == n_free
+    assert counts[UNKNOWN] == n_unknown
+    assert counts[WALL] == n_occ
+    # the image is flipped: grid row 0 is the bottom image row
+    np.testing.assert_array_equal(g.cells[0] == WALL, px[-1] == 0)
+    np.testing.assert_array_equal(g.cells[-1] == WALL, px[0] == 0)
+
+
+def test_real_map_round_trips_through_save(tmp_path):
+    g = load_map(DATA / "nav2" / "tb3_sandbox.yaml")
+    out = save_map(g, tmp_path / "sandbox.yaml")
+    g2 = load_map(out)
+    np.testing.assert_array_equal(g2.cells, g.cells)
+    assert g2.origin_xy_m == g.origin_xy_m and g2.resolution_m == g.resolution_m
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sandbox.pgm", "sandbox.yaml"]  # no temp files left
+
+
+def test_plain_image_needs_resolution_and_uses_map_server_defaults(tmp_path):
+    px = np.array([[0, 100, 205, 254]], np.uint8)  # p = 1, 0.61, 0.196, 0.004
+    Image.fromarray(px).save(tmp_path / "m.png")
+    with pytest.raises(MapError, match=r"m\.png.*'resolution_m'"):
+        load_map(tmp_path / "m.png")
+    g = load_map(tmp_path / "m.png", resolution_m=0.1, origin_xy_m=(1.0, -2.0))
+    assert g.cells.tolist() == [[WALL, UNKNOWN, UNKNOWN, FREE]]
+    assert g.origin_xy_m == (1.0, -2.0) and g.resolution_m == 0.1
+
+
+def test_yaml_overrides(tmp_path):
+    g = load_map(DATA / "nav2" / "tb3_sandbox.yaml", resolution_m=0.1, origin_xy_m=(0.0, 0.0))
+    assert g.resolution_m == 0.1 and g.origin_xy_m == (0.0, 0.0)
+
+
+# ---------------------------------------------------------------------------- pixel rule
+def _reference(px: np.ndarray, negate: bool, occ_th: float, free_th: float, mode: str) -> np.ndarray:
+    """Direct reimplementation of map_server + amcl's reading, per pixel, in Python loops."""
+    h, w = px.shape[:2]
+    out = np.empty((h, w), np.uint8)
+    for i in range(h):
+        for j in range(w):
+            p = px[i, j] if px.ndim == 3 else np.array([px[i, j]])
+            n = len(p)
+            has_alpha = n in (2, 4)
+            k = n if (mode == "trinary" or not has_alpha) else n - 1
+            c = sum(int(v) for v in p[:k]) / k
+            if negate:
+                c = 255.0 - c
+            if mode == "raw":
+                v = int(c)
+                out[i, j] = FREE if v == 0 else WALL if v == 100 else UNKNOWN
+                continue
+            occ = (255.0 - c) / 255.0
+            out[i, j] = WALL if occ > occ_th else FREE if occ < free_th else UNKNOWN
+    return out[::-1]
+
+
+thresholds = st.tuples(st.floats(0.0, 1.0), st.floats(0.0, 1.0)).filter(lambda t: t[0] > t[1] + 1e-6)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    data=st.data(),
+    th=thresholds,
+    negate=st.booleans(),
+    mode=st.sampled_from(["trinary", "scale", "raw"]),
+    fmt=st.sampled_from([("pgm", "L"), ("png", "L"), ("png", "LA"), ("png", "RGB"), ("png", "RGBA")]),
+)
+def test_loader_matches_map_server_rule(tmp_path, data, th, negate, mode, fmt):
+    occ_th, free_th = th
+    suffix, pil_mode = fmt
+    h = data.draw(st.integers(1, 6))
+    w = data.draw(st.integers(1, 6))
+    channels = {"L": 1, "LA": 2, "RGB": 3, "RGBA": 4}[pil_mode]
+    # favour the values maps use, plus anything
+    value = st.one_of(st.sampled_from([0, 100, 155, 205, 254, 255]), st.integers(0, 255))
+    flat = data.draw(st.lists(value, min_size=h * w * channels, max_size=h * w * channels))
+    px = np.array(flat, np.uint8).reshape((h, w, channels) if channels > 1 else (h, w))
+    img = tmp_path / f"m.{suffix}"
+    Image.fromarray(px, mode=pil_mode).save(img)
+    doc = {
+        "image": img.name,
+        "resolution": 0.05,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": int(negate),
+        "occupied_thresh": occ_th,
+        "free_thresh": free_th,
+        "mode": mode,
+    }
+    (tmp_path / "m.yaml").write_text(yaml.safe_dump(doc))
+    g = load_map(tmp_path / "m.yaml")
+    np.testing.assert_array_equal(g.cells, _reference(px, negate, occ_th, free_th, mode))
+
+
+def test_scale_mode_grades_between_thresholds_and_trinary_does_not():
+    px = np.array([[128]], np.uint8)  # p = 0.498, between 0.196 and 0.65
+    assert occupancy_values(px, mode="trinary").item() == -1
+    graded = occupancy_values(px, mode="scale").item()
+    assert graded == int(1 + 98 * ((127 / 255 - 0.196) / (0.65 - 0.196)))
+    transparent = np.array([[[128, 0]]], np.uint8)  # grey + alpha 0
+    assert occupancy_values(transparent, mode="scale").item() == -1
+
+
+def test_raw_mode_stores_pixel_value_as_int8():
+    px = np.array([[0, 100, 37, 255]], np.uint8)
+    assert occupancy_values(px, mode="raw").tolist() == [[0, 100, 37, -1]]
+    assert occupancy_values(px, negate=True, mode="raw").tolist() == [[-1, -101, -38, 0]]
+
+
+def test_trinary_averages_alpha_in_like_map_server():
+    # black, fully transparent: (0 + 0) / 2 = 0 -> occupied; in scale mode alpha is left out
+    assert occupancy_values(np.array([[[0, 0]]], np.uint8), mode="trinary").item() == 100
+    # white, transparent: (255 + 0)/2 = 127.5 -> p = 0.5 -> unknown in trinary, free in scale
+    px = np.array([[[255, 0]]], np.uint8)
+    assert occupancy_values(px, mode="trinary").item() == -1
+    assert occupancy_values(px, mode="scale").item() == 0
+
+
+# ---------------------------------------------------------------------------- round trips and materials
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    cells=st.integers(1, 8).flatmap(
+        lambda h: st.integers(1, 8).flatmap(
+            lambda w: st.lists(st.integers(0, 4), min_size=h * w, max_size=h * w).map(lambda v: np.array(v, np.uint8).reshape(h, w))
+        )
+    ),
+    res=st.floats(0.01, 1.0),
+    ox=st.floats(-100, 100),
+    oy=st.floats(-100, 100),
+)
+def test_save_load_round_trip(tmp_path, cells, res, ox, oy):
+    g = OccupancyGrid(cells, res, (ox, oy))
+    g2 = load_map(save_map(g, tmp_path / "rt.yaml"))
+    np.testing.assert_array_equal(g2.cells, g.cells)
+    assert g2.materials == g.materials
+    assert g2.resolution_m == res and g2.origin_xy_m == (ox, oy)
+
+
+def test_round_trip_custom_material_and_layer_semantics(tmp_path):
+    mats = DEFAULT_MATERIALS + ("curtain",)
+    cells = np.array([[0, 1, 5], [3, 4, 2]], np.uint8)
+    g = OccupancyGrid(cells, 0.5, (0.0, 0.0), mats)
+    save_map(g, tmp_path / "c.yaml")
+    doc = yaml.safe_load((tmp_path / "c.yaml").read_text())
+    assert doc["materials"] == "c_materials.pgm"
+    assert doc["material_values"] == {3: "glass", 4: "foam", 5: "curtain"}
+    # a ROS consumer sees every special material as occupied
+    occ = np.asarray(Image.open(tmp_path / "c.pgm"))[::-1]
+    assert occ.tolist() == [[254, 0, 0], [0, 0, 205]]
+    g2 = load_map(tmp_path / "c.yaml")
+    assert g2.materials == mats
+    np.testing.assert_array_equal(g2.cells, cells)
+
+
+def test_material_layer_free_carves_and_unlisted_values_keep_occupancy(tmp_path):
+    Image.fromarray(np.array([[0, 0, 254]], np.uint8)).save(tmp_path / "o.pgm")
+    Image.fromarray(np.array([[7, 9, 9]], np.uint8)).save(tmp_path / "l.pgm")
+    doc = {"image": "o.pgm", "resolution": 1.0, "origin": [0, 0, 0], "materials": "l.pgm", "material_values": {7: "free", 3: "glass"}}
+    (tmp_path / "m.yaml").write_text(yaml.safe_dump(doc))
+    g = load_map(tmp_path / "m.yaml")
+    assert g.cells.tolist() == [[FREE, WALL, FREE]]
+
+
+# ---------------------------------------------------------------------------- errors
+def _write_map(tmp_path: Path, **fields) -> Path:
+    Image.fromarray(np.full((3, 4), 254, np.uint8)).save(tmp_path / "ok.pgm")
+    doc = {"image": "ok.pgm", "resolution": 0.05, "origin": [0.0, 0.0, 0.0], "negate": 0,
+           "occupied_thresh": 0.65, "free_thresh": 0.196}
+    for k, v in fields.items():
+        if v is _DELETE:
+            doc.pop(k)
+        else:
+            doc[k] = v
+    p = tmp_path / "bad.yaml"
+    p.write_text(yaml.safe_dump(doc))
+    return p
+
+
+_DELETE = object()
+
+
+@pytest.mark.parametrize(
+    "fields, field, expect",
+    [
+        ({"resolution": -0.05}, "resolution", "positive finite"),
+        ({"resolution": float("nan")}, "resolution", "positive finite"),
+        ({"resolution": "0.05"}, "resolution", "positive finite"),
+        ({"resolution": True}, "resolution", "positive finite"),
+        ({"resolution": _DELETE}, "resolution", "required"),
+        ({"image": _DELETE}, "image", "required"),
+        ({"image": 3}, "image", "image file name"),
+        ({"image": "missing.pgm"}, "image", "existing image"),
+        ({"origin": [0.0, 0.0, 0.5]}, "origin", "yaw"),
+        ({"origin": [0.0, 0.0]}, "origin", "three finite numbers"),
+        ({"origin": "0 0 0"}, "origin", "three finite numbers"),
+        ({"negate": 2}, "negate", "0, 1"),
+        ({"occupied_thresh": 1.5}, "occupied_thresh", r"\[0, 1\]"),
+        ({"free_thresh": -0.1}, "free_thresh", r"\[0, 1\]"),
+        ({"occupied_thresh": 0.1, "free_thresh": 0.2}, "occupied_thresh", "greater than free_thresh"),
+        ({"occupied_thresh": 0.2, "free_thresh": 0.2}, "occupied_thresh", "greater than free_thresh"),
+        ({"mode": "ternary"}, "mode", "trinary"),
+        ({"negat": 1}, "negat", "did you mean 'negate'"),
+        ({"materials": "ok.pgm"}, "material_values", "mapping"),
+        ({"materials": "ok.pgm", "material_values": {300: "glass"}}, "material_values", "0..255"),
+        ({"materials": "ok.pgm", "material_values": {3: 4}}, "material_values[3]", "material name"),
+    ],
+)
+def test_bad_yaml_fields_name_file_field_and_expectation(tmp_path, fields, field, expect):
+    p = _write_map(tmp_path, **fields)
+    with pytest.raises(MapError, match=expect) as info:
+        load_map(p)
+    msg = str(info.value)
+    assert "bad.yaml" in msg
+    assert f"field {field!r}" in msg
+    assert info.value.field == field
+
+
+def test_missing_file_and_bad_suffix(tmp_path):
+    with pytest.raises(MapError, match=r"nope\.yaml.*no such file"):
+        load_map(tmp_path / "nope.yaml")
+    (tmp_path / "m.txt").write_text("x")
+    with pytest.raises(MapError, match=r"m\.txt.*'\.txt'"):
+        load_map(tmp_path / "m.txt")
+
+
+def test_unreadable_image_and_bad_yaml_syntax(tmp_path):
+    (tmp_path / "junk.pgm").write_bytes(b"not an image at all")
+    p = _write_map(tmp_path, image="junk.pgm")
+    with pytest.raises(MapError, match=r"bad\.yaml -> .*junk\.pgm: field 'image': expected a readable PNG or PGM"):
+        load_map(p)
+    (tmp_path / "s.yaml").write_text("image: [unclosed\n")
+    with pytest.raises(MapError, match=r"s\.yaml: field '<yaml>': expected valid YAML"):
+        load_map(tmp_path / "s.yaml")
+    (tmp_path / "l.yaml").write_text("- a\n- b\n")
+    with pytest.raises(MapError, match=r"l\.yaml.*mapping"):
+        load_map(tmp_path / "l.yaml")
+
+
+def test_material_layer_size_mismatch(tmp_path):
+    Image.fromarray(np.zeros((2, 2), np.uint8)).save(tmp_path / "small.pgm")
+    p = _write_map(tmp_path, materials="small.pgm", material_values={3: "glass"})
+    with pytest.raises(MapError, match=r"bad\.yaml: field 'materials': expected an image of the same size as 'image' \(4x3 px\), found 2x2 px"):
+        load_map(p)
+
+
+def test_bad_override_arguments(tmp_path):
+    p = _write_map(tmp_path)
+    with pytest.raises(MapError, match="'resolution_m'"):
+        load_map(p, resolution_m=0.0)
+    with pytest.raises(MapError, match="'origin_xy_m'"):
+        load_map(p, origin_xy_m=(float("inf"), 0.0))
