@@ -24,7 +24,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from teamnav.world.raycast import _check_blocking, _check_finite, _check_positive, _check_vec
+from teamnav.world.raycast import VERTEX_TOL_CELLS, _check_blocking, _check_finite, _check_positive, _check_vec
 
 __all__ = ["line_of_sight", "pairs_within", "visible_pairs"]
 
@@ -81,16 +81,16 @@ def _segment_visible(blocking, ax, ay, bx, by):
     while True:
         tx = ((c + offx) - ax) * idx
         ty = ((r + offy) - ay) * idy
-        if tx < ty:
+        if tx < ty - VERTEX_TOL_CELLS:
             if tx >= length:
                 return True
             c += sx
-        elif ty < tx:
+        elif ty < tx - VERTEX_TOL_CELLS:
             if ty >= length:
                 return True
             r += sy
         else:
-            if tx >= length:
+            if min(tx, ty) >= length:
                 return True
             if _blocked(blocking, r, c + sx) or _blocked(blocking, r + sy, c):
                 return False

@@ -13,9 +13,10 @@ Semantics (tested against :func:`brute_force_reference`)
 - A pose inside a blocking cell, or outside the grid, has range 0.
 - Outside the grid counts as blocking: a ray that leaves the map stops at its edge.
 - Cells are half-open (``[c, c+1) x [r, r+1)`` in cell units, as in
-  :class:`~teamnav.world.grid.OccupancyGrid`). A ray that passes exactly through a grid
-  vertex also touches the two cells beside that vertex: it stops there if either of them
-  blocks, so a ray can never slip between two diagonally touching wall cells.
+  :class:`~teamnav.world.grid.OccupancyGrid`). A ray that passes through a grid vertex
+  (within ``VERTEX_TOL_CELLS``) also touches the two cells beside that vertex: it stops
+  there if either of them blocks, so a ray can never slip between two diagonally touching
+  wall cells, whatever the last bit of ``cos``/``sin`` says.
 - Beam directions are ``(cos, sin)`` of ``theta + beam``; a component smaller than
   ``1e-12`` in magnitude is taken as exactly 0, so axis-aligned beams stay on their row or
   column (``cos(pi/2)`` is ``6e-17`` in floating point, not 0).
@@ -55,6 +56,10 @@ __all__ = ["RayCaster", "brute_force_reference", "cast_rays", "clearance_map"]
 
 #: Direction components smaller than this are snapped to exactly 0 (see module docstring).
 DIR_EPS: float = 1e-12
+#: Two plane crossings closer than this [cells] count as passing exactly through the grid
+#: vertex between them, so that the two cells beside the vertex are both tested. It makes the
+#: vertex rule immune to the last-bit rounding of directions such as ``cos(3*pi/4)``.
+VERTEX_TOL_CELLS: float = 1e-9
 #: Sub-cell step of :func:`brute_force_reference` [cells].
 REFERENCE_STEP_CELLS: float = 1e-3
 #: Largest clearance stored (uint8); larger free squares are simply jumped in several hops.
@@ -115,26 +120,45 @@ def _march(clear, fx, fy, dx, dy, tmax):
         sy = 1
         offy = 0
         idy = np.inf
+    # position tolerance matching VERTEX_TOL_CELLS in time; -1 disables it on an axis-parallel ray
+    tolx = VERTEX_TOL_CELLS * abs(dx) if dx != 0.0 else -1.0
+    toly = VERTEX_TOL_CELLS * abs(dy) if dy != 0.0 else -1.0
     while True:
         k = np.int64(v) - 1
         # exit of the free square centred on (r, c): planes c+offx+sx*k and r+offy+sy*k
         tx = ((c + offx + sx * k) - fx) * idx
         ty = ((r + offy + sy * k) - fy) * idy
-        if tx < ty:
+        if tx < ty - VERTEX_TOL_CELLS:
             t = tx
-            if k > 0:
-                rr = int(math.floor(fy + t * dy)) + 1
-                r = min(max(rr, r - k), r + k)
             c += sx * (k + 1)
-        elif ty < tx:
-            t = ty
             if k > 0:
-                cc = int(math.floor(fx + t * dx)) + 1
-                c = min(max(cc, c - k), c + k)
+                # landed on the far x-plane somewhere along the square's face
+                ye = fy + t * dy
+                yv = math.floor(ye + 0.5)
+                if abs(ye - yv) <= toly:
+                    # at a grid vertex: both cells of the new column beside it count
+                    iv = int(yv)
+                    if clear[iv, c] == 0 or clear[iv + 1, c] == 0:
+                        return min(t, tmax)
+                    r = iv + 1 if dy > 0.0 else iv
+                else:
+                    r = min(max(int(math.floor(ye)) + 1, r - k), r + k)
+        elif ty < tx - VERTEX_TOL_CELLS:
+            t = ty
             r += sy * (k + 1)
+            if k > 0:
+                xe = fx + t * dx
+                xv = math.floor(xe + 0.5)
+                if abs(xe - xv) <= tolx:
+                    iv = int(xv)
+                    if clear[r, iv] == 0 or clear[r, iv + 1] == 0:
+                        return min(t, tmax)
+                    c = iv + 1 if dx > 0.0 else iv
+                else:
+                    c = min(max(int(math.floor(xe)) + 1, c - k), c + k)
         else:
-            # exactly through the square's corner vertex: the two cells beside it count
-            t = tx
+            # through the square's corner vertex: the two cells beside it count
+            t = min(tx, ty)
             if t >= tmax:
                 return tmax
             if clear[r + sy * k, c + sx * (k + 1)] == 0 or clear[r + sy * (k + 1), c + sx * k] == 0:
@@ -211,15 +235,15 @@ def _reference_ray(blocking, h, w, fx, fy, dx, dy, tmax, step):
             by = float(max(r, r1))
             tx = (bx - fx) / dx
             ty = (by - fy) / dy
-            if tx < ty:
+            if tx < ty - VERTEX_TOL_CELLS:
                 if _blocked_cell(blocking, h, w, r, c1):
                     return min(tx, tmax)
-            elif ty < tx:
+            elif ty < tx - VERTEX_TOL_CELLS:
                 if _blocked_cell(blocking, h, w, r1, c):
                     return min(ty, tmax)
             else:
                 if _blocked_cell(blocking, h, w, r, c1) or _blocked_cell(blocking, h, w, r1, c):
-                    return min(tx, tmax)
+                    return min(min(tx, ty), tmax)
         if c1 != c or r1 != r:
             if _blocked_cell(blocking, h, w, r1, c1):
                 return t
