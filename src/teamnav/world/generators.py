@@ -1,0 +1,683 @@
+"""Maps built from code: a small map builder and the environments of the four papers.
+
+The papers show their environments only as figures, so these maps are faithful to what the
+text and figures say (sizes, topology, what makes each one hard) and are otherwise plain
+office geometry. Every choice is written in the generator's docstring and in
+:attr:`EnvironmentMap.notes`.
+
+All lengths are metres; all maps default to 0.1 m cells. Nothing here is random.
+
+Rasterisation rule: a shape covers the cells whose *centres* lie inside it (boundaries
+included), except :meth:`MapBuilder.segment`, which also covers every cell its centre line
+passes through, so a thin wall never leaks a ray or a robot.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass, field
+from typing import Callable, Iterable, Sequence
+
+import numpy as np
+
+from teamnav.world.grid import DEFAULT_MATERIALS, OccupancyGrid
+
+__all__ = [
+    "MapBuilder",
+    "EnvironmentMap",
+    "office_simple",
+    "office_complex",
+    "symmetric_hallway",
+    "hexagon",
+    "lab_and_corridor",
+    "trail_office",
+    "BUILTIN_MAPS",
+    "builtin_map",
+]
+
+SIDES: tuple[str, ...] = ("north", "south", "east", "west")
+
+
+def _finite(name: str, v) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
+        raise ValueError(f"{name} must be a finite number of metres, got {v!r}")
+    return float(v)
+
+
+def _positive(name: str, v) -> float:
+    v = _finite(name, v)
+    if v <= 0:
+        raise ValueError(f"{name} must be > 0 m, got {v!r}")
+    return v
+
+
+class MapBuilder:
+    """Draw a map with rectangles, polygons, thick segments, discs, corridors and rooms.
+
+    Every drawing method returns the builder, so calls chain. Later calls paint over
+    earlier ones, with one exception that makes buildings easy to draw: cells opened by
+    :meth:`clear_rect`, :meth:`corridor` or :meth:`room` (interiors and doors) are
+    *carved*, and the walls that :meth:`corridor` and :meth:`room` draw never close a
+    carved cell. So corridors that cross stay open, and a room drawn against a corridor
+    does not block it. Explicit obstacles (:meth:`rect`, :meth:`polygon`, :meth:`segment`,
+    :meth:`disc`, :meth:`border`, :meth:`fill`) paint over everything.
+
+    Parameters
+    ----------
+    width_m, height_m : float
+        Map size [m], positive.
+    resolution_m : float
+        Cell side [m], positive, at most the map size.
+    origin_xy_m : (float, float), default (0, 0)
+        World coordinates [m] of the lower-left corner.
+
+    Examples
+    --------
+    >>> g = (MapBuilder(4.0, 3.0, 0.5).border(0.5)
+    ...      .rect(1.5, 1.0, 2.5, 2.0, material="glass").build("demo"))
+    >>> g.shape, int((g.cells == 3).sum())
+    ((6, 8), 4)
+    """
+
+    def __init__(self, width_m: float, height_m: float, resolution_m: float, origin_xy_m=(0.0, 0.0)) -> None:
+        self.width_m = _positive("width_m", width_m)
+        self.height_m = _positive("height_m", height_m)
+        self.resolution_m = _positive("resolution_m", resolution_m)
+        if self.resolution_m > min(self.width_m, self.height_m):
+            raise ValueError(
+                f"resolution_m must be at most the map's width and height ({min(self.width_m, self.height_m)} m), got {resolution_m!r}"
+            )
+        if not isinstance(origin_xy_m, (tuple, list)) or len(origin_xy_m) != 2:
+            raise ValueError(f"origin_xy_m must be a pair (x_m, y_m), got {origin_xy_m!r}")
+        self.origin_xy_m = (_finite("origin_xy_m[0]", origin_xy_m[0]), _finite("origin_xy_m[1]", origin_xy_m[1]))
+        w = int(round(self.width_m / self.resolution_m))
+        h = int(round(self.height_m / self.resolution_m))
+        self._cells = np.zeros((h, w), dtype=np.uint8)
+        self._carved = np.zeros((h, w), dtype=bool)
+        self._materials: list[str] = list(DEFAULT_MATERIALS)
+        self._xc = self.origin_xy_m[0] + (np.arange(w) + 0.5) * self.resolution_m  # cell centres
+        self._yc = self.origin_xy_m[1] + (np.arange(h) + 0.5) * self.resolution_m
+
+    # ------------------------------------------------------------------ helpers
+    def _mat(self, material: str) -> int:
+        if not isinstance(material, str) or not material:
+            raise ValueError(f"material must be a non-empty material name, got {material!r}")
+        if material not in self._materials:
+            if len(self._materials) >= 256:
+                raise ValueError(f"a map holds at most 256 materials; cannot add {material!r}")
+            self._materials.append(material)
+        return self._materials.index(material)
+
+    def _box(self, name: str, xmin, ymin, xmax, ymax) -> tuple[float, float, float, float]:
+        xmin, ymin = _finite(f"{name}: xmin", xmin), _finite(f"{name}: ymin", ymin)
+        xmax, ymax = _finite(f"{name}: xmax", xmax), _finite(f"{name}: ymax", ymax)
+        if not (xmin < xmax and ymin < ymax):
+            raise ValueError(f"{name}: need xmin < xmax and ymin < ymax, got ({xmin}, {ymin}, {xmax}, {ymax})")
+        return xmin, ymin, xmax, ymax
+
+    def _rect_mask(self, xmin, ymin, xmax, ymax) -> np.ndarray:
+        cols = (self._xc >= xmin) & (self._xc <= xmax)
+        rows = (self._yc >= ymin) & (self._yc <= ymax)
+        return rows[:, None] & cols[None, :]
+
+    def _paint(self, mask: np.ndarray, material: str, *, respect_carved: bool = False) -> None:
+        mid = self._mat(material)
+        if respect_carved:
+            mask = mask & ~self._carved
+        self._cells[mask] = mid
+
+    def _carve(self, mask: np.ndarray) -> None:
+        self._cells[mask] = 0
+        self._carved |= mask
+
+    def _centres(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.meshgrid(self._xc, self._yc)
+
+    # ------------------------------------------------------------------ drawing
+    def fill(self, material: str = "wall") -> "MapBuilder":
+        """Paint the whole map with ``material`` (start a building as solid, then carve)."""
+        self._paint(np.ones_like(self._carved), material)
+        self._carved[:] = False
+        return self
+
+    def border(self, thickness_m: float, material: str = "wall") -> "MapBuilder":
+        """A closed wall of ``thickness_m`` (>= one cell) along the map's edges."""
+        t = _positive("border: thickness_m", thickness_m)
+        if t < self.resolution_m:
+            raise ValueError(f"border: thickness_m must be at least one cell ({self.resolution_m} m), got {thickness_m!r}")
+        x0, y0 = self.origin_xy_m
+        inner = self._rect_mask(x0 + t, y0 + t, x0 + self.width_m - t, y0 + self.height_m - t)
+        self._paint(~inner, material)
+        return self
+
+    def rect(self, xmin, ymin, xmax, ymax, material: str = "wall", filled: bool = True, thickness_m: float | None = None) -> "MapBuilder":
+        """An axis-aligned rectangle, filled, or its outline with walls ``thickness_m`` thick
+        drawn inside the rectangle's bounds (required when ``filled=False``)."""
+        xmin, ymin, xmax, ymax = self._box("rect", xmin, ymin, xmax, ymax)
+        mask = self._rect_mask(xmin, ymin, xmax, ymax)
+        if not filled:
+            if thickness_m is None:
+                raise ValueError("rect: thickness_m is required for an outline (filled=False)")
+            t = _positive("rect: thickness_m", thickness_m)
+            if t < self.resolution_m:
+                raise ValueError(f"rect: thickness_m must be at least one cell ({self.resolution_m} m), got {thickness_m!r}")
+            if 2 * t < min(xmax - xmin, ymax - ymin):
+                mask &= ~self._rect_mask(xmin + t, ymin + t, xmax - t, ymax - t)
+        self._paint(mask, material)
+        return self
+
+    def clear_rect(self, xmin, ymin, xmax, ymax) -> "MapBuilder":
+        """Carve free space (see the class docstring for *carved* cells)."""
+        xmin, ymin, xmax, ymax = self._box("clear_rect", xmin, ymin, xmax, ymax)
+        self._carve(self._rect_mask(xmin, ymin, xmax, ymax))
+        return self
+
+    def clear_polygon(self, vertices: Sequence[Sequence[float]]) -> "MapBuilder":
+        """Carve a filled polygon out of the map."""
+        self._carve(self._polygon_mask(vertices, "clear_polygon"))
+        return self
+
+    def _polygon_mask(self, vertices, name: str) -> np.ndarray:
+        v = np.asarray(vertices, dtype=np.float64)
+        if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 3 or not np.all(np.isfinite(v)):
+            raise ValueError(f"{name}: vertices must be at least 3 finite (x_m, y_m) points, got {vertices!r}")
+        px, py = self._centres()
+        inside = np.zeros(px.shape, dtype=bool)
+        xj, yj = v[-1]
+        for xi, yi in v:  # even-odd rule, one pass per edge, vectorised over cells
+            crosses = (yi > py) != (yj > py)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                x_at = (xj - xi) * (py - yi) / (yj - yi) + xi
+            inside ^= crosses & (px < x_at)
+            xj, yj = xi, yi
+        return inside
+
+    def polygon(self, vertices: Sequence[Sequence[float]], material: str = "wall") -> "MapBuilder":
+        """A filled polygon (any simple or self-intersecting outline, even-odd rule)."""
+        self._paint(self._polygon_mask(vertices, "polygon"), material)
+        return self
+
+    def segment(self, x0, y0, x1, y1, thickness_m: float, material: str = "wall") -> "MapBuilder":
+        """A thick straight wall: cells within ``thickness_m / 2`` of the segment, and at
+        least every cell the segment passes through (within half a cell diagonal)."""
+        x0, y0 = _finite("segment: x0", x0), _finite("segment: y0", y0)
+        x1, y1 = _finite("segment: x1", x1), _finite("segment: y1", y1)
+        t = _positive("segment: thickness_m", thickness_m)
+        reach = max(t / 2.0, self.resolution_m / math.sqrt(2.0))
+        px, py = self._centres()
+        dx, dy = x1 - x0, y1 - y0
+        length2 = dx * dx + dy * dy
+        if length2 == 0.0:
+            s = np.zeros_like(px)
+        else:
+            s = np.clip(((px - x0) * dx + (py - y0) * dy) / length2, 0.0, 1.0)
+        dist = np.hypot(px - (x0 + s * dx), py - (y0 + s * dy))
+        self._paint(dist <= reach, material)
+        return self
+
+    def disc(self, x, y, r, material: str = "wall") -> "MapBuilder":
+        """A filled disc of radius ``r`` [m] centred at (x, y)."""
+        x, y = _finite("disc: x", x), _finite("disc: y", y)
+        r = _positive("disc: r", r)
+        px, py = self._centres()
+        self._paint(np.hypot(px - x, py - y) <= r, material)
+        return self
+
+    def corridor(self, x0, y0, x1, y1, width_m: float, wall_thickness_m: float) -> "MapBuilder":
+        """A straight corridor from (x0, y0) to (x1, y1): free space ``width_m`` wide with a
+        wall ``wall_thickness_m`` thick along each side; both ends are left open."""
+        x0, y0 = _finite("corridor: x0", x0), _finite("corridor: y0", y0)
+        x1, y1 = _finite("corridor: x1", x1), _finite("corridor: y1", y1)
+        w = _positive("corridor: width_m", width_m)
+        t = _positive("corridor: wall_thickness_m", wall_thickness_m)
+        if t < self.resolution_m:
+            raise ValueError(f"corridor: wall_thickness_m must be at least one cell ({self.resolution_m} m), got {wall_thickness_m!r}")
+        length = math.hypot(x1 - x0, y1 - y0)
+        if length == 0.0:
+            raise ValueError(f"corridor: the two ends must differ, got ({x0}, {y0}) twice")
+        ux, uy = (x1 - x0) / length, (y1 - y0) / length
+        px, py = self._centres()
+        along = (px - x0) * ux + (py - y0) * uy
+        across = np.abs(-(px - x0) * uy + (py - y0) * ux)
+        span = (along >= 0.0) & (along <= length)
+        inside = span & (across <= w / 2.0)
+        walls = span & (across > w / 2.0) & (across <= w / 2.0 + t)
+        self._paint(walls, "wall", respect_carved=True)
+        self._carve(inside)
+        return self
+
+    def room(
+        self,
+        xmin,
+        ymin,
+        xmax,
+        ymax,
+        wall_thickness_m: float,
+        doors: Iterable[tuple[str, float, float]] = (),
+    ) -> "MapBuilder":
+        """A room: walls ``wall_thickness_m`` thick inside the bounds, a carved interior and
+        door openings.
+
+        Parameters
+        ----------
+        xmin, ymin, xmax, ymax : float
+            Outer bounds of the walls [m].
+        wall_thickness_m : float
+            At least one cell.
+        doors : iterable of (side, offset_m, width_m)
+            ``side`` in {"north", "south", "east", "west"}; ``offset_m`` is the distance
+            from the side's west end (north/south sides) or south end (east/west sides),
+            i.e. from ``xmin`` or ``ymin``, to the door's centre; ``width_m`` its width.
+            The opening must lie between the two corner walls.
+        """
+        xmin, ymin, xmax, ymax = self._box("room", xmin, ymin, xmax, ymax)
+        t = _positive("room: wall_thickness_m", wall_thickness_m)
+        if t < self.resolution_m:
+            raise ValueError(f"room: wall_thickness_m must be at least one cell ({self.resolution_m} m), got {wall_thickness_m!r}")
+        if 2 * t >= min(xmax - xmin, ymax - ymin):
+            raise ValueError(f"room: walls of {t} m leave no interior in ({xmin}, {ymin}, {xmax}, {ymax})")
+        openings = []
+        for i, door in enumerate(doors):
+            if not isinstance(door, (tuple, list)) or len(door) != 3:
+                raise ValueError(f"room: doors[{i}] must be (side, offset_m, width_m), got {door!r}")
+            side, offset, width = door
+            if side not in SIDES:
+                close = difflib.get_close_matches(str(side), SIDES, n=1)
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+                raise ValueError(f"room: doors[{i}] side must be one of {SIDES}{hint}, got {side!r}")
+            offset = _finite(f"room: doors[{i}] offset_m", offset)
+            width = _positive(f"room: doors[{i}] width_m", width)
+            side_len = (xmax - xmin) if side in ("north", "south") else (ymax - ymin)
+            if offset - width / 2 < t or offset + width / 2 > side_len - t:
+                raise ValueError(
+                    f"room: doors[{i}] must lie between the corner walls: need {t + width / 2} <= offset_m <= {side_len - t - width / 2}, got {offset}"
+                )
+            a, b = offset - width / 2, offset + width / 2
+            if side == "south":
+                openings.append((xmin + a, ymin, xmin + b, ymin + t))
+            elif side == "north":
+                openings.append((xmin + a, ymax - t, xmin + b, ymax))
+            elif side == "west":
+                openings.append((xmin, ymin + a, xmin + t, ymin + b))
+            else:
+                openings.append((xmax - t, ymin + a, xmax, ymin + b))
+        outer = self._rect_mask(xmin, ymin, xmax, ymax)
+        interior = self._rect_mask(xmin + t, ymin + t, xmax - t, ymax - t)
+        self._paint(outer & ~interior, "wall", respect_carved=True)
+        self._carve(interior)
+        for box in openings:
+            self._carve(self._rect_mask(*box))
+        return self
+
+    def build(self, name: str) -> OccupancyGrid:
+        """The finished :class:`OccupancyGrid` (a copy; the builder can keep drawing)."""
+        return OccupancyGrid(self._cells.copy(), self.resolution_m, self.origin_xy_m, tuple(self._materials), name)
+
+
+@dataclass(frozen=True)
+class EnvironmentMap:
+    """A built-in environment: the grid plus named places for experiments.
+
+    Attributes
+    ----------
+    grid : OccupancyGrid
+    places : dict of str to (float, float)
+        Named points [m] in free space (targets, home/source, start spots, patrol
+        waypoints); all reachable from one another by a robot of radius 0.25 m.
+    notes : str
+        Where the geometry comes from and which choices were made.
+    regions : dict of str to (xmin, ymin, xmax, ymax)
+        Named areas [m], e.g. the hallways "A"–"D" of Fox et al. Fig. 12(a).
+    """
+
+    grid: OccupancyGrid
+    places: dict[str, tuple[float, float]]
+    notes: str
+    regions: dict[str, tuple[float, float, float, float]] = field(default_factory=dict)
+
+
+def _res(resolution_m: float) -> float:
+    r = _positive("resolution_m", resolution_m)
+    if r > 0.25:
+        raise ValueError(f"resolution_m must be at most 0.25 m for the built-in maps (walls are 0.2-0.3 m), got {resolution_m!r}")
+    return r
+
+
+# ---------------------------------------------------------------------------- Sgorbissa & Arkin
+def office_simple(resolution_m: float = 0.1) -> EnvironmentMap:
+    """Sgorbissa & Arkin §6, Fig. 11 (and the scenario of Fig. 1): the simple office.
+
+    A 30 m x 14 m building: one 2.4 m wide corridor along its length, five 5.8 m x 5.4 m
+    rooms on each side, each with a 1.2 m door onto the corridor. Doors sit near one end of
+    the room (not in front of the centre) so a robot heading for a room's centre from the
+    corridor faces a wall: the local minimum that a potential field cannot leave (§6: PF
+    alone fails in both scenarios). Walls are 0.2 m.
+
+    Places: ``room_S1``..``room_S5`` (south, west to east) and ``room_N1``..``room_N5``
+    (north) at room centres (R1's exploration targets are "in the middle of the rooms",
+    §6); ``base`` at the corridor's west end (the base station at the entrance, Fig. 1);
+    ``patrol_1``..``patrol_5`` along the corridor's centre line (helpers "patrol the
+    corridors", §6).
+    """
+    res = _res(resolution_m)
+    b = MapBuilder(30.0, 14.0, res).fill("wall")
+    b.clear_rect(0.2, 5.8, 29.8, 8.2)  # corridor
+    places: dict[str, tuple[float, float]] = {}
+    xs = [(0.2, 5.8), (6.0, 11.8), (12.0, 17.8), (18.0, 23.8), (24.0, 29.8)]
+    for k, (x0, x1) in enumerate(xs, start=1):
+        b.clear_rect(x0, 0.2, x1, 5.6)  # south room
+        b.clear_rect(x0 + 0.6, 5.6, x0 + 1.8, 5.8)  # door near its west wall
+        b.clear_rect(x0, 8.4, x1, 13.8)  # north room
+        b.clear_rect(x1 - 1.8, 8.2, x1 - 0.6, 8.4)  # door near its east wall
+        places[f"room_S{k}"] = (round((x0 + x1) / 2, 3), 2.9)
+        places[f"room_N{k}"] = (round((x0 + x1) / 2, 3), 11.1)
+    places["base"] = (1.0, 7.0)
+    for k, x in enumerate((3.0, 9.0, 15.0, 21.0, 27.0), start=1):
+        places[f"patrol_{k}"] = (x, 7.0)
+    notes = (
+        "Sgorbissa & Arkin §6 Fig. 11 (simple office): 30x14 m, corridor y in [5.8, 8.2] m, "
+        "5 rooms each side (5.8x5.4 m) with 1.2 m doors near one end; targets at room centres; "
+        "base station at the corridor's west end; helpers patrol the corridor centre line."
+    )
+    regions = {"corridor": (0.2, 5.8, 29.8, 8.2)}
+    return EnvironmentMap(b.build("builtin:office_simple"), places, notes, regions)
+
+
+def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
+    """Sgorbissa & Arkin §6, Fig. 13: the complex office, built to trap local methods.
+
+    A 36 m x 24 m building with a cross of 2.4 m corridors (east-west ``H`` at
+    y in [10.8, 13.2] m, north-south ``V`` at x in [16.8, 19.2] m) and rooms in the four
+    quarters. What makes it complex (§6: even with three helpers the local algorithm still
+    matters, and PF alone never finishes):
+
+    - ``room_1`` (south-west): 0.9 m door at its north-west corner and a U-shaped obstacle
+      opening towards the door between the door and the target: a robot driving at the
+      target enters the U and sticks in its bottom (classic PF local minimum).
+    - ``room_2``: entered from the V corridor through a narrow door behind a baffle wall.
+    - ``room_3``..``room_5`` (south-east): ``room_4`` has no corridor door; it is reached
+      through ``room_3`` (a target behind a wall in front of the robot).
+    - ``room_6`` (north-west, large): a U-shaped obstacle and two pillars.
+    - ``room_7``, ``room_8`` (north-east): ``room_8``'s only door is 0.9 m wide at its far
+      end, opening from ``room_7``.
+
+    Places: ``room_1``..``room_8`` targets (room centres, moved off obstacles where one sits
+    there), ``base`` at the west end of H, ``patrol_*`` waypoints on both corridors.
+    """
+    res = _res(resolution_m)
+    b = MapBuilder(36.0, 24.0, res).fill("wall")
+    b.clear_rect(0.2, 10.8, 35.8, 13.2)  # corridor H
+    b.clear_rect(16.8, 0.2, 19.2, 23.8)  # corridor V
+    # room 1 (SW) with a U trap open towards its north-west door
+    b.clear_rect(0.2, 0.2, 8.2, 10.6).clear_rect(0.8, 10.6, 1.7, 10.8)
+    b.rect(2.4, 5.6, 6.4, 8.8, filled=False, thickness_m=0.3)
+    b.clear_rect(2.7, 8.5, 6.1, 8.8)  # open the U's top: it now opens towards the door
+    # room 2 with a baffle in front of its narrow east door
+    b.clear_rect(8.4, 0.2, 16.6, 10.6).clear_rect(16.6, 2.0, 16.8, 2.9)
+    b.rect(14.6, 0.2, 14.9, 7.0)  # baffle wall from the south wall, gap to the north
+    # rooms 3, 4, 5 (SE); room 4 only through room 3
+    b.clear_rect(19.4, 0.2, 24.6, 10.6).clear_rect(23.0, 10.6, 24.2, 10.8)
+    b.clear_rect(24.8, 0.2, 30.2, 10.6).clear_rect(24.6, 1.0, 24.8, 2.2)
+    b.clear_rect(30.4, 0.2, 35.8, 10.6).clear_rect(34.4, 10.6, 35.4, 10.8)
+    # room 6 (NW): big room, U obstacle and pillars
+    b.clear_rect(0.2, 13.4, 16.6, 23.8).clear_rect(13.8, 13.2, 15.0, 13.4)
+    b.rect(5.0, 16.0, 9.0, 20.0, filled=False, thickness_m=0.3)
+    b.clear_rect(5.3, 16.0, 8.7, 16.3)  # U open to the south, towards the door side
+    b.disc(11.5, 17.0, 0.5).disc(11.5, 21.0, 0.5)
+    # rooms 7, 8 (NE)
+    b.clear_rect(19.4, 13.4, 27.4, 23.8).clear_rect(19.2, 20.0, 19.4, 21.2).clear_rect(20.0, 13.2, 21.2, 13.4)
+    b.clear_rect(27.6, 13.4, 35.8, 23.8).clear_rect(27.4, 22.4, 27.6, 23.3)
+    places = {
+        "room_1": (4.4, 3.0),
+        "room_2": (11.5, 5.4),
+        "room_3": (22.0, 5.4),
+        "room_4": (27.5, 5.4),
+        "room_5": (33.1, 5.4),
+        "room_6": (7.0, 18.0),
+        "room_7": (23.4, 18.6),
+        "room_8": (31.7, 18.6),
+        "base": (1.0, 12.0),
+        "patrol_H1": (8.0, 12.0),
+        "patrol_H2": (28.0, 12.0),
+        "patrol_V1": (18.0, 5.0),
+        "patrol_V2": (18.0, 19.0),
+        "junction": (18.0, 12.0),
+    }
+    notes = (
+        "Sgorbissa & Arkin §6 Fig. 13 (complex office): 36x24 m, cross-shaped 2.4 m corridors, "
+        "8 rooms with U-shaped obstacles open towards the robot's approach, narrow 0.9 m doors, "
+        "a baffle, and rooms reached only through other rooms; targets at room centres."
+    )
+    regions = {"corridor_H": (0.2, 10.8, 35.8, 13.2), "corridor_V": (16.8, 0.2, 19.2, 23.8)}
+    return EnvironmentMap(b.build("builtin:office_complex"), places, notes, regions)
+
+
+# ---------------------------------------------------------------------------- Fox et al.
+def symmetric_hallway(resolution_m: float = 0.1) -> EnvironmentMap:
+    """Fox, Burgard, Kruppa & Thrun §5.2.1, Fig. 12(a): the symmetric hallway environment.
+
+    A square ring of 2 m wide hallways, 26 m on a side (centre lines 24 m apart). The west
+    hallway opens into a 6 m x 10 m open space ``A``; the north (``B``), east (``C``) and
+    south (``D``) hallways are identical: each has two 1.5 m x 1 m alcoves in its outer wall,
+    4 m either side of its midpoint. So the map's only symmetry is the mirror about the
+    horizontal centre line, and locally every hallway B, C, D looks the same: a robot must
+    "either pass the open space A, or move through all other hallways B, C and D" (§5.2.1)
+    to know where it is.
+
+    Places: ``A``, ``B``, ``C``, ``D`` (region centres) and ``corner_NE``, ``corner_SE``,
+    ``corner_NW``, ``corner_SW``. Regions: the four named areas.
+    """
+    res = _res(resolution_m)
+    lo, hi, w = 1.5, 27.5, 2.0  # ring's outer edge and hallway width
+    mid = (lo + hi) / 2
+    b = MapBuilder(29.0, 29.0, res).fill("wall")
+    b.clear_rect(lo, hi - w, hi, hi)  # B north
+    b.clear_rect(hi - w, lo, hi, hi)  # C east
+    b.clear_rect(lo, lo, hi, lo + w)  # D south
+    b.clear_rect(lo, lo, lo + w, hi)  # west hallway
+    b.clear_rect(lo, mid - 5.0, lo + 6.0, mid + 5.0)  # open space A
+    for off in (-4.0, 4.0):
+        b.clear_rect(mid + off - 0.75, hi, mid + off + 0.75, hi + 1.0)  # B alcoves
+        b.clear_rect(hi, mid + off - 0.75, hi + 1.0, mid + off + 0.75)  # C alcoves
+        b.clear_rect(mid + off - 0.75, lo - 1.0, mid + off + 0.75, lo)  # D alcoves
+    regions = {
+        "A": (lo, mid - 5.0, lo + 6.0, mid + 5.0),
+        "B": (lo + w, hi - w, hi - w, hi),
+        "C": (hi - w, lo + w, hi, hi - w),
+        "D": (lo + w, lo, hi - w, lo + w),
+    }
+    places = {k: ((r[0] + r[2]) / 2, (r[1] + r[3]) / 2) for k, r in regions.items()}
+    c = w / 2
+    places.update(
+        {
+            "corner_NE": (hi - c, hi - c),
+            "corner_SE": (hi - c, lo + c),
+            "corner_NW": (lo + c, hi - c),
+            "corner_SW": (lo + c, lo + c),
+        }
+    )
+    notes = (
+        "Fox et al. §5.2.1 Fig. 12(a): square ring of 2 m hallways (26 m outer side); west side "
+        "opens into a 6x10 m open space A; hallways B (north), C (east), D (south) are identical, "
+        "each with two alcoves 4 m either side of its midpoint; only mirror symmetry about y=14.5 m."
+    )
+    return EnvironmentMap(b.build("builtin:symmetric_hallway"), places, notes, regions)
+
+
+def hexagon(resolution_m: float = 0.1) -> EnvironmentMap:
+    """Fox, Burgard, Kruppa & Thrun §5.2.2, Fig. 13: the hexagon with 8 m edges.
+
+    A regular hexagon (circumradius 8 m, flat top and bottom) centred at (8.5, 7.5) m.
+    Interior obstacles are discs of radius 0.6 m made of materials only one sensor sees:
+
+    - ``glass`` (sonar only), at polar angles 20° and 200°, 4.5 m from the centre: the
+      hexagon's symmetries that keep them are the identity and the 180° turn, so a
+      sonar robot keeps two hypotheses;
+    - ``foam`` (laser only), at 100°, 220° and 340°, 2.5 m from the centre: kept by the
+      120° and 240° turns, so a laser robot keeps three hypotheses.
+
+    No mirror of the hexagon keeps either set, and the only rotation keeping both is the
+    identity, so only a team mixing sensors (sharing beliefs at detections) can localize
+    uniquely, as §5.2.2 requires ("any robot equipped with only one of the sensor types is
+    not able to determine uniquely where it is").
+
+    Places: ``centre`` and ``start_0``..``start_5`` 2 m inside each vertex. Regions: the
+    obstacles' bounding boxes (``glass_1``, ``glass_2``, ``foam_1``..``foam_3``).
+    """
+    res = _res(resolution_m)
+    cx, cy, radius = 8.5, 7.5, 8.0
+    angles = np.deg2rad(np.arange(6) * 60.0)
+    verts = [(cx + radius * math.cos(a), cy + radius * math.sin(a)) for a in angles]
+    b = MapBuilder(17.0, 15.0, res).fill("wall").clear_polygon(verts)
+    regions: dict[str, tuple[float, float, float, float]] = {}
+    r_obs = 0.6
+    for k, deg in enumerate((20.0, 200.0), start=1):
+        x, y = cx + 4.5 * math.cos(math.radians(deg)), cy + 4.5 * math.sin(math.radians(deg))
+        b.disc(x, y, r_obs, material="glass")
+        regions[f"glass_{k}"] = (x - r_obs, y - r_obs, x + r_obs, y + r_obs)
+    for k, deg in enumerate((100.0, 220.0, 340.0), start=1):
+        x, y = cx + 2.5 * math.cos(math.radians(deg)), cy + 2.5 * math.sin(math.radians(deg))
+        b.disc(x, y, r_obs, material="foam")
+        regions[f"foam_{k}"] = (x - r_obs, y - r_obs, x + r_obs, y + r_obs)
+    places = {"centre": (cx, cy)}
+    for k, a in enumerate(angles):
+        places[f"start_{k}"] = (round(cx + (radius - 2.0) * math.cos(a), 6), round(cy + (radius - 2.0) * math.sin(a), 6))
+    notes = (
+        "Fox et al. §5.2.2 Fig. 13: regular hexagon, 8 m edges; glass discs (sonar only) at 20/200 deg "
+        "(2-fold symmetric), foam discs (laser only) at 100/220/340 deg (3-fold); together unique."
+    )
+    return EnvironmentMap(b.build("builtin:hexagon"), places, notes, regions)
+
+
+def lab_and_corridor(resolution_m: float = 0.1) -> EnvironmentMap:
+    """Fox, Burgard, Kruppa & Thrun §5.1, Fig. 8: a cluttered lab beside a long corridor.
+
+    A 40 m x 2.2 m corridor with bare, featureless walls (so a robot in it "generally has
+    to travel a long distance" to resolve its position and even its heading, §5.1), and an
+    8 m x 7.3 m lab south of it, joined by a 1.6 m opening near the lab's west end. The lab
+    is cluttered and non-symmetric (desk, cabinet, round table, boxes) so a robot in it
+    knows "fairly well where it is". Marian, in the lab, faces the opening (``observer``,
+    heading +90°); Robin travels the corridor (``corridor_west`` to ``corridor_east``).
+    """
+    res = _res(resolution_m)
+    b = MapBuilder(42.0, 12.0, res).fill("wall")
+    b.clear_rect(1.0, 8.5, 41.0, 10.7)  # corridor
+    b.clear_rect(22.0, 1.0, 30.0, 8.3)  # lab
+    b.clear_rect(23.0, 8.3, 24.6, 8.5)  # opening
+    b.rect(26.0, 1.0, 29.6, 2.0)  # desk along the south wall
+    b.rect(29.4, 3.0, 30.0, 6.6)  # cabinet on the east wall
+    b.disc(25.6, 4.4, 0.7)  # round table
+    b.rect(22.0, 1.0, 23.3, 3.0)  # boxes in the south-west corner
+    b.rect(27.2, 6.6, 28.4, 8.3)  # shelf against the north wall
+    places = {
+        "observer": (23.8, 6.6),
+        "lab_centre": (27.0, 4.6),
+        "lab_door": (23.8, 9.6),
+        "corridor_west": (2.5, 9.6),
+        "corridor_east": (39.5, 9.6),
+    }
+    regions = {"corridor": (1.0, 8.5, 41.0, 10.7), "lab": (22.0, 1.0, 30.0, 8.3)}
+    notes = (
+        "Fox et al. §5.1 Fig. 8: 40x2.2 m featureless corridor; 8x7.3 m cluttered, non-symmetric lab "
+        "south of it with a 1.6 m opening at x in [23.0, 24.6] m; the observer (Marian) faces the "
+        "opening (heading +90 deg)."
+    )
+    return EnvironmentMap(b.build("builtin:lab_and_corridor"), places, notes, regions)
+
+
+# ---------------------------------------------------------------------------- Vaughan et al.
+def trail_office(resolution_m: float = 0.1) -> EnvironmentMap:
+    """Vaughan, Støy, Sukhatme & Matarić: the office used in both trail papers.
+
+    "Blazing a trail" §5: "the resource separated from the home position by two corners and
+    approximately 33 m of corridors"; "Try to see it my way" §3.2: "two corners and 31 m of
+    corridor ... the robots must make two correct turning decisions". Their Fig. 4 / Fig. 1
+    show part of an office building with narrow corridors and small rooms.
+
+    Geometry (1.8 m corridors, 0.2 m walls, 36 m x 24 m):
+
+    - ``home`` at the west end of the south corridor C1 (y = 4.9 m);
+    - corner 1 at x = 14.9 m: turn north into C2; C1 also carries on east (a wrong turn:
+      a dead end past three rooms);
+    - corner 2 at y = 15.9 m: turn east into the north corridor C3; C2 also carries on
+      north into a room, and C3 also runs west (two more wrong turns);
+    - ``source`` in C3 at x = 24.4 m, 9.5 m past corner 2; C3 goes on east to a dead end.
+
+    Centre-line route length 12.9 + 11.0 + 9.5 = 33.4 m; a robot of radius 0.25 m cutting
+    the corners drives about 31.5 m, between the two papers' 31 m and 33 m. Rooms open off every corridor through 1 m doors. Each corridor
+    has a 2 m long passing place where it widens to 2.8 m, since the robots (50 cm wide)
+    must pass each other ("passing within as little as 40 cm of each other", Blazing §4).
+    """
+    res = _res(resolution_m)
+    b = MapBuilder(36.0, 24.0, res).fill("wall")
+    # corridors
+    b.clear_rect(0.2, 4.0, 34.0, 5.8)  # C1, y centre 4.9
+    b.clear_rect(14.0, 4.0, 15.8, 23.8)  # C2, x centre 14.9; goes on north past C3 to a dead end
+    b.clear_rect(6.0, 15.0, 35.8, 16.8)  # C3, y centre 15.9
+    # passing places
+    b.clear_rect(7.0, 5.8, 9.0, 6.8)
+    b.clear_rect(15.8, 9.0, 16.8, 11.0)
+    b.clear_rect(19.0, 16.8, 21.0, 17.8)
+    # rooms south of C1 (doors on C1)
+    for x0, x1 in ((0.2, 5.8), (6.0, 11.8), (16.0, 22.0), (22.2, 28.0), (28.2, 34.0)):
+        b.clear_rect(x0, 0.2, x1, 3.8).clear_rect(x0 + 1.0, 3.8, x0 + 2.0, 4.0)
+    # rooms between C1 and C3, west and east of C2
+    b.clear_rect(0.2, 6.0, 5.8, 14.8).clear_rect(4.6, 5.8, 5.6, 6.0)  # W1, door on C1
+    b.clear_rect(6.0, 6.0, 13.8, 14.8).clear_rect(6.5, 14.8, 7.5, 15.0)  # W2, door on C3
+    b.clear_rect(16.0, 6.0, 24.0, 14.8).clear_rect(16.0, 5.8, 17.0, 6.0)  # E1, door on C1
+    b.clear_rect(24.2, 6.0, 35.8, 14.8).clear_rect(33.0, 14.8, 34.0, 15.0)  # E2, door on C3
+    # rooms north of C3
+    b.clear_rect(0.2, 17.0, 13.8, 23.8).clear_rect(8.0, 16.8, 9.0, 17.0)  # N1 (west of C2)
+    b.clear_rect(16.0, 18.0, 24.0, 23.8).clear_rect(22.0, 17.8, 23.0, 18.0)  # N2
+    b.clear_rect(24.2, 17.0, 35.8, 23.8).clear_rect(30.0, 16.8, 31.0, 17.0)  # N3
+    b.clear_rect(15.8, 21.0, 16.0, 22.0)  # C2's north end also opens into N2
+    places = {
+        "home": (2.0, 4.9),
+        "source": (24.4, 15.9),
+        "corner_1": (14.9, 4.9),
+        "corner_2": (14.9, 15.9),
+        "c1_dead_end": (32.5, 4.9),
+        "c3_west_end": (7.0, 15.9),
+        "c3_east_end": (34.5, 15.9),
+    }
+    regions = {"C1": (0.2, 4.0, 34.0, 5.8), "C2": (14.0, 4.0, 15.8, 23.8), "C3": (6.0, 15.0, 35.8, 16.8)}
+    notes = (
+        "Vaughan et al. (Blazing §5, Try-to-see §3.2): home and source ~32 m apart through two "
+        "corners (C1 east 12.9 m, C2 north 11.0 m, C3 east 9.5 m); every junction offers a wrong "
+        "turn into dead ends and rooms; 1.8 m corridors with 2.8 m passing places."
+    )
+    return EnvironmentMap(b.build("builtin:trail_office"), places, notes, regions)
+
+
+# ---------------------------------------------------------------------------- registry
+BUILTIN_MAPS: dict[str, Callable[[], EnvironmentMap]] = {
+    "office_simple": office_simple,
+    "office_complex": office_complex,
+    "symmetric_hallway": symmetric_hallway,
+    "hexagon": hexagon,
+    "lab_and_corridor": lab_and_corridor,
+    "trail_office": trail_office,
+}
+
+
+def builtin_map(name: str) -> EnvironmentMap:
+    """Build the built-in environment ``name`` (a key of :data:`BUILTIN_MAPS`).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, with a "did you mean" hint and the known names.
+
+    Examples
+    --------
+    >>> builtin_map("hexagon").grid.shape
+    (150, 170)
+    """
+    try:
+        factory = BUILTIN_MAPS[name]
+    except (KeyError, TypeError):
+        close = difflib.get_close_matches(str(name), BUILTIN_MAPS, n=1)
+        hint = f" Did you mean {close[0]!r}?" if close else ""
+        raise ValueError(f"unknown built-in map {name!r}.{hint} Known maps: {', '.join(sorted(BUILTIN_MAPS))}") from None
+    return factory()

@@ -1,0 +1,263 @@
+"""Map builder and the papers' built-in environments."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import scipy.ndimage as ndi
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from teamnav.world.generators import BUILTIN_MAPS, EnvironmentMap, MapBuilder, builtin_map
+from teamnav.world.grid import FOAM, FREE, GLASS, WALL
+from teamnav.world.mapio import load_map, save_map
+
+ROBOT_RADIUS_M = 0.25
+EIGHT = np.ones((3, 3), bool)
+
+
+def _clear_of_obstacles(grid, radius_m=ROBOT_RADIUS_M) -> np.ndarray:
+    """bool (H, W): free cells whose centre is farther than radius_m from any obstacle cell."""
+    return ndi.distance_transform_edt(grid.cells == FREE) * grid.resolution_m > radius_m
+
+
+def _shortest_path_m(grid, a, b, radius_m=ROBOT_RADIUS_M) -> float:
+    """Dijkstra over 8-connected cells with clearance > radius_m (octile metric)."""
+    ok = _clear_of_obstacles(grid, radius_m)
+    h, w = ok.shape
+    idx = -np.ones((h, w), np.int64)
+    idx[ok] = np.arange(ok.sum())
+    rows, cols, weights = [], [], []
+    for dr, dc, cost in ((0, 1, 1.0), (1, 0, 1.0), (1, 1, math.sqrt(2)), (1, -1, math.sqrt(2))):
+        r0, r1 = slice(0, h - dr), slice(dr, h)
+        c0 = slice(max(0, -dc), w - max(0, dc))
+        c1 = slice(max(0, dc), w + min(0, dc))
+        both = ok[r0, c0] & ok[r1, c1]
+        rows.append(idx[r0, c0][both])
+        cols.append(idx[r1, c1][both])
+        weights.append(np.full(int(both.sum()), cost))
+    n = int(ok.sum())
+    graph = coo_matrix((np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)).tocsr()
+    (ra, ca), (rb, cb) = grid.world_to_cell(np.array(a)), grid.world_to_cell(np.array(b))
+    assert idx[ra, ca] >= 0 and idx[rb, cb] >= 0, "endpoints need robot clearance"
+    d = dijkstra(graph, directed=False, indices=int(idx[ra, ca]))
+    return float(d[idx[rb, cb]]) * grid.resolution_m
+
+
+@pytest.fixture(scope="module", params=sorted(BUILTIN_MAPS))
+def env(request) -> EnvironmentMap:
+    return builtin_map(request.param)
+
+
+# ---------------------------------------------------------------------------- every built-in map
+def test_border_is_closed(env):
+    labels, _ = ndi.label(env.grid.cells == FREE, structure=EIGHT)  # 8-connected: stricter
+    edge = np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])
+    assert not np.any(edge), f"{env.grid.name}: free space reaches the map edge"
+
+
+def test_places_are_free_with_clearance_and_mutually_connected(env):
+    g = env.grid
+    assert len(env.places) >= 2
+    ok = _clear_of_obstacles(g)
+    labels, _ = ndi.label(ok)
+    seen = set()
+    for name, xy in env.places.items():
+        assert g.is_free_xy(np.array(xy)), f"{g.name}: place {name} at {xy} is not in free space"
+        r, c = g.world_to_cell(np.array(xy))
+        assert ok[r, c], f"{g.name}: place {name} at {xy} is closer than {ROBOT_RADIUS_M} m to an obstacle"
+        seen.add(int(labels[r, c]))
+    assert len(seen) == 1, f"{g.name}: places lie in {len(seen)} disconnected regions"
+
+
+def test_regions_lie_inside_the_map(env):
+    xmin, xmax, ymin, ymax = env.grid.bounds_m
+    for name, (x0, y0, x1, y1) in env.regions.items():
+        assert xmin <= x0 < x1 <= xmax and ymin <= y0 < y1 <= ymax, name
+
+
+def test_builtin_maps_are_deterministic_and_round_trip_through_files(env, tmp_path):
+    name = env.grid.name.split(":", 1)[1]
+    again = builtin_map(name)
+    np.testing.assert_array_equal(again.grid.cells, env.grid.cells)
+    assert again.places == env.places
+    loaded = load_map(save_map(env.grid, tmp_path / f"{name}.yaml"))
+    np.testing.assert_array_equal(loaded.cells, env.grid.cells)
+    assert loaded.materials == env.grid.materials
+
+
+# ---------------------------------------------------------------------------- paper-specific checks
+def test_hexagon_has_glass_and_foam_and_8m_edges():
+    env = builtin_map("hexagon")
+    g = env.grid
+    assert (g.cells == GLASS).sum() > 50 and (g.cells == FOAM).sum() > 50
+    assert set(env.regions) == {"glass_1", "glass_2", "foam_1", "foam_2", "foam_3"}
+    # a laser does not see glass, a sonar does not see foam
+    laser = g.blocking(("wall", "unknown", "foam"))
+    sonar = g.blocking(("wall", "unknown", "glass"))
+    assert not laser[g.cells == GLASS].any() and sonar[g.cells == GLASS].all()
+    assert not sonar[g.cells == FOAM].any() and laser[g.cells == FOAM].all()
+    # flat-topped regular hexagon with 8 m edges: 16 m wide at the centre row, 8*sqrt(3) m tall
+    cx, cy = env.places["centre"]
+    r, c = g.world_to_cell(np.array([cx, cy]))
+    row_free = np.flatnonzero(g.cells[r] != WALL)
+    col_free = np.flatnonzero(g.cells[:, c] != WALL)
+    assert row_free.size * g.resolution_m == pytest.approx(16.0, abs=2 * g.resolution_m)
+    assert col_free.size * g.resolution_m == pytest.approx(8 * math.sqrt(3), abs=2 * g.resolution_m)
+
+
+def test_hexagon_symmetries_per_sensor():
+    """Sonar map keeps a 180° symmetry, laser map a 120° one, the union neither (Fox §5.2.2)."""
+    env = builtin_map("hexagon")
+    cx, cy = env.places["centre"]
+
+    def centres(prefix):
+        return np.array([((x0 + x1) / 2 - cx, (y0 + y1) / 2 - cy) for k, (x0, y0, x1, y1) in env.regions.items() if k.startswith(prefix)])
+
+    def invariant(pts, deg):
+        a = math.radians(deg)
+        rot = pts @ np.array([[math.cos(a), math.sin(a)], [-math.sin(a), math.cos(a)]])
+        return all(np.min(np.hypot(*(pts - p).T)) < 1e-6 for p in rot)
+
+    glass, foam = centres("glass"), centres("foam")
+    assert invariant(glass, 180) and not invariant(glass, 120) and not invariant(glass, 60)
+    assert invariant(foam, 120) and not invariant(foam, 180) and not invariant(foam, 60)
+
+
+def test_trail_office_home_source_path_length():
+    env = builtin_map("trail_office")
+    length = _shortest_path_m(env.grid, env.places["home"], env.places["source"])
+    # Vaughan et al.: ~31 m (Try to see it my way §3.2) / ~33 m (Blazing a trail §5) of corridor
+    assert 31.0 * 0.9 <= length <= 33.0 * 1.1, length
+    # straight-line distance is much shorter: the route really turns two corners
+    straight = math.dist(env.places["home"], env.places["source"])
+    assert straight < 0.8 * length
+
+
+def test_symmetric_hallway_regions_and_mirror_symmetry():
+    env = builtin_map("symmetric_hallway")
+    assert set(env.regions) == {"A", "B", "C", "D"}
+    free = env.grid.cells == FREE
+    assert np.array_equal(free, free[::-1]), "mirror symmetry about the horizontal centre line"
+    assert not np.array_equal(free, free[:, ::-1]), "open space A breaks the left-right symmetry"
+    assert not np.array_equal(free, np.rot90(free, 2))
+    # hallway C (east) looks exactly like hallway B (north) turned by 90 degrees
+    g = env.grid
+
+    def patch(x0, y0, x1, y1):
+        (r0, c0), (r1, c1) = g.world_to_cell(np.array([[x0, y0], [x1, y1]]))
+        return free[r0:r1, c0:c1]
+
+    bx0, by0, bx1, by1 = env.regions["B"]
+    cx0, cy0, cx1, cy1 = env.regions["C"]
+    b = patch(bx0, by0 - 1.5, bx1, by1 + 1.5)
+    c = patch(cx0 - 1.5, cy0, cx1 + 1.5, cy1)
+    assert b.any() and c.any()
+    assert np.array_equal(np.rot90(c, 1), b) or np.array_equal(np.rot90(c, -1), b)
+    # ... while the west side (with A) does not
+    w = patch(0.0, cy0, 5.0, cy1)  # west hallway, same span and depth as C's patch
+    assert not (np.array_equal(np.rot90(w, 1), b) or np.array_equal(np.rot90(w, -1), b))
+
+
+def test_lab_is_cluttered_and_corridor_featureless():
+    env = builtin_map("lab_and_corridor")
+    g = env.grid
+    lab = g.cells[g.world_to_cell(np.array([22.0, 1.0]))[0]:g.world_to_cell(np.array([30.0, 8.3]))[0] + 1,
+                  g.world_to_cell(np.array([22.0, 1.0]))[1]:g.world_to_cell(np.array([30.0, 8.3]))[1] + 1]
+    assert (lab != FREE).mean() > 0.1  # clutter
+    assert not np.array_equal(lab, lab[::-1]) and not np.array_equal(lab, lab[:, ::-1])
+    (r0, c0), (r1, c1) = g.world_to_cell(np.array([[2.0, 8.5], [40.0, 10.7]]))
+    assert (g.cells[r0 + 1:r1, c0:c1] == FREE).all()  # the corridor itself is open along its length
+    # bare walls: apart from the lab opening, every column across the corridor (walls included)
+    # is the same, so nothing along it tells a robot where it is
+    band = g.cells[r0 - 2:r1 + 3, c0:c1] == FREE  # corridor and its two 0.2 m walls
+    (_, o0), (_, o1) = g.world_to_cell(np.array([[23.0, 0.0], [24.6, 0.0]]))
+    keep = np.ones(band.shape[1], bool)
+    keep[o0 - c0 - 1:o1 - c0 + 2] = False
+    assert (band[:, keep] == band[:, :1]).all()
+    assert not (band[:, ~keep] == band[:, :1]).all()  # the opening is visible
+
+
+# ---------------------------------------------------------------------------- registry
+def test_builtin_map_unknown_name_suggests():
+    with pytest.raises(ValueError, match=r"unknown built-in map 'hexagn'\. Did you mean 'hexagon'\?.*Known maps: .*trail_office"):
+        builtin_map("hexagn")
+    with pytest.raises(ValueError, match="unknown built-in map 'zzz'. Known maps"):
+        builtin_map("zzz")
+
+
+# ---------------------------------------------------------------------------- builder
+def test_builder_rect_polygon_disc_segment_rasterise_by_cell_centres():
+    b = MapBuilder(4.0, 2.0, 0.5)
+    g = b.rect(0.0, 0.0, 1.0, 1.0).build("r")
+    assert g.cells[:2, :2].tolist() == [[WALL, WALL], [WALL, WALL]] and g.cells.sum() == 4
+    g = MapBuilder(4.0, 4.0, 1.0).polygon([(0, 0), (4, 0), (0, 4)], "glass").build("p")
+    # cell centres (c+0.5, r+0.5) with x + y < 4 are inside the triangle
+    r, c = np.mgrid[0:4, 0:4]
+    np.testing.assert_array_equal(g.cells == GLASS, (r + c + 1) < 4)
+    g = MapBuilder(2.0, 2.0, 0.1).disc(1.0, 1.0, 0.5, "foam").build("d")
+    assert (g.cells == FOAM).sum() == pytest.approx(math.pi * 25, rel=0.1)
+    # a thin diagonal segment still blocks 4-connected leaks across it
+    g = MapBuilder(2.0, 2.0, 0.1).segment(0.0, 0.0, 2.0, 2.0, 0.01).build("s")
+    labels, n = ndi.label(g.cells == FREE)  # 4-connectivity
+    assert n == 2
+
+
+def test_builder_custom_material_is_appended():
+    g = MapBuilder(1.0, 1.0, 0.5).rect(0.0, 0.0, 0.5, 0.5, material="curtain").build("m")
+    assert g.materials[-1] == "curtain" and g.cells[0, 0] == len(g.materials) - 1
+
+
+def test_builder_corridors_cross_and_rooms_keep_doors():
+    b = MapBuilder(10.0, 10.0, 0.1).border(0.2)
+    b.corridor(0.2, 5.0, 9.8, 5.0, width_m=1.0, wall_thickness_m=0.2)
+    b.corridor(5.0, 0.2, 5.0, 9.8, width_m=1.0, wall_thickness_m=0.2)
+    g = b.build("x")
+    assert g.is_free_xy(np.array([[5.0, 5.0], [5.0, 5.45], [5.45, 5.0], [1.0, 5.0], [5.0, 1.0]])).all()
+    assert not g.is_free_xy(np.array([[2.0, 5.6], [2.0, 4.4], [5.6, 2.0]])).any()  # side walls
+    b = MapBuilder(6.0, 6.0, 0.1).room(1.0, 1.0, 5.0, 5.0, 0.2, doors=[("south", 2.0, 1.0), ("east", 1.0, 0.6)])
+    g = b.build("room")
+    assert g.is_free_xy(np.array([[3.0, 1.1], [4.9, 2.0], [3.0, 3.0]])).all()  # doors and interior
+    assert not g.is_free_xy(np.array([[1.5, 1.1], [4.9, 3.5], [3.0, 4.9], [1.1, 3.0]])).any()
+    # the room's interior is enclosed except through its doors
+    labels, _ = ndi.label(g.cells == FREE)
+    inside = labels[g.world_to_cell(np.array([3.0, 3.0]))[0], g.world_to_cell(np.array([3.0, 3.0]))[1]]
+    outside = labels[0, 0]
+    assert inside == outside
+    closed = MapBuilder(6.0, 6.0, 0.1).room(1.0, 1.0, 5.0, 5.0, 0.2).build("closed")
+    labels, _ = ndi.label(closed.cells == FREE)
+    assert labels[30, 30] != labels[0, 0]
+
+
+def test_builder_clear_rect_and_outline():
+    g = MapBuilder(3.0, 3.0, 0.5).fill().clear_rect(0.5, 0.5, 2.5, 2.5).build("c")
+    assert (g.cells == FREE).sum() == 16
+    g = MapBuilder(3.0, 3.0, 0.5).rect(0.0, 0.0, 3.0, 3.0, filled=False, thickness_m=0.5).build("o")
+    assert (g.cells == WALL).sum() == 36 - 16
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda: MapBuilder(-1.0, 2.0, 0.1), r"width_m must be > 0 m, got -1.0"),
+        (lambda: MapBuilder(1.0, float("nan"), 0.1), r"height_m must be a finite number"),
+        (lambda: MapBuilder(1.0, 1.0, 2.0), r"resolution_m must be at most"),
+        (lambda: MapBuilder(1.0, 1.0, 0.1).rect(1.0, 0.0, 0.5, 1.0), r"rect: need xmin < xmax"),
+        (lambda: MapBuilder(1.0, 1.0, 0.1).rect(0.0, 0.0, 1.0, 1.0, filled=False), r"thickness_m is required"),
+        (lambda: MapBuilder(1.0, 1.0, 0.1).border(0.01), r"border: thickness_m must be at least one cell"),
+        (lambda: MapBuilder(1.0, 1.0, 0.1).polygon([(0, 0), (1, 1)]), r"polygon: vertices must be at least 3"),
+        (lambda: MapBuilder(1.0, 1.0, 0.1).disc(0.5, 0.5, 0.0), r"disc: r must be > 0 m"),
+        (lambda: MapBuilder(1.0, 1.0, 0.1).rect(0, 0, 1, 1, material=""), r"material must be a non-empty"),
+        (lambda: MapBuilder(1.0, 1.0, 0.1).corridor(0.5, 0.5, 0.5, 0.5, 0.3, 0.1), r"corridor: the two ends must differ"),
+        (lambda: MapBuilder(6.0, 6.0, 0.1).room(1, 1, 5, 5, 0.2, doors=[("up", 1.0, 1.0)]), r"side must be one of .*got 'up'"),
+        (lambda: MapBuilder(6.0, 6.0, 0.1).room(1, 1, 5, 5, 0.2, doors=[("nort", 1.0, 1.0)]), r"did you mean 'north'"),
+        (lambda: MapBuilder(6.0, 6.0, 0.1).room(1, 1, 5, 5, 0.2, doors=[("north", 0.3, 1.0)]), r"doors\[0\] must lie between the corner walls"),
+        (lambda: MapBuilder(6.0, 6.0, 0.1).room(1, 1, 5, 5, 0.2, doors=[("north", 1.0)]), r"doors\[0\] must be \(side, offset_m, width_m\)"),
+        (lambda: BUILTIN_MAPS["hexagon"](resolution_m=1.0), r"resolution_m must be at most 0.25"),
+    ],
+)
+def test_builder_bad_input_names_parameter_and_value(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
