@@ -11,10 +11,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
+import teamnav.world
 from teamnav.world.grid import DEFAULT_MATERIALS, OccupancyGrid
 from teamnav.world.mapio import MapError, load_map, occupancy_values, save_map
 
-DATA = Path("/work/shared/data")
+# the real maps ship with the package (identical to /work/shared/data), so a clean checkout finds them
+DATA = Path(teamnav.world.__file__).parent / "maps"
 FREE, WALL, UNKNOWN, GLASS, FOAM = range(5)
 
 
