@@ -297,3 +297,20 @@ def test_bad_override_arguments(tmp_path):
         load_map(p, resolution_m=0.0)
     with pytest.raises(MapError, match="'origin_xy_m'"):
         load_map(p, origin_xy_m=(float("inf"), 0.0))
+
+
+def test_sixteen_bit_image_and_palette_image(tmp_path):
+    Image.fromarray(np.full((2, 2), 1000, np.uint16)).save(tmp_path / "deep.png")
+    with pytest.raises(MapError, match=r"deep\.png: field 'image': expected an 8-bit greyscale.*found image mode 'I;16'"):
+        load_map(tmp_path / "deep.png", resolution_m=0.1)
+    pal = Image.fromarray(np.array([[0, 1]], np.uint8), mode="P")
+    pal.putpalette([0, 0, 0, 255, 255, 255] + [0] * 762)  # index 0 black, 1 white
+    pal.save(tmp_path / "pal.png")
+    assert load_map(tmp_path / "pal.png", resolution_m=0.1).cells.tolist() == [[WALL, FREE]]
+
+
+def test_save_map_refuses_a_non_yaml_target(tmp_path):
+    g = OccupancyGrid(np.zeros((2, 2), np.uint8), 0.1)
+    with pytest.raises(MapError, match=r"m\.pgm: field '<file>': expected a path ending in one of"):
+        save_map(g, tmp_path / "m.pgm")
+    assert not any(tmp_path.iterdir())

@@ -69,8 +69,9 @@ def angle_diff(a, b):
 def mean_angle(angles, weights=None, axis=None):
     """Circular mean: the direction of the (weighted) sum of unit vectors.
 
-    ``atan2(sum(w * sin a), sum(w * cos a))``. Vaughan et al. ("Blazing a trail" §3)
-    steer along the average heading of the crumbs near the robot; this is that average.
+    ``atan2(sum(w * sin a), sum(w * cos a))``. Vaughan et al. ("Blazing a trail")
+    steer along "the average heading of all those crumbs that lie within a threshold
+    distance" (§4.1, trail laying algorithm); this is that average.
 
     Parameters
     ----------
