@@ -71,7 +71,7 @@ def mean_angle(angles, weights=None, axis=None):
 
     ``atan2(sum(w * sin a), sum(w * cos a))``. Vaughan et al. ("Blazing a trail")
     steer along "the average heading of all those crumbs that lie within a threshold
-    distance" (§4.1, trail laying algorithm); this is that average.
+    radius of its current position estimate" (§4.1, trail laying algorithm); this is that average.
 
     Parameters
     ----------
