@@ -78,19 +78,20 @@ def _segment_visible(blocking, ax, ay, bx, by):
         sy = 1
         offy = 1
         idy = np.inf
+    end = length - VERTEX_TOL_CELLS  # crossings at the end point itself do not count
     while True:
         tx = ((c + offx) - ax) * idx
         ty = ((r + offy) - ay) * idy
         if tx < ty - VERTEX_TOL_CELLS:
-            if tx >= length:
+            if tx >= end:
                 return True
             c += sx
         elif ty < tx - VERTEX_TOL_CELLS:
-            if ty >= length:
+            if ty >= end:
                 return True
             r += sy
         else:
-            if min(tx, ty) >= length:
+            if min(tx, ty) >= end:
                 return True
             if _blocked(blocking, r, c + sx) or _blocked(blocking, r + sy, c):
                 return False
