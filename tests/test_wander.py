@@ -84,6 +84,26 @@ def test_both_forms_give_identical_actions(seed, n_robots, n_steps, use_prox, p_
     assert list(batch.log()["mode"]) == modes
 
 
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), use_prox=st.booleans())
+def test_compiled_kernel_matches_its_python_execution(seed, use_prox):
+    """The numba kernel against the same source run by the interpreter (catches typing slips)."""
+    sensor = PROX if use_prox else LASER
+    rng = np.random.default_rng(seed)
+    n, nb = 6, sensor.angles_rad.size
+    p = kernel_params(WanderParams(p_turn_at_opening=0.7), sensor.max_range_m, 0.1)
+    keys = rng.integers(0, 2**63, n, dtype=np.uint64)
+    st_c, st_py = K.initial_state(n), K.initial_state(n)
+    for step in range(30):
+        r = np.minimum(rng.uniform(0.0, 1.0, (n, nb)) ** 2 * sensor.max_range_m * 1.2, sensor.max_range_m)
+        stalled = rng.random(n) < 0.1
+        out_c, out_py = (np.zeros(n), np.zeros(n)), (np.zeros(n), np.zeros(n))
+        K.wander_step(r, sensor.angles_rad, sensor.max_range_m, stalled, keys, np.int64(step), p, st_c, *out_c)
+        K.wander_step.py_func(r, sensor.angles_rad, sensor.max_range_m, stalled, keys, np.int64(step), p, st_py, *out_py)
+        np.testing.assert_allclose(out_c, out_py, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(st_c, st_py, rtol=1e-12, atol=1e-12)
+
+
 def test_rows_do_not_depend_on_their_neighbours():
     params = WanderParams()
     infos = [info(i, 3) for i in range(3)]
