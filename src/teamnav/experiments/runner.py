@@ -1,0 +1,313 @@
+"""Run a scenario: build the map and the simulation, step it, score it, write the run folder.
+
+A run folder holds everything needed to look at, score and reproduce the run::
+
+    scenario.yaml       the resolved scenario: `teamnav run DIR/scenario.yaml` reproduces it
+    metrics.json        the metrics, {name: number}
+    trajectories.npz    t_s, true_pose (T, N, 3), odom_pose (T, N, 3), stalled (the recorder)
+    events.json, logs.json, comm.json   (the recorder)
+    map.yaml + map.pgm  the true map (so figures need nothing but the folder)
+    robots.json         per-robot group, controller and body radius
+    trajectories.png    map, true paths, odometry (dashed), final poses
+    run.gif             optional animation
+
+Everything is written to a hidden staging folder next to the target and renamed into place
+at the end, so a failure (a bad scenario, an exception in a controller or a metric, Ctrl-C)
+never leaves a half-written run folder behind.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from teamnav.experiments import metrics as metric_registry
+from teamnav.experiments.errors import Problem, ScenarioError
+from teamnav.experiments.spec import Scenario, build_grid, check_controllers, load_scenario, scenario_to_yaml
+from teamnav.world.mapio import save_map
+
+__all__ = ["OutputDirError", "RunResult", "run", "run_data", "robot_radii"]
+
+#: a progress bar appears once a run has taken this long [s]
+PROGRESS_AFTER_S = 2.0
+
+
+class OutputDirError(ValueError):
+    """The output folder exists and is not empty (pass ``force=True`` / ``--force`` to replace it)."""
+
+
+@dataclass
+class RunResult:
+    """What :func:`run` returns.
+
+    Attributes
+    ----------
+    metrics : dict of str to number
+        The scenario's metrics (see :mod:`teamnav.experiments.metrics`).
+    run_dir : Path or None
+        The run folder, or None when no ``out_dir`` was given.
+    sim : teamnav.sim.engine.Simulation
+        The finished simulation (its truth and recorder, for further analysis).
+    scenario : Scenario
+        The resolved scenario that ran.
+    """
+
+    metrics: dict[str, Any]
+    run_dir: Path | None
+    sim: Any
+    scenario: Scenario
+
+
+# ---------------------------------------------------------------------------- helpers
+def robot_radii(scenario: Scenario) -> np.ndarray:
+    """(N,) body radius per robot [m], groups in scenario order (the engine's robot order)."""
+    return np.concatenate([np.full(g.count, g.radius_m) for g in scenario.robots])
+
+
+def _robots_table(scenario: Scenario) -> dict[str, list]:
+    group, controller, radius = [], [], []
+    for g in scenario.robots:
+        group += [g.name] * g.count
+        controller += [g.controller] * g.count
+        radius += [g.radius_m] * g.count
+    return {"group": group, "controller": controller, "radius_m": radius}
+
+
+def _event_names(raw: Any) -> list[str]:
+    """Event names from the recorder's events.json, one per firing."""
+    if isinstance(raw, dict) and "events" in raw:
+        raw = raw["events"]
+    names: list[str] = []
+    if isinstance(raw, dict):  # {name: [firings]} or {name: count}
+        for k, v in raw.items():
+            names += [str(k)] * (len(v) if isinstance(v, (list, tuple)) else int(v))
+    elif isinstance(raw, list):
+        for e in raw:
+            if isinstance(e, dict):
+                names.append(str(e.get("name", e.get("event", e.get("kind", "event")))))
+            elif isinstance(e, (list, tuple)) and e:
+                names.append(str(next((x for x in e if isinstance(x, str)), "event")))
+            else:
+                names.append(str(e))
+    return names
+
+
+def _comm_counts(raw: Any) -> tuple[int, int, int]:
+    """(messages sent, bytes sent, deliveries) from the recorder's comm.json."""
+    if isinstance(raw, dict):
+        sent = raw.get("messages_sent", raw.get("sent", 0))
+        nbytes = raw.get("bytes_sent", raw.get("bytes", 0))
+        delivered = raw.get("messages_delivered", raw.get("delivered", 0))
+        if isinstance(sent, list):
+            return len(sent), int(sum(m.get("size_bytes", m.get("bytes", 0)) for m in sent if isinstance(m, dict))), (
+                len(delivered) if isinstance(delivered, list) else int(delivered)
+            )
+        return int(sent), int(nbytes), int(delivered if not isinstance(delivered, list) else len(delivered))
+    if isinstance(raw, list):  # one record per message
+        nbytes = sum(int(m.get("size_bytes", m.get("bytes", 0))) for m in raw if isinstance(m, dict))
+        delivered = sum(len(m.get("to_ids", m.get("delivered_to", ()))) for m in raw if isinstance(m, dict))
+        return len(raw), nbytes, delivered
+    return 0, 0, 0
+
+
+def run_data(run_dir: Path, scenario: Scenario, grid, n_steps: int, wall_s: float) -> metric_registry.RunData:
+    """Read the recorder's files in ``run_dir`` into a :class:`~teamnav.experiments.metrics.RunData`."""
+    with np.load(run_dir / "trajectories.npz") as z:
+        t_s = np.asarray(z["t_s"], dtype=float)
+        true_pose = np.asarray(z["true_pose"], dtype=float)
+        odom_pose = np.asarray(z["odom_pose"], dtype=float)
+        stalled = np.asarray(z["stalled"], dtype=bool) if "stalled" in z.files else np.zeros(true_pose.shape[:2], bool)
+
+    def read(name: str) -> Any:
+        p = run_dir / name
+        return json.loads(p.read_text(encoding="utf-8")) if p.is_file() else None
+
+    sent, nbytes, delivered = _comm_counts(read("comm.json"))
+    return metric_registry.RunData(
+        t_s=t_s,
+        true_pose=true_pose,
+        odom_pose=odom_pose,
+        stalled=stalled,
+        radius_m=robot_radii(scenario),
+        grid=grid,
+        events=_event_names(read("events.json")),
+        messages_sent=sent,
+        bytes_sent=nbytes,
+        messages_delivered=delivered,
+        n_steps=n_steps,
+        dt_s=scenario.dt_s,
+        wall_s=wall_s,
+    )
+
+
+class _LazyBar:
+    """A rich progress bar on stderr that appears only once the run has lasted a while."""
+
+    def __init__(self, total: int, label: str, show: bool) -> None:
+        self.total, self.label, self.show = total, label, show
+        self.t0 = time.perf_counter()
+        self.bar = None
+        self.task = None
+
+    def __call__(self, done: int) -> None:
+        if self.bar is None:
+            if not self.show or time.perf_counter() - self.t0 < PROGRESS_AFTER_S:
+                return
+            from rich.console import Console
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+            self.bar = Progress(
+                TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                console=Console(stderr=True), transient=True,
+            )
+            self.bar.start()
+            self.task = self.bar.add_task(self.label, total=self.total)
+        self.bar.update(self.task, completed=int(done))
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+
+
+def _check_out_dir(out: Path, force: bool) -> None:
+    if out.exists() and not force:
+        if not out.is_dir():
+            raise OutputDirError(f"output folder {out} exists and is a file; choose another --out or pass --force")
+        if any(out.iterdir()):
+            raise OutputDirError(f"output folder {out} exists and is not empty; choose another --out or pass --force")
+
+
+def _move_into_place(staging: Path, out: Path) -> None:
+    """Rename the finished staging folder to ``out``, replacing what is there."""
+    if out.is_dir() and any(out.iterdir()):
+        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
+        os.replace(out, old / "run")
+        os.replace(staging, out)
+        shutil.rmtree(old, ignore_errors=True)
+    elif out.exists() and not out.is_dir():
+        out.unlink()
+        os.replace(staging, out)
+    else:
+        os.replace(staging, out)  # onto nothing or an empty folder
+
+
+def _json_ready(values: dict[str, Any]) -> dict[str, Any]:
+    return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in values.items()}
+
+
+# ---------------------------------------------------------------------------- run
+def run(
+    scenario: Scenario | str | os.PathLike,
+    *,
+    out_dir: str | os.PathLike | None = None,
+    progress: bool | None | Callable[[int], None] = None,
+    gif: bool = False,
+    force: bool = False,
+) -> RunResult:
+    """Run ``scenario`` for ``duration_s`` and compute its metrics; optionally write a run folder.
+
+    Parameters
+    ----------
+    scenario : Scenario, or a built-in scenario name or a file path
+    out_dir : str or Path, optional
+        Run folder to write (see the module docstring). None writes nothing.
+    progress : bool, None or callable
+        ``True``: a progress bar on stderr once the run lasts more than 2 s; ``None``
+        (default): the same, only when stderr is a terminal; ``False``: none; a callable is
+        called with the number of steps done.
+    gif : bool
+        Also write ``run.gif`` (needs ``out_dir``).
+    force : bool
+        Replace a non-empty ``out_dir`` instead of refusing.
+
+    Returns
+    -------
+    RunResult
+
+    Raises
+    ------
+    ScenarioError
+        The scenario is invalid (before anything runs).
+    OutputDirError
+        ``out_dir`` exists and is not empty, and ``force`` is False (before anything runs).
+
+    Examples
+    --------
+    >>> from teamnav import load_scenario, run
+    >>> result = run(load_scenario("demo", duration_s=1.0), progress=False)  # doctest: +SKIP
+    >>> result.metrics["steps"]  # doctest: +SKIP
+    10
+    """
+    from teamnav.sim.engine import Simulation
+
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    else:
+        problems = check_controllers(scenario)
+        if problems:
+            raise ScenarioError(scenario.source, problems)
+    out = Path(out_dir) if out_dir is not None else None
+    if out is not None:
+        _check_out_dir(out, force)
+    if gif and out is None:
+        raise ValueError("gif=True needs an out_dir to write run.gif into")
+    grid = build_grid(scenario)
+    try:
+        sim = Simulation(grid, scenario, known_map=grid if scenario.give_map else None)
+    except ScenarioError:
+        raise
+    except ValueError as exc:
+        raise ScenarioError(scenario.source, [Problem("", f"the simulator cannot set up this scenario: {exc}")]) from None
+
+    n_steps = scenario.n_steps
+    if callable(progress):
+        bar = None
+        callback = progress
+    else:
+        show = progress is True or (progress is None and sys.stderr.isatty())
+        bar = _LazyBar(n_steps, f"{scenario.name} ({scenario.n_robots} robots)", show and progress is not False)
+        callback = bar
+
+    if out is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".partial", dir=out.parent))
+    else:
+        staging = Path(tempfile.mkdtemp(prefix="teamnav-run-"))
+    try:
+        t0 = time.perf_counter()
+        try:
+            sim.run(n_steps, progress=callback)
+        finally:
+            if bar is not None:
+                bar.close()
+        wall_s = time.perf_counter() - t0
+        sim.recorder.save(staging)
+        data = run_data(staging, scenario, grid, int(sim.step_index), wall_s)
+        values = metric_registry.compute(scenario.metric_names, data)
+        if out is None:
+            shutil.rmtree(staging, ignore_errors=True)
+            return RunResult(values, None, sim, scenario)
+        (staging / "scenario.yaml").write_text(scenario_to_yaml(scenario), encoding="utf-8")
+        (staging / "metrics.json").write_text(json.dumps(_json_ready(values), indent=2) + "\n", encoding="utf-8")
+        (staging / "robots.json").write_text(json.dumps(_robots_table(scenario)) + "\n", encoding="utf-8")
+        save_map(grid, staging / "map.yaml")
+        from teamnav.viz.plots import plot_run, save_gif
+
+        plot_run(staging, title=f"{scenario.name}: {scenario.n_robots} robots, {scenario.duration_s:g} s, seed {scenario.seed}")
+        if gif:
+            save_gif(staging)
+        _move_into_place(staging, out)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    return RunResult(values, out, sim, scenario)
