@@ -110,23 +110,34 @@ def format_loc(loc: Iterable[Any], data: Any = None) -> str:
     """
     out = ""
     node = data
-    keys = list(loc)
-    for i, key in enumerate(keys):
-        last = i == len(keys) - 1
+    for key in loc:
         if isinstance(key, int):
             out += f"[{key}]"
             node = node[key] if isinstance(node, (list, tuple)) and -len(node) <= key < len(node) else None
             continue
         key = str(key)
-        if node is not None and not isinstance(node, dict) and not last:
-            continue  # a union member name under a scalar or list
-        if isinstance(node, dict) and key not in node and not last:
-            continue  # a union tag such as 'laser'
-        if node is not None and not isinstance(node, dict) and last and not isinstance(node, (list, tuple)):
+        if _is_tag(key, node):
             continue
         out += f".{key}" if out else key
         node = node.get(key) if isinstance(node, dict) else None
     return out
+
+
+#: words pydantic uses for union members in error locations
+_TYPE_WORDS = frozenset(
+    {"float", "int", "str", "bool", "none", "list", "tuple", "dict", "set", "frozenset", "bytes", "is-instance",
+     "lax-or-strict", "json-or-python", "union", "nullable", "default"}
+)
+
+
+def _is_tag(key: str, node: Any) -> bool:
+    """Whether ``key`` in an error location names a union member rather than a field."""
+    if isinstance(node, dict):
+        if key in node:
+            return False
+        if node.get("kind") == key:  # discriminated union ('laser', 'sonar', ...)
+            return True
+    return "[" in key or key in _TYPE_WORDS or key[:1].isupper()
 
 
 _LEADING_PATH = re.compile(r"^([A-Za-z_][\w.\[\]]*): (.*)$", re.S)
