@@ -80,117 +80,154 @@ def _ray_dir(ct, st, cb, sb):
 
 
 @njit(cache=True, inline="always")
-def _march(clear, fx, fy, dx, dy, tmax):
-    """Distance [cells] along unit ``(dx, dy)`` from cell-unit point ``(fx, fy)`` to the
-    first blocking cell, capped at ``tmax``.
+def _inv(d):
+    """1/d, or +inf for an axis-parallel ray (whose planes are then never reached)."""
+    return 1.0 / d if d != 0.0 else np.inf
 
-    ``clear`` is the padded clearance map (0 = blocking, ``k + 1`` = free with a free
-    ``(2k+1)``-square around the cell); its outer ring is blocking, so no bounds checks are
-    needed once the start is inside. Cell ``(r, c)`` of the grid is ``clear[r + 1, c + 1]``.
-    """
+
+@njit(cache=True, inline="always")
+def _start(clear, fx, fy):
+    """Padded cell ``(r, c)`` of cell-unit point ``(fx, fy)`` and its clearance code
+    (0 = blocking, also for a point outside the grid)."""
     if not (fx >= 0.0 and fx < clear.shape[1] - 2.0 and fy >= 0.0 and fy < clear.shape[0] - 2.0):
-        return 0.0
+        return 0, 0, np.uint8(0)
     c = int(fx) + 1
     r = int(fy) + 1
+    return r, c, clear[r, c]
+
+
+@njit(cache=True, inline="always")
+def _jump(clear, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
+    """One jump of a ray standing in padded cell ``(r, c)`` with clearance code ``v > 0``.
+
+    ``clear`` is the padded clearance map (0 = blocking, ``k + 1`` = free with a free
+    ``(2k+1)``-square centred on the cell); its outer ring is blocking, so no bounds checks
+    are needed. Grid cell ``(r, c)`` is ``clear[r + 1, c + 1]``; ``(fx, fy)`` is the ray
+    origin in grid cell units, ``(dx, dy)`` its unit direction, ``idx, idy`` their inverses.
+
+    Returns ``(r, c, v, t, done)``: the cell entered at distance ``t`` [cells] and its code,
+    ``done`` when the ray ended there (blocking cell, or ``t`` capped at ``tmax``).
+    Written with selects rather than branches: the only branches left are the rare vertex
+    case and the ways a ray ends.
+    """
+    k = np.int64(v) - 1
+    sx = 1 if dx >= 0.0 else -1
+    sy = 1 if dy >= 0.0 else -1
+    offx = 0 if dx >= 0.0 else -1  # plane ahead of padded column c is at grid x = c + offx
+    offy = 0 if dy >= 0.0 else -1
+    # exit of the free square: planes c+offx+sx*k and r+offy+sy*k
+    tx = ((c + offx + sx * k) - fx) * idx
+    ty = ((r + offy + sy * k) - fy) * idy
+    ex = tx < ty  # leaves through the x-plane
+    t = tx if ex else ty
+    if t >= tmax:
+        return r, c, v, tmax, True
+    xe = fx + t * dx
+    ye = fy + t * dy
+    # the coordinate that did not exit: is the exit point on a grid vertex (within
+    # VERTEX_TOL_CELLS of travel), other than on the square's rear line (a ray that starts
+    # on a grid line)?
+    oe = ye if ex else xe
+    od = dy if ex else dx
+    ov = math.floor(oe + 0.5)
+    iv = int(ov)
+    rear = (r - sy * k - 1 - offy) if ex else (c - sx * k - 1 - offx)
+    if od != 0.0 and abs(oe - ov) <= VERTEX_TOL_CELLS * abs(od) and iv != rear:
+        # through a vertex: the two cells beside it count (Amanatides-Woo tie)
+        if ex:
+            cb_ = c + sx * k
+            ca_ = cb_ + sx
+            rb_ = iv if dy > 0.0 else iv + 1
+            ra_ = iv + 1 if dy > 0.0 else iv
+        else:
+            rb_ = r + sy * k
+            ra_ = rb_ + sy
+            cb_ = iv if dx > 0.0 else iv + 1
+            ca_ = iv + 1 if dx > 0.0 else iv
+        if clear[rb_, ca_] == 0 or clear[ra_, cb_] == 0:
+            return r, c, v, t, True
+        c = ca_
+        r = ra_
+    else:
+        cf = min(max(int(math.floor(xe)) + 1, c - k), c + k)
+        rf = min(max(int(math.floor(ye)) + 1, r - k), r + k)
+        c = c + sx * (k + 1) if ex else cf
+        r = rf if ex else r + sy * (k + 1)
     v = clear[r, c]
+    return r, c, v, t, v == 0
+
+
+@njit(cache=True)
+def _march(clear, fx, fy, dx, dy, tmax):
+    """Distance [cells] along unit ``(dx, dy)`` from cell-unit point ``(fx, fy)`` to the
+    first blocking cell, capped at ``tmax`` (one ray; see :func:`_jump`)."""
+    r, c, v = _start(clear, fx, fy)
     if v == 0:
         return 0.0
-    # offx: plane ahead of padded column c is at grid x = c + offx (c for +x, c - 1 for -x)
-    if dx > 0.0:
-        sx = 1
-        offx = 0
-        idx = 1.0 / dx
-    elif dx < 0.0:
-        sx = -1
-        offx = -1
-        idx = 1.0 / dx
-    else:
-        sx = 1
-        offx = 0
-        idx = np.inf
-    if dy > 0.0:
-        sy = 1
-        offy = 0
-        idy = 1.0 / dy
-    elif dy < 0.0:
-        sy = -1
-        offy = -1
-        idy = 1.0 / dy
-    else:
-        sy = 1
-        offy = 0
-        idy = np.inf
-    # position tolerance matching VERTEX_TOL_CELLS in time; -1 disables it on an axis-parallel ray
-    tolx = VERTEX_TOL_CELLS * abs(dx) if dx != 0.0 else -1.0
-    toly = VERTEX_TOL_CELLS * abs(dy) if dy != 0.0 else -1.0
+    idx = _inv(dx)
+    idy = _inv(dy)
     while True:
-        k = np.int64(v) - 1
-        # exit of the free square centred on (r, c): planes c+offx+sx*k and r+offy+sy*k
-        tx = ((c + offx + sx * k) - fx) * idx
-        ty = ((r + offy + sy * k) - fy) * idy
-        if tx < ty - VERTEX_TOL_CELLS:
-            t = tx
-            c += sx * (k + 1)
-            if k > 0:
-                # landed on the far x-plane somewhere along the square's face
-                ye = fy + t * dy
-                yv = math.floor(ye + 0.5)
-                if abs(ye - yv) <= toly:
-                    # at a grid vertex: both cells of the new column beside it count
-                    iv = int(yv)
-                    if clear[iv, c] == 0 or clear[iv + 1, c] == 0:
-                        return min(t, tmax)
-                    r = iv + 1 if dy > 0.0 else iv
-                else:
-                    r = min(max(int(math.floor(ye)) + 1, r - k), r + k)
-        elif ty < tx - VERTEX_TOL_CELLS:
-            t = ty
-            r += sy * (k + 1)
-            if k > 0:
-                xe = fx + t * dx
-                xv = math.floor(xe + 0.5)
-                if abs(xe - xv) <= tolx:
-                    iv = int(xv)
-                    if clear[r, iv] == 0 or clear[r, iv + 1] == 0:
-                        return min(t, tmax)
-                    c = iv + 1 if dx > 0.0 else iv
-                else:
-                    c = min(max(int(math.floor(xe)) + 1, c - k), c + k)
-        else:
-            # through the square's corner vertex: the two cells beside it count
-            t = min(tx, ty)
-            if t >= tmax:
-                return tmax
-            if clear[r + sy * k, c + sx * (k + 1)] == 0 or clear[r + sy * (k + 1), c + sx * k] == 0:
-                return t
-            c += sx * (k + 1)
-            r += sy * (k + 1)
-        if t >= tmax:
-            return tmax
-        v = clear[r, c]
-        if v == 0:
+        r, c, v, t, done = _jump(clear, fx, fy, dx, dy, idx, idy, r, c, v, tmax)
+        if done:
             return t
 
 
 @njit(cache=True)
 def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
-    """Fill ``out[p0:p1]`` (ranges [m]); poses in world metres, ``ct/st`` per pose, ``cb/sb`` per beam."""
+    """Fill ``out[p0:p1]`` (ranges [m]); poses in world metres, ``ct/st`` per pose, ``cb/sb`` per beam.
+
+    All beams of a pose advance together, one jump per sweep over the rays still going
+    (a wavefront): the jumps of different rays are independent, so their memory loads
+    overlap instead of each ray waiting on its own chain of cache misses.
+    """
     inv = 1.0 / res
     nb = cb.shape[0]
+    dxs = np.empty(nb)
+    dys = np.empty(nb)
+    idxs = np.empty(nb)
+    idys = np.empty(nb)
+    rs = np.empty(nb, np.int64)
+    cs = np.empty(nb, np.int64)
+    vs = np.empty(nb, np.uint8)
+    act = np.empty(nb, np.int64)
     for p in range(p0, p1):
         fx = (xs[p] - ox) * inv
         fy = (ys[p] - oy) * inv
-        c0 = ct[p]
-        s0 = st[p]
+        r0, c0, v0 = _start(clear, fx, fy)
+        if v0 == 0:
+            out[p, :] = 0.0
+            continue
+        n = 0
         for b in range(nb):
-            dx, dy = _ray_dir(c0, s0, cb[b], sb[b])
-            out[p, b] = _march(clear, fx, fy, dx, dy, tmax) * res
+            dx, dy = _ray_dir(ct[p], st[p], cb[b], sb[b])
+            dxs[b] = dx
+            dys[b] = dy
+            idxs[b] = _inv(dx)
+            idys[b] = _inv(dy)
+            rs[b] = r0
+            cs[b] = c0
+            vs[b] = v0
+            act[n] = b
+            n += 1
+        while n > 0:
+            m = 0
+            for a in range(n):
+                b = act[a]
+                r, c, v, t, done = _jump(clear, fx, fy, dxs[b], dys[b], idxs[b], idys[b], rs[b], cs[b], vs[b], tmax)
+                if done:
+                    out[p, b] = t * res
+                else:
+                    rs[b] = r
+                    cs[b] = c
+                    vs[b] = v
+                    act[m] = b
+                    m += 1
+            n = m
 
 
 @njit(cache=True, parallel=True)
-def _cast_parallel(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out):
+def _cast_parallel(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, chunk):
     n = xs.shape[0]
-    chunk = 64
     nchunks = (n + chunk - 1) // chunk
     for i in prange(nchunks):
         _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, i * chunk, min(n, (i + 1) * chunk))
@@ -358,7 +395,9 @@ def _run(clear, ox, oy, res, xs, ys, thetas, beams, max_range_m, out, parallel):
     if xs.shape[0] == 0 or beams.shape[0] == 0:
         return out
     if parallel:
-        _cast_parallel(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out)
+        # a few chunks of poses per thread: balances load, amortises the per-chunk buffers
+        chunk = min(256, max(1, xs.shape[0] // (4 * numba.get_num_threads())))
+        _cast_parallel(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, chunk)
     else:
         _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, 0, xs.shape[0])
     return out
