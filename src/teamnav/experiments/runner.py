@@ -36,7 +36,7 @@ from teamnav.experiments.errors import Problem, ScenarioError
 from teamnav.experiments.spec import Scenario, build_grid, check_controllers, load_scenario, scenario_to_yaml
 from teamnav.world.mapio import save_map
 
-__all__ = ["OutputDirError", "RunResult", "run", "run_data", "robot_radii"]
+__all__ = ["OutputDirError", "RunResult", "check_scenario", "robot_radii", "run", "run_data"]
 
 #: a progress bar appears once a run has taken this long [s]
 PROGRESS_AFTER_S = 2.0
@@ -60,12 +60,15 @@ class RunResult:
         The finished simulation (its truth and recorder, for further analysis).
     scenario : Scenario
         The resolved scenario that ran.
+    data : RunData
+        What the metrics read: recorded trajectories, events, traffic, timing.
     """
 
     metrics: dict[str, Any]
     run_dir: Path | None
     sim: Any
     scenario: Scenario
+    data: metric_registry.RunData
 
 
 # ---------------------------------------------------------------------------- helpers
@@ -296,7 +299,7 @@ def run(
         values = metric_registry.compute(scenario.metric_names, data)
         if out is None:
             shutil.rmtree(staging, ignore_errors=True)
-            return RunResult(values, None, sim, scenario)
+            return RunResult(values, None, sim, scenario, data)
         (staging / "scenario.yaml").write_text(scenario_to_yaml(scenario), encoding="utf-8")
         (staging / "metrics.json").write_text(json.dumps(_json_ready(values), indent=2) + "\n", encoding="utf-8")
         (staging / "robots.json").write_text(json.dumps(_robots_table(scenario)) + "\n", encoding="utf-8")
@@ -310,4 +313,45 @@ def run(
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
-    return RunResult(values, out, sim, scenario)
+    return RunResult(values, out, sim, scenario, data)
+
+
+# ---------------------------------------------------------------------------- conformance
+def check_scenario(scenario: Scenario | str | os.PathLike, *, duration_s: float = 2.0) -> dict[str, Any]:
+    """Conformance check of a scenario (STYLE habit 12), like Gymnasium's ``check_env``.
+
+    Runs ``scenario`` for ``duration_s`` of simulated time three times: twice with its seed,
+    once with ``seed + 1``, and checks that
+
+    - the two same-seed runs give identical deterministic metrics and identical recorded
+      true and odometry trajectories (bit for bit);
+    - the other seed gives different trajectories;
+    - every metric value is a plain ``int`` or ``float``; counts of collisions are 0.
+
+    Returns
+    -------
+    dict
+        The metrics of the first run.
+
+    Raises
+    ------
+    AssertionError
+        Naming the check that failed.
+    """
+    scn = load_scenario(scenario, duration_s=duration_s)
+    other = load_scenario(scn, seed=(scn.seed + 1) % (2**63))
+    a, b, c = (run(s, progress=False) for s in (scn, scn, other))
+    keep = scn.metric_names
+    ma, mb = metric_registry.deterministic(a.metrics, keep), metric_registry.deterministic(b.metrics, keep)
+    assert ma == mb, f"{scn.name}: same seed, different metrics: {sorted(k for k in ma if ma[k] != mb.get(k))}"
+    for key in ("true_pose", "odom_pose"):
+        assert np.array_equal(getattr(a.data, key), getattr(b.data, key)), f"{scn.name}: same seed, different {key}"
+    assert not np.array_equal(a.data.true_pose, c.data.true_pose), (
+        f"{scn.name}: seeds {scn.seed} and {other.seed} gave the same trajectories"
+    )
+    for k, v in a.metrics.items():
+        assert type(v) in (int, float), f"{scn.name}: metric {k} is a {type(v).__name__}, expected int or float"
+    for k in ("collisions_wall", "collisions_robot"):
+        assert a.metrics.get(k, 0) == 0, f"{scn.name}: {k} = {a.metrics[k]}"
+    return a.metrics
+
