@@ -232,22 +232,30 @@ def test_raycaster_matches_cast_rays_and_fills_out():
     )
 
 
-def test_clearance_map_is_a_free_square_radius():
-    b = np.zeros((9, 9), np.uint8)
-    b[0, 0] = 1
-    c = clearance_map(b)
-    assert c.shape == (11, 11)
-    assert c[0].max() == 0 and c[:, -1].max() == 0  # the ring is blocking
-    assert c[1, 1] == 0
-    for r in range(1, 10):
-        for col in range(1, 10):
-            k = int(c[r, col]) - 1
-            if k >= 0:
-                # the (2k+1) square is free and the (2k+3) square is not
-                pad = np.ones((11, 11), np.uint8)
-                pad[1:-1, 1:-1] = b
-                assert pad[r - k : r + k + 1, col - k : col + k + 1].max() == 0
-                assert pad[r - k - 1 : r + k + 2, col - k - 1 : col + k + 2].max() == 1
+def test_clearance_map_codes_the_largest_free_square_per_quadrant():
+    rng = np.random.default_rng(5)
+    b = (rng.random((9, 11)) < 0.15).astype(np.uint8)
+    m = clearance_map(b)
+    assert m.shape == (4, 11, 13) and m.dtype == np.uint8
+    pad = np.ones((11, 13), np.uint8)
+    pad[1:-1, 1:-1] = b
+    assert (m[:, 0, :] == 0).all() and (m[:, :, -1] == 0).all()  # the ring is the map edge
+    for q in range(4):
+        sx = -1 if q & 1 else 1
+        sy = -1 if q & 2 else 1
+        for r in range(11):
+            for c in range(13):
+                k = int(m[q, r, c]) - 1
+                assert (k < 0) == bool(pad[r, c])
+
+                def square(n):  # cells of the n x n square from (r, c) towards the quadrant
+                    rows = sorted((r, r + sy * (n - 1)))
+                    cols = sorted((c, c + sx * (n - 1)))
+                    return pad[rows[0] : rows[1] + 1, cols[0] : cols[1] + 1]
+
+                if k >= 0:
+                    assert square(k + 1).max() == 0  # free...
+                    assert square(k + 2).max() == 1  # ...and maximal
 
 
 def test_cache_is_invalidated_when_a_read_only_mask_is_freed():

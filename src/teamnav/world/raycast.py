@@ -1,4 +1,4 @@
-"""Exact 2-D ray casting on an occupancy grid, accelerated by a Chebyshev clearance map.
+"""Exact 2-D ray casting on an occupancy grid, accelerated by per-quadrant free-square maps.
 
 Every range sensor of the simulator (laser, sonar, robot detector) and the beam models of
 Monte Carlo localization (Fox et al. §3.2) cast rays through the same grid, so this module
@@ -23,19 +23,24 @@ Semantics (tested against :func:`brute_force_reference`)
 
 Algorithm
 ---------
-The grid is padded with one ring of blocking cells (the map edge) and turned into a
-*clearance map* ``k[r, c]``: the largest radius such that the ``(2k+1) x (2k+1)`` square of
-cells centred on ``(r, c)`` is entirely free (Chebyshev distance transform minus one).
-A ray standing in cell ``(r, c)`` therefore cannot meet an obstacle before it leaves that
-square, and the exit point of an axis-aligned square is exact arithmetic on two planes, so
-the ray jumps straight to it. With ``k = 0`` the jump is one Amanatides–Woo step
-(Amanatides & Woo, "A fast voxel traversal algorithm for ray tracing", Eurographics 1987),
-so the traversal degrades to an exact DDA next to walls and skips open space in a few
-jumps. No step is ever longer than the free square, hence no obstacle is missed: the result
-is the exact crossing distance up to floating-point rounding, not a sampled one.
+The grid is padded with one ring of blocking cells (the map edge) and turned into four
+*clearance maps*, one per quadrant of directions: for quadrant ``(+x, +y)`` cell ``(r, c)``
+holds the side ``k + 1`` of the largest all-free square of cells whose corner is ``(r, c)``
+and which grows towards ``+x, +y`` (a classic dynamic programme, O(H W)). A ray heading
+into that quadrant cannot meet an obstacle before it leaves that square, and the exit point
+of an axis-aligned square is exact arithmetic on two planes, so the ray jumps straight to
+it. With ``k = 0`` the jump is one Amanatides–Woo step (Amanatides & Woo, "A fast voxel
+traversal algorithm for ray tracing", Eurographics 1987), so the traversal is an exact DDA
+next to walls and skips open space in a few jumps (about 5 per ray on an office map with
+a 10 m range). No jump is longer than its free square, hence no obstacle is missed: the
+result is the exact crossing distance up to floating-point rounding, not a sampled one.
 
-The clearance map is built once per blocking mask (:class:`RayCaster` holds it; the free
-function :func:`cast_rays` caches it for read-only masks such as those of
+All beams of one pose advance together (one jump each per sweep), so the memory loads of
+different rays overlap; poses are spread over numba's threads. ``benchmarks/README.md``
+says what each of these choices bought.
+
+The clearance maps are built once per blocking mask (:class:`RayCaster` holds them; the
+free function :func:`cast_rays` caches them for read-only masks such as those of
 :meth:`OccupancyGrid.blocking`).
 """
 
@@ -48,7 +53,6 @@ from typing import Iterable
 import numba
 import numpy as np
 from numba import njit, prange
-from scipy import ndimage
 
 from teamnav.world.grid import OccupancyGrid
 
@@ -87,23 +91,30 @@ def _inv(d):
 
 @njit(cache=True, inline="always")
 def _start(clear, fx, fy):
-    """Padded cell ``(r, c)`` of cell-unit point ``(fx, fy)`` and its clearance code
-    (0 = blocking, also for a point outside the grid)."""
-    if not (fx >= 0.0 and fx < clear.shape[1] - 2.0 and fy >= 0.0 and fy < clear.shape[0] - 2.0):
-        return 0, 0, np.uint8(0)
+    """Padded cell ``(r, c)`` of cell-unit point ``(fx, fy)`` and whether it is free
+    (False also for a point outside the grid)."""
+    if not (fx >= 0.0 and fx < clear.shape[2] - 2.0 and fy >= 0.0 and fy < clear.shape[1] - 2.0):
+        return 0, 0, False
     c = int(fx) + 1
     r = int(fy) + 1
-    return r, c, clear[r, c]
+    return r, c, clear[0, r, c] != 0
 
 
 @njit(cache=True, inline="always")
-def _jump(clear, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
+def _quadrant(dx, dy):
+    """Index into the clearance map of the quadrant a ray heads into."""
+    return (1 if dx < 0.0 else 0) + (2 if dy < 0.0 else 0)
+
+
+@njit(cache=True, inline="always")
+def _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
     """One jump of a ray standing in padded cell ``(r, c)`` with clearance code ``v > 0``.
 
-    ``clear`` is the padded clearance map (0 = blocking, ``k + 1`` = free with a free
-    ``(2k+1)``-square centred on the cell); its outer ring is blocking, so no bounds checks
-    are needed. Grid cell ``(r, c)`` is ``clear[r + 1, c + 1]``; ``(fx, fy)`` is the ray
-    origin in grid cell units, ``(dx, dy)`` its unit direction, ``idx, idy`` their inverses.
+    ``clear[q]`` is the padded clearance map of the ray's quadrant ``q`` (0 = blocking,
+    ``k + 1`` = the ``(k+1) x (k+1)`` square of cells from ``(r, c)`` towards the quadrant
+    is free); its outer ring is blocking, so no bounds checks are needed. Grid cell
+    ``(r, c)`` is ``clear[q, r + 1, c + 1]``; ``(fx, fy)`` is the ray origin in grid cell
+    units, ``(dx, dy)`` its unit direction, ``idx, idy`` their inverses.
 
     Returns ``(r, c, v, t, done)``: the cell entered at distance ``t`` [cells] and its code,
     ``done`` when the ray ended there (blocking cell, or ``t`` capped at ``tmax``).
@@ -125,13 +136,13 @@ def _jump(clear, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
     xe = fx + t * dx
     ye = fy + t * dy
     # the coordinate that did not exit: is the exit point on a grid vertex (within
-    # VERTEX_TOL_CELLS of travel), other than on the square's rear line (a ray that starts
+    # VERTEX_TOL_CELLS of travel), other than on the cell's rear line (a ray that starts
     # on a grid line)?
     oe = ye if ex else xe
     od = dy if ex else dx
     ov = math.floor(oe + 0.5)
     iv = int(ov)
-    rear = (r - sy * k - 1 - offy) if ex else (c - sx * k - 1 - offx)
+    rear = (r - 1 - offy) if ex else (c - 1 - offx)
     if od != 0.0 and abs(oe - ov) <= VERTEX_TOL_CELLS * abs(od) and iv != rear:
         # through a vertex: the two cells beside it count (Amanatides-Woo tie)
         if ex:
@@ -144,16 +155,18 @@ def _jump(clear, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
             ra_ = rb_ + sy
             cb_ = iv if dx > 0.0 else iv + 1
             ca_ = iv + 1 if dx > 0.0 else iv
-        if clear[rb_, ca_] == 0 or clear[ra_, cb_] == 0:
+        if clear[q, rb_, ca_] == 0 or clear[q, ra_, cb_] == 0:
             return r, c, v, t, True
         c = ca_
         r = ra_
     else:
-        cf = min(max(int(math.floor(xe)) + 1, c - k), c + k)
-        rf = min(max(int(math.floor(ye)) + 1, r - k), r + k)
-        c = c + sx * (k + 1) if ex else cf
-        r = rf if ex else r + sy * (k + 1)
-    v = clear[r, c]
+        ck = c + sx * k
+        rk = r + sy * k
+        cf = min(max(int(math.floor(xe)) + 1, min(c, ck)), max(c, ck))
+        rf = min(max(int(math.floor(ye)) + 1, min(r, rk)), max(r, rk))
+        c = ck + sx if ex else cf
+        r = rf if ex else rk + sy
+    v = clear[q, r, c]
     return r, c, v, t, v == 0
 
 
@@ -161,13 +174,15 @@ def _jump(clear, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
 def _march(clear, fx, fy, dx, dy, tmax):
     """Distance [cells] along unit ``(dx, dy)`` from cell-unit point ``(fx, fy)`` to the
     first blocking cell, capped at ``tmax`` (one ray; see :func:`_jump`)."""
-    r, c, v = _start(clear, fx, fy)
-    if v == 0:
+    r, c, ok = _start(clear, fx, fy)
+    if not ok:
         return 0.0
     idx = _inv(dx)
     idy = _inv(dy)
+    q = _quadrant(dx, dy)
+    v = clear[q, r, c]
     while True:
-        r, c, v, t, done = _jump(clear, fx, fy, dx, dy, idx, idy, r, c, v, tmax)
+        r, c, v, t, done = _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax)
         if done:
             return t
 
@@ -189,12 +204,13 @@ def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
     rs = np.empty(nb, np.int64)
     cs = np.empty(nb, np.int64)
     vs = np.empty(nb, np.uint8)
+    qs = np.empty(nb, np.int64)
     act = np.empty(nb, np.int64)
     for p in range(p0, p1):
         fx = (xs[p] - ox) * inv
         fy = (ys[p] - oy) * inv
-        r0, c0, v0 = _start(clear, fx, fy)
-        if v0 == 0:
+        r0, c0, ok = _start(clear, fx, fy)
+        if not ok:
             out[p, :] = 0.0
             continue
         n = 0
@@ -204,16 +220,18 @@ def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
             dys[b] = dy
             idxs[b] = _inv(dx)
             idys[b] = _inv(dy)
+            q = _quadrant(dx, dy)
+            qs[b] = q
             rs[b] = r0
             cs[b] = c0
-            vs[b] = v0
+            vs[b] = clear[q, r0, c0]
             act[n] = b
             n += 1
         while n > 0:
             m = 0
             for a in range(n):
                 b = act[a]
-                r, c, v, t, done = _jump(clear, fx, fy, dxs[b], dys[b], idxs[b], idys[b], rs[b], cs[b], vs[b], tmax)
+                r, c, v, t, done = _jump(clear, qs[b], fx, fy, dxs[b], dys[b], idxs[b], idys[b], rs[b], cs[b], vs[b], tmax)
                 if done:
                     out[p, b] = t * res
                 else:
@@ -338,8 +356,24 @@ def _check_out(out, shape) -> np.ndarray:
     return out
 
 
+@njit(cache=True)
+def _anchored_squares(free, out):
+    """``out[r, c]`` = side of the largest all-free square whose lower-left cell is
+    ``(r, c)`` (0 on blocked cells), capped at 255; classic dynamic programme, O(H W)."""
+    h, w = free.shape
+    for r in range(h - 1, -1, -1):
+        for c in range(w - 1, -1, -1):
+            if not free[r, c]:
+                out[r, c] = 0
+            elif r == h - 1 or c == w - 1:
+                out[r, c] = 1
+            else:
+                m = min(out[r + 1, c], out[r, c + 1], out[r + 1, c + 1])
+                out[r, c] = min(np.int64(m) + 1, 255)
+
+
 def clearance_map(blocking: np.ndarray) -> np.ndarray:
-    """Padded Chebyshev clearance map used by the ray caster.
+    """Padded per-quadrant clearance maps used by the ray caster.
 
     Parameters
     ----------
@@ -348,29 +382,37 @@ def clearance_map(blocking: np.ndarray) -> np.ndarray:
 
     Returns
     -------
-    ndarray of shape (H + 2, W + 2), uint8
-        0 in blocking cells and in the one-cell ring around the grid (the map edge);
-        ``k + 1`` in a free cell whose ``(2k+1) x (2k+1)`` centred square is entirely free
-        (capped at 255).
+    ndarray of shape (4, H + 2, W + 2), uint8
+        Map ``q`` serves rays heading towards ``+x`` (``q & 1 == 0``) or ``-x`` and ``+y``
+        (``q & 2 == 0``) or ``-y``. The grid sits at ``[1:-1, 1:-1]``; the one-cell ring
+        around it (the map edge) and blocking cells hold 0; a free cell holds ``k + 1`` when
+        the ``(k+1) x (k+1)`` square of cells starting at it and growing towards the
+        quadrant is entirely free (capped at 255).
 
     Examples
     --------
-    >>> b = np.zeros((3, 3), np.uint8)
-    >>> int(clearance_map(b)[2, 2])   # centre of a free 3x3 map: the 3x3 square is free, k = 1
-    2
+    >>> b = np.zeros((3, 3), np.uint8); b[2, 2] = 1
+    >>> m = clearance_map(b)
+    >>> int(m[0, 1, 1]), int(m[3, 3, 2]), int(m[0, 3, 3])  # (+x,+y) from (0,0); (-x,-y) from (2,1); wall
+    (2, 2, 0)
     """
     blocking = _check_blocking(blocking)
     free = np.zeros((blocking.shape[0] + 2, blocking.shape[1] + 2), dtype=np.bool_)
     free[1:-1, 1:-1] = blocking == 0
-    d = ndimage.distance_transform_cdt(free, metric="chessboard")
-    return np.minimum(d, _MAX_CLEAR).astype(np.uint8)
+    out = np.empty((4,) + free.shape, dtype=np.uint8)
+    for q in range(4):
+        flip = (slice(None, None, -1 if q & 2 else 1), slice(None, None, -1 if q & 1 else 1))
+        sq = np.empty(free.shape, np.uint8)
+        _anchored_squares(np.ascontiguousarray(free[flip]), sq)
+        out[q] = sq[flip]
+    return out
 
 
 _CLEAR_CACHE: dict[int, tuple[weakref.ref, np.ndarray]] = {}
 
 
 def _cached_clearance(blocking: np.ndarray) -> np.ndarray:
-    """Clearance map of ``blocking``, cached while a read-only mask is alive."""
+    """Clearance maps of ``blocking``, cached while a read-only mask is alive."""
     if blocking.flags.writeable:
         return clearance_map(blocking)
     key = id(blocking)
@@ -445,9 +487,9 @@ def cast_rays(
 
     Notes
     -----
-    The clearance map is rebuilt on every call for a writeable ``blocking`` (O(H W)); a
+    The clearance maps are rebuilt on every call for a writeable ``blocking`` (O(H W)); a
     read-only mask (``grid.blocking(...)`` returns one) is processed once and cached, and
-    :class:`RayCaster` holds it explicitly.
+    :class:`RayCaster` holds them explicitly.
 
     Examples
     --------
@@ -473,8 +515,8 @@ def cast_rays(
 class RayCaster:
     """Ray caster bound to one grid and one sensor's visible materials.
 
-    Builds the clearance map of ``grid.blocking(sees)`` once; each :meth:`cast` is then
-    O(poses × beams × jumps per ray).
+    Builds the clearance maps of ``grid.blocking(sees)`` once (:func:`clearance_map`);
+    each :meth:`cast` is then O(poses × beams × jumps per ray).
 
     Parameters
     ----------
