@@ -235,7 +235,7 @@ def test_raycaster_matches_cast_rays_and_fills_out():
 def test_clearance_map_codes_the_largest_free_square_per_quadrant():
     rng = np.random.default_rng(5)
     b = (rng.random((9, 11)) < 0.15).astype(np.uint8)
-    m = clearance_map(b)
+    m = clearance_map(b).transpose(2, 0, 1)  # (quadrant, row, col)
     assert m.shape == (4, 11, 13) and m.dtype == np.uint8
     pad = np.ones((11, 13), np.uint8)
     pad[1:-1, 1:-1] = b

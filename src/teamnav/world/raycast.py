@@ -93,11 +93,11 @@ def _inv(d):
 def _start(clear, fx, fy):
     """Padded cell ``(r, c)`` of cell-unit point ``(fx, fy)`` and whether it is free
     (False also for a point outside the grid)."""
-    if not (fx >= 0.0 and fx < clear.shape[2] - 2.0 and fy >= 0.0 and fy < clear.shape[1] - 2.0):
+    if not (fx >= 0.0 and fx < clear.shape[1] - 2.0 and fy >= 0.0 and fy < clear.shape[0] - 2.0):
         return 0, 0, False
     c = int(fx) + 1
     r = int(fy) + 1
-    return r, c, clear[0, r, c] != 0
+    return r, c, clear[r, c, 0] != 0
 
 
 @njit(cache=True, inline="always")
@@ -110,10 +110,10 @@ def _quadrant(dx, dy):
 def _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
     """One jump of a ray standing in padded cell ``(r, c)`` with clearance code ``v > 0``.
 
-    ``clear[q]`` is the padded clearance map of the ray's quadrant ``q`` (0 = blocking,
-    ``k + 1`` = the ``(k+1) x (k+1)`` square of cells from ``(r, c)`` towards the quadrant
-    is free); its outer ring is blocking, so no bounds checks are needed. Grid cell
-    ``(r, c)`` is ``clear[q, r + 1, c + 1]``; ``(fx, fy)`` is the ray origin in grid cell
+    ``clear[:, :, q]`` is the padded clearance map of the ray's quadrant ``q`` (0 =
+    blocking, ``k + 1`` = the ``(k+1) x (k+1)`` square of cells from ``(r, c)`` towards the
+    quadrant is free); its outer ring is blocking, so no bounds checks are needed. Grid cell
+    ``(r, c)`` is ``clear[r + 1, c + 1, q]``; ``(fx, fy)`` is the ray origin in grid cell
     units, ``(dx, dy)`` its unit direction, ``idx, idy`` their inverses.
 
     Returns ``(r, c, v, t, done)``: the cell entered at distance ``t`` [cells] and its code,
@@ -155,7 +155,7 @@ def _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
             ra_ = rb_ + sy
             cb_ = iv if dx > 0.0 else iv + 1
             ca_ = iv + 1 if dx > 0.0 else iv
-        if clear[q, rb_, ca_] == 0 or clear[q, ra_, cb_] == 0:
+        if clear[rb_, ca_, q] == 0 or clear[ra_, cb_, q] == 0:
             return r, c, v, t, True
         c = ca_
         r = ra_
@@ -166,7 +166,7 @@ def _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
         rf = min(max(int(math.floor(ye)) + 1, min(r, rk)), max(r, rk))
         c = ck + sx if ex else cf
         r = rf if ex else rk + sy
-    v = clear[q, r, c]
+    v = clear[r, c, q]
     return r, c, v, t, v == 0
 
 
@@ -180,7 +180,7 @@ def _march(clear, fx, fy, dx, dy, tmax):
     idx = _inv(dx)
     idy = _inv(dy)
     q = _quadrant(dx, dy)
-    v = clear[q, r, c]
+    v = clear[r, c, q]
     while True:
         r, c, v, t, done = _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax)
         if done:
@@ -224,7 +224,7 @@ def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
             qs[b] = q
             rs[b] = r0
             cs[b] = c0
-            vs[b] = clear[q, r0, c0]
+            vs[b] = clear[r0, c0, q]
             act[n] = b
             n += 1
         while n > 0:
@@ -382,9 +382,10 @@ def clearance_map(blocking: np.ndarray) -> np.ndarray:
 
     Returns
     -------
-    ndarray of shape (4, H + 2, W + 2), uint8
-        Map ``q`` serves rays heading towards ``+x`` (``q & 1 == 0``) or ``-x`` and ``+y``
-        (``q & 2 == 0``) or ``-y``. The grid sits at ``[1:-1, 1:-1]``; the one-cell ring
+    ndarray of shape (H + 2, W + 2, 4), uint8
+        Map ``[:, :, q]`` serves rays heading towards ``+x`` (``q & 1 == 0``) or ``-x`` and
+        ``+y`` (``q & 2 == 0``) or ``-y``; the four codes of a cell share a cache line, as
+        the beams of one pose use several quadrants at once. The grid sits at ``[1:-1, 1:-1]``; the one-cell ring
         around it (the map edge) and blocking cells hold 0; a free cell holds ``k + 1`` when
         the ``(k+1) x (k+1)`` square of cells starting at it and growing towards the
         quadrant is entirely free (capped at 255).
@@ -393,7 +394,7 @@ def clearance_map(blocking: np.ndarray) -> np.ndarray:
     --------
     >>> b = np.zeros((3, 3), np.uint8); b[2, 2] = 1
     >>> m = clearance_map(b)
-    >>> int(m[0, 1, 1]), int(m[3, 3, 2]), int(m[0, 3, 3])  # (+x,+y) from (0,0); (-x,-y) from (2,1); wall
+    >>> int(m[1, 1, 0]), int(m[3, 2, 3]), int(m[3, 3, 0])  # (+x,+y) from (0,0); (-x,-y) from (2,1); wall
     (2, 2, 0)
     """
     blocking = _check_blocking(blocking)
@@ -405,7 +406,7 @@ def clearance_map(blocking: np.ndarray) -> np.ndarray:
         sq = np.empty(free.shape, np.uint8)
         _anchored_squares(np.ascontiguousarray(free[flip]), sq)
         out[q] = sq[flip]
-    return out
+    return np.ascontiguousarray(out.transpose(1, 2, 0))
 
 
 _CLEAR_CACHE: dict[int, tuple[weakref.ref, np.ndarray]] = {}
