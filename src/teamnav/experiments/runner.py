@@ -86,64 +86,30 @@ def _robots_table(scenario: Scenario) -> dict[str, list]:
     return {"group": group, "controller": controller, "radius_m": radius}
 
 
-def _event_names(raw: Any) -> list[str]:
-    """Event names from the recorder's events.json, one per firing."""
-    if isinstance(raw, dict) and "events" in raw:
-        raw = raw["events"]
-    names: list[str] = []
-    if isinstance(raw, dict):  # {name: [firings]} or {name: count}
-        for k, v in raw.items():
-            names += [str(k)] * (len(v) if isinstance(v, (list, tuple)) else int(v))
-    elif isinstance(raw, list):
-        for e in raw:
-            if isinstance(e, dict):
-                names.append(str(e.get("name", e.get("event", e.get("kind", "event")))))
-            elif isinstance(e, (list, tuple)) and e:
-                names.append(str(next((x for x in e if isinstance(x, str)), "event")))
-            else:
-                names.append(str(e))
-    return names
+def _event_names(events: list[dict]) -> list[str]:
+    """Event names, one per firing, from the recorder's ``events`` records."""
+    return [str(e.get("event")) for e in events if isinstance(e, dict) and e.get("event") is not None]
 
 
-def _comm_counts(raw: Any) -> tuple[int, int, int]:
-    """(messages sent, bytes sent, deliveries) from the recorder's comm.json."""
-    if isinstance(raw, dict):
-        sent = raw.get("messages_sent", raw.get("sent", 0))
-        nbytes = raw.get("bytes_sent", raw.get("bytes", 0))
-        delivered = raw.get("messages_delivered", raw.get("delivered", 0))
-        if isinstance(sent, list):
-            return len(sent), int(sum(m.get("size_bytes", m.get("bytes", 0)) for m in sent if isinstance(m, dict))), (
-                len(delivered) if isinstance(delivered, list) else int(delivered)
-            )
-        return int(sent), int(nbytes), int(delivered if not isinstance(delivered, list) else len(delivered))
-    if isinstance(raw, list):  # one record per message
-        nbytes = sum(int(m.get("size_bytes", m.get("bytes", 0))) for m in raw if isinstance(m, dict))
-        delivered = sum(len(m.get("to_ids", m.get("delivered_to", ()))) for m in raw if isinstance(m, dict))
-        return len(raw), nbytes, delivered
-    return 0, 0, 0
+def _comm_counts(comm: dict) -> tuple[int, int, int]:
+    """(messages sent, bytes sent, deliveries) from the recorder's radio totals."""
+    return int(comm.get("messages_sent", 0)), int(comm.get("bytes_sent", 0)), int(comm.get("messages_delivered", 0))
 
 
 def run_data(run_dir: Path, scenario: Scenario, grid, n_steps: int, wall_s: float) -> metric_registry.RunData:
     """Read the recorder's files in ``run_dir`` into a :class:`~teamnav.experiments.metrics.RunData`."""
-    with np.load(run_dir / "trajectories.npz") as z:
-        t_s = np.asarray(z["t_s"], dtype=float)
-        true_pose = np.asarray(z["true_pose"], dtype=float)
-        odom_pose = np.asarray(z["odom_pose"], dtype=float)
-        stalled = np.asarray(z["stalled"], dtype=bool) if "stalled" in z.files else np.zeros(true_pose.shape[:2], bool)
+    from teamnav.sim.recorder import load
 
-    def read(name: str) -> Any:
-        p = run_dir / name
-        return json.loads(p.read_text(encoding="utf-8")) if p.is_file() else None
-
-    sent, nbytes, delivered = _comm_counts(read("comm.json"))
+    rec = load(run_dir)
+    sent, nbytes, delivered = _comm_counts(rec.comm)
     return metric_registry.RunData(
-        t_s=t_s,
-        true_pose=true_pose,
-        odom_pose=odom_pose,
-        stalled=stalled,
+        t_s=np.asarray(rec.t_s, dtype=float),
+        true_pose=np.asarray(rec.true_pose, dtype=float),
+        odom_pose=np.asarray(rec.odom_pose, dtype=float),
+        stalled=np.asarray(rec.stalled, dtype=bool),
         radius_m=robot_radii(scenario),
         grid=grid,
-        events=_event_names(read("events.json")),
+        events=_event_names(rec.events),
         messages_sent=sent,
         bytes_sent=nbytes,
         messages_delivered=delivered,
