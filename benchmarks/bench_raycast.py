@@ -17,7 +17,7 @@ Queries: random poses uniformly inside free cells of ``basement_hallways_5cm.png
 Agreement is measured against :func:`teamnav.world.raycast.brute_force_reference` (steps of
 0.001 cell) on the first ``--ref-poses`` poses: the share of rays within one cell (0.05 m) and
 the worst error. Timings exclude JIT compilation (a warm-up call first) and take the best of
-``--repeat`` runs.
+``--repeat`` rounds, the methods taking turns within a round (the machine may be shared).
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit, prange
 
 from teamnav.world.grid import OccupancyGrid
-from teamnav.world.raycast import RayCaster, brute_force_reference
+from teamnav.world.raycast import RayCaster, brute_force_reference, clearance_map
 
 MAP_PNG = Path(os.environ.get("TEAMNAV_DATA", "/work/shared/data")) / "mit" / "basement_hallways_5cm.png"
 RES_M = 0.05
@@ -199,12 +199,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--poses", type=int, default=None, help="number of poses (default 100000, quick 10000)")
     ap.add_argument("--beams", type=int, default=180)
     ap.add_argument("--ref-poses", type=int, default=None, help="poses checked against the reference (default 1000, quick 100)")
-    ap.add_argument("--repeat", type=int, default=None, help="timing repeats, best kept (default 3, quick 1)")
+    ap.add_argument("--repeat", type=int, default=None, help="timing rounds, best kept (default 5, quick 3)")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
     n = args.poses or (10_000 if args.quick else 100_000)
     n_ref = min(n, args.ref_poses or (100 if args.quick else 1000))
-    repeat = args.repeat or (1 if args.quick else 3)
+    repeat = args.repeat or (3 if args.quick else 5)
     if n < 1 or args.beams < 1 or n_ref < 1 or repeat < 1:
         raise SystemExit(f"--poses, --beams, --ref-poses and --repeat must be >= 1, got {n}, {args.beams}, {n_ref}, {repeat}")
     all_threads = numba.config.NUMBA_NUM_THREADS
@@ -218,45 +218,59 @@ def main(argv: list[str] | None = None) -> int:
           f"= {nrays / 1e6:.1f} M rays, max range {MAX_RANGE_M} m; {platform.processor() or platform.machine()}, "
           f"{all_threads} numba threads, numba {numba.__version__}")
 
+    clearance_map(np.zeros((2, 2), np.uint8))  # first numba call of the process: loads numba
     t0 = time.perf_counter()
     caster = RayCaster(grid, max_range_m=MAX_RANGE_M)
     setup_s = time.perf_counter() - t0
-    rows = []  # (name, threads, seconds, ranges)
+    tmax = MAX_RANGE_M / RES_M
 
-    def run_ours(threads: int):
-        numba.set_num_threads(threads)
-        out = np.empty((n, args.beams))
-        caster.cast_xyt(xs[:8], ys[:8], ths[:8], beams, parallel=threads > 1)  # compile / warm up
-        dt = best_time(lambda: caster.cast_xyt(xs, ys, ths, beams, out=out, parallel=threads > 1), repeat)
-        rows.append(("teamnav RayCaster", threads, dt, out))
-
-    def run_dda(threads: int):
-        numba.set_num_threads(threads)
-        out = np.empty((n, args.beams))
-        tmax = MAX_RANGE_M / RES_M
-        dda_cast(blocking, RES_M, xs[:8], ys[:8], ths[:8], beams, tmax, out[:8])
-        dt = best_time(lambda: dda_cast(blocking, RES_M, xs, ys, ths, beams, tmax, out), repeat)
-        rows.append(("numba plain DDA", threads, dt, out))
-
+    # contenders: (name, threads, prepare(), timed run(), ranges())
+    contenders = []
     for threads in sorted({1, all_threads}):
-        run_ours(threads)
-        run_dda(threads)
-
+        ours = np.empty((n, args.beams))
+        contenders.append((
+            "teamnav RayCaster", threads, lambda: None,
+            lambda o=ours, t=threads: caster.cast_xyt(xs, ys, ths, beams, out=o, parallel=t > 1),
+            lambda o=ours: o,
+        ))
+        dda = np.empty((n, args.beams))
+        contenders.append((
+            "numba plain DDA", threads, lambda: None,
+            lambda o=dda: dda_cast(blocking, RES_M, xs, ys, ths, beams, tmax, o),
+            lambda o=dda: o,
+        ))
     mod = raycast2d_module()
     if mod is not None:
         img, px, py, rays = raycast2d_prepare(blocking, xs, ys, ths, beams)
-        raycast2d_run(mod, img, px[:8], py[:8], rays[:8].copy())
-        dt = math.inf
-        for _ in range(repeat):
-            work = rays.copy()
-            t0 = time.perf_counter()
-            raycast2d_run(mod, img, px, py, work)
-            dt = min(dt, time.perf_counter() - t0)
-        rows.append(("raycast2D (C, Bresenham)", 1, dt, raycast2d_ranges(work, xs, ys, ths, beams)))
+        work = [rays.copy()]
+
+        def rc_prepare():
+            work[0] = rays.copy()  # raycast2D writes its hits into its input
+
+        contenders.append((
+            "raycast2D (C, Bresenham)", 1, rc_prepare,
+            lambda: raycast2d_run(mod, img, px, py, work[0]),
+            lambda: raycast2d_ranges(work[0], xs, ys, ths, beams),
+        ))
     else:
-        print("raycast2D not installed: its column is skipped. To compare, in a separate venv:\n"
+        print("raycast2D not installed: its row is skipped. To compare, in a separate venv:\n"
               "  python -m venv /tmp/benchenv && /tmp/benchenv/bin/pip install -r benchmarks/requirements-peers.txt\n"
               "  /tmp/benchenv/bin/pip install -e . --no-deps && /tmp/benchenv/bin/python benchmarks/bench_raycast.py")
+
+    # warm up (JIT), then time round-robin so that every method sees the same machine load
+    for name, threads, prep, run, _ in contenders:
+        numba.set_num_threads(threads)
+        prep()
+        run()
+    best = [math.inf] * len(contenders)
+    for _ in range(repeat):
+        for i, (name, threads, prep, run, _) in enumerate(contenders):
+            numba.set_num_threads(threads)
+            prep()
+            t0 = time.perf_counter()
+            run()
+            best[i] = min(best[i], time.perf_counter() - t0)
+    rows = [(c[0], c[1], dt, c[4]()) for c, dt in zip(contenders, best)]
 
     numba.set_num_threads(all_threads)
     t0 = time.perf_counter()
@@ -265,7 +279,7 @@ def main(argv: list[str] | None = None) -> int:
     hit_share = float((ref < MAX_RANGE_M).mean() * 100)
 
     base = next((r[2] for r in rows if r[0].startswith("raycast2D")), None)
-    print(f"\nclearance map built in {setup_s * 1e3:.0f} ms; reference: {n_ref} poses ({n_ref * args.beams} rays, "
+    print(f"\nclearance maps built in {setup_s * 1e3:.0f} ms; reference: {n_ref} poses ({n_ref * args.beams} rays, "
           f"{hit_share:.0f} % hit something) in {ref_s:.1f} s")
     head = f"{'method':<26}{'threads':>8}{'M rays/s':>10}{'vs raycast2D':>14}{'within 1 cell':>15}{'worst err m':>13}"
     print(head)
