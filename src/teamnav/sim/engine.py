@@ -1,0 +1,440 @@
+"""The fixed-step simulation loop: truth in, observations out, actions back.
+
+One :meth:`Simulation.step` (STYLE habit 4, f1tenth's "move everyone first, then sense"):
+
+1. pre-step hooks (read truth);
+2. apply every robot's stored action: clip to its limits (:mod:`~teamnav.sim.kinematics`)
+   and move all robots in one kernel, walls and robots never penetrated
+   (:mod:`~teamnav.sim.collisions`);
+3. integrate odometry for all robots in one kernel (:mod:`~teamnav.sim.odometry`);
+4. task events at places, from the new positions (:mod:`~teamnav.sim.events`);
+5. the radio delivers the messages sent in the previous step (:mod:`~teamnav.sim.radio`);
+6. sense: each group's range sensors in one call per sensor, the robot detector in one call
+   per group;
+7. build observations (fresh arrays, belief only) and call the brains: each per-robot
+   :class:`~teamnav.control.protocol.Controller` with its :class:`Observation`, each
+   :class:`~teamnav.control.protocol.BatchedController` once with a
+   :class:`BatchObservation` of all its robots;
+8. store their actions for the next step and hand their outboxes to the radio;
+9. record (every ``record_every`` steps) and post-step hooks.
+
+The brains' first decision (observation of step 0, before any motion) is taken lazily by the
+first :meth:`step`, so step 1 already executes a real action.
+
+Truth and belief
+----------------
+``Simulation.state`` is the truth (for metrics and hooks). Brains are built only from their
+validated parameters, their own ``Generator`` and a :class:`RobotInfo`; each observation
+carries only sensor readings, the robot's own odometry, inbox, events and stall flag, in
+arrays freshly allocated for that step (never views of the engine's arrays).
+
+Determinism
+-----------
+``SeedSequence(config.seed)`` spawns two children: *subsystems* and *controllers*.
+Subsystems spawn, in this order, the streams ``start``, ``odometry``, ``radio``,
+``detector`` (then one per group) and ``sensors`` (then one per group, then one per
+sensor). Controllers spawn one stream per robot (robot id order). A run is therefore
+bit-for-bit repeatable on one machine, and adding a sensor to one group does not change
+another group's noise.
+
+Work nobody needs is skipped: no radio when no per-robot controller runs (batched brains
+take no radio), no events without places that fire, no detector without a
+``DetectorConfig``, and a batched group senses only its controller's ``range_sensor``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+from pydantic import ValidationError
+
+from teamnav.control import registry
+from teamnav.control.protocol import RobotInfo
+from teamnav.control.types import Action, BatchAction, BatchObservation, Message, Observation, RangeScan
+from teamnav.sim.collisions import move_discs
+from teamnav.sim.config import SimConfig
+from teamnav.sim.events import Places
+from teamnav.sim.kinematics import motion_primitives
+from teamnav.sim.odometry import Odometry
+from teamnav.sim.radio import Radio
+from teamnav.sim.recorder import Recorder
+from teamnav.sim.start import start_poses
+from teamnav.sim.state import RobotState
+from teamnav.world.distance import distance_field
+from teamnav.world.grid import OccupancyGrid
+
+__all__ = ["Simulation"]
+
+
+def _sensor_factories():
+    """``(build_range_sensor, RobotDetector)`` from :mod:`teamnav.sim.sensors` (imported lazily)."""
+    from teamnav.sim.sensors import RobotDetector, build_range_sensor
+
+    return build_range_sensor, RobotDetector
+
+
+@dataclass
+class _Group:
+    """Runtime of one robot group (engine-internal)."""
+
+    index: int
+    cfg: Any
+    sl: slice
+    ids: np.ndarray
+    batched: bool
+    brain: Any  # list of Controllers, or one BatchedController
+    sensors: list = field(default_factory=list)  # range sensors sensed every step
+    angles: list = field(default_factory=list)  # read-only copies of their beam angles
+    bodies: list = field(default_factory=list)  # per sensed sensor: the `bodies` argument or None
+    rngs: list = field(default_factory=list)
+    detector: Any = None
+    detector_rng: Any = None
+    has_log: bool = False
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    a = np.array(a, dtype=np.float64, copy=True)
+    a.setflags(write=False)
+    return a
+
+
+class Simulation:
+    """A multi-robot simulation of one scenario.
+
+    Parameters
+    ----------
+    grid : OccupancyGrid
+        The true map.
+    config : SimConfig
+        Robots, sensors, odometry, radio, places, ``dt_s``, ``seed``, ``record_every``.
+    known_map : OccupancyGrid, optional
+        A map given to every robot as prior knowledge (``RobotInfo.known_map``).
+
+    Attributes
+    ----------
+    state : RobotState
+        The truth (metrics and hooks only).
+    step_index : int
+        Steps done (0 at start).
+    time_s : float
+        ``step_index * dt_s`` [s].
+    brains : list
+        Per group: a list of per-robot controllers, or the group's batched controller.
+    recorder : Recorder
+    group_of : ndarray of shape (N,), int64
+        Group index of every robot (read-only).
+
+    Raises
+    ------
+    ValueError
+        Bad grid or config, unknown controller, invalid controller parameters (naming the
+        group and the controller), impossible start poses.
+
+    Examples
+    --------
+    >>> from teamnav.sim.config import RobotGroupConfig, SimConfig
+    >>> sim = Simulation(OccupancyGrid.empty(4.0, 4.0, 0.1),
+    ...                  SimConfig(robots=(RobotGroupConfig(count=2, controller="idle-v1", sensors=()),)))
+    >>> sim.run(10); sim.step_index, round(sim.time_s, 6)
+    (10, 1.0)
+    """
+
+    def __init__(self, grid: OccupancyGrid, config: SimConfig, *, known_map: OccupancyGrid | None = None) -> None:
+        if not isinstance(grid, OccupancyGrid):
+            raise ValueError(f"grid must be an OccupancyGrid, got {type(grid).__name__}")
+        if not isinstance(config, SimConfig):
+            raise ValueError(f"config must be a teamnav.sim.config.SimConfig, got {type(config).__name__}")
+        if known_map is not None and not isinstance(known_map, OccupancyGrid):
+            raise ValueError(f"known_map must be an OccupancyGrid or None, got {type(known_map).__name__}")
+        self.grid = grid
+        self.config = config
+        self.known_map = known_map
+        self.dt_s = float(config.dt_s)
+        groups = config.robots
+        n = config.n_robots
+        self.n_robots = n
+
+        # ---- random streams
+        root = np.random.SeedSequence(config.seed)
+        sub_ss, ctrl_ss = root.spawn(2)
+        start_ss, odom_ss, radio_ss, det_ss, sens_ss = sub_ss.spawn(5)
+        det_group_ss = det_ss.spawn(len(groups))
+        sens_group_ss = sens_ss.spawn(len(groups))
+        robot_ss = ctrl_ss.spawn(n)
+
+        # ---- truth
+        self._blocking = grid.blocking(None)
+        self._clear_m = distance_field(self._blocking, grid.resolution_m)
+        self._geo = np.array([grid.origin_xy_m[0], grid.origin_xy_m[1], grid.resolution_m])
+        poses = start_poses(grid, groups, np.random.default_rng(start_ss), self._clear_m)
+        counts = [g.count for g in groups]
+        group_idx = np.repeat(np.arange(len(groups)), counts)
+        self.state = RobotState.from_poses(poses, np.repeat([g.radius_m for g in groups], counts), group_idx)
+        self.group_of = group_idx.copy()
+        self.group_of.setflags(write=False)
+        self._holonomic = np.repeat([g.kinematics == "holonomic_step" for g in groups], counts).astype(np.bool_)
+        self._max_v = np.repeat([g.max_v_mps for g in groups], counts).astype(np.float64)
+        self._max_w = np.repeat([math.radians(g.max_omega_degps) for g in groups], counts).astype(np.float64)
+        self._step_m = np.repeat([g.step_length_m for g in groups], counts).astype(np.float64)
+        self.odometry = Odometry([g.odometry for g in groups for _ in range(g.count)], poses, self.dt_s,
+                                 np.random.default_rng(odom_ss))
+
+        # ---- sensors and brains
+        self._infos: list[RobotInfo] = []
+        self._groups: list[_Group] = []
+        self.brains: list[Any] = []
+        offsets = np.concatenate([[0], np.cumsum(counts)]).astype(int)
+        factories = None
+        for gi, g in enumerate(groups):
+            label = f"robots[{gi}] ({g.name!r})"
+            sl = slice(int(offsets[gi]), int(offsets[gi + 1]))
+            needs_factory = bool(g.sensors) or g.detector is not None
+            if needs_factory and factories is None:
+                factories = _sensor_factories()
+            sensors = [factories[0](c, grid) for c in g.sensors] if g.sensors else []
+            sensor_infos = {s.name: s.info() for s in sensors}
+            infos = [
+                RobotInfo(
+                    robot_id=i, team_size=n, radius_m=g.radius_m, kinematics=g.kinematics, max_v_mps=g.max_v_mps,
+                    max_omega_radps=math.radians(g.max_omega_degps), step_length_m=g.step_length_m, dt_s=self.dt_s,
+                    sensors=dict(sensor_infos), known_map=known_map,
+                    extras={"group": g.name, "group_index": gi, "index_in_group": i - sl.start},
+                )
+                for i in range(sl.start, sl.stop)
+            ]
+            self._infos += infos
+            try:
+                cls = registry.lookup(g.controller)
+            except KeyError as exc:
+                raise ValueError(f"{label}.controller: {exc.args[0]}") from None
+            try:
+                params = cls.Params.model_validate(dict(g.params))
+            except ValidationError as exc:
+                raise ValueError(f"{label}.params are invalid for controller {g.controller!r}: {exc}") from None
+            batched = bool(getattr(cls, "batched", False))
+            rngs = [np.random.default_rng(robot_ss[i]) for i in range(sl.start, sl.stop)]
+            try:
+                if batched:
+                    if g.kinematics != "unicycle":
+                        raise ValueError(
+                            f"batched controllers command (v, omega) and need kinematics 'unicycle', got {g.kinematics!r}"
+                        )
+                    brain = cls(params, rngs, infos)
+                else:
+                    brain = [cls(params, rngs[k], infos[k]) for k in range(g.count)]
+            except ValueError as exc:
+                raise ValueError(f"{label}: controller {g.controller!r}: {exc}") from None
+            sens_rngs = [np.random.default_rng(s) for s in sens_group_ss[gi].spawn(len(sensors))]
+            grp = _Group(index=gi, cfg=g, sl=sl, ids=np.arange(sl.start, sl.stop, dtype=np.int64), batched=batched,
+                         brain=brain)
+            if batched:
+                name = getattr(brain, "range_sensor", None)
+                names = [s.name for s in sensors]
+                if name not in names:
+                    raise ValueError(
+                        f"{label}: controller {g.controller!r} reads range_sensor {name!r}, which must be one of the "
+                        f"group's sensors ({', '.join(names) or 'none'})"
+                    )
+                k = names.index(name)
+                grp.sensors, grp.rngs, cfgs = [sensors[k]], [sens_rngs[k]], [g.sensors[k]]
+            else:
+                grp.sensors, grp.rngs, cfgs = sensors, sens_rngs, list(g.sensors)
+                grp.has_log = callable(getattr(brain[0], "log", None)) if brain else False
+                if g.detector is not None:
+                    grp.detector = factories[1](g.detector, grid)
+                    grp.detector_rng = np.random.default_rng(det_group_ss[gi])
+            grp.angles = [_readonly(s.angles_rad) for s in grp.sensors]
+            # Range sensors that see robots get every robot's true disc (sim side only).
+            grp.bodies = [
+                (self.state.x_m, self.state.y_m, self.state.radius_m, grp.ids) if c.sees_robots and n > 1 else None
+                for c in cfgs
+            ]
+            self._groups.append(grp)
+            self.brains.append(brain)
+
+        self._any_per_robot = any(not grp.batched for grp in self._groups)
+        self.radio = Radio(config.radio, grid, n, np.random.default_rng(radio_ss)) if self._any_per_robot else None
+        self.places = Places(config.places, self.state.x_m, self.state.y_m)
+        self._ids_all = np.arange(n, dtype=np.int64)
+
+        # ---- buffers
+        self._v_cmd = np.zeros(n)
+        self._w_cmd = np.zeros(n)
+        self._dir_cmd = np.full(n, np.nan)
+        self._pre = np.zeros(n)
+        self._arc = np.zeros(n)
+        self._turn = np.zeros(n)
+        self._x0 = np.empty(n)
+        self._y0 = np.empty(n)
+        self._th0 = np.empty(n)
+        self._decided = False
+        self._pre_hooks: list[Callable] = []
+        self._post_hooks: list[Callable] = []
+
+        self.step_index = 0
+        self.recorder = Recorder(n, config.record_every)
+        self._record()
+
+    # ------------------------------------------------------------------ public
+    @property
+    def time_s(self) -> float:
+        return self.step_index * self.dt_s
+
+    def robot_info(self, i: int) -> RobotInfo:
+        """What robot ``i`` knows about itself (its brain was built with this)."""
+        if not (isinstance(i, (int, np.integer)) and 0 <= i < self.n_robots):
+            raise ValueError(f"i must be a robot id in [0, {self.n_robots}), got {i!r}")
+        return self._infos[int(i)]
+
+    def add_hook(self, pre_step: Callable[["Simulation"], None] | None = None,
+                 post_step: Callable[["Simulation"], None] | None = None) -> None:
+        """Register experiment hooks called with the simulation before / after each step.
+
+        Hooks may read the truth and the brains' observable outputs; they must not write into
+        a brain (STYLE habit 8).
+        """
+        for name, h in (("pre_step", pre_step), ("post_step", post_step)):
+            if h is not None and not callable(h):
+                raise ValueError(f"{name} must be callable or None, got {type(h).__name__}")
+        if pre_step is not None:
+            self._pre_hooks.append(pre_step)
+        if post_step is not None:
+            self._post_hooks.append(post_step)
+
+    def run(self, n_steps: int, *, progress: Callable[[int], None] | None = None,
+            is_finished: Callable[["Simulation"], bool] | None = None) -> None:
+        """Step ``n_steps`` times, or until ``is_finished(sim)`` is true (checked after each step).
+
+        ``progress(k)`` is called after the k-th step of this call.
+        """
+        if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or n_steps < 0:
+            raise ValueError(f"n_steps must be an int >= 0, got {n_steps!r}")
+        step = self.step
+        for k in range(int(n_steps)):
+            step()
+            if progress is not None:
+                progress(k + 1)
+            if is_finished is not None and is_finished(self):
+                break
+
+    def step(self) -> None:
+        """Advance the simulation by one fixed step ``dt_s`` (see the module docstring)."""
+        if not self._decided:
+            self._observe_and_decide(None, None)
+            self._decided = True
+        for h in self._pre_hooks:
+            h(self)
+        s = self.state
+        self.step_index += 1
+        np.copyto(self._x0, s.x_m)
+        np.copyto(self._y0, s.y_m)
+        np.copyto(self._th0, s.theta_rad)
+        motion_primitives(self._holonomic, self._v_cmd, self._w_cmd, self._dir_cmd, self._max_v, self._max_w,
+                          self._step_m, self.dt_s, s.v_mps, s.omega_radps, self._pre, self._arc, self._turn)
+        move_discs(s.x_m, s.y_m, s.theta_rad, s.radius_m, self._pre, self._arc, self._turn, self._blocking,
+                   self._clear_m, self._geo, self.config.robot_collisions, s.stalled)
+        self.odometry.step(self._x0, self._y0, self._th0, s.x_m, s.y_m, s.theta_rad)
+        events = self.places.update(self.step_index, self.time_s, s.x_m, s.y_m) if self.places.active else None
+        inboxes = self.radio.collect() if self.radio is not None and self.radio.has_pending else None
+        self._observe_and_decide(events, inboxes)
+        if self.recorder.wants(self.step_index):
+            self._record()
+        for h in self._post_hooks:
+            h(self)
+
+    # ------------------------------------------------------------------ internals
+    def _record(self) -> None:
+        logs = None
+        if any(g.has_log for g in self._groups):
+            logs = {}
+            for g in self._groups:
+                if g.has_log:
+                    for k, brain in enumerate(g.brain):
+                        logs[g.sl.start + k] = brain.log()
+        s = self.state
+        self.recorder.record(self.step_index, self.time_s, s.poses(), self.odometry.pose, s.stalled, logs)
+        self.recorder.events = self.places.log
+        if self.radio is not None:
+            self.recorder.comm = self.radio.counts()
+
+    def _observe_and_decide(self, events, inboxes) -> None:
+        s = self.state
+        step = self.step_index
+        t = self.time_s
+        odom = self.odometry.pose.copy()  # fresh belief arrays for this step's observations
+        outgoing: list[tuple[int, Message]] = []
+        xs, ys, ths = s.x_m, s.y_m, s.theta_rad
+        for grp in self._groups:
+            sl = grp.sl
+            gx, gy, gth = xs[sl], ys[sl], ths[sl]
+            if grp.batched:
+                sensor = grp.sensors[0]
+                ranges = sensor.sense(gx, gy, gth, grp.rngs[0], bodies=grp.bodies[0])
+                obs = BatchObservation(
+                    robot_ids=grp.ids.copy(), step=step, time_s=t, odom_pose=odom[sl], ranges_m=ranges,
+                    angles_rad=grp.angles[0], max_range_m=float(sensor.max_range_m), stalled=s.stalled[sl].copy(),
+                )
+                act = grp.brain.step_batch(obs)
+                self._apply_batch(grp, act)
+                continue
+            delta = self.odometry.delta.copy()
+            readings = [
+                (sensor.name, sensor.sense(gx, gy, gth, rng, bodies=bodies), angles, float(sensor.max_range_m))
+                for sensor, rng, angles, bodies in zip(grp.sensors, grp.rngs, grp.angles, grp.bodies)
+            ]
+            dets = None
+            if grp.detector is not None:
+                dets = grp.detector.detect(xs, ys, ths, s.radius_m, grp.ids, grp.detector_rng, self._ids_all)
+            stalled = s.stalled[sl].tolist()
+            for k, brain in enumerate(grp.brain):
+                i = sl.start + k
+                obs = Observation(
+                    robot_id=i, step=step, time_s=t, odom_pose=odom[i], odom_delta=delta[i],
+                    scans={name: RangeScan(r[k], a, m) for name, r, a, m in readings},
+                    detections=tuple(dets[k]) if dets is not None else (),
+                    stalled=stalled[k],
+                    inbox=inboxes[i] if inboxes is not None else (),
+                    events=events[i] if events is not None else (),
+                )
+                out = brain.step(obs)
+                if not (isinstance(out, tuple) and len(out) == 2 and isinstance(out[0], Action)):
+                    raise ValueError(
+                        f"robot {i}: controller {grp.cfg.controller!r} step() must return (Action, list of Message), "
+                        f"got {type(out).__name__}"
+                    )
+                action, outbox = out
+                self._v_cmd[i] = action.v_mps
+                self._w_cmd[i] = action.omega_radps
+                self._dir_cmd[i] = np.nan if action.direction_rad is None else action.direction_rad
+                if action.direction_rad is not None and not math.isfinite(action.direction_rad):
+                    raise ValueError(f"robot {i}: controller {grp.cfg.controller!r} direction_rad must be finite or None, "
+                                     f"got {action.direction_rad!r}")
+                if outbox:
+                    for m in outbox:
+                        outgoing.append((i, m))
+        if not (np.isfinite(self._v_cmd).all() and np.isfinite(self._w_cmd).all()):
+            bad = int(np.flatnonzero(~(np.isfinite(self._v_cmd) & np.isfinite(self._w_cmd)))[0])
+            raise ValueError(
+                f"robot {bad}: controller {self.config.robots[self.group_of[bad]].controller!r} must command finite "
+                f"v_mps and omega_radps, got ({self._v_cmd[bad]!r}, {self._w_cmd[bad]!r})"
+            )
+        if outgoing:
+            self.radio.send(outgoing, xs, ys)
+
+    def _apply_batch(self, grp: _Group, act) -> None:
+        n = grp.cfg.count
+        if not isinstance(act, BatchAction):
+            raise ValueError(f"controller {grp.cfg.controller!r} step_batch() must return a BatchAction, got "
+                             f"{type(act).__name__}")
+        v = np.asarray(act.v_mps, dtype=np.float64)
+        w = np.asarray(act.omega_radps, dtype=np.float64)
+        if v.shape != (n,) or w.shape != (n,):
+            raise ValueError(f"controller {grp.cfg.controller!r} must return v_mps and omega_radps of shape ({n},), "
+                             f"got {v.shape} and {w.shape}")
+        self._v_cmd[grp.sl] = v
+        self._w_cmd[grp.sl] = w
+
+
