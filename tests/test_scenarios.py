@@ -21,7 +21,7 @@ def test_check_scenario_catches_a_seed_that_changes_nothing(tmp_path):
     path = tmp_path / "idle.yaml"
     path.write_text(
         "name: idle\nmap: {builtin: office_simple}\nduration_s: 1\n"
-        "robots:\n  - {count: 2, controller: idle-v1, start: {poses: [[3, 7, 0], [6, 7, 0]]}}\n"
+        "robots:\n  - {count: 2, controller: idle-v1, sensors: [], start: {poses: [[3, 7, 0], [6, 7, 0]]}}\n"
     )
     with pytest.raises(AssertionError, match="gave the same trajectories"):
         check_scenario(path, duration_s=0.5)

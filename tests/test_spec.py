@@ -235,3 +235,10 @@ def test_scenario_registry_refuses_duplicates(tmp_path):
         registry.register("demo", tmp_path / "x.yaml")
     with pytest.raises(KeyError, match="did you mean 'demo'"):
         registry.path("deom")
+
+
+def test_yaml_booleans_are_yaml_1_2_so_on_stays_a_key(tmp_path):
+    # YAML 1.1 (PyYAML's default) reads the PlaceConfig key `on:` as the boolean True
+    text = BASE + "places:\n  - {name: p, x_m: 5, y_m: 7, event: here, on: inside}\nrobot_collisions: false\n"
+    s = load_scenario(write(tmp_path, text), overrides=["give_map=true"])
+    assert s.places[0].on == "inside" and s.robot_collisions is False and s.give_map is True

@@ -35,6 +35,7 @@ import copy
 import difflib
 import functools
 import os
+import re
 from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping, Sequence
@@ -68,6 +69,25 @@ __all__ = [
 PACKAGE_MAP_DIR: Path = Path(str(resources.files("teamnav.world"))) / "maps"
 
 _MAP_SUFFIXES = (".yaml", ".yml", ".png", ".pgm")
+
+
+class _YamlLoader(yaml.SafeLoader):
+    """PyYAML's safe loader with YAML 1.2 booleans: only true/false, so ``on: enter`` (a
+    PlaceConfig field) stays the key ``"on"`` instead of YAML 1.1's ``True``."""
+
+
+_YamlLoader.yaml_implicit_resolvers = {
+    first: [(tag, rx) for tag, rx in resolvers if tag != "tag:yaml.org,2002:bool"]
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
+_YamlLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF")
+)
+
+
+def read_yaml(text: str):
+    """Parse scenario YAML text (safe, YAML 1.2 booleans)."""
+    return yaml.load(text, Loader=_YamlLoader)
 
 
 def package_maps() -> list[str]:
@@ -402,7 +422,7 @@ def apply_overrides(data: dict, overrides: Mapping[str, Any] | Sequence[str] | N
             key, _, text = item.partition("=")
             key = key.strip()
             try:
-                value = yaml.safe_load(text) if text.strip() else None
+                value = read_yaml(text) if text.strip() else None
             except yaml.YAMLError as exc:
                 first = str(exc).splitlines()[0]
                 raise ScenarioError.one(file, f"--set {key}", f"expected a YAML value ({first})", text) from None
@@ -464,7 +484,7 @@ def _read_yaml(path: Path) -> dict:
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError.one(file, "", "expected a readable UTF-8 text file", str(exc), raw=True) from None
     try:
-        data = yaml.safe_load(text)
+        data = read_yaml(text)
     except yaml.YAMLError as exc:
         raise from_yaml_error(exc, file) from None
     if data is None:
