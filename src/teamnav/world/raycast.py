@@ -126,33 +126,41 @@ def _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
     sy = 1 if dy >= 0.0 else -1
     offx = 0 if dx >= 0.0 else -1  # plane ahead of padded column c is at grid x = c + offx
     offy = 0 if dy >= 0.0 else -1
-    # exit of the free square: planes c+offx+sx*k and r+offy+sy*k
-    tx = ((c + offx + sx * k) - fx) * idx
-    ty = ((r + offy + sy * k) - fy) * idy
+    ck = c + sx * k  # far column / row of the free square
+    rk = r + sy * k
+    # exit of the free square: planes ck+offx and rk+offy
+    tx = ((ck + offx) - fx) * idx
+    ty = ((rk + offy) - fy) * idy
     ex = tx < ty  # leaves through the x-plane
     t = tx if ex else ty
     if t >= tmax:
         return r, c, v, tmax, True
-    xe = fx + t * dx
-    ye = fy + t * dy
-    # the coordinate that did not exit: is the exit point on a grid vertex (within
-    # VERTEX_TOL_CELLS of travel), other than on the cell's rear line (a ray that starts
-    # on a grid line)?
-    oe = ye if ex else xe
+    # the other axis (y when leaving through an x-plane): where is the exit point on it?
     od = dy if ex else dx
-    ov = math.floor(oe + 0.5)
-    iv = int(ov)
-    rear = (r - 1 - offy) if ex else (c - 1 - offx)
-    if od != 0.0 and abs(oe - ov) <= VERTEX_TOL_CELLS * abs(od) and iv != rear:
+    oe = (fy if ex else fx) + t * od
+    fl = math.floor(oe)
+    frac = oe - fl
+    ifl = int(fl)
+    oc = r if ex else c
+    ok = rk if ex else ck
+    # on a grid vertex (within VERTEX_TOL_CELLS of travel), other than on the cell's rear
+    # line (a ray that starts on a grid line)?
+    tol = VERTEX_TOL_CELLS * abs(od)
+    vertex = False
+    iv = ifl
+    if od != 0.0 and (frac <= tol or 1.0 - frac <= tol):
+        iv = ifl if frac <= tol else ifl + 1
+        vertex = iv != oc - 1 - (offy if ex else offx)
+    if vertex:
         # through a vertex: the two cells beside it count (Amanatides-Woo tie)
         if ex:
-            cb_ = c + sx * k
-            ca_ = cb_ + sx
+            cb_ = ck
+            ca_ = ck + sx
             rb_ = iv if dy > 0.0 else iv + 1
             ra_ = iv + 1 if dy > 0.0 else iv
         else:
-            rb_ = r + sy * k
-            ra_ = rb_ + sy
+            rb_ = rk
+            ra_ = rk + sy
             cb_ = iv if dx > 0.0 else iv + 1
             ca_ = iv + 1 if dx > 0.0 else iv
         if clear[rb_, ca_, q] == 0 or clear[ra_, cb_, q] == 0:
@@ -160,31 +168,11 @@ def _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
         c = ca_
         r = ra_
     else:
-        ck = c + sx * k
-        rk = r + sy * k
-        cf = min(max(int(math.floor(xe)) + 1, min(c, ck)), max(c, ck))
-        rf = min(max(int(math.floor(ye)) + 1, min(r, rk)), max(r, rk))
-        c = ck + sx if ex else cf
-        r = rf if ex else rk + sy
+        of = min(max(ifl + 1, min(oc, ok)), max(oc, ok))
+        c = ck + sx if ex else of
+        r = of if ex else rk + sy
     v = clear[r, c, q]
     return r, c, v, t, v == 0
-
-
-@njit(cache=True)
-def _march(clear, fx, fy, dx, dy, tmax):
-    """Distance [cells] along unit ``(dx, dy)`` from cell-unit point ``(fx, fy)`` to the
-    first blocking cell, capped at ``tmax`` (one ray; see :func:`_jump`)."""
-    r, c, ok = _start(clear, fx, fy)
-    if not ok:
-        return 0.0
-    idx = _inv(dx)
-    idy = _inv(dy)
-    q = _quadrant(dx, dy)
-    v = clear[r, c, q]
-    while True:
-        r, c, v, t, done = _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax)
-        if done:
-            return t
 
 
 @njit(cache=True)
