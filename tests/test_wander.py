@@ -254,6 +254,7 @@ def _room(side_m=4.0, res_m=0.05):
 
 def _sim(controller, n_robots, seed, sensors=None, grid=None, poses=None):
     engine = pytest.importorskip("teamnav.sim.engine", reason="the engine has not landed")
+    pytest.importorskip("teamnav.sim.sensors", reason="the sensor models have not landed")
     from teamnav.sim.config import LaserConfig, RobotGroupConfig, SimConfig, StartConfig
 
     start = StartConfig(poses=poses) if poses is not None else StartConfig()
