@@ -263,14 +263,19 @@ def main(argv: list[str] | None = None) -> int:
         prep()
         run()
     best = [math.inf] * len(contenders)
+    busy = [0.0] * len(contenders)  # CPU time / (wall time x threads) of the best round
     for _ in range(repeat):
         for i, (name, threads, prep, run, _) in enumerate(contenders):
             numba.set_num_threads(threads)
             prep()
+            c0 = time.process_time()
             t0 = time.perf_counter()
             run()
-            best[i] = min(best[i], time.perf_counter() - t0)
-    rows = [(c[0], c[1], dt, c[4]()) for c, dt in zip(contenders, best)]
+            dt = time.perf_counter() - t0
+            if dt < best[i]:
+                best[i] = dt
+                busy[i] = (time.process_time() - c0) / (dt * threads)
+    rows = [(c[0], c[1], dt, c[4](), b) for c, dt, b in zip(contenders, best, busy)]
 
     numba.set_num_threads(all_threads)
     t0 = time.perf_counter()
@@ -281,15 +286,18 @@ def main(argv: list[str] | None = None) -> int:
     base = next((r[2] for r in rows if r[0].startswith("raycast2D")), None)
     print(f"\nclearance maps built in {setup_s * 1e3:.0f} ms; reference: {n_ref} poses ({n_ref * args.beams} rays, "
           f"{hit_share:.0f} % hit something) in {ref_s:.1f} s")
-    head = f"{'method':<26}{'threads':>8}{'M rays/s':>10}{'vs raycast2D':>14}{'within 1 cell':>15}{'worst err m':>13}"
+    head = (f"{'method':<26}{'threads':>8}{'M rays/s':>10}{'vs raycast2D':>14}{'within 1 cell':>15}"
+            f"{'worst err m':>13}{'cpu busy':>10}")
     print(head)
     print("-" * len(head))
-    for name, threads, dt, ranges in rows:
+    for name, threads, dt, ranges, cpu in rows:
         pct, worst = agreement(ranges[:n_ref], ref)
         ratio = f"{base / dt:.2f}x" if base else "n/a"
-        print(f"{name:<26}{threads:>8}{nrays / dt / 1e6:>10.2f}{ratio:>14}{pct:>14.3f}%{worst:>13.4f}")
+        print(f"{name:<26}{threads:>8}{nrays / dt / 1e6:>10.2f}{ratio:>14}{pct:>14.3f}%{worst:>13.4f}{cpu:>9.0%}")
+    print("(vs raycast2D: against its single thread; cpu busy well under 100 % on a multi-thread row means\n"
+          " the cores were shared with other work during that run, so its figure is low)")
     ours = {r[1]: r for r in rows if r[0].startswith("teamnav")}
-    for threads, (_, _, _, ranges) in ours.items():
+    for threads, (_, _, _, ranges, _) in ours.items():
         if not np.array_equal(ranges, ours[1][3]):
             print(f"WARNING: teamnav ranges differ between 1 and {threads} threads")
             return 1
