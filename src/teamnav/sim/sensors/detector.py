@@ -1,0 +1,289 @@
+"""Robot detector: which teammates a robot sees, and where (in its body frame).
+
+Implements the sensing of teammates used by two of the papers:
+
+- Sgorbissa & Arkin, "Local navigation strategies for a team of robots", §3 and §6.1: robots
+  see each other only in line of sight, within a visibility radius; with sensing noise the
+  perceived distance and angle follow eqs. 1–2 (the *occlusion* model below).
+- Fox, Burgard, Kruppa & Thrun, "Collaborative multi-robot localization", §4: a detection
+  reports the seen robot's identity and its relative position in polar coordinates (range,
+  bearing), with false negatives and false positives (their Table 2: 6.7 % and 3.5 %); the
+  *gaussian* model below.
+
+Simulator side (truth): it reads every robot's true pose and the map and returns, per
+observer, what that observer perceives. Rules, from :class:`~teamnav.sim.config.DetectorConfig`:
+
+1. *Range*: centre-to-centre distance ``d_r <= max_range_m``.
+2. *Field of view*: ``|alpha_r| <= fov/2`` where the bearing in the observer's body frame is
+   ``alpha_r = wrap(atan2(dy, dx) - theta)`` (every target passes when ``fov_deg = 360``).
+3. *Line of sight* (if ``line_of_sight``): the segment between the two centres crosses no
+   cell the detector ``sees`` (:func:`teamnav.world.los.line_of_sight`, symmetric bit for
+   bit, so with a 360° field of view A sees B exactly when B sees A before noise).
+4. *Noise* on range and bearing (see :meth:`RobotDetector.detect_arrays`).
+5. *False negatives*: each true detection is dropped with ``p_false_negative``.
+6. *False positives*: with ``p_false_positive`` per observer per step, one phantom at a
+   range uniform in ``(0, max_range_m]`` and a bearing uniform over the field of view.
+7. *Identity*: ``robot_id`` is the seen robot's id when ``report_identity``, else None. A
+   phantom carries None, or, when identities are reported, the id of a uniformly drawn
+   *other* robot (a misrecognised marker: Fox et al.'s detector always names a robot).
+
+Bearings are wrapped to ``(-pi, pi]``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from teamnav.control.types import Detection
+from teamnav.geometry.angles import wrap_angle
+from teamnav.sim.config import DetectorConfig
+from teamnav.world.grid import OccupancyGrid
+from teamnav.world.los import line_of_sight, pairs_within
+
+__all__ = ["DetectionArrays", "RobotDetector"]
+
+_FULL_CIRCLE_EPS_RAD = 1e-9
+
+
+@dataclass(frozen=True)
+class DetectionArrays:
+    """All detections of one step as flat arrays, ordered by observer row, then true
+    detections by target index, then the observer's false positive (if any).
+
+    Attributes
+    ----------
+    row : ndarray (M,) int64
+        Position of the observer in the ``observers`` argument.
+    observer : ndarray (M,) int64
+        Index of the observer into the pose arrays (``observers[row]``).
+    target : ndarray (M,) int64
+        Index of the seen robot into the pose arrays; -1 for a false positive.
+    robot_id : ndarray (M,) int64
+        Reported identity (``ids[target]`` or a phantom's id); -1 for "no identity".
+    range_m : ndarray (M,) float64
+        Perceived centre-to-centre distance [m].
+    bearing_rad : ndarray (M,) float64
+        Perceived direction in the observer's body frame [rad], in ``(-pi, pi]``.
+    """
+
+    row: np.ndarray
+    observer: np.ndarray
+    target: np.ndarray
+    robot_id: np.ndarray
+    range_m: np.ndarray
+    bearing_rad: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.row.shape[0])
+
+
+class RobotDetector:
+    """Sees teammates: range, field of view, line of sight, noise, false detections.
+
+    Parameters
+    ----------
+    cfg : DetectorConfig
+        The detector's parameters (validated).
+    grid : OccupancyGrid
+        The map; cells of the materials ``cfg.sees`` hide robots behind them.
+
+    Examples
+    --------
+    >>> from teamnav.world.grid import OccupancyGrid
+    >>> det = RobotDetector(DetectorConfig(max_range_m=5.0), OccupancyGrid.empty(10, 10, 0.5))
+    >>> xs, ys, th = np.array([1.0, 3.0, 9.0]), np.array([1.0, 1.0, 9.0]), np.array([0.0, np.pi, 0.0])
+    >>> out = det.detect(xs, ys, th, np.full(3, 0.2), np.array([0, 1]), np.random.default_rng(0), np.arange(3))
+    >>> [[(d.robot_id, round(d.range_m, 6), round(d.bearing_rad, 6)) for d in row] for row in out]
+    [[(1, 2.0, 0.0)], [(0, 2.0, 0.0)]]
+    """
+
+    def __init__(self, cfg: DetectorConfig, grid: OccupancyGrid):
+        if not isinstance(cfg, DetectorConfig):
+            raise ValueError(f"cfg must be a DetectorConfig, got {type(cfg).__name__}")
+        if not isinstance(grid, OccupancyGrid):
+            raise ValueError(f"grid must be an OccupancyGrid, got {type(grid).__name__}")
+        self.cfg = cfg
+        self.grid = grid
+        self.max_range_m = float(cfg.max_range_m)
+        self.fov_rad = math.radians(cfg.fov_deg)
+        self.full_circle = self.fov_rad >= 2 * math.pi - _FULL_CIRCLE_EPS_RAD
+        self.blocking = grid.blocking(cfg.sees)
+        self._ox, self._oy = grid.origin_xy_m
+        self._res = grid.resolution_m
+
+    # ------------------------------------------------------------------ validation
+    @staticmethod
+    def _check(xs, ys, thetas, radii, observers, rng, ids):
+        if not isinstance(rng, np.random.Generator):
+            raise ValueError(f"rng must be a numpy.random.Generator, got {type(rng).__name__}")
+        xs = np.ascontiguousarray(xs, dtype=np.float64)
+        if xs.ndim != 1:
+            raise ValueError(f"xs must be a 1-D array (N,), got shape {xs.shape}")
+        n_all = xs.shape[0]
+        out = [xs]
+        for name, v in (("ys", ys), ("thetas", thetas), ("radii", radii)):
+            arr = np.ascontiguousarray(v, dtype=np.float64)
+            if arr.shape != (n_all,):
+                raise ValueError(f"{name} must have shape ({n_all},) like xs, got {arr.shape}")
+            out.append(arr)
+        for name, arr in zip(("xs", "ys", "thetas", "radii"), out):
+            if not np.all(np.isfinite(arr)):
+                raise ValueError(f"{name} must be finite, got {arr[~np.isfinite(arr)][:3].tolist()}")
+        if np.any(out[3] < 0):
+            raise ValueError(f"radii must be >= 0 [m], got min {float(out[3].min())}")
+        obs = np.asarray(observers)
+        if obs.ndim != 1 or (obs.size and not np.issubdtype(obs.dtype, np.integer)):
+            raise ValueError(f"observers must be a 1-D integer array of robot indices, got {obs.dtype} {obs.shape}")
+        obs = obs.astype(np.int64)
+        if obs.size and (obs.min() < 0 or obs.max() >= n_all):
+            raise ValueError(f"observers must be indices in [0, {n_all}), got {obs[(obs < 0) | (obs >= n_all)][:3].tolist()}")
+        if np.unique(obs).shape[0] != obs.shape[0]:
+            raise ValueError("observers must not repeat a robot index")
+        id_arr = np.asarray(ids)
+        if id_arr.shape != (n_all,) or (id_arr.size and not np.issubdtype(id_arr.dtype, np.integer)):
+            raise ValueError(f"ids must be an integer array of shape ({n_all},), got {id_arr.dtype} {id_arr.shape}")
+        return (*out, obs, id_arr.astype(np.int64))
+
+    # ------------------------------------------------------------------ truth
+    def _visible(self, xs, ys, thetas, obs):
+        """Noise-free (row, observer, target, range, bearing) of every rule-1–3 pair."""
+        n_all = xs.shape[0]
+        row_of = np.full(n_all, -1, dtype=np.int64)
+        row_of[obs] = np.arange(obs.shape[0], dtype=np.int64)
+        i, j = pairs_within(xs, ys, self.max_range_m)
+        a = np.concatenate([i, j])  # directed pairs a sees b
+        b = np.concatenate([j, i])
+        keep = row_of[a] >= 0
+        a, b = a[keep], b[keep]
+        dx = xs[b] - xs[a]
+        dy = ys[b] - ys[a]
+        rng_m = np.hypot(dx, dy)
+        bearing = wrap_angle(np.arctan2(dy, dx) - thetas[a]) if a.size else np.empty(0)
+        if not self.full_circle and a.size:
+            keep = np.abs(bearing) <= self.fov_rad / 2
+            a, b, rng_m, bearing = a[keep], b[keep], rng_m[keep], bearing[keep]
+        if self.cfg.line_of_sight and a.size:
+            # one line-of-sight test per unordered pair (the test is symmetric bit for bit)
+            key = np.minimum(a, b) * n_all + np.maximum(a, b)
+            ukey, inv = np.unique(key, return_inverse=True)
+            lo, hi = ukey // n_all, ukey % n_all
+            seen = line_of_sight(self.blocking, self._ox, self._oy, self._res, xs[lo], ys[lo], xs[hi], ys[hi])[inv]
+            a, b, rng_m, bearing = a[seen], b[seen], rng_m[seen], bearing[seen]
+        row = row_of[a]
+        order = np.lexsort((b, row))
+        return row[order], a[order], b[order], rng_m[order], np.asarray(bearing)[order]
+
+    # ------------------------------------------------------------------ noise
+    def _noisy(self, d_r, a_r, size_m, rng):
+        """Perceived range and bearing of true detections (rule 4)."""
+        cfg = self.cfg
+        m = d_r.shape[0]
+        if cfg.noise_model == "occlusion":
+            # Sgorbissa & Arkin §6.1 eqs. 1-2: d_p = d_r + d_r d_noise, alpha_p = alpha_r +
+            # atan(robotsize / 2 d_r) alpha_noise, d_noise ~ U[-err_max, err_max] and, as the paper
+            # states, alpha_noise ~ U[-1, 1] (the bearing error of a partial occlusion is bounded
+            # by the half-angle the seen robot subtends, whatever err_max is).
+            u = rng.random((2, m))
+            d_noise = cfg.err_max * (2.0 * u[0] - 1.0)
+            a_noise = 2.0 * u[1] - 1.0
+            d_p = d_r + d_r * d_noise
+            with np.errstate(divide="ignore"):
+                half_angle = np.arctan(size_m / (2.0 * d_r))  # d_r = 0 -> pi/2
+            a_p = a_r + half_angle * a_noise
+            return d_p, wrap_angle(a_p) if m else a_p
+        # Fox et al. §4: Gaussian range and bearing errors (their detection model is a
+        # Gaussian mixture learned from data); ranges are kept >= 0.
+        s_r = cfg.range_noise_std_m
+        s_b = math.radians(cfg.bearing_noise_std_deg)
+        if s_r == 0.0 and s_b == 0.0:
+            return d_r, a_r
+        z = rng.standard_normal((2, m))
+        d_p = np.maximum(d_r + s_r * z[0], 0.0)
+        a_p = a_r + s_b * z[1]
+        return d_p, wrap_angle(a_p) if m else a_p
+
+    # ------------------------------------------------------------------ API
+    def detect_arrays(self, xs, ys, thetas, radii, observers, rng: np.random.Generator, ids) -> DetectionArrays:
+        """Every observer's detections at one step, as flat arrays.
+
+        Parameters
+        ----------
+        xs, ys, thetas : ndarray of shape (N,)
+            True poses of *all* robots [m, m, rad].
+        radii : ndarray of shape (N,)
+            Body radii [m]; the occlusion model's ``robotsize`` is the seen robot's diameter.
+        observers : ndarray of shape (n,), int
+            Indices (into the pose arrays) of the robots that look, without repeats.
+        rng : numpy.random.Generator
+            The detector's stream. Draws, in this order: the noise of the M true detections
+            (occlusion: ``random((2, M))``; gaussian: ``standard_normal((2, M))`` unless both
+            standard deviations are 0), false negatives ``random(M)`` (if
+            ``p_false_negative > 0``), false positives ``random(n)`` then ``random((2, K))``
+            for the K phantoms, then their ids ``integers(0, N - 1, K)`` when identities are
+            reported (all only if ``p_false_positive > 0``).
+        ids : ndarray of shape (N,), int
+            The identity each robot is reported under.
+
+        Returns
+        -------
+        DetectionArrays
+            Ordered by observer row, then target index, phantoms last.
+        """
+        xs, ys, thetas, radii, obs, ids = self._check(xs, ys, thetas, radii, observers, rng, ids)
+        cfg = self.cfg
+        row, a, b, d_r, a_r = self._visible(xs, ys, thetas, obs)
+        d_p, a_p = self._noisy(d_r, a_r, 2.0 * radii[b], rng)
+        if cfg.p_false_negative > 0.0:
+            kept = rng.random(row.shape[0]) >= cfg.p_false_negative
+            row, a, b, d_p, a_p = row[kept], a[kept], b[kept], d_p[kept], a_p[kept]
+        rid = ids[b] if cfg.report_identity else np.full(b.shape[0], -1, dtype=np.int64)
+        if cfg.p_false_positive > 0.0 and obs.shape[0]:
+            fp_rows = np.flatnonzero(rng.random(obs.shape[0]) < cfg.p_false_positive)
+            k = fp_rows.shape[0]
+            u = rng.random((2, k))
+            fp_range = self.max_range_m * (1.0 - u[0])  # (0, max_range]
+            if self.full_circle:
+                fp_bearing = math.pi - 2.0 * math.pi * u[1]  # (-pi, pi]
+            else:
+                fp_bearing = self.fov_rad * (u[1] - 0.5)
+            fp_obs = obs[fp_rows]
+            n_all = xs.shape[0]
+            if cfg.report_identity and n_all >= 2:
+                other = rng.integers(0, n_all - 1, k)
+                other += other >= fp_obs  # any robot but the observer
+                fp_id = ids[other]
+            else:
+                fp_id = np.full(k, -1, dtype=np.int64)
+            row = np.concatenate([row, fp_rows])
+            a = np.concatenate([a, fp_obs])
+            b = np.concatenate([b, np.full(k, -1, dtype=np.int64)])
+            rid = np.concatenate([rid, fp_id])
+            d_p = np.concatenate([d_p, fp_range])
+            a_p = np.concatenate([a_p, fp_bearing])
+            order = np.argsort(row, kind="stable")
+            row, a, b, rid, d_p, a_p = row[order], a[order], b[order], rid[order], d_p[order], a_p[order]
+        return DetectionArrays(
+            row=row.astype(np.int64), observer=a.astype(np.int64), target=b.astype(np.int64),
+            robot_id=rid.astype(np.int64), range_m=np.asarray(d_p, np.float64), bearing_rad=np.asarray(a_p, np.float64),
+        )
+
+    def detect(self, xs, ys, thetas, radii, observers, rng: np.random.Generator, ids) -> list[tuple[Detection, ...]]:
+        """Every observer's detections at one step, as :class:`Detection` tuples.
+
+        Same parameters as :meth:`detect_arrays`, which it wraps (same draws).
+
+        Returns
+        -------
+        list of tuple of Detection
+            ``result[k]`` holds what ``observers[k]`` perceives, in its body frame.
+        """
+        arr = self.detect_arrays(xs, ys, thetas, radii, observers, rng, ids)
+        n = np.asarray(observers).shape[0]
+        bounds = np.searchsorted(arr.row, np.arange(n + 1))
+        rids = [None if v < 0 else v for v in arr.robot_id.tolist()]
+        dets = [Detection(r, br, i) for r, br, i in zip(arr.range_m.tolist(), arr.bearing_rad.tolist(), rids)]
+        bl = bounds.tolist()
+        return [tuple(dets[bl[k]:bl[k + 1]]) for k in range(n)]
