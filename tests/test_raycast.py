@@ -273,6 +273,12 @@ def test_writeable_mask_changes_are_seen():
     assert one(b, 0.5, 2.5, 0.0) == pytest.approx(4.5)
     b[2, 2] = 1
     assert one(b, 0.5, 2.5, 0.0) == pytest.approx(1.5)
+    # a read-only view of a writeable array is not trusted to stay the same either
+    view = b.view()
+    view.setflags(write=False)
+    assert one(view, 0.5, 2.5, 0.0) == pytest.approx(1.5)
+    b[2, 2] = 0
+    assert one(view, 0.5, 2.5, 0.0) == pytest.approx(4.5)
 
 
 def test_empty_inputs():

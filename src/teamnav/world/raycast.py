@@ -401,9 +401,16 @@ _CLEAR_CACHE: dict[int, tuple[weakref.ref, np.ndarray]] = {}
 
 
 def _cached_clearance(blocking: np.ndarray) -> np.ndarray:
-    """Clearance maps of ``blocking``, cached while a read-only mask is alive."""
-    if blocking.flags.writeable:
-        return clearance_map(blocking)
+    """Clearance maps of ``blocking``, cached while a read-only mask is alive.
+
+    Only masks that nobody can write through are cached: read-only arrays whose bases are
+    read-only too (a read-only view of a writeable array may still change underneath).
+    """
+    base = blocking
+    while isinstance(base, np.ndarray):
+        if base.flags.writeable:
+            return clearance_map(blocking)
+        base = base.base
     key = id(blocking)
     hit = _CLEAR_CACHE.get(key)
     if hit is not None and hit[0]() is blocking:
