@@ -194,6 +194,20 @@ def test_false_positive_rate_and_placement(fov_deg, identity):
         assert np.all(a.robot_id == -1)
 
 
+def test_phantom_identity_is_another_robot():
+    det = RobotDetector(DetectorConfig(max_range_m=1.0, p_false_positive=1.0), empty())
+    xs, ys = np.array([1.0, 5.0, 9.0]), np.array([1.0, 5.0, 9.0])
+    ids = np.array([7, 8, 9])
+    rng = np.random.default_rng(0)
+    seen = {0: set(), 1: set(), 2: set()}
+    for _ in range(200):
+        a = det.detect_arrays(xs, ys, np.zeros(3), np.full(3, 0.2), np.arange(3), rng, ids)
+        assert a.row.tolist() == [0, 1, 2]  # p = 1: one phantom each
+        for o, rid in zip(a.observer.tolist(), a.robot_id.tolist()):
+            seen[o].add(rid)
+    assert seen == {0: {8, 9}, 1: {7, 9}, 2: {7, 8}}  # never itself, every other robot
+
+
 # ---------------------------------------------------------------------------- identity, API
 def test_identity_on_and_off():
     xs, ys, th = [1.0, 2.0, 3.0], [1.0, 1.0, 1.0], [0.0, 0.0, 0.0]
