@@ -2,7 +2,7 @@
 
 - :func:`build_range_sensor` / :class:`RangeSensor`: laser, sonar ring and proximity
   sensors ray-cast through the materials they see, optionally stop on other robots' discs
-  (:mod:`~teamnav.sim.sensors.robot_hits`), then add the beam-model noise of Fox et al. §3.1.
+  (:mod:`~teamnav.sim.sensors.robot_hits`), then add the beam-model noise of Fox et al. §2.2.
 - :class:`RobotDetector`: teammates within range, field of view and line of sight, with the
   noise models of Fox et al. §4 and Sgorbissa & Arkin §6.1, false negatives and positives.
 

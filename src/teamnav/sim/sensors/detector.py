@@ -7,8 +7,9 @@ Implements the sensing of teammates used by two of the papers:
   perceived distance and angle follow eqs. 1–2 (the *occlusion* model below).
 - Fox, Burgard, Kruppa & Thrun, "Collaborative multi-robot localization", §4: a detection
   reports the seen robot's identity and its relative position in polar coordinates (range,
-  bearing), with false negatives and false positives (their Table 2: 6.7 % and 3.5 %); the
-  *gaussian* model below.
+  bearing); §4.2 models its error as a zero-mean Gaussian with independent distance and
+  angle components (Fig. 7; the *gaussian* model below) and counts false negatives and
+  false positives (Table 2: 6.7 % and 3.5 %).
 
 Simulator side (truth): it reads every robot's true pose and the map and returns, per
 observer, what that observer perceives. Rules, from :class:`~teamnav.sim.config.DetectorConfig`:
@@ -19,7 +20,18 @@ observer, what that observer perceives. Rules, from :class:`~teamnav.sim.config.
 3. *Line of sight* (if ``line_of_sight``): the segment between the two centres crosses no
    cell the detector ``sees`` (:func:`teamnav.world.los.line_of_sight`, symmetric bit for
    bit, so with a 360° field of view A sees B exactly when B sees A before noise).
-4. *Noise* on range and bearing (see :meth:`RobotDetector.detect_arrays`).
+4. *Noise* on range and bearing:
+
+   - ``gaussian`` (Fox et al. §4.2): ``d_p = max(0, d_r + N(0, range_noise_std_m))``,
+     ``alpha_p = alpha_r + N(0, bearing_noise_std_deg)``;
+   - ``occlusion`` (Sgorbissa & Arkin §6.1, eqs. 1–2): ``d_p = d_r + d_r d_noise``,
+     ``alpha_p = alpha_r + atan(robotsize / 2 d_r) alpha_noise``, ``robotsize`` the seen
+     robot's diameter, ``d_noise ~ U[-err_max, err_max]`` and ``alpha_noise ~ U[-1, 1]``:
+     the paper draws the angle factor on ``[-1, 1]``, not on ``[-err_max, err_max]``
+     (the occlusion of a robot cannot move its perceived centre beyond its silhouette), so
+     ``|d_p - d_r| <= err_max d_r`` and ``|alpha_p - alpha_r| <= atan(robotsize / 2 d_r)``.
+     With ``err_max = 0`` the range is exact but the bearing still carries this bounded
+     occlusion error; use the gaussian model with zero deviations for perfect sensing.
 5. *False negatives*: each true detection is dropped with ``p_false_negative``.
 6. *False positives*: with ``p_false_positive`` per observer per step, one phantom at a
    range uniform in ``(0, max_range_m]`` and a bearing uniform over the field of view.
@@ -194,8 +206,8 @@ class RobotDetector:
                 half_angle = np.arctan(size_m / (2.0 * d_r))  # d_r = 0 -> pi/2
             a_p = a_r + half_angle * a_noise
             return d_p, wrap_angle(a_p) if m else a_p
-        # Fox et al. §4: Gaussian range and bearing errors (their detection model is a
-        # Gaussian mixture learned from data); ranges are kept >= 0.
+        # Fox et al. §4.2, Fig. 7: zero-mean Gaussian errors, independent in distance and
+        # angle; a perceived range is kept >= 0.
         s_r = cfg.range_noise_std_m
         s_b = math.radians(cfg.bearing_noise_std_deg)
         if s_r == 0.0 and s_b == 0.0:

@@ -11,9 +11,13 @@ cells its configuration ``sees`` (a laser passes through glass, a sonar echoes o
 - a *short* reading, uniform in ``[0, true range)``, with probability ``p_short`` (an
   unmodelled object, or sonar crosstalk).
 
-These are the failure modes of the beam model of Fox et al. §3.1 (laser and sonar) and of
-Thrun et al., *Probabilistic Robotics* §6.3, which MCL (``teamnav.localization``) then
-models. The three cases are exclusive: a beam is max with probability ``p_max``, short with
+These are the three parts of the perception model of Fox et al. §2.2 (Fig. 1: a Gaussian
+around the expected distance, overly short readings, a Dirac at max range), as in Thrun et
+al., *Probabilistic Robotics* §6.3, which MCL (``teamnav.localization``) then models. Fox et
+al. fit the short readings with a geometric distribution; the simulator draws them uniformly
+below the true range, as :class:`~teamnav.sim.config.LaserConfig` specifies (Thrun's
+exponential "short" term fitted to such data is then a modelling approximation, as on a real
+robot). The three cases are exclusive: a beam is max with probability ``p_max``, short with
 probability ``p_short``, else true + noise (so ``p_max + p_short`` may not exceed 1).
 
 Every step draws at most one ``standard_normal((n, B))`` (skipped when ``noise_std_m`` is 0)
@@ -102,7 +106,7 @@ def _mixture_kernel(true, z, u, sigma, p_max, p_short, max_range, out):
 
 
 def apply_beam_noise(true_m, rng, noise_std_m, p_max, p_short, max_range_m, out=None) -> np.ndarray:
-    """Observed ranges from true ranges: the beam mixture of Fox et al. §3.1.
+    """Observed ranges from true ranges: the beam mixture of Fox et al. §2.2 (Fig. 1).
 
     Parameters
     ----------
