@@ -71,7 +71,7 @@ def test_beam_angles_cover_fov(n, fov_deg):
     assert np.all(np.diff(a) > 0)
     if n == 1:
         assert a[0] == 0.0
-    elif fov_deg >= 360.0:
+    elif fov >= 2 * np.pi - 1e-12:  # a full circle (within rounding of 360 deg)
         np.testing.assert_allclose(np.diff(a), 2 * np.pi / n, rtol=1e-9)
         assert np.min(np.abs(a)) < 1e-12  # a beam straight ahead
         assert a[-1] - a[0] == pytest.approx(2 * np.pi * (n - 1) / n)  # no duplicate at +-pi

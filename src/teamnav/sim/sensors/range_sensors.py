@@ -79,7 +79,7 @@ def beam_angles(n: int, fov_rad: float) -> np.ndarray:
         return np.zeros(1)
     if fov_rad >= 2 * np.pi - 1e-12:
         k = np.arange(n) - (n - 1) // 2
-        return k * (2 * np.pi / n)
+        return np.minimum(k * (2 * np.pi / n), np.pi)  # k = n/2 may round past pi
     return np.linspace(-fov_rad / 2, fov_rad / 2, n)
 
 
