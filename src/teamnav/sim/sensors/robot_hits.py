@@ -31,6 +31,10 @@ from numba import njit, prange
 
 __all__ = ["apply_robot_hits", "robot_hits_reference"]
 
+#: Extra half-width [rad] of the angular window of rays tested against a disc, so that a
+#: ray grazing the disc is never skipped because of rounding in ``atan2``/``asin``.
+_ANGLE_MARGIN_RAD: float = 1e-9
+
 
 # ---------------------------------------------------------------------------- kernels
 @njit(cache=True)
@@ -64,16 +68,52 @@ def _disc_hit(fx, fy, dx, dy, r2):
     return -b - math.sqrt(disc)
 
 
+@njit(cache=True, inline="always")
+def _rays_in(sorted_ang, a0, a1):
+    """Index range ``[lo, hi)`` of ``sorted_ang`` (ascending) with ``a0 <= angle <= a1``."""
+    return _lower(sorted_ang, a0), _upper(sorted_ang, a1)
+
+
+@njit(cache=True)
+def _upper(keys, k):
+    """First index of sorted ``keys`` with ``keys[idx] > k``."""
+    lo = 0
+    hi = keys.shape[0]
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if keys[mid] <= k:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True, inline="always")
+def _hit_rays(out, i, lo, hi, ray_order, ct, st, cb, sb, fx, fy, r2):
+    for k in range(lo, hi):
+        b = ray_order[k]
+        dx = ct * cb[b] - st * sb[b]
+        dy = st * cb[b] + ct * sb[b]
+        t = _disc_hit(fx, fy, dx, dy, r2)
+        if t < out[i, b]:
+            out[i, b] = t
+
+
 @njit(cache=True, parallel=True)
-def _robot_hits_kernel(xs, ys, ct, st, cb, sb, self_idx, all_x, all_y, all_r, order, keys,
-                       x0, y0, cell, nky, nkx, rmax, out):
+def _robot_hits_kernel(xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
+                       order, keys, x0, y0, cell, nky, nkx, rmax, out):
     """Shorten ``out[i, b]`` (map ranges, modified in place) by other robots' discs.
 
     ``order``: robot indices sorted by hash key, ``keys``: their sorted keys
     ``kx * nky + ky`` with ``kx = floor((x - x0) / cell)`` (``0 <= kx < nkx``).
+    ``sorted_ang``: the ray directions wrapped to ``[-pi, pi)`` in ascending order,
+    ``ray_order`` their ray indices. A disc at distance ``d`` and body-frame bearing ``phi``
+    can only be met by rays within ``asin(r / d)`` of ``phi``: those are found by binary
+    search and intersected exactly (a margin of ``_ANGLE_MARGIN_RAD`` absorbs rounding).
     """
     n = xs.shape[0]
     nb = cb.shape[0]
+    two_pi = 2.0 * math.pi
     for i in prange(n):
         px = xs[i]
         py = ys[i]
@@ -100,16 +140,31 @@ def _robot_hits_kernel(xs, ys, ct, st, cb, sb, self_idx, all_x, all_y, all_r, or
                 fx = px - all_x[j]
                 fy = py - all_y[j]
                 r = all_r[j]
-                d = math.sqrt(fx * fx + fy * fy)
+                d2 = fx * fx + fy * fy
+                d = math.sqrt(d2)
                 if d - r >= reach:
                     continue
+                if d2 <= r * r:  # sensor inside the disc: every ray stops at once
+                    for b in range(nb):
+                        out[i, b] = 0.0
+                    continue
+                # bearing of the centre in the body frame, wrapped to [-pi, pi)
+                phi = math.atan2(-fy, -fx) - thetas[i]
+                phi -= two_pi * math.floor((phi + math.pi) / two_pi)
+                beta = math.asin(r / d) + _ANGLE_MARGIN_RAD
+                a0 = phi - beta
+                a1 = phi + beta
                 r2 = r * r
-                for b in range(nb):
-                    dx = ct[i] * cb[b] - st[i] * sb[b]
-                    dy = st[i] * cb[b] + ct[i] * sb[b]
-                    t = _disc_hit(fx, fy, dx, dy, r2)
-                    if t < out[i, b]:
-                        out[i, b] = t
+                if a0 < -math.pi:
+                    l0, h0 = _rays_in(sorted_ang, a0 + two_pi, math.pi)
+                    _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
+                    a0 = -math.pi
+                elif a1 >= math.pi:
+                    l0, h0 = _rays_in(sorted_ang, -math.pi, a1 - two_pi)
+                    _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
+                    a1 = math.pi
+                l0, h0 = _rays_in(sorted_ang, a0, a1)
+                _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
 
 
 @njit(cache=True)
@@ -220,8 +275,11 @@ def apply_robot_hits(xs, ys, thetas, angles_rad, bodies, ranges, max_range_m, ce
     keys = kx * nky + ky
     order = np.argsort(keys, kind="stable").astype(np.int64)
     skeys = np.ascontiguousarray(keys[order])
+    wrapped = angles - 2 * np.pi * np.floor((angles + np.pi) / (2 * np.pi))  # [-pi, pi)
+    ray_order = np.argsort(wrapped, kind="stable").astype(np.int64)
     _robot_hits_kernel(
-        xs, ys, np.cos(thetas), np.sin(thetas), np.cos(angles), np.sin(angles), self_idx,
+        xs, ys, np.cos(thetas), np.sin(thetas), thetas, np.cos(angles), np.sin(angles),
+        np.ascontiguousarray(wrapped[ray_order]), ray_order, self_idx,
         all_x, all_y, all_r, order, skeys, x0, y0, cell, nky, nkx, rmax, ranges,
     )
     return ranges
