@@ -241,8 +241,9 @@ def test_robot_hits_hash_matches_brute_force(seed, n_all, cell_m):
     all_y = rng.uniform(0.0, 8.0, n_all)
     all_r = rng.uniform(0.05, 0.4, n_all)
     sensing = rng.choice(n_all, size=min(n_all, 30), replace=False)
-    th = rng.uniform(-np.pi, np.pi, sensing.shape[0])
-    angles = beam_angles(37, 2 * np.pi)
+    th = rng.uniform(-10.0, 10.0, sensing.shape[0])  # unwrapped headings
+    # an even ring, or unsorted directions beyond +-pi (e.g. a sonar cone's edge rays)
+    angles = beam_angles(37, 2 * np.pi) if seed % 2 else rng.uniform(-3 * np.pi, 3 * np.pi, 37)
     base = rng.uniform(0.0, 2.5, (sensing.shape[0], 37))  # stand-in map ranges (walls at random distances)
     bodies = (all_x, all_y, all_r, sensing.astype(np.int64))
     fast = apply_robot_hits(all_x[sensing], all_y[sensing], th, angles, bodies, base.copy(), 2.5, cell_m=cell_m)
