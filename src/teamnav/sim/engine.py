@@ -213,7 +213,11 @@ class Simulation:
             try:
                 params = cls.Params.model_validate(dict(g.params))
             except ValidationError as exc:
-                raise ValueError(f"{label}.params are invalid for controller {g.controller!r}: {exc}") from None
+                problems = "; ".join(
+                    f"params.{'.'.join(str(p) for p in e['loc']) or '<root>'}: {e['msg']}, got {e.get('input')!r}"
+                    for e in exc.errors()
+                )
+                raise ValueError(f"{label}: invalid parameters for controller {g.controller!r}: {problems}") from None
             batched = bool(getattr(cls, "batched", False))
             rngs = [np.random.default_rng(robot_ss[i]) for i in range(sl.start, sl.stop)]
             try:
