@@ -3,7 +3,8 @@
 Usage::
 
     python benchmarks/bench_engine.py [--quick] [--cases laser,swarm] [--robots 10,100,1000]
-                                      [--irsim-python PATH] [--enki-python PATH] [--profile CASE]
+                                      [--irsim-python PATH] [--enki-python PATH] [--threads N]
+                                      [--profile CASE]
 
 (a) ``laser``: N robots with a 180-beam, 10 m laser on the MIT basement map (0.05 m/px),
     wandering: teamnav's per-robot ``wander-v1`` (a Python Controller per robot) and batched
@@ -190,6 +191,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--irsim-python", default=os.environ.get("TEAMNAV_BENCH_IRSIM_PYTHON", "/tmp/irsim-venv/bin/python"))
     ap.add_argument("--enki-python", default=os.environ.get("TEAMNAV_BENCH_ENKI_PYTHON", "/usr/bin/python3"))
     ap.add_argument("--no-peers", action="store_true", help="measure teamnav only")
+    ap.add_argument("--threads", type=int, default=None,
+                    help="numba threads for teamnav's parallel kernels (default: numba's, all cores)")
     ap.add_argument("--profile", metavar="CASE-FORM-N", help="cProfile one teamnav cell, e.g. swarm-batched-1000")
     a = ap.parse_args(argv)
     plan = QUICK if a.quick else FULL
@@ -204,6 +207,12 @@ def main(argv: list[str] | None = None) -> int:
             raise SystemExit(f"--forms must list 'python' and/or 'batched', got {f!r}")
     if any(n < 1 for n in sizes):
         raise SystemExit(f"--robots must list positive team sizes, got {a.robots!r}")
+    if a.threads is not None:
+        if a.threads < 1:
+            raise SystemExit(f"--threads must be >= 1, got {a.threads}")
+        import numba
+
+        numba.set_num_threads(min(a.threads, numba.config.NUMBA_NUM_THREADS))
     if a.profile:
         n = int(a.profile.rsplit("-", 1)[1])
         profile_teamnav(a.profile, _steps(plan.teamnav_steps, n))
@@ -216,7 +225,8 @@ def main(argv: list[str] | None = None) -> int:
                   {100: "batched ≥ 1×", 1000: "batched ≥ 5×"}),
     }
     print(f"teamnav engine benchmark ({'quick' if a.quick else 'full'}); python {sys.version.split()[0]}, "
-          f"numpy {np.__version__}, {os.cpu_count()} cpus")
+          f"numpy {np.__version__}, {os.cpu_count()} cpus, load average {os.getloadavg()[0]:.1f}, "
+          f"numba threads {a.threads or 'default'}")
     for case in cases:
         label, python, module, script, install, peer_steps, targets = peers[case]
         have_peer = not a.no_peers and _peer_ok(python, module)
