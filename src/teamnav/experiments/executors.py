@@ -1,0 +1,363 @@
+"""Where a sweep's trials run: local worker processes (default) or a Ray cluster (opt-in).
+
+Both executors do the same thing: keep at most ``workers`` trials in flight, and each time one
+finishes hand its :class:`TrialResult` to the parent's ``on_result`` callback (which commits it
+to the results store) *before* the freed slot gets the next trial. So the store is written by
+the parent only, one row per finished trial, and a sweep killed at any moment loses only the
+trials that were in flight.
+
+A trial runs :func:`execute` in the worker: load the scenario with the trial's overrides and
+seed, call the trial function (by default :func:`run_trial`, a full
+:func:`~teamnav.experiments.runner.run`), check its metrics. Any exception is caught *in the
+worker* and comes back as a ``'failed'`` result with the error type, message and traceback; a
+worker process that dies outright (segfault, ``os._exit``, out of memory) is reported as a
+failure of the trials it was running. A failing trial never stops the sweep.
+
+- ``local``: :class:`concurrent.futures.ProcessPoolExecutor` with the ``spawn`` start method
+  (the same on Linux, macOS and Windows; no fork of a parent that holds threads or a SQLite
+  connection). Scripts that call :func:`teamnav.sweep` must therefore guard their entry point
+  with ``if __name__ == "__main__":``, as for any ``multiprocessing`` program.
+- ``ray``: ``ray.init(address=...)`` joins a running cluster (every node needs teamnav
+  installed); with no address a local Ray is started for the sweep and shut down after it.
+  Ray is an optional dependency: ``pip install 'teamnav[ray]'``.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import importlib.util
+import logging
+import multiprocessing
+import os
+import socket
+import time
+import traceback as _tb
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Iterator, Mapping, Protocol
+
+if TYPE_CHECKING:  # pragma: no cover
+    from teamnav.experiments.spec import Scenario
+    from teamnav.experiments.sweep import Trial
+
+__all__ = [
+    "EXECUTORS",
+    "Executor",
+    "LocalExecutor",
+    "RayExecutor",
+    "TrialResult",
+    "TrialTask",
+    "default_workers",
+    "execute",
+    "make_executor",
+    "run_trial",
+]
+
+#: executor names accepted by :func:`make_executor`
+EXECUTORS = ("local", "ray")
+
+RAY_MISSING = "executor='ray' needs Ray, which is not installed; expected it importable: pip install 'teamnav[ray]'"
+
+
+# ---------------------------------------------------------------------------- what travels
+@dataclass(frozen=True)
+class TrialTask:
+    """What a worker gets: the trial, the trial function (None: :func:`run_trial`) and the
+    run folder to write (None: none)."""
+
+    trial: "Trial"
+    trial_fn: Callable[..., Mapping[str, Any]] | None = None
+    artifacts_dir: str | None = None
+
+
+@dataclass(frozen=True)
+class TrialResult:
+    """What a worker sends back.
+
+    Attributes
+    ----------
+    trial_id : str
+    status : {"ok", "failed"}
+    metrics : dict of str to (int, float, bool, str or None), or None when failed
+    error : str or None
+        ``"TypeName: message"`` when failed.
+    traceback : str or None
+        The formatted traceback when failed.
+    wall_time_s : float
+        Wall time of the trial in the worker (scenario loading included) [s].
+    started_at, finished_at : str
+        ISO 8601 UTC timestamps.
+    host : str
+        Host name of the worker.
+    pid : int
+        Process id of the worker.
+    """
+
+    trial_id: str
+    status: str
+    metrics: dict[str, Any] | None
+    error: str | None
+    traceback: str | None
+    wall_time_s: float
+    started_at: str
+    finished_at: str
+    host: str
+    pid: int
+
+
+def _now() -> str:
+    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="milliseconds")
+
+
+def run_trial(scenario: "Scenario", out_dir: Path | None) -> dict[str, Any]:
+    """The default trial function: a full run of ``scenario`` (writing ``out_dir`` if given)."""
+    from teamnav.experiments.runner import run
+
+    return dict(run(scenario, out_dir=out_dir, progress=False, force=True).metrics)
+
+
+def _plain(name: str, value: Any) -> Any:
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    item = getattr(value, "item", None)  # numpy scalars
+    if callable(item) and getattr(value, "shape", None) == ():
+        return _plain(name, item())
+    raise TypeError(f"metric {name!r}: expected a number, bool, string or None, received a {type(value).__name__}")
+
+
+def _check_metrics(metrics: Any) -> dict[str, Any]:
+    if not isinstance(metrics, Mapping):
+        raise TypeError(f"trial function: expected a dict of metrics, received a {type(metrics).__name__}")
+    out = {}
+    for k, v in metrics.items():
+        if not isinstance(k, str) or not k:
+            raise TypeError(f"trial function: expected metric names to be non-empty strings, received {k!r}")
+        out[k] = _plain(k, v)
+    return out
+
+
+def execute(task: TrialTask) -> TrialResult:
+    """Run one trial (in a worker); never raises for a failing trial.
+
+    Returns
+    -------
+    TrialResult
+        ``status='ok'`` with the metrics, or ``'failed'`` with the error and traceback of any
+        ``Exception`` raised while loading, running or scoring the trial.
+    """
+    started = _now()
+    t0 = time.perf_counter()
+    metrics = error = trace = None
+    try:
+        scenario = task.trial.load()
+        fn = task.trial_fn if task.trial_fn is not None else run_trial
+        out = Path(task.artifacts_dir) if task.artifacts_dir else None
+        metrics = _check_metrics(fn(scenario, out))
+        status = "ok"
+    except Exception as exc:  # noqa: BLE001 - a failing trial is data, not a crash
+        status = "failed"
+        error = f"{type(exc).__name__}: {exc}"
+        trace = _tb.format_exc()
+    return TrialResult(
+        trial_id=task.trial.trial_id,
+        status=status,
+        metrics=metrics,
+        error=error,
+        traceback=trace,
+        wall_time_s=time.perf_counter() - t0,
+        started_at=started,
+        finished_at=_now(),
+        host=socket.gethostname(),
+        pid=os.getpid(),
+    )
+
+
+def _lost(task: TrialTask, error: str, started: str) -> TrialResult:
+    """A failed result for a trial whose worker never answered."""
+    return TrialResult(task.trial.trial_id, "failed", None, error, None, float("nan"), started, _now(), socket.gethostname(), 0)
+
+
+# ---------------------------------------------------------------------------- executors
+class Executor(Protocol):
+    """Runs trial tasks; calls ``on_result`` in the calling thread as each one finishes."""
+
+    workers: int | None
+
+    def run(self, tasks: Iterable[TrialTask], on_result: Callable[[TrialResult], None]) -> None: ...
+
+
+def default_workers() -> int:
+    """CPUs this process may use (``os.sched_getaffinity`` where available, else ``os.cpu_count()``)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
+
+
+class LocalExecutor:
+    """Trials in local worker processes (a ``spawn`` :class:`ProcessPoolExecutor`).
+
+    Parameters
+    ----------
+    workers : int, optional
+        Processes; default :func:`default_workers`.
+    start_method : {"spawn", "forkserver"}
+        Default ``"spawn"``.
+    """
+
+    def __init__(self, workers: int | None = None, start_method: str = "spawn") -> None:
+        if start_method not in ("spawn", "forkserver"):
+            raise ValueError(f"start_method: expected 'spawn' or 'forkserver', received {start_method!r}")
+        self.workers = workers
+        self.start_method = start_method
+
+    def _pool(self, n: int) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(max_workers=n, mp_context=multiprocessing.get_context(self.start_method))
+
+    def run(self, tasks: Iterable[TrialTask], on_result: Callable[[TrialResult], None]) -> None:
+        n = self.workers or default_workers()
+        pending: Iterator[TrialTask] = iter(tasks)
+        in_flight: dict[Future, tuple[TrialTask, str]] = {}
+        pool = self._pool(n)
+
+        def fill() -> None:
+            while len(in_flight) < n:
+                task = next(pending, None)
+                if task is None:
+                    return
+                in_flight[pool.submit(execute, task)] = (task, _now())
+
+        try:
+            fill()
+            while in_flight:
+                done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
+                broken = False
+                for fut in done:
+                    task, started = in_flight.pop(fut)
+                    try:
+                        res = fut.result()
+                    except BrokenProcessPool:
+                        broken = True
+                        res = _lost(task, _DIED, started)
+                    except Exception as exc:  # noqa: BLE001 - e.g. a trial_fn that cannot be pickled
+                        res = _lost(task, f"{type(exc).__name__}: {exc}", started)
+                    on_result(res)
+                if broken:
+                    # every trial still in flight went down with the pool; report them, start afresh
+                    for task, started in in_flight.values():
+                        on_result(_lost(task, _DIED, started))
+                    in_flight.clear()
+                    pool.shutdown(wait=True, cancel_futures=True)
+                    pool = self._pool(n)
+                fill()
+        except BaseException:
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+        pool.shutdown(wait=True)
+
+
+_DIED = (
+    "WorkerDied: a worker process ended abruptly (crash, os._exit, out of memory or killed) while this "
+    "trial was running; the sweep went on, rerun it to retry"
+)
+
+
+def _import_ray():
+    try:
+        import ray
+    except ImportError:
+        from teamnav.experiments.sweep import SweepError
+
+        raise SweepError(RAY_MISSING) from None
+    return ray
+
+
+class RayExecutor:
+    """Trials as Ray tasks (one CPU each).
+
+    Parameters
+    ----------
+    workers : int, optional
+        Trials in flight at once; default: the cluster's CPU count. For a local Ray started
+        here, also its ``num_cpus``.
+    address : str, optional
+        Cluster to join (``"auto"``, ``"ray://head:10001"``); None starts a local Ray for
+        the sweep (no dashboard) and shuts it down afterwards. If Ray is already initialised
+        in this process, that session is used and left running.
+    """
+
+    def __init__(self, workers: int | None = None, address: str | None = None) -> None:
+        self.workers = workers
+        self.address = address
+
+    def run(self, tasks: Iterable[TrialTask], on_result: Callable[[TrialResult], None]) -> None:
+        ray = _import_ray()
+        started_here = False
+        if not ray.is_initialized():
+            kwargs: dict[str, Any] = {"logging_level": logging.WARNING, "log_to_driver": False}
+            if self.address is None:
+                kwargs.update(include_dashboard=False, num_cpus=self.workers or default_workers())
+            else:
+                kwargs["address"] = self.address
+            ray.init(**kwargs)
+            started_here = True
+        in_flight: dict[Any, tuple[TrialTask, str]] = {}
+        try:
+            n = self.workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
+            remote = ray.remote(num_cpus=1, max_retries=0)(execute)
+            pending: Iterator[TrialTask] = iter(tasks)
+
+            def fill() -> None:
+                while len(in_flight) < n:
+                    task = next(pending, None)
+                    if task is None:
+                        return
+                    in_flight[remote.remote(task)] = (task, _now())
+
+            fill()
+            while in_flight:
+                ready, _ = ray.wait(list(in_flight), num_returns=1)
+                for ref in ready:
+                    task, started = in_flight.pop(ref)
+                    try:
+                        res = ray.get(ref)
+                    except Exception as exc:  # noqa: BLE001 - worker crash, task cancelled, unpicklable
+                        res = _lost(task, f"{type(exc).__name__}: {exc}", started)
+                    on_result(res)
+                fill()
+        except BaseException:
+            for ref in in_flight:
+                try:
+                    ray.cancel(ref, force=True)
+                except Exception:  # noqa: BLE001 - best effort while unwinding
+                    pass
+            raise
+        finally:
+            if started_here:
+                ray.shutdown()
+
+
+def make_executor(name: str, *, workers: int | None = None, address: str | None = None) -> Executor:
+    """The executor called ``name``, with its options checked (nothing is started yet).
+
+    Raises
+    ------
+    SweepError
+        Unknown name, ``workers`` not an integer >= 1, ``address`` without Ray, or Ray
+        requested but not installed.
+    """
+    from teamnav.experiments.sweep import SweepError
+
+    if name not in EXECUTORS:
+        raise SweepError(f"executor: expected one of {', '.join(map(repr, EXECUTORS))}, received {name!r}")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise SweepError(f"workers: expected an integer >= 1 or None (all CPUs), received {workers!r}")
+    if name == "local":
+        if address is not None:
+            raise SweepError(f"address: expected None with executor='local' (it is the Ray cluster's), received {address!r}")
+        return LocalExecutor(workers)
+    if importlib.util.find_spec("ray") is None:
+        raise SweepError(RAY_MISSING)
+    return RayExecutor(workers, address)

@@ -1,0 +1,326 @@
+"""The results store of a sweep: ``OUT/results.sqlite``, one row per finished trial.
+
+A SQLite file (stdlib :mod:`sqlite3`, WAL journal, ``synchronous=FULL``), written only by the
+sweep's parent process. Each finished trial is one transaction, committed before its worker
+slot gets the next trial, so a sweep killed at any moment (SIGKILL included) leaves every
+finished trial in the file and no partial row. Readers (pandas, DuckDB, ``sqlite3``) may read
+it while the sweep runs.
+
+Table ``trials`` (a tidy table: one row per trial, one column per variable)::
+
+    trial_id         TEXT PRIMARY KEY   stable id (teamnav.experiments.sweep)
+    sweep            TEXT               sweep name
+    scenario         TEXT               scenario name
+    params           TEXT               JSON: every override of the trial ({key: value})
+    seed             INTEGER
+    config_hash      TEXT               hash of the resolved scenario without seed
+    status           TEXT               'ok' | 'failed'
+    metrics          TEXT               JSON: {metric: value} (NULL when failed)
+    error            TEXT               "Type: message" (NULL when ok)
+    traceback        TEXT
+    wall_time_s      REAL               trial wall time in the worker [s]
+    teamnav_version  TEXT
+    started_at       TEXT               ISO 8601 UTC
+    finished_at      TEXT
+    host             TEXT               worker host name
+    attempts         INTEGER            how many times the trial ran (failed ones are retried)
+    <param key>      ...                one column per override key, e.g. "robots.0.count"
+    <metric name>    ...                one column per scalar metric, e.g. path_length_m_mean
+
+Parameter and metric columns are added (``ALTER TABLE``) the first time a key appears; a key
+that would collide with an existing column gets a ``param_`` / ``metric_`` prefix (so the
+runner's ``wall_time_s`` metric is the column ``metric_wall_time_s``). Table ``columns`` maps
+every such column to its key, and table ``sweeps`` keeps each sweep's description (JSON).
+
+Examples
+--------
+Reading a store::
+
+    import sqlite3, pandas as pd
+    df = pd.read_sql("SELECT * FROM trials WHERE status = 'ok'", sqlite3.connect("out/results.sqlite"))
+    # DuckDB: INSTALL sqlite; SELECT * FROM sqlite_scan('out/results.sqlite', 'trials');
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sqlite3
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Mapping
+
+if TYPE_CHECKING:  # pragma: no cover
+    from teamnav.experiments.executors import TrialResult
+    from teamnav.experiments.sweep import Trial
+
+__all__ = ["BASE_COLUMNS", "STORE_NAME", "ResultsStore", "load_dataframe", "load_rows"]
+
+#: file name of the store inside a sweep's output folder
+STORE_NAME = "results.sqlite"
+
+#: the fixed columns of ``trials`` and their SQL types
+BASE_COLUMNS: dict[str, str] = {
+    "trial_id": "TEXT PRIMARY KEY NOT NULL",
+    "sweep": "TEXT NOT NULL",
+    "scenario": "TEXT NOT NULL",
+    "params": "TEXT NOT NULL",
+    "seed": "INTEGER NOT NULL",
+    "config_hash": "TEXT NOT NULL",
+    "status": "TEXT NOT NULL CHECK (status IN ('ok', 'failed'))",
+    "metrics": "TEXT",
+    "error": "TEXT",
+    "traceback": "TEXT",
+    "wall_time_s": "REAL",
+    "teamnav_version": "TEXT",
+    "started_at": "TEXT",
+    "finished_at": "TEXT",
+    "host": "TEXT",
+    "attempts": "INTEGER NOT NULL DEFAULT 1",
+}
+
+_SCHEMA = f"""
+CREATE TABLE IF NOT EXISTS trials ({", ".join(f"{k} {v}" for k, v in BASE_COLUMNS.items())});
+CREATE INDEX IF NOT EXISTS trials_sweep ON trials (sweep, status);
+CREATE TABLE IF NOT EXISTS columns (
+    name TEXT PRIMARY KEY NOT NULL,
+    kind TEXT NOT NULL CHECK (kind IN ('param', 'metric')),
+    key TEXT NOT NULL,
+    UNIQUE (kind, key)
+);
+CREATE TABLE IF NOT EXISTS sweeps (
+    name TEXT PRIMARY KEY NOT NULL,
+    spec TEXT NOT NULL,
+    teamnav_version TEXT,
+    first_started_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+    last_started_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now'))
+);
+"""
+
+
+def _quote(name: str) -> str:
+    return '"' + name.replace('"', '""') + '"'
+
+
+def _sql_type(value: Any) -> str:
+    if isinstance(value, bool) or isinstance(value, int):
+        return "INTEGER"
+    if isinstance(value, float):
+        return "REAL"
+    return "TEXT"
+
+
+def _cell(value: Any) -> Any:
+    """A value as stored in a param/metric column: numbers and text as is, NaN/inf as NULL,
+    anything else (lists, dicts) as JSON text."""
+    if value is None or isinstance(value, (bool, int, str)):
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    return json.dumps(value, sort_keys=True)
+
+
+def _json(value: Any) -> str:
+    """JSON text with NaN and infinities as null (standard JSON, readable by DuckDB)."""
+
+    def clean(v: Any) -> Any:
+        if isinstance(v, float) and not math.isfinite(v):
+            return None
+        if isinstance(v, dict):
+            return {k: clean(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [clean(x) for x in v]
+        return v
+
+    return json.dumps(clean(value), sort_keys=True, allow_nan=False)
+
+
+class ResultsStore:
+    """A sweep's SQLite results store (open it with ``with ResultsStore(path) as store:``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.sqlite`` file; created with its tables if missing.
+    """
+
+    def __init__(self, path: str | os.PathLike) -> None:
+        self.path = Path(path)
+        self._con = sqlite3.connect(self.path, isolation_level=None, timeout=60.0)
+        self._con.execute("PRAGMA journal_mode=WAL")
+        self._con.execute("PRAGMA synchronous=FULL")
+        self._con.execute("BEGIN IMMEDIATE")
+        try:
+            for stmt in _SCHEMA.split(";"):
+                if stmt.strip():
+                    self._con.execute(stmt)
+            self._con.execute("COMMIT")
+        except BaseException:
+            self._con.execute("ROLLBACK")
+            self._con.close()
+            raise
+
+    # context manager -------------------------------------------------------------
+    def __enter__(self) -> "ResultsStore":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self._con.close()
+
+    # reading ----------------------------------------------------------------------
+    def existing(self) -> dict[str, tuple[str, str]]:
+        """``{trial_id: (status, config_hash)}`` of every stored trial."""
+        return {tid: (status, chash) for tid, status, chash in self._con.execute("SELECT trial_id, status, config_hash FROM trials")}
+
+    def rows(self, *, sweep: str | None = None, status: str | None = None) -> list[dict[str, Any]]:
+        """Rows of ``trials`` as dicts, with ``params`` and ``metrics`` decoded from JSON."""
+        return _rows(self._con, sweep, status)
+
+    # writing ----------------------------------------------------------------------
+    def register_sweep(self, name: str, spec: Mapping[str, Any]) -> None:
+        """Record (or update) a sweep's description in table ``sweeps``."""
+        from teamnav import __version__
+
+        self._con.execute("BEGIN IMMEDIATE")
+        try:
+            self._con.execute(
+                "INSERT INTO sweeps (name, spec, teamnav_version) VALUES (?, ?, ?) ON CONFLICT (name) DO UPDATE SET "
+                "spec = excluded.spec, teamnav_version = excluded.teamnav_version, "
+                "last_started_at = strftime('%Y-%m-%dT%H:%M:%fZ', 'now')",
+                (name, _json(dict(spec)), __version__),
+            )
+            self._con.execute("COMMIT")
+        except BaseException:
+            self._con.execute("ROLLBACK")
+            raise
+
+    def _column(self, kind: str, key: str, value: Any, taken: dict[tuple[str, str], str], names: set[str]) -> str:
+        """The column of (kind, key), added to ``trials`` if new (inside the open transaction)."""
+        col = taken.get((kind, key))
+        if col is not None:
+            return col
+        col = key
+        k = 2
+        while col in names or col.lower() in {n.lower() for n in names}:
+            col = f"{kind}_{key}" if k == 2 else f"{kind}_{key}_{k}"
+            k += 1
+        self._con.execute(f"ALTER TABLE trials ADD COLUMN {_quote(col)} {_sql_type(value)}")
+        self._con.execute("INSERT INTO columns (name, kind, key) VALUES (?, ?, ?)", (col, kind, key))
+        taken[(kind, key)] = col
+        names.add(col)
+        return col
+
+    def record(self, trial: "Trial", result: "TrialResult") -> None:
+        """Write one finished trial, in one transaction (replacing an earlier attempt)."""
+        from teamnav import __version__
+
+        if result.trial_id != trial.trial_id:
+            raise ValueError(f"result.trial_id: expected {trial.trial_id!r} (the trial's), received {result.trial_id!r}")
+        if result.status not in ("ok", "failed"):
+            raise ValueError(f"result.status: expected 'ok' or 'failed', received {result.status!r}")
+        con = self._con
+        con.execute("BEGIN IMMEDIATE")
+        try:
+            taken = {(kind, key): name for name, kind, key in con.execute("SELECT name, kind, key FROM columns")}
+            names = {row[1] for row in con.execute("PRAGMA table_info(trials)")}
+            row: dict[str, Any] = {
+                "trial_id": trial.trial_id,
+                "sweep": trial.sweep,
+                "scenario": trial.scenario_name,
+                "params": _json(trial.params),
+                "seed": int(trial.seed),
+                "config_hash": trial.config_hash,
+                "status": result.status,
+                "metrics": _json(result.metrics) if result.metrics is not None else None,
+                "error": result.error,
+                "traceback": result.traceback,
+                "wall_time_s": _cell(float(result.wall_time_s)),
+                "teamnav_version": __version__,
+                "started_at": result.started_at,
+                "finished_at": result.finished_at,
+                "host": result.host,
+            }
+            for key, value in trial.params.items():
+                row[self._column("param", key, value, taken, names)] = _cell(value)
+            for key, value in (result.metrics or {}).items():
+                row[self._column("metric", key, value, taken, names)] = _cell(value)
+            prev = con.execute("SELECT attempts FROM trials WHERE trial_id = ?", (trial.trial_id,)).fetchone()
+            row["attempts"] = (prev[0] + 1) if prev else 1
+            cols = ", ".join(_quote(c) for c in row)
+            marks = ", ".join("?" for _ in row)
+            con.execute(f"INSERT OR REPLACE INTO trials ({cols}) VALUES ({marks})", tuple(row.values()))
+            con.execute("COMMIT")
+        except BaseException:
+            con.execute("ROLLBACK")
+            raise
+
+
+def _rows(con: sqlite3.Connection, sweep: str | None, status: str | None) -> list[dict[str, Any]]:
+    where, args = [], []
+    if sweep is not None:
+        where.append("sweep = ?")
+        args.append(sweep)
+    if status is not None:
+        where.append("status = ?")
+        args.append(status)
+    sql = "SELECT * FROM trials" + (" WHERE " + " AND ".join(where) if where else "") + " ORDER BY sweep, finished_at, trial_id"
+    cur = con.execute(sql, args)
+    names = [d[0] for d in cur.description]
+    out = []
+    for values in cur:
+        row = dict(zip(names, values))
+        row["params"] = json.loads(row["params"]) if row["params"] else {}
+        row["metrics"] = json.loads(row["metrics"]) if row["metrics"] else None
+        out.append(row)
+    return out
+
+
+def _store_file(path: str | os.PathLike) -> Path:
+    p = Path(path)
+    if p.is_dir():
+        p = p / STORE_NAME
+    if not p.is_file():
+        raise ValueError(f"store: expected a results.sqlite file or a sweep folder holding one, received {str(path)!r}")
+    return p
+
+
+def load_rows(path: str | os.PathLike, *, sweep: str | None = None, status: str | None = None) -> list[dict[str, Any]]:
+    """Rows of a store (file or sweep folder) as dicts; ``params``/``metrics`` decoded.
+
+    Opens the file read-only, so it is safe while a sweep writes it.
+    """
+    con = sqlite3.connect(f"{_store_file(path).resolve().as_uri()}?mode=ro", uri=True, timeout=60.0)
+    try:
+        return _rows(con, sweep, status)
+    finally:
+        con.close()
+
+
+def load_dataframe(path: str | os.PathLike, *, sweep: str | None = None, status: str | None = None):
+    """The ``trials`` table as a pandas DataFrame (``params``/``metrics`` left as JSON text).
+
+    Raises
+    ------
+    ImportError
+        When pandas is not installed.
+    """
+    try:
+        import pandas as pd
+    except ImportError:
+        raise ImportError("load_dataframe needs pandas (pip install pandas); load_rows returns plain dicts") from None
+    where, args = [], []
+    if sweep is not None:
+        where.append("sweep = ?")
+        args.append(sweep)
+    if status is not None:
+        where.append("status = ?")
+        args.append(status)
+    sql = "SELECT * FROM trials" + (" WHERE " + " AND ".join(where) if where else "") + " ORDER BY sweep, finished_at, trial_id"
+    con = sqlite3.connect(f"{_store_file(path).resolve().as_uri()}?mode=ro", uri=True, timeout=60.0)
+    try:
+        return pd.read_sql(sql, con, params=args)
+    finally:
+        con.close()
