@@ -234,8 +234,8 @@ def test_robot_body_blocks_and_own_body_does_not():
 
 
 @settings(max_examples=25, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.integers(1, 120), st.sampled_from([None, 0.3, 1.0]))
-def test_robot_hits_hash_matches_brute_force(seed, n_all, cell_m):
+@given(st.integers(0, 2**32 - 1), st.integers(1, 120), st.sampled_from([None, 0.3, 1.0]), st.booleans())
+def test_robot_hits_hash_matches_brute_force(seed, n_all, cell_m, parallel):
     rng = np.random.default_rng(seed)
     all_x = rng.uniform(0.0, 8.0, n_all)
     all_y = rng.uniform(0.0, 8.0, n_all)
@@ -246,7 +246,8 @@ def test_robot_hits_hash_matches_brute_force(seed, n_all, cell_m):
     angles = beam_angles(37, 2 * np.pi) if seed % 2 else rng.uniform(-3 * np.pi, 3 * np.pi, 37)
     base = rng.uniform(0.0, 2.5, (sensing.shape[0], 37))  # stand-in map ranges (walls at random distances)
     bodies = (all_x, all_y, all_r, sensing.astype(np.int64))
-    fast = apply_robot_hits(all_x[sensing], all_y[sensing], th, angles, bodies, base.copy(), 2.5, cell_m=cell_m)
+    fast = apply_robot_hits(all_x[sensing], all_y[sensing], th, angles, bodies, base.copy(), 2.5, cell_m=cell_m,
+                            parallel=parallel)
     ref = robot_hits_reference(all_x[sensing], all_y[sensing], th, angles, bodies, base.copy())
     np.testing.assert_array_equal(fast, ref)
     assert np.all(fast <= base)

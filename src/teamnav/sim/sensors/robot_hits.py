@@ -18,7 +18,10 @@ memory is O(N) whatever the size of the world). Robot ``i`` then visits only the
 overlapping the square of half-side ``reach_i + max(radius)`` around it, where ``reach_i``
 is the longest map range among its own rays (a robot behind a wall that every ray already
 stops at cannot be hit), and only robots ``j`` with ``|c_j - p_i| - r_j < reach_i`` are
-intersected with its rays. Sensing robots are spread over numba's threads (``prange``).
+intersected with its rays, and of those rays only the ones inside the disc's angular window
+``bearing +- asin(r_j / d)`` (binary search over the sorted ray directions). Sensing robots
+are spread over numba's threads (``prange``) once there are ``PARALLEL_MIN_RAYS`` rays: on
+the 2-core development machine smaller calls gained nothing from threads.
 Cost per step: O(N log N) for the hash plus O(sum over i of neighbours_i × rays).
 """
 
@@ -29,11 +32,13 @@ import math
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["apply_robot_hits", "robot_hits_reference"]
+__all__ = ["PARALLEL_MIN_RAYS", "apply_robot_hits", "robot_hits_reference"]
 
 #: Extra half-width [rad] of the angular window of rays tested against a disc, so that a
 #: ray grazing the disc is never skipped because of rounding in ``atan2``/``asin``.
 _ANGLE_MARGIN_RAD: float = 1e-9
+#: Fewest rays (sensing robots x rays) for which :func:`apply_robot_hits` goes parallel by default.
+PARALLEL_MIN_RAYS: int = 20_000
 
 
 # ---------------------------------------------------------------------------- kernels
@@ -99,10 +104,10 @@ def _hit_rays(out, i, lo, hi, ray_order, ct, st, cb, sb, fx, fy, r2):
             out[i, b] = t
 
 
-@njit(cache=True, parallel=True)
-def _robot_hits_kernel(xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
-                       order, keys, x0, y0, cell, nky, nkx, rmax, out):
-    """Shorten ``out[i, b]`` (map ranges, modified in place) by other robots' discs.
+@njit(cache=True)
+def _robot_hits_one(i, xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
+                    order, keys, x0, y0, cell, nky, nkx, rmax, out):
+    """Shorten row ``i`` of ``out`` (map ranges, modified in place) by other robots' discs.
 
     ``order``: robot indices sorted by hash key, ``keys``: their sorted keys
     ``kx * nky + ky`` with ``kx = floor((x - x0) / cell)`` (``0 <= kx < nkx``).
@@ -111,60 +116,76 @@ def _robot_hits_kernel(xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, se
     can only be met by rays within ``asin(r / d)`` of ``phi``: those are found by binary
     search and intersected exactly (a margin of ``_ANGLE_MARGIN_RAD`` absorbs rounding).
     """
-    n = xs.shape[0]
     nb = cb.shape[0]
     two_pi = 2.0 * math.pi
-    for i in prange(n):
-        px = xs[i]
-        py = ys[i]
-        me = self_idx[i]
-        reach = 0.0
-        for b in range(nb):
-            if out[i, b] > reach:
-                reach = out[i, b]
-        if reach <= 0.0:
-            continue
-        half = reach + rmax
-        kx0 = max(0, int(math.floor((px - half - x0) / cell)))
-        kx1 = min(nkx - 1, int(math.floor((px + half - x0) / cell)))
-        ky0 = max(0, int(math.floor((py - half - y0) / cell)))
-        ky1 = min(nky - 1, int(math.floor((py + half - y0) / cell)))
-        for kx in range(kx0, kx1 + 1):
-            # cells (kx, ky0..ky1) are contiguous in key order
-            lo = _lower(keys, kx * nky + ky0)
-            hi = _lower(keys, kx * nky + ky1 + 1)
-            for s in range(lo, hi):
-                j = order[s]
-                if j == me:
-                    continue
-                fx = px - all_x[j]
-                fy = py - all_y[j]
-                r = all_r[j]
-                d2 = fx * fx + fy * fy
-                d = math.sqrt(d2)
-                if d - r >= reach:
-                    continue
-                if d2 <= r * r:  # sensor inside the disc: every ray stops at once
-                    for b in range(nb):
-                        out[i, b] = 0.0
-                    continue
-                # bearing of the centre in the body frame, wrapped to [-pi, pi)
-                phi = math.atan2(-fy, -fx) - thetas[i]
-                phi -= two_pi * math.floor((phi + math.pi) / two_pi)
-                beta = math.asin(r / d) + _ANGLE_MARGIN_RAD
-                a0 = phi - beta
-                a1 = phi + beta
-                r2 = r * r
-                if a0 < -math.pi:
-                    l0, h0 = _rays_in(sorted_ang, a0 + two_pi, math.pi)
-                    _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
-                    a0 = -math.pi
-                elif a1 >= math.pi:
-                    l0, h0 = _rays_in(sorted_ang, -math.pi, a1 - two_pi)
-                    _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
-                    a1 = math.pi
-                l0, h0 = _rays_in(sorted_ang, a0, a1)
+    px = xs[i]
+    py = ys[i]
+    me = self_idx[i]
+    reach = 0.0
+    for b in range(nb):
+        if out[i, b] > reach:
+            reach = out[i, b]
+    if reach <= 0.0:
+        return
+    half = reach + rmax
+    kx0 = max(0, int(math.floor((px - half - x0) / cell)))
+    kx1 = min(nkx - 1, int(math.floor((px + half - x0) / cell)))
+    ky0 = max(0, int(math.floor((py - half - y0) / cell)))
+    ky1 = min(nky - 1, int(math.floor((py + half - y0) / cell)))
+    for kx in range(kx0, kx1 + 1):
+        # cells (kx, ky0..ky1) are contiguous in key order
+        lo = _lower(keys, kx * nky + ky0)
+        hi = _lower(keys, kx * nky + ky1 + 1)
+        for s in range(lo, hi):
+            j = order[s]
+            if j == me:
+                continue
+            fx = px - all_x[j]
+            fy = py - all_y[j]
+            r = all_r[j]
+            d2 = fx * fx + fy * fy
+            d = math.sqrt(d2)
+            if d - r >= reach:
+                continue
+            if d2 <= r * r:  # sensor inside the disc: every ray stops at once
+                for b in range(nb):
+                    out[i, b] = 0.0
+                continue
+            # bearing of the centre in the body frame, wrapped to [-pi, pi)
+            phi = math.atan2(-fy, -fx) - thetas[i]
+            phi -= two_pi * math.floor((phi + math.pi) / two_pi)
+            beta = math.asin(r / d) + _ANGLE_MARGIN_RAD
+            a0 = phi - beta
+            a1 = phi + beta
+            r2 = r * r
+            if a0 < -math.pi:
+                l0, h0 = _rays_in(sorted_ang, a0 + two_pi, math.pi)
                 _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
+                a0 = -math.pi
+            elif a1 >= math.pi:
+                l0, h0 = _rays_in(sorted_ang, -math.pi, a1 - two_pi)
+                _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
+                a1 = math.pi
+            l0, h0 = _rays_in(sorted_ang, a0, a1)
+            _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
+
+
+@njit(cache=True, parallel=True)
+def _robot_hits_parallel(xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
+                         order, keys, x0, y0, cell, nky, nkx, rmax, out):
+    """:func:`_robot_hits_one` for every sensing robot, spread over numba's threads."""
+    for i in prange(xs.shape[0]):
+        _robot_hits_one(i, xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
+                        order, keys, x0, y0, cell, nky, nkx, rmax, out)
+
+
+@njit(cache=True)
+def _robot_hits_serial(xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
+                       order, keys, x0, y0, cell, nky, nkx, rmax, out):
+    """:func:`_robot_hits_one` for every sensing robot, in this thread."""
+    for i in range(xs.shape[0]):
+        _robot_hits_one(i, xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
+                        order, keys, x0, y0, cell, nky, nkx, rmax, out)
 
 
 @njit(cache=True)
@@ -223,7 +244,7 @@ def _check_inputs(xs, ys, thetas, angles_rad, bodies, ranges):
     return xs, ys, thetas, angles, all_x, all_y, all_r, self_idx
 
 
-def apply_robot_hits(xs, ys, thetas, angles_rad, bodies, ranges, max_range_m, cell_m=None) -> np.ndarray:
+def apply_robot_hits(xs, ys, thetas, angles_rad, bodies, ranges, max_range_m, cell_m=None, parallel=None) -> np.ndarray:
     """Shorten map ranges by the first hit on another robot's disc, in place.
 
     Parameters
@@ -241,6 +262,10 @@ def apply_robot_hits(xs, ys, thetas, angles_rad, bodies, ranges, max_range_m, ce
         Sensor range [m]; sets the default hash cell.
     cell_m : float, optional
         Side of the hash cells [m]; default ``max_range_m + max(all_radius)``.
+    parallel : bool or None, default None
+        Spread sensing robots over numba's threads. None: only when there are at least
+        ``PARALLEL_MIN_RAYS`` rays in all (below that, waking the threads costs more than
+        it saves, and far more on a loaded machine).
 
     Returns
     -------
@@ -262,6 +287,8 @@ def apply_robot_hits(xs, ys, thetas, angles_rad, bodies, ranges, max_range_m, ce
     n, nn = xs.shape[0], all_x.shape[0]
     if n == 0 or nn == 0 or angles.shape[0] == 0:
         return ranges
+    if parallel is None:
+        parallel = n * angles.shape[0] >= PARALLEL_MIN_RAYS
     rmax = float(all_r.max())
     cell = float(max_range_m) + rmax if cell_m is None else float(cell_m)
     if not (np.isfinite(cell) and cell > 0):
@@ -277,7 +304,8 @@ def apply_robot_hits(xs, ys, thetas, angles_rad, bodies, ranges, max_range_m, ce
     skeys = np.ascontiguousarray(keys[order])
     wrapped = angles - 2 * np.pi * np.floor((angles + np.pi) / (2 * np.pi))  # [-pi, pi)
     ray_order = np.argsort(wrapped, kind="stable").astype(np.int64)
-    _robot_hits_kernel(
+    kernel = _robot_hits_parallel if parallel else _robot_hits_serial
+    kernel(
         xs, ys, np.cos(thetas), np.sin(thetas), thetas, np.cos(angles), np.sin(angles),
         np.ascontiguousarray(wrapped[ray_order]), ray_order, self_idx,
         all_x, all_y, all_r, order, skeys, x0, y0, cell, nky, nkx, rmax, ranges,
