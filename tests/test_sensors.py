@@ -253,6 +253,53 @@ def test_robot_hits_hash_matches_brute_force(seed, n_all, cell_m, parallel):
     assert np.all(fast <= base)
 
 
+def numpy_robot_hits(xs, ys, thetas, angles, bodies, ranges):
+    """Pure-NumPy reference: every ray against every disc by broadcasting (n, N, R)."""
+    all_x, all_y, all_r, me = bodies
+    dirs = thetas[:, None] + angles[None, :]  # (n, R)
+    dx, dy = np.cos(dirs)[:, None, :], np.sin(dirs)[:, None, :]
+    fx = (xs[:, None] - all_x[None, :])[:, :, None]
+    fy = (ys[:, None] - all_y[None, :])[:, :, None]
+    cc = fx**2 + fy**2 - (all_r**2)[None, :, None]
+    b = fx * dx + fy * dy
+    disc = b**2 - cc
+    with np.errstate(invalid="ignore"):
+        t = np.where((b < 0) & (disc >= 0), -b - np.sqrt(disc), np.inf)
+    t = np.where(cc <= 0, 0.0, t)
+    own = me >= 0
+    t[np.flatnonzero(own), me[own]] = np.inf  # the sensing robot's own disc
+    return np.minimum(ranges, t.min(axis=1))
+
+
+def test_robot_hits_kernels_match_numpy_reference():
+    rng = np.random.default_rng(21)
+    n_all = 60
+    all_x, all_y, all_r = rng.uniform(0, 6, n_all), rng.uniform(0, 6, n_all), rng.uniform(0.05, 0.3, n_all)
+    sensing = np.arange(0, n_all, 3)
+    th = rng.uniform(-np.pi, np.pi, sensing.shape[0])
+    angles = beam_angles(90, 2 * np.pi)
+    base = rng.uniform(0.5, 3.0, (sensing.shape[0], 90))
+    bodies = (all_x, all_y, all_r, sensing)
+    ref = numpy_robot_hits(all_x[sensing], all_y[sensing], th, angles, bodies, base)
+    fast = apply_robot_hits(all_x[sensing], all_y[sensing], th, angles, bodies, base.copy(), 3.0)
+    np.testing.assert_allclose(fast, ref, rtol=1e-12, atol=1e-12)
+    assert (ref < base).any()
+
+
+def test_mixture_kernel_matches_numpy_reference():
+    rng_true = np.random.default_rng(0)
+    true = rng_true.uniform(0.0, 6.0, (200, 50))
+    sigma, p_max, p_short, rmax = 0.3, 0.1, 0.15, 5.0
+    got = apply_beam_noise(true, np.random.default_rng(3), sigma, p_max, p_short, rmax)
+    g = np.random.default_rng(3)  # the documented draws, in order
+    z = g.standard_normal(true.shape)
+    u = g.random(true.shape)
+    expect = np.clip(true + sigma * z, 0.0, rmax)
+    expect = np.where(u < p_max + p_short, true * (u - p_max) / p_short, expect)
+    expect = np.where(u < p_max, rmax, expect)
+    np.testing.assert_allclose(got, expect, rtol=1e-15, atol=0)
+
+
 def test_robot_hits_reference_geometry():
     # ray from the origin along +x; disc of radius 0.5 at (2, 0.3): hit at 2 - sqrt(0.25 - 0.09) = 1.6
     r = robot_hits_reference(np.zeros(1), np.zeros(1), np.zeros(1), np.array([0.0, 0.5, np.pi]),
