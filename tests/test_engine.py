@@ -327,3 +327,18 @@ def test_random_start_respects_region_clearance_and_no_overlap():
                                                  start=StartConfig(region=(0.5, 1.5, 0.5, 1.5))),))
     with pytest.raises(ValueError, match=r"robots\[0\] \('g'\)\.start"):
         Simulation(_room(), crowded)
+
+
+def test_detector_reports_teammates_in_the_observers_body_frame():
+    from teamnav.sim.config import DetectorConfig
+
+    cfg = SimConfig(robots=(RobotGroupConfig(
+        count=3, controller="spy-test-v1", sensors=(), detector=DetectorConfig(max_range_m=3.0),
+        start=StartConfig(poses=((1.0, 1.0, 90.0), (2.0, 1.0, 0.0), (1.0, 5.0, 0.0))),
+    ),))
+    sim = Simulation(_room(), cfg)
+    sim.run(1)
+    dets = sim.brains[0][0].seen[-1].detections
+    # robot 1 is 1 m away on robot 0's right (-90 deg); robot 2 is out of range and behind the stub
+    assert [(d.robot_id, round(d.range_m, 9), round(d.bearing_rad, 9)) for d in dets] == [(1, 1.0, round(-math.pi / 2, 9))]
+    assert sim.brains[0][2].seen[-1].detections == ()

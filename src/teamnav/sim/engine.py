@@ -280,6 +280,9 @@ class Simulation:
 
         self.step_index = 0
         self.recorder = Recorder(n, config.record_every)
+        self.recorder.events = self.places.log
+        if self.radio is not None:
+            self.recorder.comm_counts = self.radio.counts
         self._record()
 
     # ------------------------------------------------------------------ public
@@ -360,9 +363,6 @@ class Simulation:
                         logs[g.sl.start + k] = brain.log()
         s = self.state
         self.recorder.record(self.step_index, self.time_s, s.poses(), self.odometry.pose, s.stalled, logs)
-        self.recorder.events = self.places.log
-        if self.radio is not None:
-            self.recorder.comm = self.radio.counts()
 
     def _observe_and_decide(self, events, inboxes) -> None:
         s = self.state

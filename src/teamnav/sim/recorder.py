@@ -31,7 +31,7 @@ import os
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -121,9 +121,19 @@ class Recorder:
         self._odom = np.zeros((cap, self.n, 3), np.float32)
         self._stalled = np.zeros((cap, self.n), np.bool_)
         self.size = 0
+        #: Place events, each a dict (step, t_s, robot, place, event); the engine shares its list.
         self.events: list[dict] = []
         self.logs: list[dict] = []
-        self.comm: dict = {}
+        #: Returns the radio's traffic counts when asked (set by the engine); None: no radio.
+        self.comm_counts: Callable[[], dict] | None = None
+
+    @property
+    def comm(self) -> dict:
+        """Radio traffic so far (zeros when the run has no radio)."""
+        if self.comm_counts is not None:
+            return self.comm_counts()
+        return {"mode": None, "messages_sent": 0, "bytes_sent": 0, "messages_delivered": 0, "bytes_delivered": 0,
+                "deliveries_lost": 0, "sent_by_kind": {}, "per_robot": {}}
 
     def wants(self, step: int) -> bool:
         """Whether step ``step`` is sampled."""
