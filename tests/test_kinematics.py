@@ -189,19 +189,22 @@ def test_random_driving_on_basement_never_penetrates_and_stall_is_exact():
     res = grid.resolution_m
     geo = np.array([ox, oy, res])
     rng = np.random.default_rng(5)
-    # 60 robots of mixed size packed into free space near one another
+    # 60 robots of two sizes, uniformly over the free space
     from teamnav.sim.config import RobotGroupConfig, StartConfig
     from teamnav.sim.start import start_poses
 
-    xmin, xmax, ymin, ymax = grid.bounds_m
-    groups = [RobotGroupConfig(count=30, radius_m=0.2), RobotGroupConfig(count=30, radius_m=0.12)]
+    # 30 robots over the whole map, 30 smaller ones crowded into 3 m x 3 m of open floor
+    row, col = np.unravel_index(np.argmax(clear), clear.shape)
+    cx, cy = ox + (col + 0.5) * res, oy + (row + 0.5) * res
+    crowd = StartConfig(region=(cx - 1.5, cx + 1.5, cy - 1.5, cy + 1.5))
+    groups = [RobotGroupConfig(count=30, radius_m=0.2), RobotGroupConfig(count=30, radius_m=0.12, start=crowd)]
     poses = start_poses(grid, groups, rng, clear)
     x, y, th = poses[:, 0].copy(), poses[:, 1].copy(), poses[:, 2].copy()
     r = np.repeat([0.2, 0.12], 30)
     n = len(x)
     stalled = np.zeros(n, bool)
-    # keep them close together so they meet: start them all in one region of free space
     total_stalls = 0
+    closest = np.inf
     for step in range(400):
         v = rng.uniform(-0.3, 1.2, n)  # fast: up to 12 cm per 0.1 s step
         w = rng.uniform(-2.0, 2.0, n)
@@ -211,7 +214,9 @@ def test_random_driving_on_basement_never_penetrates_and_stall_is_exact():
         # never inside a wall or another robot
         dw = wall_distance_ref(b, ox, oy, res, x, y)
         assert np.all(dw >= r - 1e-9), f"step {step}: penetration {np.min(dw - r)}"
-        assert pair_gaps(x, y, r) >= -1e-9
+        gap = pair_gaps(x, y, r)
+        assert gap >= -1e-9
+        closest = min(closest, gap)
         # stall flag exactly when the commanded path was blocked (sequential, index order)
         for i in np.flatnonzero(~stalled):
             ex, ey, eth = arc_point(x0[i], y0[i], th0[i], arc[i], turn[i], 1.0)
@@ -222,7 +227,7 @@ def test_random_driving_on_basement_never_penetrates_and_stall_is_exact():
             or_ = np.concatenate([r[:i], r[i + 1:]])
             assert stalled[i] == path_blocked_ref(b, clear, geo, x0[i], y0[i], th0[i], arc[i], turn[i], r[i], ox_, oy_, or_)
         total_stalls += int(stalled.sum())
-    assert total_stalls > 100  # the test really drove into walls and robots
+    assert total_stalls > 100 and closest < 0.01  # the test really drove into walls and into robots
 
 
 @settings(max_examples=60, deadline=None)
@@ -248,7 +253,9 @@ def test_hypothesis_crowd_in_a_box_never_overlaps(seed):
         turn = rng.uniform(-1, 1, 12)
         move_discs(x, y, th, r, np.zeros(12), arc, turn, b, clear, geo, True, stalled)
         assert np.all(wall_distance_ref(b, 0.0, 0.0, 0.1, x, y) >= r - 1e-9)
-        assert pair_gaps(x, y, r) >= -1e-9
+        gap = pair_gaps(x, y, r)
+        assert gap >= -1e-9
+        closest = min(closest, gap)
 
 
 def test_discs_hit_walls_touching_is_allowed():
