@@ -56,6 +56,26 @@ def _lower(keys, k):
     return lo
 
 
+@njit(cache=True)
+def _upper(keys, k):
+    """First index of sorted ``keys`` with ``keys[idx] > k``."""
+    lo = 0
+    hi = keys.shape[0]
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if keys[mid] <= k:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True, inline="always")
+def _rays_in(sorted_ang, a0, a1):
+    """Index range ``[lo, hi)`` of ``sorted_ang`` (ascending) with ``a0 <= angle <= a1``."""
+    return _lower(sorted_ang, a0), _upper(sorted_ang, a1)
+
+
 @njit(cache=True, inline="always")
 def _disc_hit(fx, fy, dx, dy, r2):
     """Distance along unit ray ``(dx, dy)`` from a point at offset ``f = origin - centre``
@@ -74,27 +94,8 @@ def _disc_hit(fx, fy, dx, dy, r2):
 
 
 @njit(cache=True, inline="always")
-def _rays_in(sorted_ang, a0, a1):
-    """Index range ``[lo, hi)`` of ``sorted_ang`` (ascending) with ``a0 <= angle <= a1``."""
-    return _lower(sorted_ang, a0), _upper(sorted_ang, a1)
-
-
-@njit(cache=True)
-def _upper(keys, k):
-    """First index of sorted ``keys`` with ``keys[idx] > k``."""
-    lo = 0
-    hi = keys.shape[0]
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if keys[mid] <= k:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
-
-
-@njit(cache=True, inline="always")
 def _hit_rays(out, i, lo, hi, ray_order, ct, st, cb, sb, fx, fy, r2):
+    """Shorten ``out[i, ray_order[lo:hi]]`` by a disc at offset ``f = origin - centre``."""
     for k in range(lo, hi):
         b = ray_order[k]
         dx = ct * cb[b] - st * sb[b]
