@@ -37,7 +37,9 @@ class LaserConfig(Model):
     Readings: the ray-cast range plus Gaussian noise ``noise_std_m``; with probability
     ``p_max`` a beam returns ``max_range_m`` (a missed return), with probability ``p_short``
     a uniform random range shorter than the true one (an unexpected object), as in the
-    mixture that Fox et al. §3.1 (and Thrun et al. *Probabilistic Robotics* §6.3) model.
+    mixture that Fox et al. §2.2 (Fig. 1) and Thrun et al. (*Probabilistic Robotics* §6.3)
+    model. Deviation: short readings are uniform on [0, true range) here, where Fox et al. model
+    them as geometric; the filter's model, not the simulator's, is what the paper specifies.
     """
 
     kind: Literal["laser"] = "laser"
@@ -108,7 +110,9 @@ class DetectorConfig(Model):
       N(0, ``bearing_noise_std_deg``) (Fox et al. §4);
     - ``noise_model="occlusion"``: Sgorbissa & Arkin eqs. 1–2,
       ``d_p = d_r + d_r·d_noise``, ``α_p = α_r + atan(size / 2 d_r)·α_noise`` with
-      ``d_noise, α_noise ~ U[-err_max, err_max]`` and ``size`` the seen robot's diameter.
+      ``d_noise ~ U[-err_max, err_max]``, ``α_noise ~ U[-1, 1]`` (§6.1: the bearing error is
+      bounded by the seen robot's angular half-width whatever ``err_max`` is) and ``size``
+      the seen robot's diameter. Perfect sensing is the gaussian model with zero deviations.
 
     ``p_false_negative``: a visible teammate is missed. ``p_false_positive``: per step, a
     phantom detection at a uniform range/bearing within the field of view.
