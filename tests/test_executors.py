@@ -1,0 +1,121 @@
+"""Executors: failures caught in the worker, option checks, local vs Ray give the same metrics."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from teamnav.experiments import metrics as metric_registry
+from teamnav.experiments.executors import LocalExecutor, RayExecutor, TrialTask, execute, make_executor
+from teamnav.experiments.sweep import SweepError, SweepSpec, expand, sweep
+
+
+def bad_metrics_trial(scenario, out_dir):
+    return {"path": [1.0, 2.0]}
+
+
+def ok_trial(scenario, out_dir):
+    return {"count": np.int64(scenario.robots[0].count), "seed": scenario.seed, "out": str(out_dir)}
+
+
+def slow_trial(scenario, out_dir):
+    time.sleep(0.3)
+    return {"seed": scenario.seed}
+
+
+@pytest.fixture(scope="module")
+def trials():
+    return expand(SweepSpec(scenario="demo", grid={"robots.0.count": [1, 2]}, seeds=2, duration_s=0.5))
+
+
+def test_execute_returns_metrics_as_plain_python(trials):
+    res = execute(TrialTask(trials[3], ok_trial, "/tmp/x"))
+    assert res.status == "ok" and res.error is None
+    assert res.metrics == {"count": 2, "seed": 1, "out": "/tmp/x"} and type(res.metrics["count"]) is int
+    assert res.trial_id == trials[3].trial_id and res.wall_time_s >= 0 and res.started_at <= res.finished_at
+
+
+def test_execute_catches_errors_in_the_worker(trials):
+    res = execute(TrialTask(trials[0], bad_metrics_trial))
+    assert res.status == "failed" and res.metrics is None
+    assert res.error == "TypeError: metric 'path': expected a number, bool, string or None, received a list"
+    assert "Traceback" in res.traceback
+
+
+def test_default_trial_runs_the_scenario_and_can_write_its_run_folder(trials, tmp_path):
+    res = execute(TrialTask(trials[1], None, str(tmp_path / "run")))
+    assert res.status == "ok", res.traceback
+    assert res.metrics["steps"] == 5 and res.metrics["sim_time_s"] == 0.5
+    assert (tmp_path / "run" / "metrics.json").is_file()
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"name": "dask"}, "executor: expected one of 'local', 'ray', received 'dask'"),
+        ({"name": "local", "workers": 0}, "workers: expected an integer >= 1 or None (all CPUs), received 0"),
+        ({"name": "local", "workers": 1.5}, "received 1.5"),
+        ({"name": "local", "address": "auto"}, "address: expected None with executor='local'"),
+    ],
+)
+def test_make_executor_checks_options(kwargs, words):
+    name = kwargs.pop("name")
+    with pytest.raises(SweepError) as info:
+        make_executor(name, **kwargs)
+    assert words in str(info.value)
+
+
+def test_ray_missing_gives_install_hint(monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda n, *a: None if n == "ray" else real(n, *a))
+    with pytest.raises(SweepError, match=r"pip install 'teamnav\[ray\]'"):
+        make_executor("ray")
+
+
+def test_local_executor_keeps_at_most_workers_in_flight(trials):
+    seen = []
+    t0 = time.perf_counter()
+    LocalExecutor(workers=2).run([TrialTask(t, slow_trial) for t in trials], seen.append)
+    assert sorted(r.trial_id for r in seen) == sorted(t.trial_id for t in trials)
+    assert all(r.status == "ok" for r in seen)
+    assert len({r.pid for r in seen}) <= 2  # two worker processes served the four trials
+    assert time.perf_counter() - t0 >= 0.6  # 4 trials x 0.3 s on 2 workers
+
+
+def test_local_and_ray_executors_give_identical_metrics(tmp_path):
+    ray = pytest.importorskip("ray")
+    grid = {"robots.0.count": [1, 3]}
+    local = sweep("demo", grid=grid, seeds=2, duration_s=1, out_dir=tmp_path / "local", workers=2, progress=False)
+    assert (local.done, local.failed) == (4, 0)
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        remote = sweep("demo", grid=grid, seeds=2, duration_s=1, out_dir=tmp_path / "ray", executor="ray", workers=2,
+                       progress=False)
+        assert ray.is_initialized()  # a session the caller started is left running
+    finally:
+        ray.shutdown()
+    assert (remote.done, remote.failed) == (4, 0), remote.failures
+    a = {r["trial_id"]: r for r in local.rows()}
+    b = {r["trial_id"]: r for r in remote.rows()}
+    assert set(a) == set(b) and len(a) == 4
+    for tid in a:
+        ma = metric_registry.deterministic(a[tid]["metrics"])
+        mb = metric_registry.deterministic(b[tid]["metrics"])
+        assert ma == mb and ma["steps"] == 10
+        assert a[tid]["config_hash"] == b[tid]["config_hash"] and a[tid]["seed"] == b[tid]["seed"]
+    # different seeds really give different runs
+    seeds = {a[t]["seed"]: a[t]["metrics"]["odom_error_m_mean"] for t in a if a[t]["params"]["robots.0.count"] == 3}
+    assert seeds[0] != seeds[1]
+
+
+def test_ray_executor_starts_and_stops_its_own_local_ray(trials):
+    ray = pytest.importorskip("ray")
+    assert not ray.is_initialized()
+    seen = []
+    RayExecutor(workers=2).run([TrialTask(t) for t in trials[:2]], seen.append)
+    assert [r.status for r in seen] == ["ok", "ok"], [r.error for r in seen]
+    assert not ray.is_initialized()
