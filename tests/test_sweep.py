@@ -421,3 +421,28 @@ def test_cli_runs_a_real_sweep_quietly_and_resumes(tmp_path):
     assert rows == [("ok", 5, 1), ("ok", 5, 2)]
     r2 = CliRunner().invoke(_app(), args)
     assert r2.exit_code == 0 and "0 ok, 0 failed, 2 skipped" in r2.output
+
+
+def test_cli_trial_failing_at_run_time_exits_1_and_the_rest_is_stored_with_artifacts(tmp_path):
+    # 400 robots pass validation but cannot be placed in the start region: the run raises
+    out = tmp_path / "o"
+    args = ["sweep", "demo", "--grid", "robots.0.count=1,400", "--duration", "0.5", "--out", str(out), "-j", "1", "--artifacts"]
+    r = CliRunner().invoke(_app(), args)
+    assert r.exit_code == 1, r.output
+    assert "1 ok, 1 failed" in r.output and "could not place robot" in r.output and "robots.0.count=400" in r.output
+    con = sqlite3.connect(out / "results.sqlite")
+    rows = dict(con.execute('SELECT "robots.0.count", status FROM trials').fetchall())
+    (ok_id,) = con.execute("SELECT trial_id FROM trials WHERE status = 'ok'").fetchone()
+    con.close()
+    assert rows == {1: "ok", 400: "failed"}
+    assert (out / "trials" / ok_id / "metrics.json").is_file()  # the ok trial's run folder
+
+
+def test_progress_bar_shows_counts_on_stderr(tmp_path, log, capfd):
+    sweep("demo", grid={"robots.0.count": [1, 3]}, seeds=1, duration_s=1, out_dir=tmp_path / "o", workers=1,
+          trial_fn=fake_trial, progress=True)
+    err = capfd.readouterr().err
+    assert "sweep demo" in err and "2/2" in err and "1 ok" in err and "1 failed" in err
+    sweep("demo", grid={"robots.0.count": [1, 3]}, seeds=1, duration_s=1, out_dir=tmp_path / "o", workers=1,
+          trial_fn=fake_trial, progress=False)
+    assert capfd.readouterr().err == ""
