@@ -296,6 +296,12 @@ def test_store_with_another_configuration_under_the_same_ids_is_refused(tmp_path
     assert len(_executions(log)) == 1
 
 
+def test_unpicklable_trial_fn_is_refused_before_anything_runs(tmp_path):
+    with pytest.raises(SweepError, match=r"trial_fn: expected a module-level function .* cannot be pickled"):
+        sweep("demo", seeds=1, out_dir=tmp_path / "o", trial_fn=lambda scn, out: {"x": 1}, progress=False)
+    assert not (tmp_path / "o").exists()
+
+
 def test_a_worker_that_dies_fails_its_trial_and_the_sweep_goes_on(tmp_path, log):
     res = sweep("demo", grid={"robots.0.count": [1, 3, 2]}, seeds=1, duration_s=1, out_dir=tmp_path / "o", workers=1,
                 trial_fn=crash_trial, progress=False)

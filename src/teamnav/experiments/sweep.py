@@ -49,6 +49,7 @@ import hashlib
 import itertools
 import json
 import os
+import pickle
 import time
 from dataclasses import dataclass, field
 from importlib import resources
@@ -450,6 +451,8 @@ def resolve_spec(
         if text in sweep_names() or _is_sweep_file(text):
             base = load_sweep(text)
         else:
+            if _looks_like_path(text) and Path(text).exists():
+                text = str(Path(text).resolve())  # workers may run elsewhere (another cwd, a Ray node)
             base = _validate_spec({"scenario": text}, f"of scenario {text!r}")
     data = base.model_dump()
     extra_grid = parse_grid(grid)
@@ -762,6 +765,14 @@ def sweep(
     runner = make_executor(executor, workers=workers, address=address)  # checks options, starts nothing
     if trial_fn is not None and not callable(trial_fn):
         raise SweepError(f"trial_fn: expected a callable or None, received {trial_fn!r}")
+    if trial_fn is not None and executor == "local":
+        try:
+            pickle.dumps(trial_fn)
+        except Exception:  # noqa: BLE001 - any pickling failure means the workers cannot get it
+            raise SweepError(
+                f"trial_fn: expected a module-level function (spawned worker processes import it by name), "
+                f"received {trial_fn!r}, which cannot be pickled"
+            ) from None
     trials = expand(spec)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
