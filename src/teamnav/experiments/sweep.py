@@ -845,8 +845,10 @@ class _Bar:
             console=Console(stderr=True),
             transient=False,
         )
+        from rich.markup import escape
+
         note = f" ({skipped} already done)" if skipped else ""
-        self._task = self._progress.add_task(f"sweep {name}{note}", total=total, ok=0, failed=0, left=total)
+        self._task = self._progress.add_task(escape(f"sweep {name}{note}"), total=total, ok=0, failed=0, left=total)
         self._total, self._ok, self._failed = total, 0, 0
         self._progress.start()
 
