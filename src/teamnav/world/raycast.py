@@ -66,7 +66,7 @@ DIR_EPS: float = 1e-12
 VERTEX_TOL_CELLS: float = 1e-9
 #: Sub-cell step of :func:`brute_force_reference` [cells].
 REFERENCE_STEP_CELLS: float = 1e-3
-#: Largest clearance stored (uint8); larger free squares are simply jumped in several hops.
+#: Largest code stored (uint8): larger free squares are simply crossed in several jumps.
 _MAX_CLEAR: int = 255
 
 
@@ -357,7 +357,7 @@ def _anchored_squares(free, out):
                 out[r, c] = 1
             else:
                 m = min(out[r + 1, c], out[r, c + 1], out[r + 1, c + 1])
-                out[r, c] = min(np.int64(m) + 1, 255)
+                out[r, c] = min(np.int64(m) + 1, _MAX_CLEAR)
 
 
 def clearance_map(blocking: np.ndarray) -> np.ndarray:
