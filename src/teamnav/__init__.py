@@ -13,11 +13,12 @@ from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
-__all__ = ["__version__", "load_scenario", "run"]
+__all__ = ["__version__", "load_scenario", "run", "sweep"]
 
 if TYPE_CHECKING:  # pragma: no cover
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
+    from teamnav.experiments.sweep import sweep
 
 
 def __getattr__(name: str) -> Any:
@@ -31,4 +32,8 @@ def __getattr__(name: str) -> Any:
         from teamnav.experiments.runner import run
 
         return run
+    if name == "sweep":
+        from teamnav.experiments.sweep import sweep
+
+        return sweep
     raise AttributeError(f"module 'teamnav' has no attribute {name!r}")

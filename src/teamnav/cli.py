@@ -1,4 +1,4 @@
-"""The ``teamnav`` command: list, run and validate scenarios.
+"""The ``teamnav`` command: list, run, validate and sweep scenarios.
 
 The CLI only parses, loads the scenario and calls the library (STYLE habit 17). Every bad
 input (a scenario, a map, an override, an output folder) ends in one message on stderr and
@@ -186,6 +186,11 @@ def validate(
         f"seed {scn.seed}",
         markup=False,
     )
+
+
+from teamnav.experiments.sweep_cli import sweep_command  # noqa: E402  (after the app exists)
+
+app.command("sweep")(sweep_command)
 
 
 def main() -> None:  # pragma: no cover - console entry for `python -m teamnav`
