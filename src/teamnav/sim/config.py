@@ -251,6 +251,10 @@ class SimConfig(Model):
     seed: int = Field(0, ge=0, le=2**63 - 1)
     robot_collisions: bool = True
     record_every: int = Field(1, ge=1, le=1_000_000)
+    #: also record, at every recorded step, what robots sensed and said: each range sensor's
+    #: scan, the robot detector's detections and the delivered radio messages (the recorder's
+    #: ``scan.*`` arrays and ``detections`` / ``messages`` segment layers, for replays and MCAP)
+    record_scans: bool = False
 
     @field_validator("robots")
     @classmethod

@@ -283,6 +283,10 @@ class Simulation:
         self.recorder.events = self.places.log
         if self.radio is not None:
             self.recorder.comm_counts = self.radio.counts
+        self._rec_sensing = bool(config.record_scans)
+        if self._rec_sensing:
+            self.recorder.declare_layer("detections", "segments", description="robot detector: observer to detected robot")
+            self.recorder.declare_layer("messages", "segments", description="radio message delivered: sender to receiver")
         self._record()
 
     # ------------------------------------------------------------------ public
@@ -346,6 +350,8 @@ class Simulation:
         self.odometry.step(self._x0, self._y0, self._th0, s.x_m, s.y_m, s.theta_rad)
         events = self.places.update(self.step_index, self.time_s, s.x_m, s.y_m) if self.places.active else None
         inboxes = self.radio.collect() if self.radio is not None and self.radio.has_pending else None
+        if inboxes is not None and self._rec_sensing and self.recorder.wants(self.step_index):
+            self._record_messages(inboxes)
         self._observe_and_decide(events, inboxes)
         if self.recorder.wants(self.step_index):
             self._record()
@@ -381,6 +387,8 @@ class Simulation:
                     robot_ids=grp.ids.copy(), step=step, time_s=t, odom_pose=odom[sl], ranges_m=ranges,
                     angles_rad=grp.angles[0], max_range_m=float(sensor.max_range_m), stalled=s.stalled[sl].copy(),
                 )
+                if self._rec_sensing and self.recorder.wants(step):
+                    self._record_sensing(grp, [(sensor.name, ranges)], None)
                 act = grp.brain.step_batch(obs)
                 self._apply_batch(grp, act)
                 continue
@@ -392,6 +400,8 @@ class Simulation:
             dets = None
             if grp.detector is not None:
                 dets = grp.detector.detect(xs, ys, ths, s.radius_m, grp.ids, grp.detector_rng, self._ids_all)
+            if self._rec_sensing and self.recorder.wants(step):
+                self._record_sensing(grp, [(r[0], r[1]) for r in readings], dets)
             stalled = s.stalled[sl].tolist()
             for k, brain in enumerate(grp.brain):
                 i = sl.start + k
@@ -440,5 +450,34 @@ class Simulation:
                              f"got {v.shape} and {w.shape}")
         self._v_cmd[grp.sl] = v
         self._w_cmd[grp.sl] = w
+
+    # ------------------------------------------------------------------ recording what was sensed and said
+    def _record_sensing(self, grp: _Group, scans: list, dets) -> None:
+        """Record a group's scans (``[(sensor name, ranges (n, B))]``) and its detections as
+        world segments from each observer's true pose (``config.record_scans``)."""
+        step = self.step_index
+        for (name, ranges), sensor, angles in zip(scans, grp.sensors, grp.angles):
+            key = f"g{grp.index}_" + "".join(c if c.isalnum() or c in "_-" else "_" for c in name)
+            self.recorder.add_scan(key, step, grp.ids, ranges, angles_rad=angles, max_range_m=float(sensor.max_range_m),
+                                   group=grp.cfg.name, sensor=name, kind=str(getattr(sensor, "kind", "")))
+        if dets is None:
+            return
+        s = self.state
+        for k, seen in enumerate(dets):
+            if not seen:
+                continue
+            i = int(grp.ids[k])
+            x, y, th = float(s.x_m[i]), float(s.y_m[i]), float(s.theta_rad[i])
+            rows = [(x, y, x + d.range_m * math.cos(th + d.bearing_rad), y + d.range_m * math.sin(th + d.bearing_rad))
+                    for d in seen]
+            self.recorder.add_layer_sample("detections", step, i, rows)
+
+    def _record_messages(self, inboxes) -> None:
+        """Record this step's deliveries as world segments sender → receiver (true positions)."""
+        xs, ys = self.state.x_m, self.state.y_m
+        for r, box in enumerate(inboxes):
+            if box:
+                rows = [(xs[m.sender], ys[m.sender], xs[r], ys[r]) for m in box if 0 <= m.sender < self.n_robots]
+                self.recorder.add_layer_sample("messages", self.step_index, r, rows)
 
 
