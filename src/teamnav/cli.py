@@ -14,6 +14,9 @@ Examples
     teamnav run my_scenario.yaml --out runs/mine --gif
     teamnav run runs/mine/scenario.yaml --out runs/again      # reproduces runs/mine
     teamnav validate my_scenario.yaml
+    teamnav run demo --set record_scans=true --html             # + runs/demo-*/replay.html
+    teamnav replay runs/mine --out mine.html --every 2
+    teamnav export runs/mine --mcap mine.mcap                   # open in Foxglove
 """
 
 from __future__ import annotations
@@ -148,6 +151,7 @@ def run(
     gif: bool = typer.Option(False, "--gif", help="Also write run.gif."),
     force: bool = typer.Option(False, "--force", help="Replace --out if it exists and is not empty."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no table; print only the run folder."),
+    html: bool = typer.Option(False, "--html", help="Also write replay.html (see `teamnav replay`)."),
 ) -> None:
     """Run a scenario, write its run folder and print its metrics."""
     from teamnav.experiments.runner import run as run_scenario
@@ -157,6 +161,10 @@ def run(
         scn = load_scenario(scenario, overrides=set_ or None, seed=seed, duration_s=duration)
         target = out if out is not None else _default_out(scn.name)
         result = run_scenario(scn, out_dir=target, progress=False if quiet else None, gif=gif, force=force)
+        if html:
+            from teamnav.viz.replay import build_replay
+
+            build_replay(result.run_dir)
     con = _out()
     if quiet:
         con.print(str(result.run_dir), markup=False)
@@ -186,6 +194,40 @@ def validate(
         f"seed {scn.seed}",
         markup=False,
     )
+
+
+# ---------------------------------------------------------------------------- replay / export
+@app.command()
+def replay(
+    run_dir: Path = typer.Argument(..., help="A run folder (written by `teamnav run`)."),
+    out: Optional[Path] = typer.Option(None, "--out", help="HTML file to write (default RUN_DIR/replay.html)."),
+    every: int = typer.Option(1, "--every", help="Keep every K-th recorded sample as a frame."),
+    max_frames: int = typer.Option(5000, "--max-frames", help="At most this many frames (--every grows to fit)."),
+    max_points: int = typer.Option(300, "--max-points", help="At most this many points per sample of a points layer."),
+    no_scans: bool = typer.Option(False, "--no-scans", help="Leave recorded range scans out (smaller file)."),
+) -> None:
+    """Write a self-contained HTML replay of a run (open it from disk in any browser)."""
+    from teamnav.viz.replay import build_replay
+
+    with _bad_input_exits():
+        stats = build_replay(run_dir, out, every=every, max_frames=max_frames, max_points=max_points, scans=not no_scans)
+    _out().print(f"{stats.path}  ({stats.bytes / 1e6:.2f} MB, {stats.n_frames} frames of {stats.n_robots} robots; "
+                 f"layers: {', '.join(stats.layers)})", markup=False)
+
+
+@app.command()
+def export(
+    run_dir: Path = typer.Argument(..., help="A run folder (written by `teamnav run`)."),
+    mcap: Path = typer.Option(..., "--mcap", help="MCAP file to write (opens in Foxglove)."),
+    force: bool = typer.Option(False, "--force", help="Replace the MCAP file if it exists."),
+) -> None:
+    """Export a run to MCAP with Foxglove's well-known schemas (map, poses, scans, frames, markers)."""
+    from teamnav.viz.mcap_export import export_mcap
+
+    with _bad_input_exits():
+        stats = export_mcap(run_dir, mcap, force=force)
+    _out().print(f"{stats.path}  ({stats.bytes / 1e6:.2f} MB, {stats.messages} messages on {stats.channels} channels)",
+                 markup=False)
 
 
 from teamnav.experiments.sweep_cli import sweep_command  # noqa: E402  (after the app exists)

@@ -394,7 +394,7 @@ class Recorder:
                 spec = {"kind": "points", "data": value}
             kind = spec.get("kind", "points")
             default_hold = kind != "segments"
-            self.declare_layer(name, kind, frame=spec.get("frame", "odom"), hold=bool(spec.get("hold", default_hold)),
+            self.declare_layer(name, kind, frame=spec.get("frame", "world" if kind == "state" else "odom"), hold=bool(spec.get("hold", default_hold)),
                                description=spec.get("description", ""))
             self.add_layer_sample(name, step, robot, spec["data"])
 
