@@ -333,6 +333,8 @@ def build_replay(
     for name in sorted(rec.layers):
         lay = rec.layers[name]
         S = lay.step.shape[0]
+        if S == 0:  # declared but never written (e.g. no radio in a swarm run): nothing to toggle
+            continue
         f = frame_of(lay.step)
         keep = f < F
         counts = np.diff(lay.offset)
