@@ -126,3 +126,13 @@ def test_cli_replay_writes_the_file_and_refuses_bad_folders(lab_run, tmp_path):
     (tmp_path / "empty").mkdir()
     res = runner.invoke(app, ["replay", str(tmp_path / "empty")])
     assert res.exit_code == 2 and "not a run folder" in res.output
+
+
+def test_cli_run_html_writes_the_replay_next_to_the_run(tmp_path):
+    _replay_run.register()
+    yml = tmp_path / "lab.yaml"
+    yml.write_text(_replay_run.SCENARIO, encoding="utf-8")
+    res = CliRunner().invoke(app, ["run", str(yml), "--duration", "1", "--out", str(tmp_path / "r"), "--html", "--quiet"])
+    assert res.exit_code == 0, res.output
+    meta, arrays = _decode((tmp_path / "r" / "replay.html").read_text(encoding="utf-8"))
+    assert meta["n_frames"] == 11 and meta["n_robots"] == 3 and meta["scans"][0]["beams"] == 24
