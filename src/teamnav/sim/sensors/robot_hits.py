@@ -28,17 +28,32 @@ Cost per step: O(N log N) for the hash plus O(sum over i of neighbours_i × rays
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["PARALLEL_MIN_RAYS", "apply_robot_hits", "robot_hits_reference"]
+__all__ = ["PARALLEL_MIN_RAYS", "BeamPlan", "apply_robot_hits", "beam_plan", "check_bodies", "default_cell_m",
+           "robot_hits_reference", "robot_hits_unchecked"]
 
 #: Extra half-width [rad] of the angular window of rays tested against a disc, so that a
-#: ray grazing the disc is never skipped because of rounding in ``atan2``/``asin``.
-_ANGLE_MARGIN_RAD: float = 1e-9
+#: ray grazing the disc is never skipped: covers :func:`_fast_atan2`'s error (< 4e-8 rad)
+#: and rounding.
+_ANGLE_MARGIN_RAD: float = 1e-6
+#: Odd minimax polynomial ``atan(a) ~ a P(a^2)`` on ``[0, 1]`` (8 terms, |error| < 4e-8 rad;
+#: Abramowitz & Stegun 4.4.49 form, coefficients refitted), tested in tests/test_sensors.py.
+_ATAN_COEFFS = (0.9999993355776595, -0.33329860775195863, 0.19946565505954247, -0.13908628679642634,
+                0.09642194818765205, -0.055912289332481796, 0.021862930032968544, -0.00405455905160092)
 #: Fewest rays (sensing robots x rays) for which :func:`apply_robot_hits` goes parallel by default.
 PARALLEL_MIN_RAYS: int = 20_000
+#: Added to a robot's longest ray [m] before discs are culled by distance, so that a hit
+#: at (almost) exactly that range is never lost to rounding of ``d - r``.
+_REACH_SLACK_M: float = 1e-9
+#: Largest deviation [rad] of a ray from the even fan ``first + k * step`` for the fan to
+#: be indexed by arithmetic (far below ``_ANGLE_MARGIN_RAD``).
+_EVEN_TOL_RAD: float = 1e-12
+#: Hash cells per robot at most (the cell side grows beyond that: sparse, huge worlds).
+_CELLS_PER_ROBOT: int = 4
 
 
 # ---------------------------------------------------------------------------- kernels
@@ -71,9 +86,24 @@ def _upper(keys, k):
 
 
 @njit(cache=True, inline="always")
-def _rays_in(sorted_ang, a0, a1):
-    """Index range ``[lo, hi)`` of ``sorted_ang`` (ascending) with ``a0 <= angle <= a1``."""
-    return _lower(sorted_ang, a0), _upper(sorted_ang, a1)
+def _fast_atan2(y, x):
+    """``atan2(y, x)`` in ``[-pi, pi]`` to within 4e-8 rad (polynomial, no libm call; 0 at the origin)."""
+    ax = abs(x)
+    ay = abs(y)
+    mx = max(ax, ay)
+    if mx == 0.0:
+        return 0.0
+    a = min(ax, ay) / mx
+    s = a * a
+    c0, c1, c2, c3, c4, c5, c6, c7 = _ATAN_COEFFS
+    r = a * (c0 + s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * (c5 + s * (c6 + s * c7)))))))
+    if ay > ax:
+        r = 0.5 * math.pi - r
+    if x < 0.0:
+        r = math.pi - r
+    if y < 0.0:
+        r = -r
+    return r
 
 
 @njit(cache=True, inline="always")
@@ -94,99 +124,191 @@ def _disc_hit(fx, fy, dx, dy, r2):
 
 
 @njit(cache=True, inline="always")
-def _hit_rays(out, i, lo, hi, ray_order, ct, st, cb, sb, fx, fy, r2):
-    """Shorten ``out[i, ray_order[lo:hi]]`` by a disc at offset ``f = origin - centre``."""
-    for k in range(lo, hi):
-        b = ray_order[k]
-        dx = ct * cb[b] - st * sb[b]
-        dy = st * cb[b] + ct * sb[b]
-        t = _disc_hit(fx, fy, dx, dy, r2)
-        if t < out[i, b]:
-            out[i, b] = t
+def _disc_hit_cc(fx, fy, cc, dx, dy):
+    """:func:`_disc_hit` with ``cc = |f|^2 - r^2`` computed once per disc (same arithmetic)."""
+    if cc <= 0.0:
+        return 0.0
+    b = fx * dx + fy * dy
+    if b >= 0.0:
+        return np.inf
+    disc = b * b - cc
+    if disc < 0.0:
+        return np.inf
+    return -b - math.sqrt(disc)
+
+
+@njit(cache=True, inline="always")
+def _even_span(lo, hi, inv_step, nb):
+    """Beams ``[k0, k1)`` of an even fan (beam ``k`` at ``k * step`` past the first) inside ``[lo, hi]``."""
+    k0 = max(0, int(math.ceil(lo * inv_step)))
+    k1 = min(nb, int(math.floor(hi * inv_step)) + 1)
+    return k0, k1
 
 
 @njit(cache=True)
-def _robot_hits_one(i, xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
-                    order, keys, x0, y0, cell, nky, nkx, rmax, out):
+def _build_hash(all_x, all_y, all_r, cell_m, max_cells):
+    """Bucket the discs in a dense grid of square cells (counting sort).
+
+    Returns ``(sx, sy, sr, sid, start, x0, y0, cell, nkx, nky)``: disc coordinates, radii
+    and indices in cell order (cell ``kx * nky + ky`` holds ``start[c]:start[c + 1]``). The
+    cell side grows past ``cell_m`` if the grid would have more than ``max_cells`` cells.
+    """
+    n = all_x.shape[0]
+    x0 = all_x.min()
+    y0 = all_y.min()
+    wx = all_x.max() - x0
+    wy = all_y.max() - y0
+    cell = cell_m
+    while (math.floor(wx / cell) + 1.0) * (math.floor(wy / cell) + 1.0) > max_cells:
+        cell *= 1.5
+    nkx = int(math.floor(wx / cell)) + 1
+    nky = int(math.floor(wy / cell)) + 1
+    key = np.empty(n, np.int64)
+    start = np.zeros(nkx * nky + 1, np.int64)
+    for j in range(n):
+        kx = min(nkx - 1, int(math.floor((all_x[j] - x0) / cell)))
+        ky = min(nky - 1, int(math.floor((all_y[j] - y0) / cell)))
+        key[j] = kx * nky + ky
+        start[key[j] + 1] += 1
+    for c in range(nkx * nky):
+        start[c + 1] += start[c]
+    fill = start[:-1].copy()
+    sx = np.empty(n)
+    sy = np.empty(n)
+    sr = np.empty(n)
+    sid = np.empty(n, np.int64)
+    for j in range(n):  # ascending j within a cell: a stable order
+        s = fill[key[j]]
+        fill[key[j]] += 1
+        sx[s] = all_x[j]
+        sy[s] = all_y[j]
+        sr[s] = all_r[j]
+        sid[s] = j
+    return sx, sy, sr, sid, start, x0, y0, cell, nkx, nky
+
+
+@njit(cache=True)
+def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
     """Shorten row ``i`` of ``out`` (map ranges, modified in place) by other robots' discs.
 
-    ``order``: robot indices sorted by hash key, ``keys``: their sorted keys
-    ``kx * nky + ky`` with ``kx = floor((x - x0) / cell)`` (``0 <= kx < nkx``).
-    ``sorted_ang``: the ray directions wrapped to ``[-pi, pi)`` in ascending order,
-    ``ray_order`` their ray indices. A disc at distance ``d`` and body-frame bearing ``phi``
-    can only be met by rays within ``asin(r / d)`` of ``phi``: those are found by binary
-    search and intersected exactly (a margin of ``_ANGLE_MARGIN_RAD`` absorbs rounding).
+    ``beams = (cb, sb, sorted_ang, ray_order)``: cos/sin of the ray directions, the
+    directions wrapped to ``[-pi, pi)`` in ascending order and their ray indices.
+    ``even = (is_even, first, inv_step)``: when the rays form an even fan (ray ``k`` at
+    ``first + k * step``, all within one turn; then ``ray_order`` is the identity) a disc's
+    rays are found by arithmetic, otherwise by binary search in ``sorted_ang``.
+    ``hsh``: :func:`_build_hash`'s result and the largest radius.
+
+    A disc of radius ``r`` at distance ``d`` and body-frame bearing ``phi`` can only be met
+    by rays within ``asin(r / d)`` of ``phi``; the window used is the wider
+    ``r / sqrt(d^2 - r^2)`` (``tan >= angle``, and no ``asin``) plus ``_ANGLE_MARGIN_RAD``,
+    and every ray inside it is intersected exactly, so the result is that of testing every
+    ray. A disc is skipped before any angle is computed when ``d - r`` is beyond the longest
+    ray of robot ``i``.
     """
+    cb, sb, sorted_ang, ray_order = beams
+    is_even, first, inv_step, front, mid = even
+    sx, sy, sr, sid, start, x0, y0, cell, nkx, nky, rmax = hsh
     nb = cb.shape[0]
     two_pi = 2.0 * math.pi
     px = xs[i]
     py = ys[i]
+    cti = ct[i]
+    sti = st[i]
     me = self_idx[i]
+    # rays of a fan no wider than a half-turn stay in the half-plane ahead of its middle
+    # direction: a disc wholly behind that line is skipped before any angle is computed
+    hx = math.cos(mid) * cti - math.sin(mid) * sti if front else 0.0
+    hy = math.cos(mid) * sti + math.sin(mid) * cti if front else 0.0
     reach = 0.0
     for b in range(nb):
-        if out[i, b] > reach:
-            reach = out[i, b]
+        reach = max(reach, out[i, b])
     if reach <= 0.0:
         return
+    reach += _REACH_SLACK_M
     half = reach + rmax
     kx0 = max(0, int(math.floor((px - half - x0) / cell)))
     kx1 = min(nkx - 1, int(math.floor((px + half - x0) / cell)))
     ky0 = max(0, int(math.floor((py - half - y0) / cell)))
     ky1 = min(nky - 1, int(math.floor((py + half - y0) / cell)))
     for kx in range(kx0, kx1 + 1):
-        # cells (kx, ky0..ky1) are contiguous in key order
-        lo = _lower(keys, kx * nky + ky0)
-        hi = _lower(keys, kx * nky + ky1 + 1)
-        for s in range(lo, hi):
-            j = order[s]
-            if j == me:
+        # cells (kx, ky0..ky1) are contiguous
+        s0 = start[kx * nky + ky0]
+        s1 = start[kx * nky + ky1 + 1]
+        for s in range(s0, s1):
+            gx = sx[s] - px  # sensor -> centre
+            gy = sy[s] - py
+            r = sr[s]
+            d2 = gx * gx + gy * gy
+            lim = reach + r
+            if d2 >= lim * lim or sid[s] == me or gx * hx + gy * hy < -r - _REACH_SLACK_M:
                 continue
-            fx = px - all_x[j]
-            fy = py - all_y[j]
-            r = all_r[j]
-            d2 = fx * fx + fy * fy
-            d = math.sqrt(d2)
-            if d - r >= reach:
-                continue
-            if d2 <= r * r:  # sensor inside the disc: every ray stops at once
+            r2 = r * r
+            if d2 <= r2:  # sensor inside the disc: every ray stops at once
                 for b in range(nb):
                     out[i, b] = 0.0
                 continue
-            # bearing of the centre in the body frame, wrapped to [-pi, pi)
-            phi = math.atan2(-fy, -fx) - thetas[i]
-            phi -= two_pi * math.floor((phi + math.pi) / two_pi)
-            beta = math.asin(r / d) + _ANGLE_MARGIN_RAD
-            a0 = phi - beta
-            a1 = phi + beta
-            r2 = r * r
-            if a0 < -math.pi:
-                l0, h0 = _rays_in(sorted_ang, a0 + two_pi, math.pi)
-                _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
-                a0 = -math.pi
-            elif a1 >= math.pi:
-                l0, h0 = _rays_in(sorted_ang, -math.pi, a1 - two_pi)
-                _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
-                a1 = math.pi
-            l0, h0 = _rays_in(sorted_ang, a0, a1)
-            _hit_rays(out, i, l0, h0, ray_order, ct[i], st[i], cb, sb, fx, fy, r2)
+            near = math.sqrt(d2) - r - _REACH_SLACK_M  # no hit is nearer
+            # bearing of the centre in the body frame, in [-pi, pi]
+            phi = _fast_atan2(cti * gy - sti * gx, cti * gx + sti * gy)
+            beta = r / math.sqrt(d2 - r2) + _ANGLE_MARGIN_RAD
+            # the rays to intersect: positions [ka0, ka1) and [kb0, kb1) in ray_order
+            kb0 = 0
+            kb1 = 0
+            if beta >= math.pi:
+                ka0 = 0
+                ka1 = nb
+            elif is_even:
+                u = phi - first
+                u -= two_pi * math.floor(u / two_pi)  # [0, 2 pi)
+                ka0, ka1 = _even_span(u - beta, u + beta, inv_step, nb)
+                if u - beta < 0.0:
+                    kb0, kb1 = _even_span(u - beta + two_pi, u + beta + two_pi, inv_step, nb)
+                elif u + beta >= two_pi:
+                    kb0, kb1 = _even_span(u - beta - two_pi, u + beta - two_pi, inv_step, nb)
+            else:
+                if phi >= math.pi:
+                    phi -= two_pi
+                a0 = phi - beta
+                a1 = phi + beta
+                ka0 = _lower(sorted_ang, a0)
+                ka1 = _upper(sorted_ang, a1)
+                if a0 < -math.pi:
+                    kb0 = _lower(sorted_ang, a0 + two_pi)
+                    kb1 = nb
+                elif a1 >= math.pi:
+                    kb1 = _upper(sorted_ang, a1 - two_pi)
+            # written out here rather than in a helper: numba increfs/decrefs every array
+            # handed to a call (even an inlined one), which cost more than the rays
+            fx = -gx  # origin - centre
+            fy = -gy
+            cc = d2 - r2  # > 0: the origin is outside the disc
+            for part in range(2):
+                k0 = ka0 if part == 0 else kb0
+                k1 = ka1 if part == 0 else kb1
+                for k in range(k0, k1):
+                    # _disc_hit's arithmetic with selects for branches (short spans mispredict)
+                    b = ray_order[k]
+                    dx = cti * cb[b] - sti * sb[b]
+                    dy = sti * cb[b] + cti * sb[b]
+                    bb = fx * dx + fy * dy
+                    disc = bb * bb - cc
+                    t = -bb - math.sqrt(max(disc, 0.0))
+                    t = t if (bb < 0.0 and disc >= 0.0) else np.inf
+                    out[i, b] = min(out[i, b], t)
 
 
 @njit(cache=True, parallel=True)
-def _robot_hits_parallel(xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
-                         order, keys, x0, y0, cell, nky, nkx, rmax, out):
+def _robot_hits_parallel(xs, ys, ct, st, self_idx, beams, even, hsh, out):
     """:func:`_robot_hits_one` for every sensing robot, spread over numba's threads."""
     for i in prange(xs.shape[0]):
-        _robot_hits_one(i, xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
-                        order, keys, x0, y0, cell, nky, nkx, rmax, out)
+        _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out)
 
 
 @njit(cache=True)
-def _robot_hits_serial(xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
-                       order, keys, x0, y0, cell, nky, nkx, rmax, out):
+def _robot_hits_serial(xs, ys, ct, st, self_idx, beams, even, hsh, out):
     """:func:`_robot_hits_one` for every sensing robot, in this thread."""
     for i in range(xs.shape[0]):
-        _robot_hits_one(i, xs, ys, ct, st, thetas, cb, sb, sorted_ang, ray_order, self_idx, all_x, all_y, all_r,
-                        order, keys, x0, y0, cell, nky, nkx, rmax, out)
+        _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out)
 
 
 @njit(cache=True)
@@ -208,6 +330,69 @@ def _reference_kernel(xs, ys, ct, st, cb, sb, self_idx, all_x, all_y, all_r, out
 
 
 # ---------------------------------------------------------------------------- API
+class BeamPlan(NamedTuple):
+    """What :func:`_robot_hits_one` needs to know of a sensor's ray directions (built once).
+
+    Attributes
+    ----------
+    beams : tuple of 4 ndarrays
+        ``(cos (R,), sin (R,), sorted_ang (R,), ray_order (R,) int64)``: the directions
+        wrapped to ``[-pi, pi)`` in ascending order and the ray index of each (the identity
+        for an even fan).
+    even : tuple (bool, float, float, bool, float)
+        ``(is_even, first_rad, 1 / step_rad, front, mid_rad)``: ray ``k`` is at
+        ``first + k * step`` to within ``_EVEN_TOL_RAD`` and the fan spans less than a turn;
+        ``front``: the fan spans at most a half-turn around ``mid_rad`` (so no ray leaves
+        the half-plane ahead of that direction).
+    """
+
+    beams: tuple
+    even: tuple
+
+
+def beam_plan(angles_rad: np.ndarray) -> BeamPlan:
+    """The :class:`BeamPlan` of ray directions ``angles_rad`` (R,) [rad] (unchecked)."""
+    angles = np.ascontiguousarray(angles_rad, dtype=np.float64)
+    nb = angles.shape[0]
+    even = False
+    first, inv_step = 0.0, 0.0
+    if nb == 1:
+        even, first, inv_step = True, float(angles[0]), 1.0 / (2 * np.pi)
+    elif nb > 1:
+        step = (angles[-1] - angles[0]) / (nb - 1)
+        fan = angles[0] + step * np.arange(nb)
+        if step > 0 and step * nb <= 2 * np.pi + _EVEN_TOL_RAD and np.max(np.abs(angles - fan)) <= _EVEN_TOL_RAD:
+            even, first, inv_step = True, float(angles[0]), 1.0 / step
+    front, mid = False, 0.0
+    if even and nb > 1:
+        mid = float(0.5 * (angles[0] + angles[-1]))
+        front = bool(angles[-1] - angles[0] <= np.pi and np.max(np.abs(angles - mid)) <= 0.5 * np.pi)
+    wrapped = angles - 2 * np.pi * np.floor((angles + np.pi) / (2 * np.pi))  # [-pi, pi)
+    ray_order = np.arange(nb, dtype=np.int64) if even else np.argsort(wrapped, kind="stable").astype(np.int64)
+    beams = (np.cos(angles), np.sin(angles), np.ascontiguousarray(wrapped[ray_order]), ray_order)
+    return BeamPlan(beams, (even, first, inv_step, front, mid))
+
+
+def robot_hits_unchecked(xs, ys, thetas, plan: BeamPlan, all_x, all_y, all_r, self_idx, ranges, cell_m,
+                         parallel: bool) -> np.ndarray:
+    """:func:`apply_robot_hits` without input checks, for callers whose arrays are known good.
+
+    ``xs, ys, thetas, all_x, all_y, all_r`` contiguous float64, ``self_idx`` int64,
+    ``ranges`` (n, R) C-contiguous float64, ``cell_m`` > 0 [m], ``plan`` from
+    :func:`beam_plan`. The engine's sensors call this every step.
+    """
+    n = xs.shape[0]
+    nn = all_x.shape[0]
+    if n == 0 or nn == 0 or ranges.shape[1] == 0:
+        return ranges
+    sx, sy, sr, sid, start, x0, y0, cell, nkx, nky = _build_hash(all_x, all_y, all_r, float(cell_m),
+                                                                 _CELLS_PER_ROBOT * nn + 16)
+    hsh = (sx, sy, sr, sid, start, x0, y0, cell, nkx, nky, float(sr.max()))
+    kernel = _robot_hits_parallel if parallel else _robot_hits_serial
+    kernel(xs, ys, np.cos(thetas), np.sin(thetas), self_idx, plan.beams, plan.even, hsh, ranges)
+    return ranges
+
+
 def _vec(name: str, value, n: int | None = None, dtype=np.float64) -> np.ndarray:
     arr = np.ascontiguousarray(value, dtype=dtype)
     if arr.ndim != 1 or (n is not None and arr.shape[0] != n):
@@ -218,12 +403,8 @@ def _vec(name: str, value, n: int | None = None, dtype=np.float64) -> np.ndarray
     return arr
 
 
-def _check_inputs(xs, ys, thetas, angles_rad, bodies, ranges):
-    xs = _vec("xs", xs)
-    n = xs.shape[0]
-    ys = _vec("ys", ys, n)
-    thetas = _vec("thetas", thetas, n)
-    angles = _vec("angles_rad", angles_rad)
+def check_bodies(bodies, n: int) -> tuple:
+    """Validated ``bodies`` tuple ``(all_x (N,), all_y (N,), all_radius (N,) >= 0, self_index (n,) int64)``."""
     if not (isinstance(bodies, tuple) and len(bodies) == 4):
         raise ValueError(
             "bodies must be a tuple (all_x (N,), all_y (N,), all_radius (N,), self_index (n,)), "
@@ -236,6 +417,16 @@ def _check_inputs(xs, ys, thetas, angles_rad, bodies, ranges):
     if np.any(all_r < 0.0):
         raise ValueError(f"bodies[2] (all_radius) must be >= 0 [m], got min {float(all_r.min())}")
     self_idx = _vec("bodies[3] (self_index)", bodies[3], n, dtype=np.int64)
+    return all_x, all_y, all_r, self_idx
+
+
+def _check_inputs(xs, ys, thetas, angles_rad, bodies, ranges):
+    xs = _vec("xs", xs)
+    n = xs.shape[0]
+    ys = _vec("ys", ys, n)
+    thetas = _vec("thetas", thetas, n)
+    angles = _vec("angles_rad", angles_rad)
+    all_x, all_y, all_r, self_idx = check_bodies(bodies, n)
     if not (isinstance(ranges, np.ndarray) and ranges.dtype == np.float64 and ranges.shape == (n, angles.shape[0])
             and ranges.flags.c_contiguous and ranges.flags.writeable):
         raise ValueError(
@@ -262,7 +453,7 @@ def apply_robot_hits(xs, ys, thetas, angles_rad, bodies, ranges, max_range_m, ce
     max_range_m : float
         Sensor range [m]; sets the default hash cell.
     cell_m : float, optional
-        Side of the hash cells [m]; default ``max_range_m + max(all_radius)``.
+        Side of the hash cells [m]; default :func:`default_cell_m` (half the sensor's reach).
     parallel : bool or None, default None
         Spread sensing robots over numba's threads. None: only when there are at least
         ``PARALLEL_MIN_RAYS`` rays in all (below that, waking the threads costs more than
@@ -290,28 +481,16 @@ def apply_robot_hits(xs, ys, thetas, angles_rad, bodies, ranges, max_range_m, ce
         return ranges
     if parallel is None:
         parallel = n * angles.shape[0] >= PARALLEL_MIN_RAYS
-    rmax = float(all_r.max())
-    cell = float(max_range_m) + rmax if cell_m is None else float(cell_m)
+    cell = default_cell_m(max_range_m, all_r) if cell_m is None else cell_m
     if not (np.isfinite(cell) and cell > 0):
         raise ValueError(f"cell_m must be a positive number of metres, got {cell_m!r}")
-    x0 = float(all_x.min())
-    y0 = float(all_y.min())
-    kx = np.floor((all_x - x0) / cell).astype(np.int64)
-    ky = np.floor((all_y - y0) / cell).astype(np.int64)
-    nkx = int(kx.max()) + 1
-    nky = int(ky.max()) + 1
-    keys = kx * nky + ky
-    order = np.argsort(keys, kind="stable").astype(np.int64)
-    skeys = np.ascontiguousarray(keys[order])
-    wrapped = angles - 2 * np.pi * np.floor((angles + np.pi) / (2 * np.pi))  # [-pi, pi)
-    ray_order = np.argsort(wrapped, kind="stable").astype(np.int64)
-    kernel = _robot_hits_parallel if parallel else _robot_hits_serial
-    kernel(
-        xs, ys, np.cos(thetas), np.sin(thetas), thetas, np.cos(angles), np.sin(angles),
-        np.ascontiguousarray(wrapped[ray_order]), ray_order, self_idx,
-        all_x, all_y, all_r, order, skeys, x0, y0, cell, nky, nkx, rmax, ranges,
-    )
-    return ranges
+    return robot_hits_unchecked(xs, ys, thetas, beam_plan(angles), all_x, all_y, all_r, self_idx, ranges, float(cell),
+                                bool(parallel))
+
+
+def default_cell_m(max_range_m: float, all_radius: np.ndarray) -> float:
+    """Default hash cell side [m]: ``(max_range_m + max radius) / 2``, floored at 1 mm."""
+    return max(1e-3, 0.5 * (float(max_range_m) + float(np.max(all_radius, initial=0.0))))
 
 
 def robot_hits_reference(xs, ys, thetas, angles_rad, bodies, ranges) -> np.ndarray:
