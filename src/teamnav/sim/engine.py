@@ -76,6 +76,13 @@ def _sensor_factories():
     return build_range_sensor, RobotDetector
 
 
+def _check_bodies():
+    """:func:`teamnav.sim.sensors.robot_hits.check_bodies` (imported lazily)."""
+    from teamnav.sim.sensors.robot_hits import check_bodies
+
+    return check_bodies
+
+
 @dataclass
 class _Group:
     """Runtime of one robot group (engine-internal)."""
@@ -251,11 +258,14 @@ class Simulation:
                     grp.detector = factories[1](g.detector, grid)
                     grp.detector_rng = np.random.default_rng(det_group_ss[gi])
             grp.angles = [_readonly(s.angles_rad) for s in grp.sensors]
-            # Range sensors that see robots get every robot's true disc (sim side only).
-            grp.bodies = [
-                (self.state.x_m, self.state.y_m, self.state.radius_m, grp.ids) if c.sees_robots and n > 1 else None
-                for c in cfgs
-            ]
+            # Range sensors that see robots get every robot's true disc (sim side only). The
+            # tuple holds the state's own arrays (updated in place every step); it is checked
+            # here once, and the per-step sensing path does no checks.
+            bodies = (self.state.x_m, self.state.y_m, self.state.radius_m, grp.ids)
+            if any(c.sees_robots for c in cfgs) and n > 1:
+                checked = _check_bodies()(bodies, g.count)
+                assert all(a is b for a, b in zip(checked, bodies)), "bodies must be the state's own arrays"
+            grp.bodies = [bodies if c.sees_robots and n > 1 else None for c in cfgs]
             self._groups.append(grp)
             self.brains.append(brain)
 
@@ -382,7 +392,7 @@ class Simulation:
             gx, gy, gth = xs[sl], ys[sl], ths[sl]
             if grp.batched:
                 sensor = grp.sensors[0]
-                ranges = sensor.sense(gx, gy, gth, grp.rngs[0], bodies=grp.bodies[0])
+                ranges = sensor._sense(gx, gy, gth, grp.rngs[0], grp.bodies[0])
                 obs = BatchObservation(
                     robot_ids=grp.ids.copy(), step=step, time_s=t, odom_pose=odom[sl], ranges_m=ranges,
                     angles_rad=grp.angles[0], max_range_m=float(sensor.max_range_m), stalled=s.stalled[sl].copy(),
@@ -394,7 +404,7 @@ class Simulation:
                 continue
             delta = self.odometry.delta.copy()
             readings = [
-                (sensor.name, sensor.sense(gx, gy, gth, rng, bodies=bodies), angles, float(sensor.max_range_m))
+                (sensor.name, sensor._sense(gx, gy, gth, rng, bodies), angles, float(sensor.max_range_m))
                 for sensor, rng, angles, bodies in zip(grp.sensors, grp.rngs, grp.angles, grp.bodies)
             ]
             dets = None

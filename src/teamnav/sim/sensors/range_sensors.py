@@ -37,7 +37,7 @@ from numba import njit
 from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
 from teamnav.sim.config import LaserConfig, ProximityConfig, SonarConfig
-from teamnav.sim.sensors.robot_hits import apply_robot_hits
+from teamnav.sim.sensors.robot_hits import PARALLEL_MIN_RAYS, beam_plan, check_bodies, default_cell_m, robot_hits_unchecked
 from teamnav.world.grid import OccupancyGrid
 from teamnav.world.raycast import RayCaster
 
@@ -225,6 +225,7 @@ class RangeSensor:
         self.sees_robots = bool(sees_robots)
         self.sees = tuple(sees)
         self.caster = RayCaster(grid, self.sees, self.max_range_m)
+        self._plan = beam_plan(rays)
 
     def __repr__(self) -> str:
         return (f"RangeSensor(name={self.name!r}, kind={self.kind!r}, beams={self.angles_rad.shape[0]}, "
@@ -255,12 +256,31 @@ class RangeSensor:
         xs = np.ascontiguousarray(xs, dtype=np.float64)
         ys = np.ascontiguousarray(ys, dtype=np.float64)
         thetas = np.ascontiguousarray(thetas, dtype=np.float64)
-        rays = self.caster.cast_xyt(xs, ys, thetas, self.ray_angles_rad)
+        if not (xs.ndim == 1 and ys.shape == xs.shape and thetas.shape == xs.shape):
+            raise ValueError(f"xs, ys and thetas must be 1-D arrays of one shape (n,), got {xs.shape}, {ys.shape}, "
+                             f"{thetas.shape}")
+        if not (np.isfinite(xs).all() and np.isfinite(ys).all() and np.isfinite(thetas).all()):
+            raise ValueError("xs, ys and thetas must be finite")
         if bodies is not None and self.sees_robots:
-            apply_robot_hits(xs, ys, thetas, self.ray_angles_rad, bodies, rays, self.max_range_m)
+            bodies = check_bodies(bodies, xs.shape[0])
+        return self._true_ranges(xs, ys, thetas, bodies)
+
+    def _true_ranges(self, xs, ys, thetas, bodies) -> np.ndarray:
+        """:meth:`true_ranges` without input checks (the engine's per-step path).
+
+        ``xs, ys, thetas``: contiguous float64 (n,); ``bodies``: None or as returned by
+        :func:`~teamnav.sim.sensors.robot_hits.check_bodies`. Small calls run serially
+        (below ``PARALLEL_MIN_RAYS`` rays, waking numba's threads costs more than it saves).
+        """
+        n = xs.shape[0]
+        parallel = n * self.ray_angles_rad.shape[0] >= PARALLEL_MIN_RAYS
+        rays = self.caster.cast_xyt(xs, ys, thetas, self.ray_angles_rad, parallel=parallel)
+        if bodies is not None and self.sees_robots:
+            all_x, all_y, all_r, self_idx = bodies
+            robot_hits_unchecked(xs, ys, thetas, self._plan, all_x, all_y, all_r, self_idx, rays,
+                                 default_cell_m(self.max_range_m, all_r), parallel)
         if self.rays_per_beam == 1:
             return rays
-        n = xs.shape[0]
         return rays.reshape(n, self.angles_rad.shape[0], self.rays_per_beam).min(axis=2)
 
     # ------------------------------------------------------------------ observation
@@ -287,6 +307,12 @@ class RangeSensor:
         if out is None:
             out = true  # a fresh array already; noise is applied in place
         return apply_beam_noise(true, rng, self.noise_std_m, self.p_max, self.p_short, self.max_range_m, out)
+
+    def _sense(self, xs, ys, thetas, rng: np.random.Generator, bodies=None) -> np.ndarray:
+        """:meth:`sense` without input checks, into a fresh array (the engine's per-step path;
+        arrays as in :meth:`_true_ranges`)."""
+        true = self._true_ranges(xs, ys, thetas, bodies)
+        return apply_beam_noise(true, rng, self.noise_std_m, self.p_max, self.p_short, self.max_range_m, true)
 
 
 def build_range_sensor(cfg: LaserConfig | SonarConfig | ProximityConfig, grid: OccupancyGrid) -> RangeSensor:
