@@ -1,0 +1,564 @@
+"""Monte Carlo localization (MCL): the per-robot sample-based belief of Fox et al. §3.1.
+
+Fox, Burgard, Kruppa & Thrun, "A probabilistic approach to collaborative multi-robot
+localization", Autonomous Robots 8(3), 2000, doi:10.1023/A:1008937911390.
+
+The belief ``Bel_n(L)`` is a set of K weighted samples ``<l_i, p_i>`` (eq. 11). One step:
+
+1. *resample* (§3.1 step 1): draw K samples with likelihood given by their p-values
+   (low-variance resampling, :mod:`~teamnav.localization.resample`); replace a few with
+   samples uniform over free space (§3.1, "a small number of uniformly distributed, random
+   samples after each estimation step"), a fixed fraction or, with ``recovery="augmented"``,
+   the adaptive fraction ``max(0, 1 - w_fast / w_slow)`` of *Probabilistic Robotics* Table 8.3;
+   with ``adaptive=True`` the count K itself follows KLD-sampling
+   (:mod:`~teamnav.localization.kld`: many samples when lost, few when tracking);
+2. *predict* (eq. 6): move every sample by a draw of the odometry motion model
+   (:mod:`~teamnav.localization.motion`);
+3. *update* (eq. 12): ``p <- alpha P(o | l) p`` with the beam model (Fig. 1, laser or sonar
+   cones; :mod:`~teamnav.localization.beam_model`) or the likelihood field
+   (:mod:`~teamnav.localization.likelihood_field`).
+
+Detections from teammates enter through :meth:`MCL.multiply_weights` (eq. 14; see
+:mod:`~teamnav.localization.sync`). The filter sees only its robot's map, sensor datasheet,
+odometry and ranges; scoring against a reference pose is the caller's business
+(:func:`sample_error_m`, :func:`pose_error`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+from scipy import ndimage
+
+from teamnav.control.protocol import SensorInfo
+from teamnav.geometry.angles import wrap_angle
+from teamnav.localization._checks import array, generator
+from teamnav.localization.beam_model import BeamModelParams, beam_log_table, beam_loglik_kernel
+from teamnav.localization.kld import KLDParams, kld_count_kernel
+from teamnav.localization.likelihood_field import LikelihoodFieldParams, build_log_field, lf_loglik_kernel
+from teamnav.localization.motion import MotionParams, motion_kernel
+from teamnav.localization.resample import effective_sample_size, low_variance_kernel, normalize_log_weights
+from teamnav.world.distance import distance_field
+from teamnav.world.grid import DEFAULT_SEES, FREE, OccupancyGrid
+from teamnav.world.raycast import RayCaster
+
+__all__ = ["Estimate", "MCL", "MCLParams", "pose_error", "sample_error_m"]
+
+
+class MCLParams(BaseModel):
+    """Parameters of one robot's MCL filter.
+
+    Attributes
+    ----------
+    n_particles : int, default 1000
+        Sample set size K (with ``adaptive``: the size used by :meth:`MCL.init_pose`; global
+        initialisation uses ``kld.max_particles``).
+    sensor_model : {"beam", "likelihood_field"}, default "beam"
+        Perception model (§2.2 Fig. 1, or Probabilistic Robotics §6.4).
+    beam, likelihood_field, motion, kld
+        Parameters of each part.
+    beam_stride : int, default 1
+        Use every ``beam_stride``-th beam of the scan (neighbouring beams are far from
+        independent, Probabilistic Robotics §6.3.4).
+    likelihood_exponent : float in (0, 1], default 1
+        ``P(o | l)`` is raised to this power (tempering against correlated beams).
+    sonar_cone_deg, sonar_rays_per_cone
+        Opening [deg] of a sonar transducer's cone and rays cast across it (its expected
+        distance is their minimum); used when the sensor's ``kind`` is ``"sonar"``.
+    sees : tuple of str or None
+        Materials the sensor perceives; None: ``DEFAULT_SEES[sensor.kind]``.
+    recovery : {"none", "fixed", "augmented"}, default "fixed"
+        Random samples per resampling: none; ``random_fraction`` of them (Fox et al. §3.1);
+        ``max(0, 1 - w_fast / w_slow)`` of them (Probabilistic Robotics Table 8.3).
+    random_fraction : float in [0, 0.5], default 0.01
+    alpha_slow, alpha_fast : float
+        Averaging rates of ``w_slow``, ``w_fast`` (``0 < alpha_slow < alpha_fast <= 1``).
+    adaptive : bool, default False
+        KLD-sampling of the sample count (Fox 2003).
+    init_clearance_m : float, default 0
+        Uniform samples are drawn only where the nearest obstacle is at least this far [m].
+    min_update_trans_m, min_update_rot_rad : float, default 0
+        :meth:`MCL.step` applies the scan only once the robot moved this far since the last
+        applied scan (a standing robot would re-apply the same evidence); 0: every step.
+    cluster_cell_m : float, default 0.5
+        Cell of the grid whose connected components are the belief's clusters [m].
+    parallel : bool, default True
+        Use numba's threads in ray casting.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    n_particles: int = Field(1000, ge=1, le=10_000_000)
+    sensor_model: Literal["beam", "likelihood_field"] = "beam"
+    beam: BeamModelParams = BeamModelParams()
+    likelihood_field: LikelihoodFieldParams = LikelihoodFieldParams()
+    motion: MotionParams = MotionParams()
+    beam_stride: int = Field(1, ge=1, le=4096)
+    likelihood_exponent: float = Field(1.0, gt=0.0, le=1.0)
+    sonar_cone_deg: float = Field(15.0, ge=0.0, le=90.0)
+    sonar_rays_per_cone: int = Field(5, ge=1, le=64)
+    sees: tuple[str, ...] | None = None
+    recovery: Literal["none", "fixed", "augmented"] = "fixed"
+    random_fraction: float = Field(0.01, ge=0.0, le=0.5)
+    alpha_slow: float = Field(0.001, gt=0.0, lt=1.0)
+    alpha_fast: float = Field(0.1, gt=0.0, le=1.0)
+    adaptive: bool = False
+    kld: KLDParams = KLDParams()
+    init_clearance_m: float = Field(0.0, ge=0.0, le=10.0)
+    min_update_trans_m: float = Field(0.0, ge=0.0, le=100.0)
+    min_update_rot_rad: float = Field(0.0, ge=0.0, le=2 * math.pi)
+    cluster_cell_m: float = Field(0.5, gt=0.0, le=100.0)
+    parallel: bool = True
+
+    @model_validator(mode="after")
+    def _rates(self) -> "MCLParams":
+        if self.recovery == "augmented" and not self.alpha_slow < self.alpha_fast:
+            raise ValueError(f"alpha_slow must be < alpha_fast ({self.alpha_fast}) for recovery='augmented', "
+                             f"got {self.alpha_slow}")
+        return self
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A summary of the belief.
+
+    Attributes
+    ----------
+    pose : ndarray of shape (3,)
+        Weighted mean ``x [m], y [m]`` and circular mean heading [rad] of all samples.
+    cov : ndarray of shape (3, 3)
+        Weighted covariance (heading deviations wrapped around the mean).
+    cluster_pose : ndarray of shape (3,)
+        Weighted mean of the heaviest cluster (connected cells of ``cluster_cell_m`` holding
+        samples): the estimate to act on when the belief is multi-modal.
+    cluster_weight : float
+        Total weight of that cluster, in (0, 1].
+    n_clusters : int
+        Number of clusters.
+    ess : float
+        Effective sample size of the weights.
+    n_particles : int
+    """
+
+    pose: np.ndarray
+    cov: np.ndarray
+    cluster_pose: np.ndarray
+    cluster_weight: float
+    n_clusters: int
+    ess: float
+    n_particles: int
+
+
+def _weighted_pose(p: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    s = w.sum()
+    x = float(np.dot(w, p[:, 0]) / s)
+    y = float(np.dot(w, p[:, 1]) / s)
+    th = math.atan2(float(np.dot(w, np.sin(p[:, 2]))), float(np.dot(w, np.cos(p[:, 2]))))
+    mean = np.array([x, y, th])
+    d = np.stack([p[:, 0] - x, p[:, 1] - y, wrap_angle(p[:, 2] - th)], axis=1)
+    cov = (d * (w / s)[:, None]).T @ d
+    return mean, cov
+
+
+class MCL:
+    """One robot's Monte Carlo localization filter (Fox et al. §3.1).
+
+    Parameters
+    ----------
+    params : MCLParams
+    known_map : OccupancyGrid
+        The map the robot was given (:attr:`RobotInfo.known_map`).
+    sensor : SensorInfo
+        The range sensor whose scans :meth:`update` receives (beam directions, range, kind).
+    rng : numpy.random.Generator
+        This filter's own stream.
+
+    Attributes
+    ----------
+    particles : ndarray of shape (n, 3)
+        Sample poses ``x [m], y [m], theta [rad]`` (read-only view).
+    weights : ndarray of shape (n,)
+        Normalised p-values (read-only view).
+
+    Examples
+    --------
+    >>> from teamnav.world.grid import OccupancyGrid
+    >>> g = OccupancyGrid.empty(4.0, 2.0, 0.1)
+    >>> s = SensorInfo("laser", "laser", np.linspace(-np.pi / 2, np.pi / 2, 5), 5.0)
+    >>> f = MCL(MCLParams(n_particles=200), g, s, np.random.default_rng(0))
+    >>> f.init_pose([1.0, 1.0, 0.0], np.diag([0.01, 0.01, 0.01]))
+    >>> f.step([0.1, 0.0, 0.0], np.array([1.0, 1.0, 2.9, 1.0, 1.0]))
+    >>> est = f.estimate()
+    >>> bool(abs(est.pose[0] - 1.1) < 0.1), f.particles.shape
+    (True, (200, 3))
+    """
+
+    def __init__(self, params: MCLParams, known_map: OccupancyGrid, sensor: SensorInfo, rng: np.random.Generator):
+        if not isinstance(params, MCLParams):
+            raise ValueError(f"params must be an MCLParams, got {type(params).__name__}")
+        if not isinstance(known_map, OccupancyGrid):
+            raise ValueError(f"known_map must be an OccupancyGrid, got {type(known_map).__name__}")
+        if not isinstance(sensor, SensorInfo):
+            raise ValueError(f"sensor must be a SensorInfo, got {type(sensor).__name__}")
+        self.params = params
+        self.map = known_map
+        self.sensor = sensor
+        self.rng = generator("rng", rng)
+        angles = array("sensor.angles_rad", sensor.angles_rad, (-1,))
+        if angles.shape[0] == 0:
+            raise ValueError("sensor.angles_rad must hold at least one beam direction, got none")
+        if not (math.isfinite(sensor.max_range_m) and sensor.max_range_m > 0):
+            raise ValueError(f"sensor.max_range_m must be a finite number > 0, got {sensor.max_range_m!r}")
+        sees = params.sees
+        if sees is None:
+            if sensor.kind not in DEFAULT_SEES:
+                raise ValueError(f"sensor.kind must be one of {sorted(DEFAULT_SEES)} when params.sees is None, "
+                                 f"got {sensor.kind!r}")
+            sees = DEFAULT_SEES[sensor.kind]
+        self.sees = tuple(sees)
+        self.max_range_m = float(sensor.max_range_m)
+        self.n_beams = int(angles.shape[0])
+        self._beam_idx = np.arange(0, self.n_beams, params.beam_stride)
+        used = angles[self._beam_idx]
+        if sensor.kind == "sonar" and params.sonar_rays_per_cone > 1 and params.sonar_cone_deg > 0:
+            half = math.radians(params.sonar_cone_deg) / 2
+            offsets = np.linspace(-half, half, params.sonar_rays_per_cone)
+        else:
+            offsets = np.zeros(1)
+        self._k = int(offsets.shape[0])
+        self._ray_angles = np.ascontiguousarray((used[:, None] + offsets[None, :]).ravel())
+        self._used_angles = used
+        blocking = known_map.blocking(self.sees)
+        self._caster = RayCaster(known_map, self.sees, self.max_range_m) if params.sensor_model == "beam" else None
+        free = known_map.cells == FREE
+        if params.init_clearance_m > 0:
+            free &= distance_field(known_map) >= params.init_clearance_m
+        self._free_cells = np.argwhere(free)
+        if self._free_cells.shape[0] == 0:
+            raise ValueError(f"known_map {known_map.name} has no free cell with clearance >= "
+                             f"{params.init_clearance_m} m to sample poses in")
+        #: Free area a pose can be in [m²] (the support of the uniform prior).
+        self.free_area_m2 = float(self._free_cells.shape[0] * known_map.resolution_m ** 2)
+        if params.sensor_model == "likelihood_field":
+            self._lf_table, self._lf_outside = build_log_field(known_map, blocking, params.likelihood_field,
+                                                               self.max_range_m)
+            self._lf_free = (known_map.cells == FREE).astype(np.uint8)
+            self._lf_worst = math.log(params.likelihood_field.z_rand / self.max_range_m)
+        # KLD histogram over the map's bounding box
+        kp = params.kld
+        xmin, xmax, ymin, ymax = known_map.bounds_m
+        self._kld_geom = (xmin, ymin, kp.bin_xy_m, math.radians(kp.bin_theta_deg),
+                          max(1, int(math.ceil((xmax - xmin) / kp.bin_xy_m))),
+                          max(1, int(math.ceil((ymax - ymin) / kp.bin_xy_m))),
+                          max(1, int(math.ceil(360.0 / kp.bin_theta_deg))))
+        self._kld_hist = None
+        self._particles = np.zeros((0, 3))
+        self._weights = np.zeros(0)
+        self._weighted = False
+        self._rays = np.empty((0, 0))
+        self._ll = np.empty(0)
+        self._log_w_slow = None
+        self._log_w_fast = None
+        self._since_update = np.zeros(2)  # |trans| [m], |rot| [rad] since the last applied scan
+        self._updated_once = False
+        #: Log of the average likelihood ``sum_i p_i P(o | l_i)`` of the last applied scan.
+        self.last_log_mean_likelihood = float("nan")
+
+    # ------------------------------------------------------------------ state
+    @property
+    def particles(self) -> np.ndarray:
+        v = self._particles.view()
+        v.flags.writeable = False
+        return v
+
+    @property
+    def weights(self) -> np.ndarray:
+        v = self._weights.view()
+        v.flags.writeable = False
+        return v
+
+    @property
+    def n_particles(self) -> int:
+        return int(self._particles.shape[0])
+
+    def _set(self, particles: np.ndarray) -> None:
+        self._particles = np.ascontiguousarray(particles, dtype=np.float64)
+        n = self._particles.shape[0]
+        self._weights = np.full(n, 1.0 / n)
+        self._weighted = False
+
+    def _uniform_poses(self, n: int) -> np.ndarray:
+        """``n`` poses uniform over free space (cells with the clearance), headings uniform."""
+        cells = self._free_cells[self.rng.integers(0, self._free_cells.shape[0], size=n)]
+        res = self.map.resolution_m
+        u = self.rng.random((n, 3))
+        out = np.empty((n, 3))
+        out[:, 0] = self.map.origin_xy_m[0] + (cells[:, 1] + u[:, 0]) * res
+        out[:, 1] = self.map.origin_xy_m[1] + (cells[:, 0] + u[:, 1]) * res
+        out[:, 2] = wrap_angle(-math.pi + 2.0 * math.pi * u[:, 2])
+        return out
+
+    # ------------------------------------------------------------------ initialisation
+    def init_global(self) -> None:
+        """Uniform belief over the free space (Fox et al. §2.2: ``Bel(0)`` uniform; Fig. 4a).
+
+        K samples (``kld.max_particles`` when ``adaptive``) uniform over free cells, headings
+        uniform in (-pi, pi].
+        """
+        n = self.params.kld.max_particles if self.params.adaptive else self.params.n_particles
+        self._set(self._uniform_poses(n))
+        self._reset_recovery()
+
+    def init_pose(self, pose, cov) -> None:
+        """Gaussian belief ``N(pose, cov)`` of K = ``n_particles`` samples (position tracking).
+
+        Parameters
+        ----------
+        pose : array_like of shape (3,)
+            Mean ``x [m], y [m], theta [rad]``.
+        cov : array_like of shape (3, 3)
+            Symmetric positive semi-definite covariance [m², m², rad²].
+        """
+        mu = array("pose", pose, (3,))
+        c = array("cov", cov, (3, 3))
+        if not np.allclose(c, c.T, atol=1e-12) or np.linalg.eigvalsh(c).min() < -1e-12:
+            raise ValueError(f"cov must be a symmetric positive semi-definite (3, 3) matrix, got {c.tolist()}")
+        n = self.params.n_particles
+        z = self.rng.standard_normal((n, 3))
+        vals, vecs = np.linalg.eigh(c)
+        p = mu + (z * np.sqrt(np.clip(vals, 0.0, None))) @ vecs.T
+        p[:, 2] = wrap_angle(p[:, 2])
+        self._set(p)
+        self._reset_recovery()
+
+    def _reset_recovery(self) -> None:
+        self._log_w_slow = None
+        self._log_w_fast = None
+        self._since_update[:] = 0.0
+        self._updated_once = False
+
+    def _require_particles(self, what: str) -> None:
+        if self._particles.shape[0] == 0:
+            raise ValueError(f"{what}: the filter has no samples yet; call init_global() or init_pose() first")
+
+    # ------------------------------------------------------------------ the three phases
+    def predict(self, odom_delta) -> None:
+        """Motion update (eq. 6): move every sample by a draw of ``P(l | l', a)``.
+
+        Parameters
+        ----------
+        odom_delta : array_like of shape (3,)
+            Odometry step ``(dx [m], dy [m], dtheta [rad])`` in the previous body frame
+            (:attr:`Observation.odom_delta`).
+        """
+        self._require_particles("predict")
+        d = array("odom_delta", odom_delta, (3,))
+        noise = self.rng.standard_normal((self._particles.shape[0], 3))
+        motion_kernel(self._particles, float(d[0]), float(d[1]), float(d[2]),
+                      np.asarray(self.params.motion.alpha, dtype=np.float64), noise)
+        self._since_update[0] += math.hypot(d[0], d[1])
+        self._since_update[1] += abs(float(wrap_angle(d[2])))
+
+    def log_likelihood(self, scan_ranges) -> np.ndarray:
+        """``log P(o | l_i)`` (times ``likelihood_exponent``) of a scan for every sample, (n,)."""
+        self._require_particles("log_likelihood")
+        z = array("scan_ranges", scan_ranges, (self.n_beams,))
+        if (z < 0).any():
+            raise ValueError(f"scan_ranges must be >= 0 m, got {z[z < 0][0]!r}")
+        z = np.minimum(z[self._beam_idx], self.max_range_m)
+        n = self._particles.shape[0]
+        if self._ll.shape[0] != n:
+            self._ll = np.empty(n)
+        exponent = self.params.likelihood_exponent
+        if self.params.sensor_model == "beam":
+            r = self._ray_angles.shape[0]
+            if self._rays.shape != (n, r):
+                self._rays = np.empty((n, r))
+            p = self._particles
+            self._caster.cast_xyt(p[:, 0], p[:, 1], p[:, 2], self._ray_angles, out=self._rays,
+                                  parallel=self.params.parallel)
+            table, step = beam_log_table(z, self.params.beam, self.max_range_m)
+            beam_loglik_kernel(self._rays, self._k, table, 1.0 / step, exponent, self._ll)
+        else:
+            keep = z < self.max_range_m - 1e-6
+            a = self._used_angles[keep]
+            zz = z[keep]
+            g = self.map
+            lf_loglik_kernel(self._particles, np.ascontiguousarray(zz * np.cos(a)), np.ascontiguousarray(zz * np.sin(a)),
+                             self._lf_table, self._lf_free, g.origin_xy_m[0], g.origin_xy_m[1], 1.0 / g.resolution_m,
+                             self._lf_outside, self._lf_worst, exponent, self._ll)
+        return self._ll
+
+    def update(self, scan_ranges) -> None:
+        """Perception update (eq. 12): ``p <- alpha P(o | l) p``.
+
+        Parameters
+        ----------
+        scan_ranges : array_like of shape (B,)
+            The sensor's ranges [m] (``RangeScan.ranges_m``), one per beam of ``sensor``;
+            readings at or beyond ``max_range_m`` are max-range readings.
+        """
+        ll = self.log_likelihood(scan_ranges)
+        with np.errstate(divide="ignore"):
+            log_w = np.log(self._weights) + ll
+        self._weights, log_mean = normalize_log_weights(log_w)
+        self.last_log_mean_likelihood = log_mean
+        self._weighted = True
+        self._since_update[:] = 0.0
+        self._updated_once = True
+        if self.params.recovery == "augmented":  # Table 8.3 lines 8-10, in log space
+            ps = self.params
+            if self._log_w_slow is None:
+                self._log_w_slow = self._log_w_fast = log_mean
+            else:
+                self._log_w_slow = float(np.logaddexp(math.log1p(-ps.alpha_slow) + self._log_w_slow,
+                                                      math.log(ps.alpha_slow) + log_mean))
+                self._log_w_fast = float(np.logaddexp(math.log1p(-ps.alpha_fast) + self._log_w_fast if ps.alpha_fast < 1
+                                                      else -math.inf, math.log(ps.alpha_fast) + log_mean))
+
+    def random_sample_probability(self) -> float:
+        """Share of samples the next :meth:`resample` draws uniformly over free space."""
+        ps = self.params
+        if ps.recovery == "fixed":
+            return ps.random_fraction
+        if ps.recovery == "augmented" and self._log_w_slow is not None:
+            return max(0.0, 1.0 - math.exp(min(self._log_w_fast - self._log_w_slow, 50.0)))
+        return 0.0
+
+    def resample(self) -> None:
+        """Draw a new, equally weighted sample set from the weighted one (§3.1 step 1).
+
+        Low-variance draws; the count is ``n_particles`` or, with ``adaptive``, the
+        KLD-sampling bound (Fox 2003) over the drawn samples; then each sample is replaced with
+        probability :meth:`random_sample_probability` by one uniform over free space.
+        """
+        self._require_particles("resample")
+        ps = self.params
+        w = self._weights
+        if ps.adaptive:
+            kp = ps.kld
+            m = kp.max_particles
+            idx = low_variance_kernel(w, m, float(self.rng.random()), np.empty(m, dtype=np.int64))
+            idx = idx[self.rng.permutation(m)]
+            xmin, ymin, bxy, bth, nx, ny, nth = self._kld_geom
+            if self._kld_hist is None:
+                self._kld_hist = np.zeros(nx * ny * nth, dtype=np.uint8)
+            n = kld_count_kernel(self._particles, idx, xmin, ymin, bxy, bth, self._kld_hist, nx, ny, nth,
+                                 kp.epsilon, kp.z, kp.min_particles, m)
+            idx = np.sort(idx[:n])
+        else:
+            n = ps.n_particles
+            idx = low_variance_kernel(w, n, float(self.rng.random()), np.empty(n, dtype=np.int64))
+        new = self._particles[idx]
+        p_rand = self.random_sample_probability()
+        if p_rand > 0:
+            k = int(self.rng.binomial(n, p_rand))
+            if k:
+                where = self.rng.choice(n, size=k, replace=False)
+                new[where] = self._uniform_poses(k)
+        self._set(new)
+
+    def step(self, odom_delta, scan_ranges) -> None:
+        """One MCL step: :meth:`resample` (if weighted), :meth:`predict`, :meth:`update`.
+
+        The scan is applied only once the robot moved ``min_update_trans_m`` or turned
+        ``min_update_rot_rad`` since the last applied scan (always the first time), and the set
+        is resampled only after a scan was applied.
+        """
+        self._require_particles("step")
+        if self._weighted:
+            self.resample()
+        self.predict(odom_delta)
+        ps = self.params
+        moved = (self._since_update[0] >= ps.min_update_trans_m) or (self._since_update[1] >= ps.min_update_rot_rad)
+        if moved or not self._updated_once:
+            self.update(scan_ranges)
+
+    # ------------------------------------------------------------------ detections
+    def multiply_weights(self, factors) -> bool:
+        """``p_i <- alpha p_i f_i``: fold external evidence into the weights (eq. 14).
+
+        Parameters
+        ----------
+        factors : array_like of shape (n,)
+            Finite, >= 0, one per sample (e.g. a density tree evaluated at the samples).
+
+        Returns
+        -------
+        bool
+            False (weights unchanged) when every product is 0: the evidence contradicts the
+            whole belief and is ignored rather than wiping it out.
+        """
+        self._require_particles("multiply_weights")
+        f = array("factors", factors, (self._particles.shape[0],))
+        if (f < 0).any():
+            raise ValueError(f"factors must be >= 0, got {f[f < 0][0]!r}")
+        w = self._weights * f
+        s = float(w.sum())
+        if not s > 0:
+            return False
+        self._weights = w / s
+        self._weighted = True
+        return True
+
+    # ------------------------------------------------------------------ estimates
+    def estimate(self) -> Estimate:
+        """Weighted mean and covariance, and the heaviest cluster's mean (see :class:`Estimate`)."""
+        self._require_particles("estimate")
+        p, w = self._particles, self._weights
+        mean, cov = _weighted_pose(p, w)
+        cell = self.params.cluster_cell_m
+        xmin, ymin = p[:, 0].min(), p[:, 1].min()
+        ix = ((p[:, 0] - xmin) / cell).astype(np.int64)
+        iy = ((p[:, 1] - ymin) / cell).astype(np.int64)
+        shape = (int(iy.max()) + 1, int(ix.max()) + 1)
+        occ = np.zeros(shape, dtype=bool)
+        occ[iy, ix] = True
+        labels, n_clusters = ndimage.label(occ, structure=np.ones((3, 3), dtype=bool))
+        lab = labels[iy, ix]
+        cw = np.bincount(lab, weights=w, minlength=n_clusters + 1)
+        best = int(np.argmax(cw))
+        sel = lab == best
+        cmean, _ = _weighted_pose(p[sel], w[sel])
+        return Estimate(mean, cov, cmean, float(cw[best]), int(n_clusters), effective_sample_size(w), int(p.shape[0]))
+
+
+# ---------------------------------------------------------------------------- scoring helpers
+def sample_error_m(particles, weights, reference_xy) -> float:
+    """Weighted average distance of all samples from a reference position [m].
+
+    Fox et al. §5.1: "The estimation error is measured by the average distance of all samples
+    from the reference position." The reference comes from the caller (an experiment reading
+    the simulator); the filter never has it.
+
+    Examples
+    --------
+    >>> sample_error_m(np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 1.0]]), np.array([0.5, 0.5]), [1.0, 0.0])
+    1.0
+    """
+    p = array("particles", particles, (-1, 3))
+    w = array("weights", weights, (p.shape[0],))
+    ref = array("reference_xy", reference_xy, (-1,))
+    if ref.shape[0] not in (2, 3):
+        raise ValueError(f"reference_xy must have 2 (x, y) or 3 (x, y, theta) entries, got {ref.shape[0]}")
+    if (w < 0).any() or not w.sum() > 0:
+        raise ValueError("weights must be >= 0 with a positive sum")
+    d = np.hypot(p[:, 0] - ref[0], p[:, 1] - ref[1])
+    return float(np.dot(w, d) / w.sum())
+
+
+def pose_error(estimate_pose, reference_pose) -> tuple[float, float]:
+    """Position error [m] and absolute heading error [rad] of an estimate against a reference.
+
+    Examples
+    --------
+    >>> [round(v, 12) for v in pose_error([1.0, 1.0, 3.1], [1.0, 2.0, -3.1])]
+    [1.0, 0.08318530718]
+    """
+    e = array("estimate_pose", estimate_pose, (3,))
+    r = array("reference_pose", reference_pose, (3,))
+    return float(math.hypot(e[0] - r[0], e[1] - r[1])), abs(float(wrap_angle(e[2] - r[2])))
