@@ -14,9 +14,12 @@ from teamnav.sim.sensors import (
     apply_beam_noise,
     apply_robot_hits,
     beam_angles,
+    beam_noise_keyed,
     build_range_sensor,
     robot_hits_reference,
 )
+from teamnav.sim.sensors import range_sensors as rs_mod
+from teamnav.sim.sensors import robot_hits as rh_mod
 from teamnav.world.grid import FOAM, GLASS, WALL, OccupancyGrid
 from teamnav.world.raycast import RayCaster
 
@@ -197,6 +200,69 @@ def test_sonar_specular_fraction():
     assert abs(frac - 0.25) < 5 * math.sqrt(0.25 * 0.75 / obs.size)  # ... so max readings are speculars
 
 
+def test_keyed_normals_are_standard_normal():
+    # 1e6 ziggurat normals from the counter-based streams: moments, KS, tail beyond the base strip
+    from scipy import stats
+
+    z = (beam_noise_keyed(np.full((1000, 1000), 5.0), 12345, 1.0, 0.0, 0.0, 100.0) - 5.0).ravel()
+    n = z.size
+    assert abs(z.mean()) < 5 / math.sqrt(n)
+    assert z.std() == pytest.approx(1.0, abs=5 * math.sqrt(0.5 / n))
+    assert abs(stats.skew(z)) < 5 * math.sqrt(6 / n)
+    assert abs(stats.kurtosis(z)) < 5 * math.sqrt(24 / n)
+    assert stats.kstest(z, "norm").pvalue > 1e-4
+    p_tail = 2 * stats.norm.sf(rs_mod._ZIG_R)  # draws from the ziggurat's tail branch
+    assert abs((np.abs(z) > rs_mod._ZIG_R).mean() - p_tail) < 5 * math.sqrt(p_tail / n)
+    # neighbouring beams and other keys are uncorrelated
+    assert abs(np.corrcoef(z[:-1], z[1:])[0, 1]) < 5 / math.sqrt(n)
+    z2 = (beam_noise_keyed(np.full((1000, 1000), 5.0), 12346, 1.0, 0.0, 0.0, 100.0) - 5.0).ravel()
+    assert abs(np.corrcoef(z, z2)[0, 1]) < 5 / math.sqrt(n)
+
+
+def test_keyed_mixture_fractions_and_short_uniform():
+    from scipy import stats
+
+    true = np.full((500, 400), 5.0)
+    obs = beam_noise_keyed(true, 99, 0.0, 0.3, 0.4, 10.0)
+    m = obs.size
+    assert abs((obs == 10.0).mean() - 0.3) < 5 * math.sqrt(0.3 * 0.7 / m)
+    short = obs < 5.0
+    assert abs(short.mean() - 0.4) < 5 * math.sqrt(0.4 * 0.6 / m)
+    assert stats.kstest(obs[short] / 5.0, "uniform").pvalue > 1e-4
+    np.testing.assert_array_equal(obs[~short & (obs != 10.0)], 5.0)
+
+
+def test_keyed_noise_deterministic_on_any_thread_count():
+    true = np.random.default_rng(0).uniform(0.0, 8.0, (400, 180))  # above NOISE_PARALLEL_MIN_BEAMS
+    assert true.size >= rs_mod.NOISE_PARALLEL_MIN_BEAMS
+    par = beam_noise_keyed(true, 2**64 - 1, 0.05, 0.02, 0.03, 8.0)
+    ser = np.empty_like(true)
+    rs_mod._counter_noise_rows(true, np.uint64(2**64 - 1), 0, 400, 0.05, 0.02, 0.03, 8.0, ser)
+    np.testing.assert_array_equal(par, ser)
+    # rows do not depend on the rows around them: a slice of the batch reads the same numbers
+    np.testing.assert_array_equal(beam_noise_keyed(true[:7], 2**64 - 1, 0.05, 0.02, 0.03, 8.0), par[:7])
+    assert not np.array_equal(beam_noise_keyed(true, 5, 0.05, 0.02, 0.03, 8.0), par)
+    inplace = true.copy()
+    assert beam_noise_keyed(inplace, 2**64 - 1, 0.05, 0.02, 0.03, 8.0, out=inplace) is inplace
+    np.testing.assert_array_equal(inplace, par)
+    with pytest.raises(ValueError, match="key must be an integer"):
+        beam_noise_keyed(true, -1, 0.05, 0.0, 0.0, 8.0)
+
+
+def test_sense_draws_one_key_from_the_generator():
+    g = walled_grid(wall_x_m=5.0)
+    s = build_range_sensor(laser(n_beams=30, noise_std_m=0.05, p_max=0.1, p_short=0.1), g)
+    x, y, th = np.full(20, 2.0), np.full(20, 2.0), np.linspace(-1, 1, 20)
+    rng = np.random.default_rng(3)
+    got = s.sense(x, y, th, rng)
+    key_rng = np.random.default_rng(3)
+    expect = beam_noise_keyed(s.true_ranges(x, y, th), rs_mod.draw_noise_key(key_rng), 0.05, 0.1, 0.1, 20.0)
+    np.testing.assert_array_equal(got, expect)
+    assert rng.bit_generator.state == key_rng.bit_generator.state  # one draw, nothing more
+    # the engine's unchecked path reads the same
+    np.testing.assert_array_equal(s._sense(x, y, th, np.random.default_rng(3)), got)
+
+
 def test_noise_clipped_to_range_and_deterministic():
     g = walled_grid(wall_x_m=9.0)
     s = build_range_sensor(laser(noise_std_m=0.5, max_range_m=3.0, p_max=0.05, p_short=0.05), g)
@@ -298,6 +364,62 @@ def test_mixture_kernel_matches_numpy_reference():
     expect = np.where(u < p_max + p_short, true * (u - p_max) / p_short, expect)
     expect = np.where(u < p_max, rmax, expect)
     np.testing.assert_allclose(got, expect, rtol=1e-15, atol=0)
+
+
+def test_fast_atan2_error_bound():
+    from numba import njit
+
+    f = njit(lambda y, x: rh_mod._fast_atan2(y, x))
+    rng = np.random.default_rng(5)
+    pts = np.concatenate([rng.normal(size=(20000, 2)) * 10.0 ** rng.uniform(-6, 3, (20000, 1)),
+                          [[0.0, 1.0], [1.0, 0.0], [0.0, -1.0], [-1.0, 0.0], [1.0, 1.0], [-1.0, -1.0], [0.0, 0.0]]])
+    err = max(abs(f(py, px) - math.atan2(py, px)) for py, px in pts)
+    assert err < 4e-8 < rh_mod._ANGLE_MARGIN_RAD / 10
+
+
+def test_beam_plan_even_fans():
+    for n, fov in ((180, np.pi), (181, np.pi), (360, 2 * np.pi), (7, 2 * np.pi), (1, 1.0), (5, 0.3)):
+        plan = rh_mod.beam_plan(beam_angles(n, fov))
+        assert plan.even[0], (n, fov)
+        np.testing.assert_array_equal(plan.beams[3], np.arange(n))
+    assert rh_mod.beam_plan(beam_angles(180, np.pi)).even[3]  # a half-turn fan: half-plane cull on
+    assert not rh_mod.beam_plan(beam_angles(36, 2 * np.pi)).even[3]
+    assert not rh_mod.beam_plan(np.array([0.0, 0.1, 0.3])).even[0]  # uneven: binary search
+    assert not rh_mod.beam_plan(np.array([0.0, 0.1, 0.1])).even[0]  # repeated direction
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(180, 180.0), (181, 180.0), (90, 120.0), (64, 360.0), (1, 1.0),
+                                                   (12, 350.0)]), st.booleans())
+def test_robot_hits_even_fans_match_brute_force(seed, fan, parallel):
+    # crowded discs (touching, overlapping, some radius 0) around sensors on even fans, where the
+    # windows are computed by arithmetic and discs behind a <= 180 deg fan are culled early
+    rng = np.random.default_rng(seed)
+    n_all = int(rng.integers(2, 150))
+    side = float(rng.choice([0.5, 3.0, 15.0]))
+    all_x, all_y = rng.uniform(0.0, side, n_all), rng.uniform(0.0, side, n_all)
+    all_r = rng.choice([0.0, 0.05, 0.2, 0.5], n_all)
+    sensing = rng.choice(n_all, size=min(n_all, 25), replace=False)
+    th = rng.uniform(-7.0, 7.0, sensing.shape[0])
+    angles = beam_angles(fan[0], math.radians(fan[1])) + rng.choice([0.0, rng.uniform(-4, 4)])
+    base = rng.uniform(0.0, float(rng.choice([1.0, 20.0])), (sensing.shape[0], fan[0]))
+    bodies = (all_x, all_y, all_r, sensing.astype(np.int64))
+    fast = apply_robot_hits(all_x[sensing], all_y[sensing], th, angles, bodies, base.copy(), 20.0, parallel=parallel)
+    ref = robot_hits_reference(all_x[sensing], all_y[sensing], th, angles, bodies, base.copy())
+    np.testing.assert_array_equal(fast, ref)
+
+
+def test_robot_hits_disc_abeam_of_a_half_turn_fan():
+    # discs exactly beside the sensor (bearing +-90 deg: the fan's edge rays) and just behind it
+    angles = beam_angles(181, np.pi)
+    all_x = np.array([0.0, 0.0, 0.0, -0.25, -0.35])
+    all_y = np.array([0.0, 2.0, -3.0, 1.0, -1.0])
+    all_r = np.array([0.1, 0.2, 0.2, 0.3, 0.3])
+    bodies = (all_x, all_y, all_r, np.array([0]))
+    fast = apply_robot_hits(np.zeros(1), np.zeros(1), np.zeros(1), angles, bodies, np.full((1, 181), 9.0), 9.0)
+    ref = robot_hits_reference(np.zeros(1), np.zeros(1), np.zeros(1), angles, bodies, np.full((1, 181), 9.0))
+    np.testing.assert_array_equal(fast, ref)
+    assert fast[0, -1] == pytest.approx(1.0 - math.sqrt(0.3**2 - 0.25**2)) and fast[0, 0] == pytest.approx(2.8)
 
 
 def test_robot_hits_reference_geometry():

@@ -11,7 +11,14 @@ robot's body frame.
 """
 
 from teamnav.sim.sensors.detector import DetectionArrays, RobotDetector
-from teamnav.sim.sensors.range_sensors import RangeSensor, apply_beam_noise, beam_angles, build_range_sensor
+from teamnav.sim.sensors.range_sensors import (
+    RangeSensor,
+    apply_beam_noise,
+    beam_angles,
+    beam_noise_keyed,
+    build_range_sensor,
+    draw_noise_key,
+)
 from teamnav.sim.sensors.robot_hits import apply_robot_hits, robot_hits_reference
 
 __all__ = [
@@ -21,6 +28,8 @@ __all__ = [
     "apply_beam_noise",
     "apply_robot_hits",
     "beam_angles",
+    "beam_noise_keyed",
     "build_range_sensor",
+    "draw_noise_key",
     "robot_hits_reference",
 ]
