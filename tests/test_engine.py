@@ -342,3 +342,35 @@ def test_detector_reports_teammates_in_the_observers_body_frame():
     # robot 1 is 1 m away on robot 0's right (-90 deg); robot 2 is out of range and behind the stub
     assert [(d.robot_id, round(d.range_m, 9), round(d.bearing_rad, 9)) for d in dets] == [(1, 1.0, round(-math.pi / 2, 9))]
     assert sim.brains[0][2].seen[-1].detections == ()
+
+
+# ------------------------------------------------------------------------ sensing path
+@pytest.mark.parametrize("count", [6, 130])  # 130 x 181 rays: the parallel kernels
+def test_engine_readings_equal_the_public_sensor_api(count):
+    # the engine senses through an unchecked per-step path; it must read exactly what the
+    # checked public RangeSensor.sense returns from the same poses, bodies and Generator state
+    import copy
+
+    cfg = SimConfig(robots=(RobotGroupConfig(count=count, controller="spy-test-v1", radius_m=0.2,
+                                             params={"v_mps": 0.3, "omega_radps": 0.4},
+                                             sensors=(LaserConfig(n_beams=181, noise_std_m=0.02, p_max=0.01,
+                                                                  p_short=0.01),)),),
+                    seed=5)
+    sim = Simulation(_room(side_m=12.0), cfg)
+    grp = sim._groups[0]
+    sensor = grp.sensors[0]
+    ids = np.arange(count)
+    hit_robot = False
+    sim.step()  # the first step also takes the brains' step-0 decision (a second sensing)
+    for _ in range(3):
+        rng_before = copy.deepcopy(grp.rngs[0])
+        sim.step()
+        s = sim.state
+        expect = sensor.sense(s.x_m.copy(), s.y_m.copy(), s.theta_rad.copy(), rng_before,
+                              bodies=(s.x_m.copy(), s.y_m.copy(), s.radius_m.copy(), ids))
+        got = np.stack([b.seen[-1].scans[sensor.name].ranges_m for b in sim.brains[0]])
+        np.testing.assert_array_equal(got, expect)
+        walls_only = sensor.true_ranges(s.x_m, s.y_m, s.theta_rad)
+        with_bodies = sensor.true_ranges(s.x_m, s.y_m, s.theta_rad, bodies=(s.x_m, s.y_m, s.radius_m, ids))
+        hit_robot |= bool((with_bodies < walls_only).any())
+    assert hit_robot  # the robots do block each other's beams here
