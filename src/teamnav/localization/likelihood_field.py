@@ -6,8 +6,13 @@ nearest obstacle (Thrun, Burgard & Fox, *Probabilistic Robotics* §6.4, Table 6.
 
     q = prod_b ( z_hit N(d_b; 0, sigma_hit^2) + z_rand / z_max )      (max-range beams skipped)
 
-The distance transform of the map (:func:`teamnav.world.distance.distance_field`, the
-obstacles the sensor sees) is computed once, and so is the per-cell table
+The distance ``d`` is to the *surface* of the obstacles the sensor sees, on both sides: from a
+free cell the distance to the nearest blocking cell, from a blocking cell the distance to the
+nearest free cell (each minus half a cell, so both cells at a wall face score ``d = 0``). The
+book's one-sided distance is 0 everywhere inside obstacles, so a pose whose end points all fall
+deep into a large blocked area (the unknown space around a building) would score as well as
+the true pose; with the surface distance such end points score as misses. It is computed once
+(:func:`teamnav.world.distance.distance_field`), and so is the per-cell table
 ``log(z_hit N(min(d, d_max); 0, sigma^2) + z_rand / z_max)``; an update is then one table
 load per particle-beam. End points outside the map score as if ``d = d_max``. A particle whose
 own pose is not in free space (inside a wall, outside the map) scores ``log(z_rand / z_max)``
@@ -47,7 +52,11 @@ def build_log_field(grid: OccupancyGrid, blocking: np.ndarray, params: Likelihoo
                     max_range_m: float) -> tuple[np.ndarray, float]:
     """Per-cell ``log(z_hit N(d; 0, sigma^2) + z_rand / z_max)`` (float32, (H, W)) and the value
     used for end points outside the map (``d = max_distance_m``)."""
-    d = np.minimum(distance_field(blocking, grid.resolution_m), params.max_distance_m)
+    res = grid.resolution_m
+    outside_walls = distance_field(blocking, res)  # 0 in blocking cells
+    inside_walls = distance_field((blocking == 0).astype(np.uint8), res)  # 0 in free cells
+    d = np.clip(np.maximum(outside_walls, inside_walls) - 0.5 * res, 0.0, params.max_distance_m)
+    d = np.where(np.isfinite(d), d, params.max_distance_m)
     s = params.sigma_hit_m
     norm = 1.0 / (s * math.sqrt(2.0 * math.pi))
     rand = params.z_rand / max_range_m
