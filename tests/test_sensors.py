@@ -233,11 +233,10 @@ def test_keyed_mixture_fractions_and_short_uniform():
 
 
 def test_keyed_noise_deterministic_on_any_thread_count():
-    true = np.random.default_rng(0).uniform(0.0, 8.0, (400, 180))  # above NOISE_PARALLEL_MIN_BEAMS
-    assert true.size >= rs_mod.NOISE_PARALLEL_MIN_BEAMS
-    par = beam_noise_keyed(true, 2**64 - 1, 0.05, 0.02, 0.03, 8.0)
-    ser = np.empty_like(true)
-    rs_mod._counter_noise_rows(true, np.uint64(2**64 - 1), 0, 400, 0.05, 0.02, 0.03, 8.0, ser)
+    true = np.random.default_rng(0).uniform(0.0, 8.0, (400, 180))
+    ser = beam_noise_keyed(true, 2**64 - 1, 0.05, 0.02, 0.03, 8.0)  # serial below NOISE_PARALLEL_MIN_BEAMS
+    par = np.empty_like(true)
+    rs_mod._counter_noise_parallel(true, np.uint64(2**64 - 1), 0.05, 0.02, 0.03, 8.0, par)
     np.testing.assert_array_equal(par, ser)
     # rows do not depend on the rows around them: a slice of the batch reads the same numbers
     np.testing.assert_array_equal(beam_noise_keyed(true[:7], 2**64 - 1, 0.05, 0.02, 0.03, 8.0), par[:7])

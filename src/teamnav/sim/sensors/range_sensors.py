@@ -40,7 +40,7 @@ from numba import njit, prange
 from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
 from teamnav.sim.config import LaserConfig, ProximityConfig, SonarConfig
-from teamnav.sim.sensors.robot_hits import PARALLEL_MIN_RAYS, beam_plan, check_bodies, default_cell_m, robot_hits_unchecked
+from teamnav.sim.sensors.robot_hits import PARALLEL_MIN_RAYS, beam_plan, check_bodies, robot_hits_unchecked
 from teamnav.world.grid import OccupancyGrid
 from teamnav.world.raycast import RayCaster
 
@@ -298,8 +298,9 @@ def apply_beam_noise(true_m, rng, noise_std_m, p_max, p_short, max_range_m, out=
     return out
 
 
-#: Fewest beams (rows x beams) for which the keyed noise is spread over numba's threads.
-NOISE_PARALLEL_MIN_BEAMS: int = 50_000
+#: Fewest beams (rows x beams) for which the keyed noise is spread over numba's threads: it
+#: takes ~4 ns a beam, so below ~4 ms of work waking threads on a busy machine costs more.
+NOISE_PARALLEL_MIN_BEAMS: int = 1_000_000
 
 
 def draw_noise_key(rng: np.random.Generator) -> int:
@@ -472,8 +473,8 @@ class RangeSensor:
         rays = self.caster.cast_xyt(xs, ys, thetas, self.ray_angles_rad, parallel=parallel)
         if bodies is not None and self.sees_robots:
             all_x, all_y, all_r, self_idx = bodies
-            robot_hits_unchecked(xs, ys, thetas, self._plan, all_x, all_y, all_r, self_idx, rays,
-                                 default_cell_m(self.max_range_m, all_r), parallel)
+            robot_hits_unchecked(xs, ys, thetas, self._plan, all_x, all_y, all_r, self_idx, rays, self.max_range_m, 0.0,
+                                 parallel)
         if self.rays_per_beam == 1:
             return rays
         return rays.reshape(n, self.angles_rad.shape[0], self.rays_per_beam).min(axis=2)

@@ -297,16 +297,33 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
                     out[i, b] = min(out[i, b], t)
 
 
+@njit(cache=True)
+def _prepare(xs, ys, thetas, all_x, all_y, all_r, max_range_m, cell_m):
+    """Cos/sin of the headings and :func:`_build_hash` (cell side :func:`default_cell_m`
+    when ``cell_m <= 0``) plus the largest radius."""
+    rmax = 0.0
+    for j in range(all_r.shape[0]):
+        rmax = max(rmax, all_r[j])
+    if cell_m <= 0.0:
+        cell_m = max(1e-3, 0.5 * (max_range_m + rmax))
+    sx, sy, sr, sid, start, x0, y0, cell, nkx, nky = _build_hash(all_x, all_y, all_r, cell_m,
+                                                                 _CELLS_PER_ROBOT * all_x.shape[0] + 16)
+    return np.cos(thetas), np.sin(thetas), (sx, sy, sr, sid, start, x0, y0, cell, nkx, nky, rmax)
+
+
 @njit(cache=True, parallel=True)
-def _robot_hits_parallel(xs, ys, ct, st, self_idx, beams, even, hsh, out):
+def _robot_hits_parallel(xs, ys, thetas, self_idx, beams, even, all_x, all_y, all_r, max_range_m, cell_m, out):
     """:func:`_robot_hits_one` for every sensing robot, spread over numba's threads."""
+    ct, st, hsh = _prepare(xs, ys, thetas, all_x, all_y, all_r, max_range_m, cell_m)
     for i in prange(xs.shape[0]):
         _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out)
 
 
 @njit(cache=True)
-def _robot_hits_serial(xs, ys, ct, st, self_idx, beams, even, hsh, out):
-    """:func:`_robot_hits_one` for every sensing robot, in this thread."""
+def _robot_hits_serial(xs, ys, thetas, self_idx, beams, even, all_x, all_y, all_r, max_range_m, cell_m, out):
+    """:func:`_robot_hits_one` for every sensing robot, in this thread (one call: small teams
+    pay a single dispatch)."""
+    ct, st, hsh = _prepare(xs, ys, thetas, all_x, all_y, all_r, max_range_m, cell_m)
     for i in range(xs.shape[0]):
         _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out)
 
@@ -373,23 +390,20 @@ def beam_plan(angles_rad: np.ndarray) -> BeamPlan:
     return BeamPlan(beams, (even, first, inv_step, front, mid))
 
 
-def robot_hits_unchecked(xs, ys, thetas, plan: BeamPlan, all_x, all_y, all_r, self_idx, ranges, cell_m,
-                         parallel: bool) -> np.ndarray:
+def robot_hits_unchecked(xs, ys, thetas, plan: BeamPlan, all_x, all_y, all_r, self_idx, ranges, max_range_m,
+                         cell_m, parallel: bool) -> np.ndarray:
     """:func:`apply_robot_hits` without input checks, for callers whose arrays are known good.
 
     ``xs, ys, thetas, all_x, all_y, all_r`` contiguous float64, ``self_idx`` int64,
-    ``ranges`` (n, R) C-contiguous float64, ``cell_m`` > 0 [m], ``plan`` from
-    :func:`beam_plan`. The engine's sensors call this every step.
+    ``ranges`` (n, R) C-contiguous float64, ``plan`` from :func:`beam_plan`, ``cell_m`` the
+    hash cell side [m] or 0 for :func:`default_cell_m`. The engine's sensors call this every
+    step.
     """
-    n = xs.shape[0]
-    nn = all_x.shape[0]
-    if n == 0 or nn == 0 or ranges.shape[1] == 0:
+    if xs.shape[0] == 0 or all_x.shape[0] == 0 or ranges.shape[1] == 0:
         return ranges
-    sx, sy, sr, sid, start, x0, y0, cell, nkx, nky = _build_hash(all_x, all_y, all_r, float(cell_m),
-                                                                 _CELLS_PER_ROBOT * nn + 16)
-    hsh = (sx, sy, sr, sid, start, x0, y0, cell, nkx, nky, float(sr.max()))
     kernel = _robot_hits_parallel if parallel else _robot_hits_serial
-    kernel(xs, ys, np.cos(thetas), np.sin(thetas), self_idx, plan.beams, plan.even, hsh, ranges)
+    kernel(xs, ys, thetas, self_idx, plan.beams, plan.even, all_x, all_y, all_r, float(max_range_m), float(cell_m),
+           ranges)
     return ranges
 
 
@@ -484,8 +498,8 @@ def apply_robot_hits(xs, ys, thetas, angles_rad, bodies, ranges, max_range_m, ce
     cell = default_cell_m(max_range_m, all_r) if cell_m is None else cell_m
     if not (np.isfinite(cell) and cell > 0):
         raise ValueError(f"cell_m must be a positive number of metres, got {cell_m!r}")
-    return robot_hits_unchecked(xs, ys, thetas, beam_plan(angles), all_x, all_y, all_r, self_idx, ranges, float(cell),
-                                bool(parallel))
+    return robot_hits_unchecked(xs, ys, thetas, beam_plan(angles), all_x, all_y, all_r, self_idx, ranges,
+                                max_range_m, cell, bool(parallel))
 
 
 def default_cell_m(max_range_m: float, all_radius: np.ndarray) -> float:
