@@ -111,13 +111,14 @@ def _mixture_kernel(true, z, u, sigma, p_max, p_short, max_range, out):
                                      sigma, p_max, p_short, max_range)
 
 
-# Counter-based streams (no array of draws): beam ``c = i * B + b`` of a call keyed by
-# ``key`` reads the SplitMix64 sequence (Steele, Lea & Flood, OOPSLA 2014) started from
-# ``mix(key + c * _STREAM)``; its 1st output is the mixture's uniform, the next ones feed
-# the ziggurat normal (Marsaglia & Tsang, J. Stat. Softw. 5(8), 2000; 256 layers, 52-bit,
-# as numpy's ``standard_normal``).
+# Counter-based streams (no array of draws): a call keyed by ``key`` reads the SplitMix64
+# sequence (Steele, Lea & Flood, OOPSLA 2014) ``out[m] = mix64(key + m * _GAMMA)`` by random
+# access; beam ``c = i * B + b`` owns the block ``m = c * _SLOTS + 1, ...``: its 1st draw is
+# the mixture's uniform, the next ones feed the ziggurat normal (Marsaglia & Tsang, J. Stat.
+# Softw. 5(8), 2000; 256 layers, 52-bit, as numpy's ``standard_normal``), which needs more
+# than two draws about once in 100 and more than _SLOTS never in practice (< 1e-100).
 _GAMMA = np.uint64(0x9E3779B97F4A7C15)
-_STREAM = np.uint64(0xD1B54A32D192ED03)
+_SLOTS = 64
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
 _M2 = np.uint64(0x94D049BB133111EB)
 _ZIG_R: float = 3.6541528853610088  # start of the tail
@@ -215,7 +216,7 @@ def _counter_noise_rows(true, key, i0, i1, sigma, p_max, p_short, max_range, out
     use_z = sigma > 0.0
     for i in range(i0, i1):
         for b in range(nb):
-            s = _mix64(key + np.uint64(i * nb + b) * _STREAM)
+            s = key + np.uint64((i * nb + b) * _SLOTS) * _GAMMA
             v = 0.0
             if use_u:
                 s += _GAMMA
@@ -323,9 +324,10 @@ def _keyed_noise(true_m, key, noise_std_m, p_max, p_short, max_range_m, out) -> 
 def beam_noise_keyed(true_m, key, noise_std_m, p_max, p_short, max_range_m, out=None) -> np.ndarray:
     """The beam mixture of :func:`apply_beam_noise`, with draws from counter-based streams.
 
-    Same model, other random numbers: no ``(n, B)`` arrays of draws are made. Beam
-    ``c = i * B + b`` reads the SplitMix64 sequence (Steele, Lea & Flood, OOPSLA 2014)
-    started at ``mix64(key + c * 0xD1B54A32D192ED03)``: its first output is the mixture's
+    Same model, other random numbers: no ``(n, B)`` arrays of draws are made. The call
+    reads the SplitMix64 sequence (Steele, Lea & Flood, OOPSLA 2014)
+    ``out[m] = mix64(key + m * 0x9E3779B97F4A7C15)`` by random access; beam
+    ``c = i * B + b`` owns the 64 outputs from ``m = 64 c + 1``: the first is the mixture's
     uniform (drawn only when ``p_max + p_short > 0``), the next ones feed a 256-layer
     ziggurat standard normal (Marsaglia & Tsang, J. Stat. Softw. 5(8), 2000; drawn only for
     a beam that is neither max nor short and when ``noise_std_m > 0``). The result depends
