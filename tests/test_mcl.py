@@ -16,7 +16,7 @@ from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
 from teamnav.localization import MCL, BeamModelParams, KLDParams, MCLParams, MotionParams, pose_error, sample_error_m
 from teamnav.localization.beam_model import (
-    beam_density, beam_log_likelihood_reference, beam_log_table, beam_loglik_kernel, beam_probability,
+    BeamTable, beam_density, beam_log_likelihood_reference, beam_log_table, beam_loglik_kernel, beam_probability,
 )
 from teamnav.localization.likelihood_field import lf_log_likelihood_reference
 from teamnav.localization.motion import motion_kernel, sample_motion, sample_motion_reference
@@ -129,6 +129,7 @@ def test_tabulated_beam_kernel_matches_exact_mixture():
     measured = np.r_[rng.uniform(0.1, 9.9, 18), 10.0, 10.0]
     ref = beam_log_likelihood_reference(expected, measured, params, 10.0)
     table, step = beam_log_table(measured, params, 10.0)
+    assert_allclose(BeamTable(params, 10.0)(measured), table, rtol=1e-9, atol=1e-9)  # compiled table
     got = beam_loglik_kernel(expected, 1, table, 1.0 / step, 1.0, np.empty(300))
     assert_allclose(got, ref, atol=20 * step**2 / (8 * 0.1**2) + 1e-9)
     # a sonar cone: expected distance is the minimum over its rays

@@ -49,7 +49,7 @@ from scipy.special import ndtr
 from teamnav.localization._checks import array, positive
 
 __all__ = [
-    "BeamModelParams", "beam_density", "beam_probability", "beam_log_table", "beam_loglik_kernel",
+    "BeamModelParams", "BeamTable", "beam_density", "beam_table_kernel", "beam_probability", "beam_log_table", "beam_loglik_kernel",
     "beam_log_likelihood_reference", "max_reading",
 ]
 
@@ -149,6 +149,62 @@ def beam_log_table(measured: np.ndarray, params: BeamModelParams, max_range_m: f
     grid = np.minimum(np.arange(n) * step, zmax)
     p = beam_probability(measured[:, None], grid[None, :], params, zmax)
     return np.log(p), step
+
+
+@njit(cache=True, parallel=True)
+def beam_table_kernel(z, grid, eta_hit, eta_short, z_hit, z_short, z_max, z_rand, sigma, lam, zmax, out):
+    """Compiled :func:`beam_log_table`: ``out[b, j] = log P(z_b | grid_j)`` with the per-``z*``
+    normalisers ``eta_hit``, ``eta_short`` precomputed (:class:`BeamTable`)."""
+    inv_norm = 1.0 / (sigma * math.sqrt(2.0 * math.pi))
+    for b in prange(z.shape[0]):
+        zb = z[b]
+        is_max = zb >= zmax - MAX_READING_TOL_M
+        if is_max:
+            zb = zmax
+        base = z_max if is_max else z_rand / zmax
+        e_short = lam * math.exp(-lam * zb)
+        for j in range(grid.shape[0]):
+            ze = grid[j]
+            d = (zb - ze) / sigma
+            p = base
+            if d * d < 1400.0:
+                p += z_hit * eta_hit[j] * inv_norm * math.exp(-0.5 * d * d)
+            if zb <= ze and ze > 0.0:
+                p += z_short * eta_short[j] * e_short
+            out[b, j] = math.log(p)
+    return out
+
+
+class BeamTable:
+    """Per-scan tables of one beam model and range (normalisers over ``z*`` computed once).
+
+    Examples
+    --------
+    >>> bt = BeamTable(BeamModelParams(), 10.0)
+    >>> t = bt(np.array([2.0, 10.0]))
+    >>> t.shape == (2, bt.grid.shape[0]), bool(np.allclose(t, beam_log_table(np.array([2.0, 10.0]), BeamModelParams(), 10.0)[0]))
+    (True, True)
+    """
+
+    def __init__(self, params: BeamModelParams, max_range_m: float) -> None:
+        self.params = params
+        self.max_range_m = positive("max_range_m", max_range_m)
+        self.step_m = params.step_m
+        n = int(math.ceil(self.max_range_m / self.step_m)) + 1
+        self.grid = np.minimum(np.arange(n) * self.step_m, self.max_range_m)
+        s, zmax = params.sigma_hit_m, self.max_range_m
+        self.eta_hit = 1.0 / (ndtr((zmax - self.grid) / s) - ndtr(-self.grid / s))
+        with np.errstate(divide="ignore"):
+            self.eta_short = np.where(self.grid > 0, 1.0 / -np.expm1(-params.lambda_short_per_m * self.grid), 0.0)
+
+    def __call__(self, measured: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """``log P(z_b | z*_j)``, shape (B, J + 1), for the scan ``measured`` (B,)."""
+        z = np.ascontiguousarray(measured, dtype=np.float64)
+        if out is None or out.shape != (z.shape[0], self.grid.shape[0]):
+            out = np.empty((z.shape[0], self.grid.shape[0]))
+        p = self.params
+        return beam_table_kernel(z, self.grid, self.eta_hit, self.eta_short, p.z_hit, p.z_short, p.z_max, p.z_rand,
+                                 p.sigma_hit_m, p.lambda_short_per_m, self.max_range_m, out)
 
 
 @njit(cache=True, parallel=True)

@@ -37,7 +37,7 @@ from scipy import ndimage
 from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
 from teamnav.localization._checks import array, generator
-from teamnav.localization.beam_model import BeamModelParams, beam_log_table, beam_loglik_kernel
+from teamnav.localization.beam_model import BeamModelParams, BeamTable, beam_loglik_kernel
 from teamnav.localization.kld import KLDParams, kld_count_kernel
 from teamnav.localization.likelihood_field import LikelihoodFieldParams, build_log_field, lf_loglik_kernel
 from teamnav.localization.motion import MotionParams, motion_kernel
@@ -234,6 +234,7 @@ class MCL:
         self._used_angles = used
         blocking = known_map.blocking(self.sees)
         self._caster = RayCaster(known_map, self.sees, self.max_range_m) if params.sensor_model == "beam" else None
+        self._beam_table = BeamTable(params.beam, self.max_range_m) if params.sensor_model == "beam" else None
         free = known_map.cells == FREE
         if params.init_clearance_m > 0:
             free &= distance_field(known_map) >= params.init_clearance_m
@@ -381,8 +382,8 @@ class MCL:
             p = self._particles
             self._caster.cast_xyt(p[:, 0], p[:, 1], p[:, 2], self._ray_angles, out=self._rays,
                                   parallel=self.params.parallel)
-            table, step = beam_log_table(z, self.params.beam, self.max_range_m)
-            beam_loglik_kernel(self._rays, self._k, table, 1.0 / step, exponent, self._ll)
+            table = self._beam_table(z)
+            beam_loglik_kernel(self._rays, self._k, table, 1.0 / self._beam_table.step_m, exponent, self._ll)
         else:
             keep = z < self.max_range_m - 1e-6
             a = self._used_angles[keep]
