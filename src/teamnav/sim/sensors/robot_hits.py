@@ -222,6 +222,11 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
     reach = 0.0
     for b in range(nb):
         reach = max(reach, out[i, b])
+    rdx = np.empty(nb)  # world directions of the rays (the reference's arithmetic, once per robot)
+    rdy = np.empty(nb)
+    for b in range(nb):
+        rdx[b] = cti * cb[b] - sti * sb[b]
+        rdy[b] = sti * cb[b] + cti * sb[b]
     if reach <= 0.0:
         return
     reach += _REACH_SLACK_M
@@ -288,8 +293,8 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
                 for k in range(k0, k1):
                     # _disc_hit's arithmetic with selects for branches (short spans mispredict)
                     b = ray_order[k]
-                    dx = cti * cb[b] - sti * sb[b]
-                    dy = sti * cb[b] + cti * sb[b]
+                    dx = rdx[b]
+                    dy = rdy[b]
                     bb = fx * dx + fy * dy
                     disc = bb * bb - cc
                     t = -bb - math.sqrt(max(disc, 0.0))
