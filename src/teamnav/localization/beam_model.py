@@ -151,7 +151,7 @@ def beam_log_table(measured: np.ndarray, params: BeamModelParams, max_range_m: f
     return np.log(p), step
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def beam_table_kernel(z, grid, eta_hit, eta_short, z_hit, z_short, z_max, z_rand, sigma, lam, zmax, out):
     """Compiled :func:`beam_log_table`: ``out[b, j] = log P(z_b | grid_j)`` with the per-``z*``
     normalisers ``eta_hit``, ``eta_short`` precomputed (:class:`BeamTable`)."""
@@ -252,3 +252,8 @@ def beam_log_likelihood_reference(expected: np.ndarray, measured: np.ndarray, pa
     e = array("expected", expected, (-1, -1))
     z = array("measured", measured, (e.shape[1],))
     return np.log(beam_probability(z[None, :], e, params, max_range_m)).sum(axis=1)
+
+
+#: Serial twin of :func:`beam_loglik_kernel` (same body, no threads): small calls on busy cores
+#: lose milliseconds to thread launch.
+beam_loglik_kernel_serial = njit(cache=True)(beam_loglik_kernel.py_func)

@@ -136,3 +136,8 @@ def lf_log_likelihood_reference(poses, measured, angles, table, free, origin_xy,
     pin = (pr >= 0) & (pr < h) & (pc >= 0) & (pc < w)
     ok = pin & (free[np.clip(pr, 0, h - 1), np.clip(pc, 0, w - 1)] == 1)
     return np.where(ok, s, worst * z.shape[0])
+
+
+#: Serial twin of :func:`lf_loglik_kernel` (same body, no threads): small calls on busy cores
+#: lose milliseconds to thread launch.
+lf_loglik_kernel_serial = njit(cache=True)(lf_loglik_kernel.py_func)

@@ -37,10 +37,12 @@ from scipy import ndimage
 from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
 from teamnav.localization._checks import array, generator
-from teamnav.localization.beam_model import BeamModelParams, BeamTable, beam_loglik_kernel
+from teamnav.localization.beam_model import BeamModelParams, BeamTable, beam_loglik_kernel, beam_loglik_kernel_serial
 from teamnav.localization.kld import KLDParams, kld_count_kernel
-from teamnav.localization.likelihood_field import LikelihoodFieldParams, build_log_field, lf_loglik_kernel
-from teamnav.localization.motion import MotionParams, motion_kernel
+from teamnav.localization.likelihood_field import (
+    LikelihoodFieldParams, build_log_field, lf_loglik_kernel, lf_loglik_kernel_serial,
+)
+from teamnav.localization.motion import MotionParams, motion_kernel, motion_kernel_serial
 from teamnav.localization.resample import effective_sample_size, low_variance_kernel, normalize_log_weights
 from teamnav.world.distance import distance_field
 from teamnav.world.grid import DEFAULT_SEES, FREE, OccupancyGrid
@@ -87,7 +89,9 @@ class MCLParams(BaseModel):
     cluster_cell_m : float, default 0.5
         Cell of the grid whose connected components are the belief's clusters [m].
     parallel : bool, default True
-        Use numba's threads in ray casting.
+        Use numba's threads for calls of at least ``parallel_min_work`` particle-beams
+        (smaller calls run serially: on busy cores a thread launch costs milliseconds).
+    parallel_min_work : int, default 200000
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True)
@@ -113,6 +117,7 @@ class MCLParams(BaseModel):
     min_update_rot_rad: float = Field(0.0, ge=0.0, le=2 * math.pi)
     cluster_cell_m: float = Field(0.5, gt=0.0, le=100.0)
     parallel: bool = True
+    parallel_min_work: int = Field(200_000, ge=0, le=10**12)
 
     @model_validator(mode="after")
     def _rates(self) -> "MCLParams":
@@ -359,10 +364,14 @@ class MCL:
         self._require_particles("predict")
         d = array("odom_delta", odom_delta, (3,))
         noise = self.rng.standard_normal((self._particles.shape[0], 3))
-        motion_kernel(self._particles, float(d[0]), float(d[1]), float(d[2]),
+        kernel = motion_kernel if self._threads(self._particles.shape[0] * 3) else motion_kernel_serial
+        kernel(self._particles, float(d[0]), float(d[1]), float(d[2]),
                       np.asarray(self.params.motion.alpha, dtype=np.float64), noise)
         self._since_update[0] += math.hypot(d[0], d[1])
         self._since_update[1] += abs(float(wrap_angle(d[2])))
+
+    def _threads(self, work: int) -> bool:
+        return self.params.parallel and work >= self.params.parallel_min_work
 
     def log_likelihood(self, scan_ranges) -> np.ndarray:
         """``log P(o | l_i)`` (times ``likelihood_exponent``) of a scan for every sample, (n,)."""
@@ -380,16 +389,17 @@ class MCL:
             if self._rays.shape != (n, r):
                 self._rays = np.empty((n, r))
             p = self._particles
-            self._caster.cast_xyt(p[:, 0], p[:, 1], p[:, 2], self._ray_angles, out=self._rays,
-                                  parallel=self.params.parallel)
+            threads = self._threads(n * r)
+            self._caster.cast_xyt(p[:, 0], p[:, 1], p[:, 2], self._ray_angles, out=self._rays, parallel=threads)
             table = self._beam_table(z)
-            beam_loglik_kernel(self._rays, self._k, table, 1.0 / self._beam_table.step_m, exponent, self._ll)
+            (beam_loglik_kernel if threads else beam_loglik_kernel_serial)(self._rays, self._k, table, 1.0 / self._beam_table.step_m, exponent, self._ll)
         else:
             keep = z < self.max_range_m - 1e-6
             a = self._used_angles[keep]
             zz = z[keep]
             g = self.map
-            lf_loglik_kernel(self._particles, np.ascontiguousarray(zz * np.cos(a)), np.ascontiguousarray(zz * np.sin(a)),
+            kernel = lf_loglik_kernel if self._threads(n * zz.shape[0]) else lf_loglik_kernel_serial
+            kernel(self._particles, np.ascontiguousarray(zz * np.cos(a)), np.ascontiguousarray(zz * np.sin(a)),
                              self._lf_table, self._lf_free, g.origin_xy_m[0], g.origin_xy_m[1], 1.0 / g.resolution_m,
                              self._lf_outside, self._lf_worst, exponent, self._ll)
         return self._ll

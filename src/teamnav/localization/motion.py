@@ -165,3 +165,8 @@ def sample_motion_reference(particles, odom_delta, alpha, noise) -> np.ndarray:
     r2 = rot2 - n[:, 2] * math.sqrt(a[0] * rot2**2 + a[1] * trans**2)
     return np.stack([p[:, 0] + t * np.cos(p[:, 2] + r1), p[:, 1] + t * np.sin(p[:, 2] + r1),
                      wrap_angle(p[:, 2] + r1 + r2)], axis=1)
+
+
+#: Serial twin of :func:`motion_kernel` (same body, no threads): small calls on busy cores
+#: lose milliseconds to thread launch.
+motion_kernel_serial = njit(cache=True)(motion_kernel.py_func)
