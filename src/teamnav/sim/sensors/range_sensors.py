@@ -210,7 +210,7 @@ def _normal(s):
 
 @njit(cache=True)
 def _counter_noise_rows(true, key, i0, i1, sigma, p_max, p_short, max_range, out):
-    """Rows ``[i0, i1)`` of :func:`_counter_noise_kernel`."""
+    """Rows ``[i0, i1)`` of :func:`beam_noise_keyed` (``out`` may be ``true``)."""
     nb = true.shape[1]
     use_u = p_max + p_short > 0.0
     use_z = sigma > 0.0

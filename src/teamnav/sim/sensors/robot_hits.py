@@ -12,17 +12,31 @@ The sensing robot's own disc is skipped (its sensor sits inside it), as Stage do
 
 Scaling
 -------
-Robot centres are bucketed once per call in a uniform spatial hash (square cells of side
-``max_range_m + max(radius)`` by default; keys sorted, cells found by binary search, so
-memory is O(N) whatever the size of the world). Robot ``i`` then visits only the hash cells
-overlapping the square of half-side ``reach_i + max(radius)`` around it, where ``reach_i``
-is the longest map range among its own rays (a robot behind a wall that every ray already
-stops at cannot be hit), and only robots ``j`` with ``|c_j - p_i| - r_j < reach_i`` are
-intersected with its rays, and of those rays only the ones inside the disc's angular window
-``bearing +- asin(r_j / d)`` (binary search over the sorted ray directions). Sensing robots
-are spread over numba's threads (``prange``) once there are ``PARALLEL_MIN_RAYS`` rays: on
-the 2-core development machine smaller calls gained nothing from threads.
-Cost per step: O(N log N) for the hash plus O(sum over i of neighbours_i × rays).
+Robot centres are bucketed once per call in a dense grid of square cells (side
+``(max_range_m + max(radius)) / 2`` by default, enlarged so that there are at most 4 cells
+per robot: memory O(N) whatever the size of the world; a counting sort, so O(N)). Robot
+``i`` visits only the cells overlapping the square of half-side ``reach_i + max(radius)``
+around it, where ``reach_i`` is the longest map range among its own rays (a robot behind a
+wall that every ray already stops at cannot be hit). A disc ``j`` is then dropped, before any
+angle is computed, when ``|c_j - p_i| - r_j >= reach_i`` or when it lies wholly behind a fan
+no wider than a half-turn. The survivors are intersected only with the rays inside their
+angular window ``bearing +- (r / sqrt(d^2 - r^2) + margin)`` (wider than ``asin(r / d)``):
+for an even fan the window's ray indices are floor/ceil of ``(angle - first) / step``, for
+any other set of directions a binary search over the sorted directions; the bearing comes
+from a polynomial ``atan2`` good to 4e-8 rad, well inside the margin. Every ray of a window is
+intersected with the same arithmetic as :func:`robot_hits_reference`, so the result is
+identical to testing every ray against every disc (the tests compare bit for bit).
+Sensing robots are spread over numba's threads (``prange``) once there are
+``PARALLEL_MIN_RAYS`` rays: on the 2-core development machine smaller calls gained nothing.
+Cost per step: O(N) for the hash plus O(sum over i of (candidates_i + window rays_i)).
+
+Measured (1000 robots x 180 beams on the MIT basement map, one thread, busy 2-core box):
+21 ms with the former sorted-key hash, ``atan2``/``asin`` and binary searches per disc;
+12.7 ms with the dense hash, arithmetic windows and the ``tan`` bound; 9.9 ms with the
+polynomial ``atan2``; 8.4 ms without per-ray or per-block "already shorter" tests (they
+mispredict more than they save: one front disc in seven is hidden, and its window is ~3
+rays); 7.3 ms with the half-plane cull; 6.8 ms rotating the rays once per robot. Per robot:
+~210 candidates, ~155 within reach, half of them behind, ~480 ray-disc intersections.
 """
 
 from __future__ import annotations
