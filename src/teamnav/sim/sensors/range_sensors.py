@@ -511,7 +511,8 @@ class RangeSensor:
                   and out.flags.writeable):
             raise ValueError(f"out must be a writeable float64 array of shape {true.shape}, got "
                              f"{getattr(out, 'dtype', type(out).__name__)} {getattr(out, 'shape', '')}")
-        return _keyed_noise(true, draw_noise_key(rng), self.noise_std_m, self.p_max, self.p_short, self.max_range_m, out)
+        return _keyed_noise(true, draw_noise_key(rng), self.noise_std_m, self.p_max, self.p_short, self.max_range_m,
+                            out)
 
     def _sense(self, xs, ys, thetas, rng: np.random.Generator, bodies=None) -> np.ndarray:
         """:meth:`sense` without input checks, into a fresh array (the engine's per-step path;

@@ -138,20 +138,6 @@ def _disc_hit(fx, fy, dx, dy, r2):
 
 
 @njit(cache=True, inline="always")
-def _disc_hit_cc(fx, fy, cc, dx, dy):
-    """:func:`_disc_hit` with ``cc = |f|^2 - r^2`` computed once per disc (same arithmetic)."""
-    if cc <= 0.0:
-        return 0.0
-    b = fx * dx + fy * dy
-    if b >= 0.0:
-        return np.inf
-    disc = b * b - cc
-    if disc < 0.0:
-        return np.inf
-    return -b - math.sqrt(disc)
-
-
-@njit(cache=True, inline="always")
 def _even_span(lo, hi, inv_step, nb):
     """Beams ``[k0, k1)`` of an even fan (beam ``k`` at ``k * step`` past the first) inside ``[lo, hi]``."""
     k0 = max(0, int(math.ceil(lo * inv_step)))
@@ -317,9 +303,9 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
 
 
 @njit(cache=True)
-def _prepare(xs, ys, thetas, all_x, all_y, all_r, max_range_m, cell_m):
-    """Cos/sin of the headings and :func:`_build_hash` (cell side :func:`default_cell_m`
-    when ``cell_m <= 0``) plus the largest radius."""
+def _prepare(all_x, all_y, all_r, max_range_m, cell_m):
+    """:func:`_build_hash` (cell side :func:`default_cell_m` when ``cell_m <= 0``) plus the
+    largest radius, as the ``hsh`` tuple of :func:`_robot_hits_one`."""
     rmax = 0.0
     for j in range(all_r.shape[0]):
         rmax = max(rmax, all_r[j])
@@ -327,22 +313,22 @@ def _prepare(xs, ys, thetas, all_x, all_y, all_r, max_range_m, cell_m):
         cell_m = max(1e-3, 0.5 * (max_range_m + rmax))
     sx, sy, sr, sid, start, x0, y0, cell, nkx, nky = _build_hash(all_x, all_y, all_r, cell_m,
                                                                  _CELLS_PER_ROBOT * all_x.shape[0] + 16)
-    return np.cos(thetas), np.sin(thetas), (sx, sy, sr, sid, start, x0, y0, cell, nkx, nky, rmax)
+    return (sx, sy, sr, sid, start, x0, y0, cell, nkx, nky, rmax)
 
 
 @njit(cache=True, parallel=True)
-def _robot_hits_parallel(xs, ys, thetas, self_idx, beams, even, all_x, all_y, all_r, max_range_m, cell_m, out):
+def _robot_hits_parallel(xs, ys, ct, st, self_idx, beams, even, all_x, all_y, all_r, max_range_m, cell_m, out):
     """:func:`_robot_hits_one` for every sensing robot, spread over numba's threads."""
-    ct, st, hsh = _prepare(xs, ys, thetas, all_x, all_y, all_r, max_range_m, cell_m)
+    hsh = _prepare(all_x, all_y, all_r, max_range_m, cell_m)
     for i in prange(xs.shape[0]):
         _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out)
 
 
 @njit(cache=True)
-def _robot_hits_serial(xs, ys, thetas, self_idx, beams, even, all_x, all_y, all_r, max_range_m, cell_m, out):
+def _robot_hits_serial(xs, ys, ct, st, self_idx, beams, even, all_x, all_y, all_r, max_range_m, cell_m, out):
     """:func:`_robot_hits_one` for every sensing robot, in this thread (one call: small teams
     pay a single dispatch)."""
-    ct, st, hsh = _prepare(xs, ys, thetas, all_x, all_y, all_r, max_range_m, cell_m)
+    hsh = _prepare(all_x, all_y, all_r, max_range_m, cell_m)
     for i in range(xs.shape[0]):
         _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out)
 
@@ -421,8 +407,9 @@ def robot_hits_unchecked(xs, ys, thetas, plan: BeamPlan, all_x, all_y, all_r, se
     if xs.shape[0] == 0 or all_x.shape[0] == 0 or ranges.shape[1] == 0:
         return ranges
     kernel = _robot_hits_parallel if parallel else _robot_hits_serial
-    kernel(xs, ys, thetas, self_idx, plan.beams, plan.even, all_x, all_y, all_r, float(max_range_m), float(cell_m),
-           ranges)
+    # cos/sin by NumPy, as robot_hits_reference: the rays' directions agree to the last bit
+    kernel(xs, ys, np.cos(thetas), np.sin(thetas), self_idx, plan.beams, plan.even, all_x, all_y, all_r,
+           float(max_range_m), float(cell_m), ranges)
     return ranges
 
 
