@@ -264,7 +264,10 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
                 ka1 = nb
             elif is_even:
                 u = phi - first
-                u -= two_pi * math.floor(u / two_pi)  # [0, 2 pi)
+                if u < 0.0:
+                    u += two_pi
+                if not (0.0 <= u < two_pi):  # first far outside [-pi, pi]
+                    u -= two_pi * math.floor(u / two_pi)  # [0, 2 pi)
                 ka0, ka1 = _even_span(u - beta, u + beta, inv_step, nb)
                 if u - beta < 0.0:
                     kb0, kb1 = _even_span(u - beta + two_pi, u + beta + two_pi, inv_step, nb)
