@@ -374,3 +374,24 @@ def test_engine_readings_equal_the_public_sensor_api(count):
         with_bodies = sensor.true_ranges(s.x_m, s.y_m, s.theta_rad, bodies=(s.x_m, s.y_m, s.radius_m, ids))
         hit_robot |= bool((with_bodies < walls_only).any())
     assert hit_robot  # the robots do block each other's beams here
+
+
+def test_same_run_on_one_or_all_threads():
+    # every sensing kernel is exact or counter-based: the thread count never changes a run
+    import numba
+
+    cfg = SimConfig(robots=(RobotGroupConfig(count=130, controller="wander-batched-v1", radius_m=0.2,
+                                             sensors=(LaserConfig(n_beams=181, noise_std_m=0.02, p_max=0.01,
+                                                                  p_short=0.01),)),),
+                    seed=9)
+    runs = []
+    before = numba.get_num_threads()
+    try:
+        for threads in (1, numba.config.NUMBA_NUM_THREADS):
+            numba.set_num_threads(threads)
+            sim = Simulation(_room(side_m=12.0), cfg)
+            sim.run(15)
+            runs.append(sim.state.poses())
+    finally:
+        numba.set_num_threads(before)
+    np.testing.assert_array_equal(runs[0], runs[1])
