@@ -185,10 +185,10 @@ def _normal_slow(s, rabs, idx, x):
         idx = int(r & np.uint64(0xFF))
         r >>= np.uint64(8)
         rabs = (r >> np.uint64(1)) & np.uint64(0x000FFFFFFFFFFFFF)
-        x = float(rabs) * _ZIG_WI[idx]
+        x = float(np.int64(rabs)) * _ZIG_WI[idx]
         if r & np.uint64(1):
             x = -x
-        if float(rabs) < _ZIG_KI[idx]:
+        if float(np.int64(rabs)) < _ZIG_KI[idx]:
             return x
 
 
@@ -200,10 +200,10 @@ def _normal(s):
     idx = int(r & np.uint64(0xFF))
     r >>= np.uint64(8)
     rabs = (r >> np.uint64(1)) & np.uint64(0x000FFFFFFFFFFFFF)
-    x = float(rabs) * _ZIG_WI[idx]
+    x = float(np.int64(rabs)) * _ZIG_WI[idx]
     if r & np.uint64(1):
         x = -x
-    if float(rabs) < _ZIG_KI[idx]:
+    if float(np.int64(rabs)) < _ZIG_KI[idx]:
         return x
     return _normal_slow(s, rabs, idx, x)
 
@@ -214,9 +214,12 @@ def _counter_noise_rows(true, key, i0, i1, sigma, p_max, p_short, max_range, out
     nb = true.shape[1]
     use_u = p_max + p_short > 0.0
     use_z = sigma > 0.0
+    block = np.uint64(_SLOTS) * _GAMMA
+    s0 = key + np.uint64(i0 * nb * _SLOTS) * _GAMMA
     for i in range(i0, i1):
         for b in range(nb):
-            s = key + np.uint64((i * nb + b) * _SLOTS) * _GAMMA
+            s = s0
+            s0 += block
             v = 0.0
             if use_u:
                 s += _GAMMA
