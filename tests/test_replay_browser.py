@@ -1,11 +1,15 @@
 """The HTML replay in a real browser: Debian's headless Chromium driven by Playwright.
 
-Not skipped anywhere: ``.ci/run`` installs ``chromium`` when it is missing, and Playwright
-(from the test extra) drives that binary; Playwright's own browser downloads are never used.
+Never skipped in CI: ``.ci/run`` installs ``chromium`` when it is missing and sets
+``TEAMNAV_REQUIRE_BROWSER=1``, so a missing browser there is a failure. On a developer's fresh
+machine without Debian's ``chromium`` the test is skipped with a message saying how to get it,
+so the README's test command still works. Playwright (from the test extra) drives that binary;
+Playwright's own browser downloads are never used.
 """
 
 from __future__ import annotations
 
+import os
 import shutil
 import tempfile
 
@@ -16,6 +20,9 @@ import _replay_run
 from teamnav.viz.replay import build_replay
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+if not os.path.exists(CHROMIUM) and os.environ.get("TEAMNAV_REQUIRE_BROWSER") != "1":
+    pytest.skip("Debian's chromium is not installed (apt-get install -y chromium); "
+                ".ci/run installs it and never skips this test", allow_module_level=True)
 ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 
