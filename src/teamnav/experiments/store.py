@@ -258,7 +258,8 @@ class ResultsStore:
             raise
 
 
-def _rows(con: sqlite3.Connection, sweep: str | None, status: str | None) -> list[dict[str, Any]]:
+def _select_trials(sweep: str | None, status: str | None) -> tuple[str, list[str]]:
+    """The SELECT over ``trials`` filtered by sweep name and status, with its arguments."""
     where, args = [], []
     if sweep is not None:
         where.append("sweep = ?")
@@ -267,6 +268,11 @@ def _rows(con: sqlite3.Connection, sweep: str | None, status: str | None) -> lis
         where.append("status = ?")
         args.append(status)
     sql = "SELECT * FROM trials" + (" WHERE " + " AND ".join(where) if where else "") + " ORDER BY sweep, finished_at, trial_id"
+    return sql, args
+
+
+def _rows(con: sqlite3.Connection, sweep: str | None, status: str | None) -> list[dict[str, Any]]:
+    sql, args = _select_trials(sweep, status)
     cur = con.execute(sql, args)
     names = [d[0] for d in cur.description]
     out = []
@@ -311,14 +317,7 @@ def load_dataframe(path: str | os.PathLike, *, sweep: str | None = None, status:
         import pandas as pd
     except ImportError:
         raise ImportError("load_dataframe needs pandas (pip install pandas); load_rows returns plain dicts") from None
-    where, args = [], []
-    if sweep is not None:
-        where.append("sweep = ?")
-        args.append(sweep)
-    if status is not None:
-        where.append("status = ?")
-        args.append(status)
-    sql = "SELECT * FROM trials" + (" WHERE " + " AND ".join(where) if where else "") + " ORDER BY sweep, finished_at, trial_id"
+    sql, args = _select_trials(sweep, status)
     con = sqlite3.connect(f"{_store_file(path).resolve().as_uri()}?mode=ro", uri=True, timeout=60.0)
     try:
         return pd.read_sql(sql, con, params=args)
