@@ -24,6 +24,8 @@ failure of the trials it was running. A failing trial never stops the sweep.
 
 from __future__ import annotations
 
+import contextlib
+
 import datetime as _dt
 import importlib.util
 import logging
@@ -329,10 +331,8 @@ class RayExecutor:
                 fill()
         except BaseException:
             for ref in in_flight:
-                try:
+                with contextlib.suppress(Exception):  # best effort while unwinding
                     ray.cancel(ref, force=True)
-                except Exception:  # noqa: BLE001 - best effort while unwinding
-                    pass
             raise
         finally:
             if started_here:

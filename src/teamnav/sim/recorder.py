@@ -69,6 +69,8 @@ Brains write layers through ``log()``: a ``"layers"`` entry maps layer names to 
 
 from __future__ import annotations
 
+import contextlib
+
 import json
 import os
 import re
@@ -112,10 +114,8 @@ def _write_atomic(path: Path, write) -> None:
             os.fsync(f.fileno())
         os.replace(tmp, path)
     except BaseException:
-        try:
+        with contextlib.suppress(OSError):  # the temp file may not exist yet
             os.unlink(tmp)
-        except OSError:
-            pass
         raise
 
 

@@ -34,6 +34,8 @@ topic                          schema                     what
 
 from __future__ import annotations
 
+import contextlib
+
 import colorsys
 import math
 import os
@@ -254,10 +256,8 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
                     log(ch, SceneUpdate(entities=[SceneEntity(**{k: v for k, v in ent.items() if v is not None})]), lay_ns[s])
         os.replace(tmp, path)
     except BaseException:
-        try:
+        with contextlib.suppress(OSError):  # the temp file may not exist yet
             tmp.unlink()
-        except OSError:
-            pass
         raise
     return McapStats(path=path, bytes=path.stat().st_size, messages=sum(counts.values()), channels=len(counts),
                      counts=dict(sorted(counts.items())))
