@@ -58,6 +58,14 @@ class RunData:
         Step length [s].
     wall_s : float
         Wall-clock time of the stepping loop [s].
+    event_log : list of dict
+        Every task event that fired, in order: ``{"step", "t_s", "robot", "place", "event"}``.
+    logs : list of dict
+        The brains' ``log()`` values as recorded: ``{"step", "t_s", "robot", "values"}``
+        (belief-side data: what the robot believed or decided; metrics compare it with the truth).
+    finished : bool
+        The run stopped early because every brain that reports ``finished`` said so
+        (scenario ``stop_when_finished``).
     """
 
     t_s: np.ndarray
@@ -73,6 +81,9 @@ class RunData:
     n_steps: int = 0
     dt_s: float = 0.1
     wall_s: float = 0.0
+    event_log: list[dict] = field(default_factory=list)
+    logs: list[dict] = field(default_factory=list)
+    finished: bool = False
 
     @property
     def n_robots(self) -> int:
@@ -272,5 +283,22 @@ register("steps", steps, "steps run and simulated time [s]")
 register("wall_time", wall_time, "wall-clock time of the run [s]", deterministic=False)
 register("throughput", throughput, "robot-steps per wall-clock second", deterministic=False)
 
+
+def _discover_metric_sets() -> None:
+    """Import every module of :mod:`teamnav.experiments.metric_sets` so that each paper's
+    metrics register themselves. A metric set's functions return ``{}`` for a run that lacks
+    their data (another paper's scenario), because a scenario with ``metrics: []`` computes all."""
+    import importlib
+    import pkgutil
+
+    from teamnav.experiments import metric_sets
+
+    for info in sorted(pkgutil.iter_modules(metric_sets.__path__), key=lambda m: m.name):
+        if not info.name.startswith("_"):
+            importlib.import_module(f"{metric_sets.__name__}.{info.name}")
+
+
 #: keys each non-deterministic metric produces (for :func:`deterministic`)
 _KEYS: dict[str, tuple[str, ...]] = {"wall_time": ("wall_time_s",), "throughput": ("robot_steps_per_s",)}
+
+_discover_metric_sets()

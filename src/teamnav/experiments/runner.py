@@ -96,7 +96,8 @@ def _comm_counts(comm: dict) -> tuple[int, int, int]:
     return int(comm.get("messages_sent", 0)), int(comm.get("bytes_sent", 0)), int(comm.get("messages_delivered", 0))
 
 
-def run_data(run_dir: Path, scenario: Scenario, grid, n_steps: int, wall_s: float) -> metric_registry.RunData:
+def run_data(run_dir: Path, scenario: Scenario, grid, n_steps: int, wall_s: float, *,
+             finished: bool = False) -> metric_registry.RunData:
     """Read the recorder's files in ``run_dir`` into a :class:`~teamnav.experiments.metrics.RunData`."""
     from teamnav.sim.recorder import load
 
@@ -116,6 +117,9 @@ def run_data(run_dir: Path, scenario: Scenario, grid, n_steps: int, wall_s: floa
         n_steps=n_steps,
         dt_s=scenario.dt_s,
         wall_s=wall_s,
+        event_log=list(rec.events),
+        logs=list(rec.logs),
+        finished=finished,
     )
 
 
@@ -175,6 +179,26 @@ def _json_ready(values: dict[str, Any]) -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------------- run
+def all_finished(sim) -> bool:
+    """True when every per-robot brain that has a ``finished`` attribute reports it true, and at
+    least one does (a brain with a task: R1's 200 targets; a helper has no ``finished``).
+
+    This reads the brains' own outputs, never the truth, so stopping early does not steer.
+    """
+    seen = False
+    for group in sim.brains:
+        if not isinstance(group, list):
+            continue
+        for brain in group:
+            flag = getattr(brain, "finished", None)
+            if flag is None:
+                continue
+            seen = True
+            if not flag:
+                return False
+    return seen
+
+
 def run(
     scenario: Scenario | str | os.PathLike,
     *,
@@ -255,13 +279,14 @@ def run(
     try:
         t0 = time.perf_counter()
         try:
-            sim.run(n_steps, progress=callback)
+            sim.run(n_steps, progress=callback, is_finished=all_finished if scenario.stop_when_finished else None)
         finally:
             if bar is not None:
                 bar.close()
         wall_s = time.perf_counter() - t0
         sim.recorder.save(staging)
-        data = run_data(staging, scenario, grid, int(sim.step_index), wall_s)
+        data = run_data(staging, scenario, grid, int(sim.step_index), wall_s,
+                        finished=bool(scenario.stop_when_finished and all_finished(sim)))
         values = metric_registry.compute(scenario.metric_names, data)
         if out is None:
             shutil.rmtree(staging, ignore_errors=True)

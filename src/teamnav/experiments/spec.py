@@ -15,6 +15,7 @@ A scenario is a YAML file validated by :class:`Scenario`, which extends the simu
     duration_s: 60                    # simulated time [s]
     metrics: [path_length, collisions] # names from teamnav.experiments.metrics (default: all)
     give_map: false                   # robots get the map as prior knowledge (RobotInfo.known_map)
+    stop_when_finished: false         # stop early once every brain with a `finished` flag is done
 
 With a ``builtin`` map, named places of that environment can stand in for coordinates: a
 ``places`` entry ``{place: home, radius_m: 1.5, event: took_resource}`` takes its name and
@@ -198,6 +199,10 @@ class Scenario(SimConfig):
         Metric names (:func:`teamnav.experiments.metrics.names`); empty means all.
     give_map : bool
         Robots receive the map as prior knowledge (``RobotInfo.known_map``), default False.
+    stop_when_finished : bool
+        End the run before ``duration_s`` once every brain that reports ``finished`` (a
+        controller attribute: its task is done, e.g. R1 reached its last target) says so;
+        ``duration_s`` is then the step budget. Default False.
     """
 
     name: str = Field(min_length=1, max_length=100, pattern=r"^[A-Za-z0-9][A-Za-z0-9_.\-]*$")
@@ -206,6 +211,7 @@ class Scenario(SimConfig):
     duration_s: float = Field(60.0, gt=0.0, le=1e7)
     metrics: tuple[str, ...] = ()
     give_map: bool = False
+    stop_when_finished: bool = False
 
     _source: str = PrivateAttr(default="<code>")
 
