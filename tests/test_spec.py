@@ -79,7 +79,7 @@ def test_nan_written_in_yaml(tmp_path):
 
 def test_every_problem_is_reported_on_its_own_line(tmp_path):
     path = write(tmp_path, BASE + "radio: {p_loss: 2}\nbogus: 1\n")
-    err = error_of(path, overrides={"robots.0.count": 0})
+    err = error_of(path, overrides={"robots.0.count": -1})
     fields = {p.field for p in err.problems}
     assert {"radio.p_loss", "bogus", "robots[0].count"} <= fields
     assert len(str(err).splitlines()) == 1 + len(err.problems)

@@ -185,7 +185,7 @@ class RobotGroupConfig(Model):
     """
 
     name: str = "robot"
-    count: int = Field(1, ge=1, le=100_000)
+    count: int = Field(1, ge=0, le=100_000)
     radius_m: float = Field(0.2, gt=0.0, le=10.0)
     kinematics: Literal["unicycle", "holonomic_step"] = "unicycle"
     max_v_mps: float = Field(0.5, gt=0.0, le=100.0)
