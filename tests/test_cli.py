@@ -54,7 +54,7 @@ BAD_FILES = {
     "unknown key": (("    sensors:", "    sensrs:"), (), "robots[0].sensrs", ["unknown key", "did you mean 'sensors'"]),
     "wrong type": (("duration_s: 1.0", "duration_s: soon"), (), "duration_s", ["'soon'"]),
     "nan": (("duration_s: 1.0", "duration_s: .nan"), (), "duration_s", ["finite", "nan"]),
-    "out of range": (("  - count: 2", "  - count: -3"), (), "robots[0].count", ["greater than or equal to 1", "-3"]),
+    "out of range": (("  - count: 2", "  - count: -3"), (), "robots[0].count", ["greater than or equal to 0", "-3"]),
     "missing map": (("{builtin: office_simple}", "{file: maps/none.yaml}"), (), "map.file", ["none.yaml", "no such file"]),
     "malformed map": (("{builtin: office_simple}", "{file: bad_map.yaml}"), (), "map.file", ["bad_map.yaml", "'origin'"]),
     "unknown controller": (("wander-v1", "wandr-v1"), (), "robots[0].controller", ["did you mean 'wander-v1'"]),
