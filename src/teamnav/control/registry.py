@@ -50,3 +50,6 @@ def lookup(name: str) -> Any:
 register("idle-v1", "teamnav.control.idle:Idle")
 register("wander-v1", "teamnav.control.nav.wander:Wander")
 register("wander-batched-v1", "teamnav.control.nav.wander:WanderBatched")
+
+# Trail experiments baseline (Vaughan et al.; helper H7): the single optimal robot
+register("route-follow-v1", "teamnav.control.nav.route_follow:RouteFollow")
