@@ -1,4 +1,4 @@
-"""The ``teamnav`` command: list, run, validate and sweep scenarios.
+"""The ``teamnav`` command: list, run, validate and sweep scenarios; write paper reports.
 
 The CLI only parses, loads the scenario and calls the library (STYLE habit 17). Every bad
 input (a scenario, a map, an override, an output folder) ends in one message on stderr and
@@ -17,6 +17,7 @@ Examples
     teamnav run demo --set record_scans=true --html             # + runs/demo-*/replay.html
     teamnav replay runs/mine --out mine.html --every 2
     teamnav export runs/mine --mcap mine.mcap                   # open in Foxglove
+    teamnav report all --quick --out reports/quick              # paper report (teamnav.experiments.report)
 """
 
 from __future__ import annotations
@@ -233,6 +234,10 @@ def export(
 from teamnav.experiments.sweep_cli import sweep_command  # noqa: E402  (after the app exists)
 
 app.command("sweep")(sweep_command)
+
+from teamnav.experiments.report.cli import report_command  # noqa: E402
+
+app.command("report")(report_command)
 
 
 def main() -> None:  # pragma: no cover - console entry for `python -m teamnav`

@@ -1,0 +1,471 @@
+"""Paper reports: run (or reuse) each paper's sweeps and write one self-contained HTML file.
+
+``teamnav report EXPERIMENT|all --out DIR [--quick]`` and :func:`build_report` do the same:
+
+1. find the sections: every module of :mod:`teamnav.experiments.report.sections` that defines
+   ``SECTION`` (a :class:`~teamnav.experiments.report.model.SectionSpec`), plus sections added
+   with :func:`register_section` (tests, plug-ins);
+2. for each chosen section, call ``SECTION.build(ctx)`` with a
+   :class:`~teamnav.experiments.report.context.SweepContext`; its ``ctx.sweep(...)`` runs the
+   section's sweeps into ``DIR/sweeps/<sweep name>/results.sqlite`` or reuses the trials
+   already there (the store is resumable, so a report killed half-way resumes too);
+3. render the blocks into ``DIR/index.html`` (:mod:`teamnav.experiments.report.html`), written
+   under a temporary name and renamed, plus ``DIR/report.json`` (what each section returned:
+   status, wall time, comparisons, sweeps run and reused).
+
+The four papers of EXPERIMENTS.md are always in ``all`` (:data:`EXPECTED_SECTIONS`): while a
+paper's section module does not exist, the report shows it as missing ("system not built
+yet"), never as numbers. A section whose ``build`` raises is shown as missing with the error,
+the other sections still run, and :attr:`ReportResult.ok` is False (the CLI exits 1 after
+writing the report).
+
+Examples
+--------
+::
+
+    from teamnav.experiments.report import build_report
+    index = build_report("all", "reports/quick", quick=True)          # -> reports/quick/index.html
+    index = build_report(["collab-mcl"], "reports/full", workers=16)  # the full reproduction
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import difflib
+import importlib
+import json
+import os
+import pkgutil
+import sys
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterable, Sequence
+
+from teamnav.experiments.report.model import (
+    Comparison,
+    MapView,
+    Missing,
+    Plot,
+    SectionSpec,
+    Table,
+    Text,
+)
+
+__all__ = [
+    "EXPECTED_SECTIONS",
+    "MARKER_NAME",
+    "ReportError",
+    "ReportResult",
+    "SectionOutcome",
+    "available_sections",
+    "build_report",
+    "discover_sections",
+    "register_section",
+    "resolve_names",
+    "run_report",
+    "unregister_section",
+]
+
+#: File that marks a folder as a teamnav report (so ``--out`` can be reused, and nothing else is).
+MARKER_NAME = "teamnav-report.json"
+
+#: The papers of ``shared/EXPERIMENTS.md``: key -> (title, paper file, order). ``report all``
+#: always has these four sections, as results or as missing.
+EXPECTED_SECTIONS: dict[str, tuple[str, str, int]] = {
+    "los-help": (
+        "Sgorbissa & Arkin: line-of-sight help",
+        "sgorbissa-arkin-local-navigation-strategies-for-a-team-of-robots.txt",
+        10,
+    ),
+    "collab-mcl": (
+        "Fox, Burgard, Kruppa & Thrun: collaborative multi-robot localization",
+        "fox-burgard-kruppa-thrun-collaborative-multi-robot-localization.txt",
+        20,
+    ),
+    "blazing-a-trail": (
+        "Vaughan et al.: Blazing a trail",
+        "vaughan-stoy-sukhatme-mataric-blazing-a-trail.txt",
+        30,
+    ),
+    "try-to-see-it-my-way": (
+        "Vaughan et al.: Try to see it my way",
+        "vaughan-stoy-sukhatme-mataric-try-to-see-it-my-way.txt",
+        40,
+    ),
+}
+
+_BLOCK_TYPES = (Text, Table, Plot, MapView, Comparison, Missing)
+_SECTIONS_PACKAGE = "teamnav.experiments.report.sections"
+_registered: dict[str, SectionSpec] = {}
+
+
+class ReportError(ValueError):
+    """Bad report input: an unknown section name, an output folder that is not a report's,
+    a bad executor option. The CLI prints the message and exits with status 2."""
+
+
+# ---------------------------------------------------------------------------- sections
+def register_section(spec: SectionSpec, *, replace: bool = False) -> None:
+    """Add a section that is not a module of ``report.sections`` (tests, plug-ins).
+
+    Raises
+    ------
+    ReportError
+        ``spec`` is not a SectionSpec, or its key is registered already (unless ``replace``).
+    """
+    if not isinstance(spec, SectionSpec):
+        raise ReportError(f"register_section: expected a SectionSpec, received {type(spec).__name__}")
+    if spec.key in _registered and not replace:
+        raise ReportError(f"register_section: section {spec.key!r} is registered already; pass replace=True to replace it")
+    _registered[spec.key] = spec
+
+
+def unregister_section(key: str) -> None:
+    """Remove a section added with :func:`register_section` (no error when absent)."""
+    _registered.pop(key, None)
+
+
+def _broken_section(key: str, module: str, error: str) -> SectionSpec:
+    """A stand-in for a section module that cannot be imported: its build raises the error."""
+    title, paper, order = EXPECTED_SECTIONS.get(key, (key, "", 100))
+
+    def build(ctx: Any) -> list:
+        raise ImportError(f"section module {module} could not be imported: {error}")
+
+    return SectionSpec(key=key, title=title, paper=paper, build=build, order=order)
+
+
+def discover_sections() -> dict[str, SectionSpec]:
+    """Every ``SECTION`` defined by a module of :mod:`teamnav.experiments.report.sections`.
+
+    A module that fails to import, or has no valid ``SECTION``, becomes a section whose build
+    raises that error (so the report shows it instead of losing it). A module ``foo_bar`` with
+    no importable SECTION gets the key ``foo-bar``.
+
+    Returns
+    -------
+    dict of str to SectionSpec
+        By section key.
+    """
+    pkg = importlib.import_module(_SECTIONS_PACKAGE)
+    found: dict[str, SectionSpec] = {}
+    for info in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda m: m.name):
+        if info.name.startswith("_"):
+            continue
+        module = f"{_SECTIONS_PACKAGE}.{info.name}"
+        guess = info.name.replace("_", "-")
+        try:
+            mod = importlib.import_module(module)
+        except Exception as exc:  # noqa: BLE001 - a broken section must not break the others
+            found[guess] = _broken_section(guess, module, f"{type(exc).__name__}: {exc}")
+            continue
+        spec = getattr(mod, "SECTION", None)
+        if not isinstance(spec, SectionSpec):
+            found[guess] = _broken_section(guess, module, f"expected SECTION = SectionSpec(...), found {type(spec).__name__}")
+            continue
+        found[spec.key] = spec
+    return found
+
+
+def available_sections() -> dict[str, SectionSpec | None]:
+    """Every known section key, in report order: discovered or registered sections, and the
+    expected paper sections whose module does not exist yet (value None)."""
+    found = {**discover_sections(), **_registered}
+    keys = set(found) | set(EXPECTED_SECTIONS)
+
+    def order(key: str) -> tuple[int, str]:
+        spec = found.get(key)
+        if key in EXPECTED_SECTIONS:
+            return (EXPECTED_SECTIONS[key][2], key)
+        return (spec.order if spec is not None else 100, key)
+
+    return {k: found.get(k) for k in sorted(keys, key=order)}
+
+
+def resolve_names(names: str | Sequence[str], known: Iterable[str]) -> list[str]:
+    """The section keys to build: ``"all"`` (every known key) or the given keys, checked.
+
+    Raises
+    ------
+    ReportError
+        An unknown name, with "did you mean" and the known names; or no name at all.
+    """
+    known = list(known)
+    if isinstance(names, str):
+        names = [names]
+    names = [n.strip() for item in names for n in str(item).split(",") if n.strip()]
+    if not names:
+        raise ReportError(f"report: expected a section name or 'all', received none (known: {', '.join(known)})")
+    if "all" in names:
+        return known
+    out: list[str] = []
+    for name in names:
+        if name not in known:
+            close = difflib.get_close_matches(name, known, n=1, cutoff=0.5)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise ReportError(f"report: unknown section {name!r}{hint} (known: all, {', '.join(known)})")
+        if name not in out:
+            out.append(name)
+    return out
+
+
+# ---------------------------------------------------------------------------- results
+@dataclass
+class SectionOutcome:
+    """What one section produced.
+
+    Attributes
+    ----------
+    key, title, paper : str
+        From the SectionSpec (or :data:`EXPECTED_SECTIONS` for a paper not built yet).
+    status : {"ok", "missing", "error"}
+        ``missing``: no section module yet; ``error``: its build raised (the blocks then hold
+        one Missing block with the error).
+    blocks : list
+        The blocks to render, in order.
+    wall_s : float
+        Wall time of the section's build [s].
+    error : str
+        ``"Type: message"`` when ``status == "error"``.
+    traceback : str
+    sweeps : list of dict
+        One entry per ``ctx.sweep`` call: name, folder, total, run (done + failed), reused.
+    """
+
+    key: str
+    title: str
+    paper: str
+    status: str
+    blocks: list = field(default_factory=list)
+    wall_s: float = 0.0
+    error: str = ""
+    traceback: str = ""
+    summary: str = ""
+    sweeps: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def comparisons(self) -> list[Comparison]:
+        return [b for b in self.blocks if isinstance(b, Comparison)]
+
+
+@dataclass
+class ReportResult:
+    """What :func:`run_report` returns: the index file and each section's outcome."""
+
+    index: Path
+    sections: list[SectionOutcome]
+    quick: bool
+    wall_s: float
+
+    @property
+    def ok(self) -> bool:
+        """False when some section raised (the report still holds every other section)."""
+        return not any(s.status == "error" for s in self.sections)
+
+    @property
+    def errors(self) -> list[SectionOutcome]:
+        return [s for s in self.sections if s.status == "error"]
+
+
+# ---------------------------------------------------------------------------- output folder
+def _check_out_dir(out_dir: Path) -> None:
+    """``out_dir`` must be missing, empty, or a folder an earlier report wrote (it has the marker)."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise ReportError(f"--out {out_dir}: expected a folder for the report, received an existing file")
+    if out_dir.is_dir() and any(out_dir.iterdir()) and not (out_dir / MARKER_NAME).is_file():
+        raise ReportError(
+            f"--out {out_dir}: expected a new or empty folder, or one an earlier `teamnav report` wrote "
+            f"(it holds {MARKER_NAME}); received a non-empty folder that is not a report"
+        )
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def _write_marker(out_dir: Path, quick: bool) -> None:
+    from teamnav import __version__
+
+    marker = out_dir / MARKER_NAME
+    data: dict[str, Any] = {}
+    if marker.is_file():
+        try:
+            data = json.loads(marker.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            data = {}
+    now = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    data.setdefault("created_at", now)
+    data.update({"tool": "teamnav report", "teamnav_version": __version__, "last_started_at": now, "last_quick": quick})
+    _write_atomic(marker, json.dumps(data, indent=2) + "\n")
+
+
+# ---------------------------------------------------------------------------- building
+def _check_blocks(blocks: Any, key: str) -> list:
+    if not isinstance(blocks, (list, tuple)):
+        raise TypeError(f"section {key}: build(ctx) must return a list of blocks, returned {type(blocks).__name__}")
+    for i, block in enumerate(blocks):
+        if not isinstance(block, _BLOCK_TYPES):
+            names = ", ".join(t.__name__ for t in _BLOCK_TYPES)
+            raise TypeError(f"section {key}: block {i} is a {type(block).__name__}; expected one of {names}")
+    return list(blocks)
+
+
+def _build_one(key: str, spec: SectionSpec | None, make_ctx: Callable[[str], Any], say: Callable[[str], None]) -> SectionOutcome:
+    if spec is None:
+        title, paper, _ = EXPECTED_SECTIONS[key]
+        return SectionOutcome(
+            key, title, paper, "missing", [Missing(what="this paper's reproduction", why="system not built yet (no section module)")]
+        )
+    ctx = make_ctx(key)
+    out = SectionOutcome(spec.key, spec.title, spec.paper, "ok", summary=spec.summary)
+    say(f"section {key}: building ({'quick' if ctx.quick else 'full'})")
+    t0 = time.perf_counter()
+    try:
+        out.blocks = _check_blocks(spec.build(ctx), key)
+    except Exception as exc:  # noqa: BLE001 - one section's failure must not lose the others
+        out.status = "error"
+        out.error = f"{type(exc).__name__}: {exc}"
+        out.traceback = traceback.format_exc()
+        out.blocks = [Missing(what=f"section {key}", why=f"its build raised {out.error}")]
+    out.wall_s = time.perf_counter() - t0
+    out.sweeps = list(ctx.sweeps)
+    say(f"section {key}: {out.status} in {out.wall_s:.1f} s" + (f" ({out.error})" if out.error else ""))
+    return out
+
+
+def _outcome_json(s: SectionOutcome) -> dict[str, Any]:
+    return {
+        "key": s.key,
+        "title": s.title,
+        "paper": s.paper,
+        "status": s.status,
+        "wall_s": round(s.wall_s, 3),
+        "error": s.error or None,
+        "traceback": s.traceback or None,
+        "comparisons": [
+            {"claim": c.claim, "paper": c.paper, "ours": c.ours, "holds": c.holds, "differs": c.differs} for c in s.comparisons
+        ],
+        "missing": [{"what": b.what, "why": b.why} for b in s.blocks if isinstance(b, Missing)],
+        "sweeps": s.sweeps,
+    }
+
+
+def run_report(
+    names: str | Sequence[str],
+    out_dir: str | os.PathLike,
+    *,
+    quick: bool = False,
+    executor: str = "local",
+    workers: int | None = None,
+    address: str | None = None,
+    progress: bool = True,
+) -> ReportResult:
+    """Build the report and say how each section went (see :func:`build_report`).
+
+    Returns
+    -------
+    ReportResult
+        ``.index`` is ``out_dir/index.html``; ``.ok`` is False when some section raised.
+
+    Raises
+    ------
+    ReportError
+        Unknown section name, an output folder that is not a report's, a bad executor option;
+        raised before anything is written.
+    """
+    from teamnav.experiments.executors import make_executor
+    from teamnav.experiments.report.context import SweepContext
+    from teamnav.experiments.report.html import render_report
+    from teamnav.experiments.sweep import SweepError
+
+    t_start = time.perf_counter()
+    if out_dir is None or not os.fspath(out_dir):
+        raise ReportError("--out: expected a folder for the report, received nothing")
+    out = Path(out_dir)
+    try:
+        make_executor(executor, workers=workers, address=address)  # checks the options, starts nothing
+    except SweepError as exc:
+        raise ReportError(str(exc)) from None
+    sections = available_sections()
+    keys = resolve_names(names, sections)
+    _check_out_dir(out)
+    out.mkdir(parents=True, exist_ok=True)
+    _write_marker(out, quick)
+
+    def say(msg: str) -> None:
+        if progress:
+            print(msg, file=sys.stderr, flush=True)
+
+    def make_ctx(key: str) -> SweepContext:
+        return SweepContext(out, quick=quick, executor=executor, workers=workers, address=address, progress=progress, section=key)
+
+    outcomes = [_build_one(key, sections[key], make_ctx, say) for key in keys]
+    wall = time.perf_counter() - t_start
+    meta = {"quick": quick, "executor": executor, "workers": workers, "address": address, "wall_s": wall}
+    html_text = render_report(outcomes, meta)
+    index = out / "index.html"
+    _write_atomic(index, html_text)
+    from teamnav import __version__
+
+    summary = {
+        "teamnav_version": __version__,
+        "written_at": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        **meta,
+        "sections": [_outcome_json(s) for s in outcomes],
+    }
+    _write_atomic(out / "report.json", json.dumps(summary, indent=2, default=str) + "\n")
+    return ReportResult(index=index, sections=outcomes, quick=quick, wall_s=time.perf_counter() - t_start)
+
+
+def build_report(
+    names: str | Sequence[str],
+    out_dir: str | os.PathLike,
+    quick: bool = False,
+    executor: str = "local",
+    workers: int | None = None,
+    address: str | None = None,
+    progress: bool = True,
+) -> Path:
+    """Run (or reuse) the sweeps of the named sections and write ``out_dir/index.html``.
+
+    Parameters
+    ----------
+    names : "all", str or list of str
+        Section keys (``"collab-mcl"``), comma-separated keys, or ``"all"``.
+    out_dir : str or Path
+        The report folder: new, empty, or an earlier report's (then its sweeps are reused and
+        only missing trials run). Holds ``index.html``, ``report.json``, ``sweeps/<name>/``.
+    quick : bool
+        The short version (few seeds, short runs; what CI runs). Default: the full reproduction.
+    executor : {"local", "ray"}
+        Where the trials run (see :func:`teamnav.experiments.sweep.sweep`).
+    workers : int, optional
+        Trials at once (default: all CPUs / the Ray cluster's).
+    address : str, optional
+        Ray cluster address, with ``executor="ray"``.
+    progress : bool
+        Progress bars and one line per section on stderr.
+
+    Returns
+    -------
+    Path
+        ``out_dir/index.html``. A section that raised is shown in it as missing with its error;
+        use :func:`run_report` to learn whether that happened.
+
+    Raises
+    ------
+    ReportError
+        See :func:`run_report`.
+    """
+    return run_report(names, out_dir, quick=quick, executor=executor, workers=workers, address=address, progress=progress).index
