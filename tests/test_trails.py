@@ -1,0 +1,169 @@
+"""Trails of "Try to see it my way" (Vaughan et al. 2002 §2): Places, Crumbs, combining through
+two common Places, the policies, expiry, the lowest time-to-place rule, an N-place round."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from teamnav.control.coop.forager import PlaceRound
+from teamnav.control.coop.trails import Trail, TrailMessage, place_transform, temporary_trail
+from teamnav.geometry.similarity import Similarity
+
+
+def _msg(places: dict[str, tuple[float, float]], crumbs: list[tuple[str, float, float, float, float]]) -> TrailMessage:
+    names = tuple(places)
+    return TrailMessage(names, np.array([places[n] for n in names], float).reshape(-1, 2),
+                        tuple(c[0] for c in crumbs), np.array([c[1:3] for c in crumbs], float).reshape(-1, 2),
+                        np.array([c[3] for c in crumbs], float), np.array([c[4] for c in crumbs], float))
+
+
+coord = st.floats(-50.0, 50.0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(scale=st.floats(0.5, 2.0), rot=st.floats(-math.pi, math.pi), tx=coord, ty=coord,
+       ax=coord, ay=coord, bx=coord, by=coord,
+       crumbs=st.lists(st.tuples(coord, coord), min_size=1, max_size=20))
+def test_two_common_places_recover_any_similarity(scale, rot, tx, ty, ax, ay, bx, by, crumbs):
+    """§2.1.5: the sender's frame is the local one through an unknown similarity T; combining
+    maps its crumbs and its extra Place back exactly where they are locally."""
+    a, b = np.array([ax, ay]), np.array([bx, by])
+    if np.linalg.norm(a - b) < 1.0:
+        b = a + np.array([1.0, 0.5])
+    T = Similarity(scale, rot, tx, ty)  # local -> sender
+    local = Trail()
+    local.set_place("A", *a)
+    local.set_place("B", *b)
+    c_local = np.array(crumbs)
+    c_sender = T.apply(c_local)
+    far_place = np.array([3.0, -7.0])
+    sent = _msg({"A": tuple(T.apply(a)), "B": tuple(T.apply(b)), "C": tuple(T.apply(far_place))},
+                [("B", x, y, 5.0, 1.0) for x, y in c_sender])
+    used = local.combine(sent, "pessimistic")
+    assert used is not None
+    assert used.scale == pytest.approx(1.0 / scale, rel=1e-9)
+    tol = 1e-7 * (1.0 + np.abs(c_local).max() + np.abs([tx, ty]).max()) * max(scale, 1 / scale) ** 2
+    np.testing.assert_allclose(local.crumb_xy_m, c_local, atol=tol)
+    np.testing.assert_allclose(local.places["C"], far_place, atol=tol + 1e-7 * 10)
+    # common Places are not copied: they keep their local estimates
+    np.testing.assert_array_equal(local.places["A"], a)
+    np.testing.assert_array_equal(local.places["B"], b)
+
+
+def test_policies_with_zero_one_two_common_places():
+    crumb = [("B", 1.0, 2.0, 7.0, 0.0)]
+    # 2 common: both policies transform (here: pure translation by (+10, 0))
+    for policy in ("pessimistic", "optimistic"):
+        tr = Trail(); tr.set_place("A", 10.0, 0.0); tr.set_place("B", 20.0, 0.0)
+        T = tr.combine(_msg({"A": (0.0, 0.0), "B": (10.0, 0.0)}, crumb), policy)
+        assert T is not None and T.tx == pytest.approx(10.0)
+        np.testing.assert_allclose(tr.crumb_xy_m, [[11.0, 2.0]])
+    # 1 common: pessimistic refuses (nothing copied, not even Places), optimistic translates
+    tr = Trail(); tr.set_place("A", 10.0, 0.0)
+    assert tr.combine(_msg({"A": (0.0, 0.0), "B": (5.0, 5.0)}, crumb), "pessimistic") is None
+    assert len(tr) == 0 and set(tr.places) == {"A"}
+    tr.combine(_msg({"A": (0.0, 0.0), "B": (5.0, 5.0)}, crumb), "optimistic")
+    np.testing.assert_allclose(tr.crumb_xy_m, [[11.0, 2.0]])
+    np.testing.assert_allclose(tr.places["B"], [15.0, 5.0])
+    np.testing.assert_allclose(tr.places["A"], [10.0, 0.0])
+    # 0 common: pessimistic refuses, optimistic copies as-is
+    tr = Trail(); tr.set_place("A", 10.0, 0.0)
+    assert tr.combine(_msg({"B": (5.0, 5.0)}, crumb), "pessimistic") is None
+    assert len(tr) == 0
+    tr.combine(_msg({"B": (5.0, 5.0)}, crumb), "optimistic")
+    np.testing.assert_allclose(tr.crumb_xy_m, [[1.0, 2.0]])
+    np.testing.assert_allclose(tr.places["B"], [5.0, 5.0])
+
+
+def test_without_place_transforms_trails_are_copied_as_is():
+    tr = Trail(); tr.set_place("A", 10.0, 0.0); tr.set_place("B", 20.0, 0.0)
+    T = tr.combine(_msg({"A": (0.0, 0.0), "B": (0.0, 10.0)}, [("B", 1.0, 2.0, 7.0, 0.0)]), "pessimistic",
+                   use_transforms=False)
+    assert T == Similarity.identity()
+    np.testing.assert_allclose(tr.crumb_xy_m, [[1.0, 2.0]])
+
+
+def test_coincident_common_places_count_as_one():
+    loc = {"A": [0.0, 0.0], "B": [0.0, 0.0]}
+    rec = {"A": [1.0, 1.0], "B": [1.0, 1.0]}
+    assert place_transform(loc, rec, "pessimistic") is None
+    assert place_transform(loc, rec, "optimistic") == Similarity(1.0, 0.0, -1.0, -1.0)
+    with pytest.raises(ValueError, match="policy must be one of"):
+        place_transform(loc, rec, "hopeful")
+
+
+def test_more_than_two_common_places_use_the_farthest_pair():
+    """N places: the best-conditioned pair fixes T; a slightly inconsistent third is ignored."""
+    loc = {"A": [0.0, 0.0], "B": [0.5, 0.0], "C": [20.0, 0.0]}
+    rec = {"A": [0.0, 0.0], "B": [0.5, 0.3], "C": [0.0, 20.0]}  # rotated 90 deg; B off by 0.3 m
+    T = place_transform(loc, rec, "pessimistic")
+    assert T.rotation_rad == pytest.approx(-math.pi / 2)
+    assert T.scale == pytest.approx(1.0)
+
+
+def test_expiry_removes_old_crumbs_and_bounds_memory():
+    tr = Trail()
+    tr.set_place("A", 0.0, 0.0)
+    tr.add_crumbs(["A", "A", "A"], [[0, 0], [1, 1], [2, 2]], [1.0, 2.0, 3.0], [0.0, 100.0, 250.0])
+    assert tr.expire(now_s=300.0, max_age_s=240.0) == 1  # t=0 is 300 s old
+    np.testing.assert_array_equal(tr.crumb_t, [100.0, 250.0])
+    np.testing.assert_allclose(tr.crumb_xy_m, [[1, 1], [2, 2]])
+    assert tr.crumb_place == ["A", "A"]
+    # a robot receiving 1-crumb trails from 4 robots every 2 s for an hour keeps ~4 min of them
+    tr = Trail(); tr.set_place("A", 0.0, 0.0)
+    for k in range(1800):
+        now = 2.0 * k
+        tr.add_crumbs(["A"] * 4, np.zeros((4, 2)), np.ones(4), np.full(4, now))
+        tr.expire(now, 240.0)
+    assert len(tr) == 4 * 121
+
+
+def test_lowest_time_to_place_within_radius_for_the_goal_only():
+    """§2.3: head for the lowest-s crumb of the current goal within the radius."""
+    tr = Trail()
+    tr.set_place("A", 0.0, 0.0); tr.set_place("B", 30.0, 0.0)
+    tr.add_crumbs(["B", "B", "B", "A", "B"],
+                  [[1.0, 0.0], [0.0, 1.5], [5.0, 0.0], [0.0, -1.0], [-1.0, 0.0]],
+                  [20.0, 12.0, 1.0, 0.5, 30.0], [0.0] * 5)
+    idx, s = tr.best_crumb("B", 0.0, 0.0, radius_m=2.0)
+    # (5, 0) has s=1 but is out of the radius; the A crumb has s=0.5 but is for another place
+    assert (idx, s) == (1, 12.0)
+    assert tr.heading_to_best("B", 0.0, 0.0, 2.0) == pytest.approx(math.pi / 2)
+    assert tr.best_crumb("A", 0.0, 0.0, 2.0) == (3, 0.5)
+    assert tr.best_crumb("B", 20.0, 20.0, 2.0) is None
+    assert tr.best_crumb("C", 0.0, 0.0, 2.0) is None
+
+
+def test_temporary_trail_carries_all_places_and_one_crumb():
+    tr = Trail()
+    tr.set_place("home", 0.0, 0.0); tr.set_place("source", 9.0, 3.0)
+    tr.add_crumbs(["home"], [[1.0, 1.0]], [3.0], [4.0])
+    m = temporary_trail(tr, "source", 5.0, 2.0, 11.0, 40.0)
+    assert m.place_names == ("home", "source") and m.crumb_place == ("source",)
+    np.testing.assert_allclose(m.crumb_xy_m, [[5.0, 2.0]])
+    assert (m.crumb_s[0], m.crumb_t[0]) == (11.0, 40.0)
+    # two places + one crumb, as plain numbers: bytes are countable
+    from teamnav.control.types import Message
+    assert Message(0, 40.0, m, kind="trail").size_bytes() > 24 + 8 * 4
+
+
+def test_place_round_with_three_places():
+    """N = 3 (a mail round): only the sought place advances, in cyclic order."""
+    r = PlaceRound(["depot", "mail_a", "mail_b"])
+    assert r.goal == "mail_a"
+    assert r.observe(("mail_b",), 1.0) == [] and r.last_place == "mail_b"
+    assert r.observe(("mail_a",), 2.0) == ["mail_a"] and r.goal == "mail_b"
+    assert r.observe(("mail_b", "depot"), 3.0) == ["mail_b", "depot"]
+    assert (r.goal, r.trips, r.last_place, r.last_place_time_s) == ("mail_a", 3, "depot", 3.0)
+    with pytest.raises(ValueError, match="at least 2 distinct"):
+        PlaceRound(["home", "home"])
+
+
+def test_trail_message_rejects_mismatched_columns():
+    with pytest.raises(ValueError, match="must have one length"):
+        TrailMessage(("A",), np.zeros((1, 2)), ("A", "A"), np.zeros((1, 2)), np.zeros(1), np.zeros(1))
