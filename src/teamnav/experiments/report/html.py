@@ -61,6 +61,10 @@ def git_commit() -> str | None:
     """The short commit of the checkout teamnav runs from (``+dirty`` when modified), or None."""
     here = Path(__file__).resolve().parent
     try:
+        top = subprocess.run(["git", "rev-parse", "--show-toplevel"], cwd=here, capture_output=True, text=True, timeout=5)
+        # only teamnav's own checkout (an installed copy may sit inside some other repository)
+        if top.returncode != 0 or not here.is_relative_to(Path(top.stdout.strip()).resolve() / "src" / "teamnav"):
+            return None
         sha = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], cwd=here, capture_output=True, text=True, timeout=5)
         if sha.returncode != 0:
             return None
