@@ -1,0 +1,416 @@
+"""Exploration tasks, patrol routes and scenario files of the line-of-sight help experiments.
+
+Sgorbissa & Arkin §6: R1 is given *exploration tasks*, "each corresponding to a set of 200
+randomly chosen targets to be reached in sequence", the targets "located in the middle of
+the rooms"; "each navigation algorithm is used to execute 5 exploration tasks" (different
+random target sets); helpers R2..R4 "patrol the corridors". This module makes those tasks
+and routes, deterministically, and writes the scenario and sweep files that run them.
+
+What is ours (the paper leaves it open)
+---------------------------------------
+- Targets are the room centres of the built-in maps (places ``room_*`` of
+  :func:`teamnav.world.generators.office_simple` / ``office_complex``), drawn with a
+  SHA-256 counter stream so that the lists never change with a NumPy version; consecutive
+  targets are different rooms.
+- R1 starts at the map's ``base`` place with a heading of 90° (so R1's start frame is
+  *not* the world frame, and a brain that confused them would miss every target).
+- Routes: on the simple map R2 and R3 patrol the whole corridor in opposite phases and R4
+  starts in the middle; on the complex map R2 patrols the east-west corridor, R3 the
+  north-south one and R4 loops over both through the junction. Each helper is its own
+  robot group (``robots.1`` .. ``robots.3``) so each has its own route; its start is a
+  1 cm box (``start.region``) so that a sweep can drop it with ``robots.K.count: 0``
+  (explicit ``poses`` must list exactly ``count`` poses).
+- Robot frames: every robot's odometry frame is its start pose (``odometry.frame: start``);
+  targets and patrol points are converted from world coordinates into that frame here,
+  from the robot's start pose (:func:`world_to_frame`). Odometry is exact: §6.1 ignores
+  localization uncertainty on purpose.
+- The detector block is written once with a YAML anchor and aliased by the helpers, so one
+  override ``robots.0.detector.err_max`` sets the eqs. 1–2 noise of every robot (PyYAML
+  builds one dict for an anchor and its aliases, and overrides edit it in place; a test
+  checks it).
+
+Files
+-----
+:func:`write_files` (re)writes ``scenarios/los-help-{simple,complex,noise}.yaml`` and the
+sweeps ``sweeps/los-{table1,table2,noise-simple,noise-complex,ablation}.yaml``; run
+``python -m teamnav.experiments.los_tasks`` after changing anything here and commit them.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+import yaml
+
+from teamnav.geometry import se2
+
+__all__ = [
+    "ERR_MAX",
+    "LAYOUTS",
+    "MAPS",
+    "NAVIGATORS",
+    "N_TARGETS",
+    "N_TASKS",
+    "Layout",
+    "frame_to_world",
+    "patrol_xy",
+    "room_centres",
+    "scenario_data",
+    "task_rooms",
+    "task_targets_world",
+    "task_targets_xy",
+    "world_to_frame",
+    "write_files",
+]
+
+#: Map key -> built-in map name (§6: Fig. 11 the simple office, Fig. 13 the complex one).
+MAPS: dict[str, str] = {"simple": "office_simple", "complex": "office_complex"}
+#: Scenario file of each map.
+SCENARIOS: dict[str, str] = {"simple": "los-help-simple", "complex": "los-help-complex"}
+#: §6: 5 exploration tasks per algorithm, 200 targets each.
+N_TASKS: int = 5
+N_TARGETS: int = 200
+#: §6 set A: 1) potential field, 2) potential field + Avoid-Past, 3) VisBug-21.
+NAVIGATORS: tuple[str, ...] = ("potential_field", "avoid_past", "visbug21")
+#: §6.1, Figs. 16-17: err_max of eqs. 1-2.
+ERR_MAX: tuple[float, ...] = (0.0, 0.1, 0.2, 0.3, 0.4)
+
+# Body, sensing and motion shared by every robot (our choices; the paper gives none).
+STEP_LENGTH_M = 0.2  # §6: fixed distance per motion step, so steps measure path length
+RADIUS_M = 0.2
+VISIBILITY_M = 8.0  # bounded omnidirectional visibility radius (§2) = laser range = radio range
+GOAL_TOLERANCE_M = 0.5  # ε of §2
+DT_S = 0.1
+RECORD_EVERY = 10
+#: Step budget per target: a run that has not reached all its targets by then "fails"
+#: (the potential field alone, §6). Generous: VisBug alone needs ~1/5 of it on average.
+BUDGET_STEPS_PER_TARGET: dict[str, int] = {"simple": 400, "complex": 600}
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where R1 starts and where the helpers patrol, in world coordinates.
+
+    ``r1_start``: (x_m, y_m, theta_deg). ``helpers``: per helper, its start pose
+    (x_m, y_m, theta_deg) and its patrol route [(x_m, y_m), ...], run back and forth
+    (``patrol_mode: ping_pong`` of ``los-helper-v1``).
+    """
+
+    r1_start: tuple[float, float, float]
+    helpers: tuple[tuple[tuple[float, float, float], tuple[tuple[float, float], ...]], ...]
+
+
+LAYOUTS: dict[str, Layout] = {
+    # corridor y in [5.8, 8.2], x in [0.2, 29.8]; base (1, 7)
+    "simple": Layout(
+        r1_start=(1.0, 7.0, 90.0),
+        helpers=(
+            ((3.0, 6.5, 0.0), ((28.5, 6.5), (3.0, 6.5))),  # R2: whole corridor, west -> east first
+            ((28.5, 7.5, 180.0), ((3.0, 7.5), (28.5, 7.5))),  # R3: whole corridor, east -> west first
+            ((15.0, 7.0, 0.0), ((28.5, 7.0), (3.0, 7.0))),  # R4: whole corridor, from the middle
+        ),
+    ),
+    # corridor H y in [10.8, 13.2], corridor V x in [16.8, 19.2]; base (1, 12)
+    "complex": Layout(
+        r1_start=(1.0, 12.0, 90.0),
+        helpers=(
+            ((3.0, 11.6, 0.0), ((34.5, 11.6), (3.0, 11.6))),  # R2: east-west corridor
+            ((18.4, 22.5, 270.0), ((18.4, 1.5), (18.4, 22.5))),  # R3: north-south corridor
+            # R4: both corridors, through the junction (ping-pong over this list)
+            ((20.0, 12.4, 0.0), ((34.5, 12.4), (17.6, 12.4), (17.6, 22.5), (17.6, 12.4), (3.0, 12.4),
+                                 (17.6, 12.4), (17.6, 1.5))),
+        ),
+    ),
+}
+
+
+# ---------------------------------------------------------------------------- frames
+def world_to_frame(pose_deg: Sequence[float], pts_xy) -> np.ndarray:
+    """World points expressed in the frame of a robot whose start pose is ``pose_deg``.
+
+    Parameters
+    ----------
+    pose_deg : (x_m, y_m, theta_deg)
+        The robot's start pose in the world (its odometry frame with ``frame: start``).
+    pts_xy : array_like of shape (..., 2)
+        World points [m].
+
+    Returns
+    -------
+    ndarray of shape (..., 2)
+        The points in the robot's frame [m].
+    """
+    x, y, th = (float(v) for v in pose_deg)
+    return se2.transform_points(se2.inverse([x, y, math.radians(th)]), np.asarray(pts_xy, dtype=float))
+
+
+def frame_to_world(pose_deg: Sequence[float], pts_xy) -> np.ndarray:
+    """Inverse of :func:`world_to_frame`: points of the robot's frame in the world [m]."""
+    x, y, th = (float(v) for v in pose_deg)
+    return se2.transform_points([x, y, math.radians(th)], np.asarray(pts_xy, dtype=float))
+
+
+# ---------------------------------------------------------------------------- tasks
+def _env(map_key: str):
+    from teamnav.world import builtin_map
+
+    if map_key not in MAPS:
+        raise ValueError(f"map_key must be one of {sorted(MAPS)}, got {map_key!r}")
+    return builtin_map(MAPS[map_key])
+
+
+def room_centres(map_key: str) -> dict[str, tuple[float, float]]:
+    """The targets' candidates: places ``room_*`` of the map (room centres, §6), sorted by name."""
+    places = _env(map_key).places
+    return {k: tuple(map(float, places[k])) for k in sorted(places) if k.startswith("room_")}
+
+
+def _draw(map_key: str, task: int, i: int, n: int) -> int:
+    """The i-th draw of task ``task``: an integer in [0, n) from SHA-256 (stable forever)."""
+    digest = hashlib.sha256(f"sgorbissa-arkin/{map_key}/task{task}/{i}".encode()).digest()
+    return int.from_bytes(digest[:8], "big") % n
+
+
+def task_rooms(map_key: str, task: int, n_targets: int = N_TARGETS) -> list[str]:
+    """Room names of exploration task ``task`` (1-based), ``n_targets`` long.
+
+    Each target is a uniformly drawn room other than the previous target's (§6: random
+    targets reached in sequence; a target equal to the previous one would be reached at once).
+    The first ``k`` targets of a task do not depend on ``n_targets``, so a short (quick) task
+    is a prefix of the full one.
+    """
+    if task < 1:
+        raise ValueError(f"task must be >= 1, got {task}")
+    if n_targets < 1:
+        raise ValueError(f"n_targets must be >= 1, got {n_targets}")
+    names = list(room_centres(map_key))
+    out: list[str] = []
+    prev = -1
+    for i in range(n_targets):
+        if prev < 0:
+            k = _draw(map_key, task, i, len(names))
+        else:
+            k = _draw(map_key, task, i, len(names) - 1)
+            k += k >= prev
+        out.append(names[k])
+        prev = k
+    return out
+
+
+def task_targets_world(map_key: str, task: int, n_targets: int = N_TARGETS) -> np.ndarray:
+    """Targets of task ``task`` in world coordinates, shape (n_targets, 2) [m]."""
+    rooms = room_centres(map_key)
+    return np.array([rooms[r] for r in task_rooms(map_key, task, n_targets)], dtype=float)
+
+
+def _rounded(pts: np.ndarray) -> list[list[float]]:
+    return [[round(float(x), 4) + 0.0, round(float(y), 4) + 0.0] for x, y in np.asarray(pts).reshape(-1, 2)]
+
+
+def task_targets_xy(map_key: str, task: int, n_targets: int = N_TARGETS) -> list[list[float]]:
+    """R1's ``targets_xy`` for task ``task``: the targets in R1's start frame [m], rounded to 0.1 mm."""
+    return _rounded(world_to_frame(LAYOUTS[map_key].r1_start, task_targets_world(map_key, task, n_targets)))
+
+
+def patrol_xy(map_key: str, helper: int) -> list[list[float]]:
+    """Helper ``helper``'s (0 = R2) patrol route in its own start frame [m]."""
+    start, route = LAYOUTS[map_key].helpers[helper]
+    return _rounded(world_to_frame(start, route))
+
+
+# ---------------------------------------------------------------------------- scenarios
+def _detector(err_max: float) -> dict[str, Any]:
+    return {
+        "fov_deg": 360.0,
+        "max_range_m": VISIBILITY_M,
+        "line_of_sight": True,
+        "noise_model": "occlusion",  # eqs. 1-2
+        "err_max": float(err_max),
+        "report_identity": True,
+    }
+
+
+def _body() -> dict[str, Any]:
+    return {
+        "radius_m": RADIUS_M,
+        "kinematics": "holonomic_step",
+        "step_length_m": STEP_LENGTH_M,
+        "sensors": [{"kind": "laser", "name": "laser", "n_beams": 72, "fov_deg": 360.0, "max_range_m": VISIBILITY_M,
+                     "noise_std_m": 0.0}],
+        "odometry": {"frame": "start"},
+    }
+
+
+def r1_params(map_key: str, *, task: int = 1, n_targets: int = N_TARGETS, navigator: str = "visbug21",
+              state_sharing: bool = True, delayed_visibility: bool = True, goal_sharing: bool = True) -> dict[str, Any]:
+    """``los-explorer-v1`` params of R1 for one task."""
+    return {
+        "navigator": navigator,
+        "targets_xy": task_targets_xy(map_key, task, n_targets),
+        "goal_tolerance_m": GOAL_TOLERANCE_M,
+        "goal_sharing": goal_sharing,
+        "delayed_visibility": delayed_visibility,
+        "state_sharing": state_sharing,
+        "laser": "laser",
+        "log_layers": False,
+    }
+
+
+def scenario_data(map_key: str, *, name: str | None = None, task: int = 1, n_targets: int = N_TARGETS,
+                  navigator: str = "visbug21", helpers: int = 3, err_max: float = 0.0,
+                  description: str | None = None) -> dict[str, Any]:
+    """The scenario (as YAML data) of R1's task ``task`` on ``map_key`` with ``helpers`` helpers.
+
+    R1 is ``robots.0``; helper R(k+2) is ``robots.(k+1)``, present when ``count`` is 1. All
+    robots share one ``detector`` dict (written as a YAML anchor and aliases).
+    """
+    layout = LAYOUTS[map_key]
+    det = _detector(err_max)
+    r1 = {"name": "R1", "count": 1, **_body(), "controller": "los-explorer-v1",
+          "params": r1_params(map_key, task=task, n_targets=n_targets, navigator=navigator),
+          "detector": det, "start": {"poses": [list(layout.r1_start)]}}
+    groups = [r1]
+    for k, (start, _route) in enumerate(layout.helpers):
+        x, y, th = start
+        groups.append({
+            "name": f"R{k + 2}", "count": 1 if k < helpers else 0, **_body(), "controller": "los-helper-v1",
+            "params": {"navigator": "potential_field", "patrol_xy": patrol_xy(map_key, k), "goal_sharing": True,
+                       "delayed_visibility": True, "state_sharing": True, "laser": "laser",
+                       "log_layers": False},
+            "detector": det,
+            "start": {"region": [x - 0.005, x + 0.005, y - 0.005, y + 0.005], "theta_deg": th},
+        })
+    budget = BUDGET_STEPS_PER_TARGET[map_key] * n_targets
+    return {
+        "name": name or SCENARIOS[map_key],
+        "description": description or (
+            f"Sgorbissa & Arkin §6 ({'Fig. 11' if map_key == 'simple' else 'Fig. 13'}): R1 reaches {n_targets} "
+            f"room-centre targets in sequence (task {task}) on {MAPS[map_key]} helped by R2..R4 patrolling the corridors."
+        ),
+        "map": {"builtin": MAPS[map_key]},
+        "duration_s": round(budget * DT_S, 6),
+        "dt_s": DT_S,
+        "seed": 0,
+        "record_every": RECORD_EVERY,
+        "stop_when_finished": True,
+        "metrics": ["los_help", "steps", "messages", "collisions"],
+        "robots": groups,
+        "radio": {"mode": "line_of_sight", "range_m": VISIBILITY_M},
+    }
+
+
+class _Dumper(yaml.SafeDumper):
+    """Block style for mappings, flow style for short numeric lists (poses, points)."""
+
+
+def _repr_list(dumper: yaml.SafeDumper, data: list):
+    flow = all(isinstance(v, (int, float)) for v in data) or all(
+        isinstance(v, list) and all(isinstance(u, (int, float)) for u in v) for v in data
+    ) and bool(data)
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flow)
+
+
+_Dumper.add_representer(list, _repr_list)
+
+
+def to_yaml(data: dict[str, Any], header: str = "") -> str:
+    """YAML text of ``data`` (anchors named after what they hold)."""
+    text = yaml.dump(data, Dumper=_Dumper, sort_keys=False, width=120, allow_unicode=True)
+    text = text.replace("&id001", "&detector").replace("*id001", "*detector")
+    return header + text
+
+
+_HEADER = (
+    "# GENERATED by `python -m teamnav.experiments.los_tasks` (teamnav/experiments/los_tasks.py): edit that\n"
+    "# module, not this file. {what}\n"
+)
+
+
+def sweep_data(kind: str) -> dict[str, Any]:
+    """The named sweep ``los-<kind>`` as YAML data (see :func:`write_files`)."""
+    tasks = lambda m: [task_targets_xy(m, t) for t in range(1, N_TASKS + 1)]  # noqa: E731
+    if kind in ("table1", "table2"):
+        m = "simple" if kind == "table1" else "complex"
+        return {
+            "name": f"los-{kind}",
+            "description": (f"Sgorbissa & Arkin Table {kind[-1]}: R1's steps per algorithm with helpers R2, R3, R4 each "
+                            f"present or not (the paper's rows are R1; R1+R2; R1..R3; R1..R4), 5 tasks of 200 targets."),
+            "scenario": SCENARIOS[m],
+            "grid": {
+                "robots.0.params.navigator": list(NAVIGATORS),
+                "robots.1.count": [0, 1],
+                "robots.2.count": [0, 1],
+                "robots.3.count": [0, 1],
+                "robots.0.params.targets_xy": tasks(m),
+            },
+            "seeds": 1,
+        }
+    if kind in ("noise-simple", "noise-complex"):
+        m = kind.split("-")[1]
+        return {
+            "name": f"los-{kind}",
+            "description": (f"Sgorbissa & Arkin Fig. {16 if m == 'simple' else 17}: R1's steps vs err_max of eqs. 1-2 "
+                            f"(every robot's detector) with all helpers, per algorithm, 5 tasks of 200 targets."),
+            "scenario": SCENARIOS[m],
+            "grid": {
+                "robots.0.params.navigator": list(NAVIGATORS),
+                "robots.0.detector.err_max": list(ERR_MAX),
+                "robots.0.params.targets_xy": tasks(m),
+            },
+            "seeds": 1,
+        }
+    if kind == "ablation":
+        return {
+            "name": "los-ablation",
+            "description": ("What each rule buys (simple map, all helpers): reflected visibility only, + ghost robots "
+                            "(delayed visibility), + state sharing, per algorithm, 5 tasks of 200 targets."),
+            "scenario": SCENARIOS["simple"],
+            "grid": {
+                "robots.0.params.navigator": list(NAVIGATORS),
+                "robots.0.params.delayed_visibility": [False, True],
+                "robots.0.params.state_sharing": [False, True],
+                "robots.0.params.targets_xy": tasks("simple"),
+            },
+            "seeds": 1,
+        }
+    raise ValueError(f"unknown los sweep kind {kind!r}")
+
+
+SWEEP_KINDS: tuple[str, ...] = ("table1", "table2", "noise-simple", "noise-complex", "ablation")
+
+
+def write_files(scenario_dir: Path | None = None, sweep_dir: Path | None = None) -> list[Path]:
+    """(Re)write the los-help scenario files and the los sweeps; returns the paths written."""
+    from teamnav.experiments.registry import SCENARIO_DIR
+    from teamnav.experiments.sweep import SWEEP_DIR
+
+    scenario_dir = Path(scenario_dir or SCENARIO_DIR)
+    sweep_dir = Path(sweep_dir or SWEEP_DIR)
+    written: list[Path] = []
+    for m in MAPS:
+        p = scenario_dir / f"{SCENARIOS[m]}.yaml"
+        p.write_text(to_yaml(scenario_data(m), _HEADER.format(what=f"R1 runs task 1 ({MAPS[m]}).")), encoding="utf-8")
+        written.append(p)
+    p = scenario_dir / "los-help-noise.yaml"
+    noisy = scenario_data("simple", name="los-help-noise", err_max=0.2, description=(
+        "Sgorbissa & Arkin §6.1 (Fig. 16): the simple office with every robot's detector noisy "
+        "(eqs. 1-2, err_max = 0.2); R1 reaches 200 room-centre targets helped by R2..R4."))
+    p.write_text(to_yaml(noisy, _HEADER.format(what="Detector noise err_max = 0.2 on every robot.")), encoding="utf-8")
+    written.append(p)
+    for kind in SWEEP_KINDS:
+        p = sweep_dir / f"los-{kind}.yaml"
+        p.write_text(to_yaml(sweep_data(kind), _HEADER.format(what="`teamnav sweep " + f"los-{kind} --out DIR`.")),
+                     encoding="utf-8")
+        written.append(p)
+    return written
+
+
+if __name__ == "__main__":  # pragma: no cover - regenerates the shipped files
+    for path in write_files():
+        print(path)

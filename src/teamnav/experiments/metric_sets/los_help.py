@@ -1,0 +1,88 @@
+"""Metrics of the line-of-sight help experiments (Sgorbissa & Arkin §6).
+
+§6 measures "the *average number of motion steps* required by R1 to complete exploration
+tasks"; with a fixed step length, steps are proportional to the path length. R1 is the robot
+whose brain logs ``targets_reached`` and ``finished`` (``los-explorer-v1``; a helper logs no
+``finished``); its ``moves`` counter is the
+number of motion steps it made.
+
+Keys
+----
+``los_finished``
+    1 when R1 reached every target within the step budget (the run stopped early, scenario
+    ``stop_when_finished``), else 0 (§6: the potential field alone "fails").
+``los_steps``
+    R1's motion steps to finish the task; the run's step budget when it did not finish.
+    Logs are kept every ``record_every`` steps, so for a finished run the steps after the
+    last kept sample are added as if R1 moved at each (an upper bound, off by less than
+    ``record_every``).
+``los_steps_per_target``
+    ``los_steps`` over the targets reached (over 1 when none was).
+``los_targets_reached``
+    Targets R1 reached.
+``los_msgs_r1``, ``los_bytes_r1``
+    Messages and bytes R1 sent (its own counters, §4.4).
+``los_msgs_per_robot``, ``los_bytes_per_robot``
+    The same, averaged over every robot that logs ``msgs_sent`` (R1 and the helpers).
+``los_trouble_frac``
+    Fraction of R1's kept samples in which it was "in trouble" (``tr``, §5).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from teamnav.experiments.metrics import RunData, register
+
+
+def _last_by_robot(data: RunData) -> dict[int, dict[str, Any]]:
+    """Each robot's last logged values (with the step they were kept at under ``"_step"``)."""
+    last: dict[int, dict[str, Any]] = {}
+    for entry in data.logs:
+        values = entry.get("values") or {}
+        robot = int(entry.get("robot", -1))
+        prev = last.get(robot)
+        if prev is None or int(entry.get("step", 0)) >= prev["_step"]:
+            last[robot] = {**values, "_step": int(entry.get("step", 0))}
+    return last
+
+
+def _explorer(last: dict[int, dict[str, Any]]) -> int | None:
+    ids = sorted(r for r, v in last.items() if "targets_reached" in v and "finished" in v)
+    return ids[0] if ids else None
+
+
+def los_help(data: RunData) -> dict[str, float | int]:
+    """R1's motion steps, targets and messages (see the module docstring); {} without an explorer log."""
+    last = _last_by_robot(data)
+    r1 = _explorer(last)
+    if r1 is None:
+        return {}
+    v = last[r1]
+    finished = bool(data.finished)
+    reached = int(v.get("targets_reached", 0))
+    moves = int(v.get("moves", 0))
+    if finished:
+        steps = moves + max(0, int(data.n_steps) - v["_step"])
+    else:
+        steps = int(data.n_steps)
+    trouble = [bool((e.get("values") or {}).get("tr", False)) for e in data.logs if int(e.get("robot", -1)) == r1]
+    msgs = [int(x["msgs_sent"]) for x in last.values() if "msgs_sent" in x]
+    nbytes = [int(x["bytes_sent"]) for x in last.values() if "bytes_sent" in x]
+    return {
+        "los_finished": int(finished),
+        "los_steps": int(steps),
+        "los_steps_per_target": float(steps) / max(reached, 1),
+        "los_targets_reached": reached,
+        "los_msgs_r1": int(v.get("msgs_sent", 0)),
+        "los_bytes_r1": int(v.get("bytes_sent", 0)),
+        "los_msgs_per_robot": float(np.mean(msgs)) if msgs else 0.0,
+        "los_bytes_per_robot": float(np.mean(nbytes)) if nbytes else 0.0,
+        "los_trouble_frac": float(np.mean(trouble)) if trouble else 0.0,
+    }
+
+
+register("los_help", los_help,
+         "Sgorbissa & Arkin §6: R1's motion steps to finish its targets (budget if not), targets reached, messages/bytes")
