@@ -53,3 +53,6 @@ register("wander-batched-v1", "teamnav.control.nav.wander:WanderBatched")
 
 # Trail experiments baseline (Vaughan et al.; helper H7): the single optimal robot
 register("route-follow-v1", "teamnav.control.nav.route_follow:RouteFollow")
+
+# Vaughan et al. trail papers: low-level Navigate + Panic, random exploration (helper H3)
+register("explore-v1", "teamnav.control.nav.explore:Explore")

@@ -1,0 +1,363 @@
+"""Navigate: the trail robots' low-level controller (wall following, openings, sharp turns, Panic).
+
+Vaughan, Støy, Sukhatme & Matarić, *Blazing a trail* §4.2 (and *Try to see it my way* §3.3,
+which reuses it): "Navigation and obstacle avoidance is provided by two simple high-level
+behaviours: Navigate and panic." Navigate "drives the robot around the environment following
+walls, turning down corridors and following crumb trails"; an emergency stop runs in parallel
+and hands control to Panic when an obstacle is critically close. The trail algorithms "provide
+a hint of a 'good' heading" (§4.1): here ``preferred_heading_rad``, in the robot's own odometry
+frame, or None to explore.
+
+One step, in priority order:
+
+1. **Panic** (:mod:`teamnav.control.nav.panic`) overrides everything: an obstacle critically
+   close to the front, or the stall flag, stops the robot and starts Panic; Navigate resumes
+   when Panic times out.
+2. A **sharp turn** under way (on the spot, by odometry heading) runs to its end; an
+   **advance** to the centre of a chosen opening runs (wall following) until the odometry has
+   covered the distance, then the 90 deg turn starts.
+3. **Against the trail**: "If the robot is heading in approximately the opposite direction to
+   the trail it makes a sharp 180° right turn" (§4.2). "Approximately opposite" is taken as
+   more than ``reverse_threshold_deg`` (default 135 deg) between the odometry heading and the
+   preferred heading; afterwards no second reversal for ``reverse_cooldown_s``.
+4. **Openings** (:mod:`teamnav.control.nav.openings`): "If the robot detects a corridor and it
+   is not already turning, there is a 50% chance that the robot will decide to take the new
+   corridor and make a sharp 90° turn into the corridor" (exploring; ``p_take_opening``). With a
+   trail, "the corridor-seeking behaviour is overridden by a trail-following component if the
+   trail points away from the opening": the robot takes the direction, among continuing
+   straight (when the way ahead is clear for ``straight_clear_m``) and the detected openings
+   (current heading +-90 deg), closest to the preferred heading. This is our reading; the
+   paper's results paragraph (§5.1) says the robot turns "if the average heading of the crumbs
+   points to the side where the opening is detected", i.e. within 90 deg of the opening
+   direction; ``trail_rule="side"`` gives that rule instead (any preferred heading more than
+   ``side_rule_min_deg`` to that side). Each opening is decided once: a side is not looked at
+   again until the robot has driven ``opening_cooldown_m`` (or the opening's width) further.
+5. Otherwise **wall following** with the sliding box (:mod:`teamnav.control.nav.wall_follow`).
+
+Odometry is used only as the robot's own dead reckoning over short spans (how far it has turned,
+how far it has driven), never as a position in any shared frame.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from teamnav.control.nav.openings import Opening, OpeningDetector
+from teamnav.control.nav.panic import Panic
+from teamnav.control.nav.wall_follow import BoxCommand, SlidingBox, box_exit_ranges
+from teamnav.control.protocol import RobotInfo
+from teamnav.control.types import Observation
+
+__all__ = ["Navigate", "NavigateParams"]
+
+_TWO_PI = 2.0 * math.pi
+
+
+def _wrap(a_rad: float) -> float:
+    """Scalar angle wrap to [-pi, pi] (the hot-path twin of ``teamnav.geometry.wrap_angle``)."""
+    return math.remainder(a_rad, _TWO_PI)
+
+
+class NavigateParams(BaseModel):
+    """Parameters of :class:`Navigate` (units in the names; module docstring for the rules).
+
+    Speeds and turn rates above the robot's limits are capped at construction. Defaults follow
+    the papers where they give a number: cruise 0.25 m/s (*Try to see it my way* §3.6), a 50 %
+    chance at openings (*Blazing* §4.2), a box "a little bigger than the robot".
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    cruise_speed_mps: float = Field(0.25, gt=0.0, le=10.0)
+    turn_rate_radps: float = Field(1.0, gt=0.0, le=20.0)
+    steer_gain_per_s: float = Field(1.5, gt=0.0, le=50.0)
+    min_speed_fraction: float = Field(0.3, ge=0.0, le=1.0)
+    wall_side: Literal["left", "right"] = "left"
+    box_margin_m: float = Field(0.15, ge=0.0, le=5.0)
+    box_length_m: float = Field(1.0, gt=0.0, le=20.0)
+    box_reach_m: float = Field(1.2, gt=0.0, le=20.0)
+    slide_step_m: float = Field(0.05, gt=0.0, le=1.0)
+    p_take_opening: float = Field(0.5, ge=0.0, le=1.0)
+    opening_near_m: float = Field(2.0, gt=0.0, le=50.0)
+    opening_jump_m: float = Field(1.5, gt=0.0, le=50.0)
+    opening_margin_m: float = Field(0.2, ge=0.0, le=5.0)
+    opening_extreme_deg: float = Field(20.0, gt=0.0, le=90.0)
+    opening_sector_deg: float = Field(80.0, gt=0.0, le=180.0)
+    opening_wall_tolerance_m: float = Field(0.4, ge=0.0, le=10.0)
+    opening_cooldown_m: float = Field(1.5, ge=0.0, le=50.0)
+    straight_clear_m: float = Field(2.0, ge=0.0, le=50.0)
+    trail_rule: Literal["closest", "side"] = "closest"
+    side_rule_min_deg: float = Field(20.0, ge=0.0, le=90.0)
+    reverse_threshold_deg: float = Field(135.0, ge=90.0, le=180.0)
+    reverse_cooldown_s: float = Field(5.0, ge=0.0, le=600.0)
+    turn_tolerance_deg: float = Field(3.0, gt=0.0, le=45.0)
+    turn_timeout_s: float = Field(8.0, gt=0.0, le=600.0)
+    panic_clearance_m: float = Field(0.08, gt=0.0, le=5.0)
+    panic_half_angle_deg: float = Field(60.0, gt=0.0, le=180.0)
+    panic_free_m: float = Field(0.8, gt=0.0, le=20.0)
+    panic_forward_s: float = Field(2.0, ge=0.0, le=60.0)
+    panic_turn_timeout_s: float = Field(8.0, gt=0.0, le=600.0)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "NavigateParams":
+        if self.opening_sector_deg < self.opening_extreme_deg:
+            raise ValueError(
+                f"opening_sector_deg must be >= opening_extreme_deg ({self.opening_extreme_deg}), "
+                f"got {self.opening_sector_deg}"
+            )
+        return self
+
+
+class Navigate:
+    """The Navigate + Panic controller of the trail papers, as a library the trail brains call.
+
+    Parameters
+    ----------
+    params : NavigateParams
+    rng : numpy.random.Generator
+        The robot's own stream (openings taken at random, Panic's turn direction).
+    info : RobotInfo
+        The robot's radius, limits, ``dt_s`` and sensors.
+    laser : str, default "laser"
+        Name of the range sensor to read (a scanning laser in the papers).
+
+    Attributes
+    ----------
+    mode : str
+        ``"navigate"``, ``"advance"`` (driving to an opening's centre), ``"turn"`` (a sharp
+        90 or 180 deg turn) or ``"panic"``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from teamnav.control import Observation, RangeScan, RobotInfo, SensorInfo
+    >>> angles = np.linspace(-np.pi / 2, np.pi / 2, 181)
+    >>> info = RobotInfo(0, 1, 0.25, "unicycle", 0.5, 2.0, 0.1, 0.1,
+    ...                  sensors={"laser": SensorInfo("laser", "laser", angles, 8.0)})
+    >>> nav = Navigate(NavigateParams(), np.random.default_rng(0), info)
+    >>> scan = RangeScan(np.full(181, 8.0), angles, 8.0)
+    >>> obs = Observation(0, 0, 0.0, np.zeros(3), np.zeros(3), scans={"laser": scan})
+    >>> nav.step(obs), nav.mode
+    ((0.25, 0.0), 'navigate')
+    """
+
+    def __init__(self, params: NavigateParams, rng: np.random.Generator, info: RobotInfo, laser: str = "laser") -> None:
+        if not isinstance(params, NavigateParams):
+            raise ValueError(f"params must be a NavigateParams, got {type(params).__name__}")
+        try:
+            sensor = info.sensors[laser]
+        except KeyError:
+            raise ValueError(
+                f"laser must name one of robot {info.robot_id}'s range sensors ({', '.join(sorted(info.sensors))}), "
+                f"got {laser!r}"
+            ) from None
+        self.params = params
+        self.info = info
+        self.rng = rng
+        self.laser = laser
+        self.angles_rad = np.asarray(sensor.angles_rad, dtype=np.float64).copy()
+        self.max_range_m = float(sensor.max_range_m)
+        self.max_v_mps = float(info.max_v_mps)
+        self.max_omega_radps = float(info.max_omega_radps)
+        self.dt_s = float(info.dt_s)
+        p = params
+        self.cruise_mps = min(p.cruise_speed_mps, self.max_v_mps)
+        self.turn_rate_radps = min(p.turn_rate_radps, self.max_omega_radps)
+        self.side_sign = 1.0 if p.wall_side == "left" else -1.0
+        radius = float(info.radius_m)
+        width = 2.0 * radius + 2.0 * p.box_margin_m
+        self.box = SlidingBox(self.angles_rad, width, p.box_length_m, max(p.slide_step_m, p.box_reach_m - 0.5 * width),
+                              p.slide_step_m, self.cruise_mps, p.steer_gain_per_s, self.turn_rate_radps,
+                              p.min_speed_fraction, p.wall_side)
+        self.openings = OpeningDetector(self.angles_rad, p.opening_near_m, p.opening_jump_m,
+                                        2.0 * radius + p.opening_margin_m, p.opening_extreme_deg,
+                                        p.opening_sector_deg, p.opening_wall_tolerance_m)
+        self.panic = Panic(self.angles_rad, radius, p.panic_clearance_m, p.panic_half_angle_deg, width,
+                           p.panic_free_m, self.cruise_mps, self.turn_rate_radps, p.panic_forward_s,
+                           p.panic_turn_timeout_s, self.dt_s)
+        half = 0.5 * width
+        self._straight_exit = box_exit_ranges(self.angles_rad, -0.01, max(p.straight_clear_m, 1e-3),
+                                              np.array([-half]), np.array([half]))[0]
+        self._reverse_rad = math.radians(p.reverse_threshold_deg)
+        self._side_rule_rad = math.radians(p.side_rule_min_deg)
+        self._turn_tol_rad = math.radians(p.turn_tolerance_deg)
+        self._turn_max_steps = max(1, int(round(p.turn_timeout_s / self.dt_s)))
+        self.reset()
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        """Forget every manoeuvre and cooldown (e.g. after arriving at a place); back to navigate."""
+        self.mode = "navigate"
+        self.panic.reset()
+        self.box.reset()
+        self.box_state = "open"
+        self.last_opening: str | None = None
+        self._odo_m = 0.0  # odometry path length so far [m]
+        self._last_pose: tuple[float, float, float] | None = None
+        self._cool_until_m = [0.0, 0.0]  # per side (left, right): no decision before this odometry length
+        self._reverse_after_s = -math.inf
+        self._turn_dir = 0.0
+        self._turn_goal_rad = 0.0
+        self._turned_rad = 0.0
+        self._turn_steps = 0
+        self._advance_to_m = 0.0
+        self._advance_steps = 0
+        self._advance_max_steps = 0
+        self._pending_dir = 0.0
+
+    def _cool(self, extra_m: float) -> None:
+        self._cool_until_m = [self._odo_m + extra_m, self._odo_m + extra_m]
+
+    def _start_turn(self, direction: float, amount_rad: float) -> None:
+        self.mode = "turn"
+        self._turn_dir = direction
+        self._turn_goal_rad = amount_rad
+        self._turned_rad = 0.0
+        self._turn_steps = 0
+
+    # ------------------------------------------------------------------ rules
+    def _turn_command(self) -> tuple[float, float] | None:
+        """One step of a sharp turn on the spot, or None when it is done (or timed out)."""
+        remaining = self._turn_goal_rad - self._turn_dir * self._turned_rad
+        self._turn_steps += 1
+        if remaining <= self._turn_tol_rad or self._turn_steps > self._turn_max_steps:
+            return None
+        # Full rate, easing off over the last ~0.3 rad so the turn does not overshoot.
+        rate = self.turn_rate_radps * min(1.0, max(0.3, remaining / 0.3))
+        return 0.0, self._turn_dir * rate
+
+    def _straight_ok(self, ranges_m: np.ndarray) -> bool:
+        """The way ahead is clear for ``straight_clear_m``: continuing straight is an option."""
+        return not bool((ranges_m < self._straight_exit).any())
+
+    def _choose_opening(self, found: list[Opening], ranges_m: np.ndarray, heading_rad: float,
+                        preferred_rad: float | None) -> Opening | None:
+        """Which detected opening to take, if any (*Blazing* §4.2 rules; module docstring, item 4)."""
+        if preferred_rad is None:
+            # Exploring: each opening is taken with p_take_opening; both chosen: one at random.
+            draws = [self.rng.random() for _ in found]
+            taken = [o for o, u in zip(found, draws) if u < self.params.p_take_opening]
+            if len(taken) > 1:
+                return taken[int(self.rng.integers(len(taken)))]
+            return taken[0] if taken else None
+        if self.params.trail_rule == "side":
+            rel = _wrap(preferred_rad - heading_rad)
+            for o in found:
+                if o.side * rel > self._side_rule_rad:
+                    return o
+            return None
+        best: Opening | None = None
+        best_err = abs(_wrap(preferred_rad - heading_rad)) if self._straight_ok(ranges_m) else math.inf
+        for o in found:
+            err = abs(_wrap(preferred_rad - (heading_rad + o.direction_rad)))
+            if err < best_err:
+                best, best_err = o, err
+        return best
+
+    def _clip(self, v: float, w: float) -> tuple[float, float]:
+        return (float(min(max(v, 0.0), self.max_v_mps)),
+                float(min(max(w, -self.max_omega_radps), self.max_omega_radps)))
+
+    # ------------------------------------------------------------------ step
+    def step(self, obs: Observation, preferred_heading_rad: float | None = None) -> tuple[float, float]:
+        """The command ``(v_mps, omega_radps)`` for this step.
+
+        Parameters
+        ----------
+        obs : Observation
+            The robot's own observation; reads its laser scan, odometry pose and stall flag.
+        preferred_heading_rad : float or None
+            Heading suggested by a trail, in the robot's own odometry frame [rad]; None to
+            explore (random turns at openings).
+
+        Returns
+        -------
+        (float, float)
+            Forward speed [m/s] (never negative) and turn rate [rad/s], within the robot's limits.
+        """
+        try:
+            scan = obs.scans[self.laser]
+        except KeyError:
+            raise ValueError(
+                f"observation of robot {obs.robot_id} must carry scan {self.laser!r}, has {sorted(obs.scans)}"
+            ) from None
+        r = np.asarray(scan.ranges_m, dtype=np.float64)
+        if r.shape != self.angles_rad.shape:
+            raise ValueError(f"scan {self.laser!r} must have {self.angles_rad.size} beams, got shape {r.shape}")
+        if not np.isfinite(r).all():
+            r = np.where(np.isfinite(r), r, self.max_range_m)
+        x, y, th = (float(v) for v in obs.odom_pose[:3])
+        if self._last_pose is not None:
+            lx, ly, lth = self._last_pose
+            self._odo_m += math.hypot(x - lx, y - ly)
+            self._turned_rad += _wrap(th - lth)
+        self._last_pose = (x, y, th)
+
+        # 1. Panic overrides Navigate (emergency stop running in parallel).
+        if self.mode == "panic":
+            v, w = self.panic.step(r)
+            if not self.panic.active:
+                self.mode = "navigate"
+                self._cool(self.params.opening_cooldown_m)
+            return self._clip(v, w)
+        if obs.stalled or self.panic.critical(r):
+            self.panic.start(self.rng)
+            self.mode = "panic"
+            return self._clip(*self.panic.step(r))
+
+        # 2. Manoeuvres under way.
+        if self.mode == "turn":
+            cmd = self._turn_command()
+            if cmd is not None:
+                return self._clip(*cmd)
+            self.mode = "navigate"
+            self._cool(self.params.opening_cooldown_m)
+        elif self.mode == "advance":
+            self._advance_steps += 1
+            if self._odo_m >= self._advance_to_m or self._advance_steps > self._advance_max_steps:
+                self._start_turn(self._pending_dir, 0.5 * math.pi)
+                cmd = self._turn_command()
+                if cmd is not None:
+                    return self._clip(*cmd)
+                self.mode = "navigate"
+            else:
+                box = self.box.command(r)
+                self.box_state = box.state
+                return self._clip(box.v_mps, box.omega_radps)
+
+        # 3. Heading against the trail: a sharp 180 deg right turn.
+        if (preferred_heading_rad is not None and obs.time_s >= self._reverse_after_s
+                and abs(_wrap(preferred_heading_rad - th)) > self._reverse_rad):
+            self._reverse_after_s = obs.time_s + self.params.reverse_cooldown_s
+            self._start_turn(-self.side_sign, math.pi)
+            cmd = self._turn_command()
+            if cmd is not None:
+                return self._clip(*cmd)
+            self.mode = "navigate"
+
+        box: BoxCommand = self.box.command(r)
+        self.box_state = box.state
+        # 4. Openings: decided once each, not while the box has the robot turning on the spot.
+        if box.state != "blocked":
+            left, right = self.openings.detect(r)
+            found = [o for k, o in enumerate((left, right))
+                     if o is not None and self._odo_m >= self._cool_until_m[k]]
+            if found:
+                choice = self._choose_opening(found, r, th, preferred_heading_rad)
+                for o in found:
+                    k = 0 if o.side > 0 else 1
+                    span = o.width_m if math.isfinite(o.width_m) else 0.0
+                    self._cool_until_m[k] = self._odo_m + max(self.params.opening_cooldown_m, span)
+                if choice is not None:
+                    self.last_opening = "left" if choice.side > 0 else "right"
+                    self.mode = "advance"
+                    self._pending_dir = float(choice.side)
+                    self._advance_to_m = self._odo_m + choice.advance_m
+                    self._advance_steps = 0
+                    self._advance_max_steps = int(round((choice.advance_m / self.cruise_mps + 3.0) / self.dt_s))
+        # 5. Wall following.
+        return self._clip(box.v_mps, box.omega_radps)
