@@ -184,10 +184,12 @@ def trail_metrics(data: RunData) -> dict[str, Any]:
     out["lifetime_min_total"] = float(life.sum() / 60.0)
     out["units_per_robot_min"] = int(per_units.min())
     out["units_per_robot_max"] = int(per_units.max())
-    out["first_delivery_s"] = float(dl[0][0]) if dl else float("nan")
+    if dl:  # keys left out when there is nothing to time (NaN would not compare equal to itself)
+        out["first_delivery_s"] = float(dl[0][0])
     sources = [float(e["t_s"]) for e in data.event_log if e.get("event") == SOURCE_EVENT]
-    first_trail = min(sources) if sources else float("nan")
-    out["first_trail_s"] = first_trail
+    first_trail = min(sources) if sources else math.inf
+    if sources:
+        out["first_trail_s"] = first_trail
     before = [t1 - t0 for _, t0, t1, _, _ in tr if not (t0 >= first_trail)]
     after = [t1 - t0 for _, t0, t1, _, _ in tr if t0 >= first_trail]
     out.update(_stats("trip_time_s_before", before))
