@@ -157,7 +157,8 @@ def mapview_png(view: Any, *, size_in: float = 6.0, max_points: int = 20000) -> 
     Parameters
     ----------
     view : teamnav.experiments.report.model.MapView
-        ``grid`` may be None (then only points and markers, on equal axes).
+        ``grid`` may be None (then only points and markers, on equal axes) or an
+        EnvironmentMap (its ``grid`` is drawn).
     size_in : float
         The longer side of the figure [inch].
     max_points : int
@@ -174,6 +175,8 @@ def mapview_png(view: Any, *, size_in: float = 6.0, max_points: int = 20000) -> 
         A point cloud that is not of shape (n, 2) or more columns.
     """
     grid = view.grid
+    if grid is not None and not hasattr(grid, "bounds_m") and hasattr(grid, "grid"):
+        grid = grid.grid  # an EnvironmentMap (builtin_map(...)) instead of its OccupancyGrid
     if grid is not None:
         xmin, xmax, ymin, ymax = grid.bounds_m
         w, h = max(xmax - xmin, 1e-6), max(ymax - ymin, 1e-6)
