@@ -56,3 +56,7 @@ register("route-follow-v1", "teamnav.control.nav.route_follow:RouteFollow")
 
 # Vaughan et al. trail papers: low-level Navigate + Panic, random exploration (helper H3)
 register("explore-v1", "teamnav.control.nav.explore:Explore")
+
+# Sgorbissa & Arkin: line-of-sight help, R1 explorer and patrolling helpers (helper H2)
+register("los-explorer-v1", "teamnav.control.coop.los_help.brain:LosExplorer")
+register("los-helper-v1", "teamnav.control.coop.los_help.brain:LosHelper")

@@ -1,0 +1,593 @@
+"""The brains of the line-of-sight help system (Sgorbissa & Arkin §2–§6).
+
+Paper: A. Sgorbissa and R. C. Arkin, "Local navigation strategies for a team of robots".
+
+- :class:`LosExplorer` (``los-explorer-v1``) is R1: it is given targets in its own frame,
+  reached in sequence within ε (§2), drives with a local navigation algorithm A
+  (``navigator``), and is helped by teammates through goal sharing (§3–§4) and state sharing
+  (§5).
+- :class:`LosHelper` (``los-helper-v1``) is R2..R4: it patrols waypoints (§6: helpers "patrol
+  the corridors") with the same navigator family, runs the same sharing rules (shares its
+  own patrol goal, relays the goals it knows, reports D for every goal it sees, keeps ghosts)
+  and never leaves its patrol to help.
+
+One step of either brain (belief only: its odometry pose, its omnidirectional range scan
+``laser``, its robot detector's detections with identities, its inbox):
+
+1. remember its pose and its sightings of this step (a message sent at step k arrives at
+   k + 1; the receiver pairs it with its own sighting of the sender *at k*);
+2. read the inbox: for each :class:`~.messages.LosHelpMsg` whose sender it saw at the sending
+   step and which carries the sender's bearing of it, compute the sender's frame from the
+   mutual bearings (§3.1), map the goals and the sender's position into its own frame and
+   apply the Id rule and the shortest-D arbitration (:mod:`.goal_sharing`); keep the
+   sender's Tr bit (§5);
+3. advance its own task (target reached within ε → next target, §2);
+4. check visibility of every known goal and keep the §4.3 bookkeeping;
+5. choose what to head to (explorer, in this priority): its goal when it sees it (straight,
+   suppressing A, §2 point 4) — ``own_goal``; the point offering the shortest D: a teammate
+   that reports now (``follow_teammate``) or a ghost (``ghost``) (§3 rule 5, §4.2); when in
+   trouble, the nearest teammate it sees that is not (``trouble_follow``, §5 rule 3); else
+   its navigator towards its goal (``own_goal``);
+6. update Pr/Tr/Nt from this step's progress (§5);
+7. broadcast its sightings, goals, reports and Tr if it sees a teammate (§4.4: O(M) terms).
+
+Heading to a visible point (goal, teammate, ghost) goes straight unless the next step would
+touch something the laser sees; then the navigator is asked for a heading towards that point
+(gap filled: the paper's robots are points, ours have a radius). Progress (§5) is the
+navigator's own estimate while it drives, and "the distance to the point being headed for fell
+by at least ``progress_min_fraction`` of a step since the last step" otherwise.
+
+``Action(direction_rad=...)`` is a body-frame direction for ``holonomic_step`` kinematics
+(Sgorbissa & Arkin count motion steps); ``Action()`` stays and does not count as a move.
+
+Parameters, log keys and layers are documented on :class:`LosExplorerParams`,
+:meth:`LosExplorer.log` and :class:`LosHelperParams`; keep them stable (experiments and
+the report read them).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from teamnav.control.coop.los_help.goal_sharing import (
+    GoalSharing,
+    goal_in_own_frame,
+    point_visible,
+)
+from teamnav.control.coop.los_help.messages import MESSAGE_KIND, GoalShare, LosHelpMsg, Sighting, VisReport
+from teamnav.control.coop.los_help.state_sharing import TroubleState, choose_helper
+from teamnav.control.protocol import RobotInfo
+from teamnav.control.types import Action, Message, Observation, RangeScan
+from teamnav.geometry.angles import wrap_angle
+
+__all__ = ["LosExplorer", "LosExplorerParams", "LosHelper", "LosHelperParams", "make_navigator"]
+
+NavigatorName = Literal["potential_field", "avoid_past", "visbug21"]
+XY = tuple[float, float]
+
+#: Steps of own pose/sightings kept to pair delayed messages with (O(1) memory).
+_HISTORY_STEPS = 4
+
+
+def make_navigator(name: str, params: dict | None, *, rng: np.random.Generator, step_length_m: float,
+                   radius_m: float):
+    """The local navigation algorithm A (``teamnav.control.nav.local``), built lazily.
+
+    Tests replace this module attribute with a trivial navigator; brains call it only when
+    they first need to navigate (a brain with nothing to do needs no navigator).
+    """
+    from teamnav.control.nav.local import make_navigator as _make
+
+    return _make(name, params or None, rng=rng, step_length_m=step_length_m, radius_m=radius_m)
+
+
+class _CommonParams(BaseModel):
+    """Parameters shared by both brains (units in the names).
+
+    Attributes
+    ----------
+    navigator : {"potential_field", "avoid_past", "visbug21"}
+        The local navigation algorithm A (§6).
+    navigator_params : dict
+        Its parameters (validated by the navigator).
+    goal_tolerance_m : float
+        ε: a target (or waypoint, or ghost point) is reached when closer than this (§2).
+        Should be at least half a step length.
+    goal_sharing : bool
+        Rules 1–5 of §3 (share goals, relay, report D, head to the shortest D).
+    delayed_visibility : bool
+        Delayed visibility V_D with ghost robots and §4.3 bookkeeping (§4); False keeps only
+        reflected visibility V_R (§3). Ignored without goal sharing.
+    state_sharing : bool
+        §5: share Tr and, for the explorer, head to a teammate not in trouble when in trouble.
+    id_gain_k : int or None
+        M in ``Id = k·M`` (§3.1); None uses the team size (all robots must agree).
+    trouble_cr : int
+        Cr of §5 (steps without progress before the first "in trouble").
+    reset_trouble_on_target : bool
+        Restart Pr, Tr, Nt when a new target is taken (gap filled; the paper has one goal).
+    laser : str
+        Name of the omnidirectional range sensor used for visibility and navigation.
+    visibility_radius_m : float or None
+        Radius of the visibility region V(R) (§2); None uses the laser's maximum range.
+    progress_min_fraction : float
+        Progress while heading straight to a point: its distance fell by at least this
+        fraction of the step length since the last step.
+    straight_when_visible : bool
+        Head straight to a visible target, suppressing A (§2 point 4); False asks A.
+    log_layers : bool
+        Add the ``"layers"`` entry (goal and ghost points) to :meth:`log`.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    navigator: NavigatorName = "potential_field"
+    navigator_params: dict[str, Any] = Field(default_factory=dict)
+    goal_tolerance_m: float = Field(0.5, gt=0.0, le=100.0)
+    goal_sharing: bool = True
+    delayed_visibility: bool = True
+    state_sharing: bool = True
+    id_gain_k: int | None = Field(None, ge=1, le=1_000_000)
+    trouble_cr: int = Field(50, ge=1, le=10_000_000)
+    reset_trouble_on_target: bool = True
+    laser: str = Field("laser", min_length=1)
+    visibility_radius_m: float | None = Field(None, gt=0.0, le=1000.0)
+    progress_min_fraction: float = Field(0.25, ge=0.0, le=1.0)
+    straight_when_visible: bool = True
+    log_layers: bool = True
+
+
+class LosExplorerParams(_CommonParams):
+    """R1's parameters: :class:`_CommonParams` plus its task.
+
+    Attributes
+    ----------
+    targets_xy : list of (x, y)
+        Targets [m] in the robot's own odometry frame, reached in sequence (§2, §6). Empty:
+        finished at once (the robot stays and still relays).
+    """
+
+    targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
+
+
+class LosHelperParams(_CommonParams):
+    """A helper's parameters: :class:`_CommonParams` plus its patrol.
+
+    Attributes
+    ----------
+    patrol_xy : list of (x, y)
+        Waypoints [m] in the robot's own odometry frame. Empty: stays where it is.
+    patrol_mode : {"ping_pong", "cycle"}
+        After the last waypoint, go back through them (ping-pong) or start again (cycle).
+    """
+
+    patrol_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=10_000)
+    patrol_mode: Literal["ping_pong", "cycle"] = "ping_pong"
+
+
+class _LosBrain:
+    """What both brains share: sensing, the receive path, sharing rules, motion and logs."""
+
+    Params: type[_CommonParams] = _CommonParams
+
+    def __init__(self, params: _CommonParams, rng: np.random.Generator, info: RobotInfo) -> None:
+        if not isinstance(params, self.Params):
+            raise ValueError(f"params must be a {type(self).__name__}.Params, got {type(params).__name__}")
+        if params.laser not in info.sensors:
+            raise ValueError(
+                f"laser must name one of robot {info.robot_id}'s range sensors ({', '.join(sorted(info.sensors))}), "
+                f"got {params.laser!r}"
+            )
+        self.params = params
+        self.info = info
+        self.me = int(info.robot_id)
+        self.team_size = int(params.id_gain_k or max(1, info.team_size))
+        sensor = info.sensors[params.laser]
+        self.vis_radius_m = float(params.visibility_radius_m or sensor.max_range_m)
+        self.step_m = float(info.step_length_m)
+        self.radius_m = float(info.radius_m)
+        self._rng = rng
+        self._nav = None
+        self._nav_goal: tuple[float, float] | None = None
+        self.sharing = GoalSharing(self.me, self.team_size, delayed=params.delayed_visibility,
+                                   point_margin_m=2.5 * self.radius_m)
+        self.trouble = TroubleState(int(params.trouble_cr))
+        self._history: dict[int, tuple[np.ndarray, dict[int, tuple[float, float]]]] = {}
+        self._teammate_tr: dict[int, bool | None] = {}
+        self._seen_now: dict[int, tuple[float, float]] = {}
+        self._prev_xy: XY | None = None
+        self._last_target: tuple[str, Any, float] | None = None
+        self.mode = "own_goal"
+        self.moves = 0
+        self.msgs_sent = 0
+        self.bytes_sent = 0
+        self.msgs_received = 0
+        self._pose = np.zeros(3)
+        self._scan: RangeScan | None = None
+
+    # ------------------------------------------------------------------ sensing helpers
+    def _odom_to_body(self, x: float, y: float) -> XY:
+        px, py, th = self._pose
+        dx, dy = x - px, y - py
+        c, s = math.cos(th), math.sin(th)
+        return c * dx + s * dy, -s * dx + c * dy
+
+    def _body_to_odom(self, pose: np.ndarray, bx: float, by: float) -> XY:
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        return pose[0] + c * bx - s * by, pose[1] + s * bx + c * by
+
+    def _sees(self, x: float, y: float, margin_m: float = 0.0) -> bool:
+        """V(R): the point (own frame) is in sight, from this step's omnidirectional scan (§2)."""
+        if self._scan is None:
+            return False
+        bx, by = self._odom_to_body(x, y)
+        return point_visible((bx, by), self._scan.ranges_m, self._scan.angles_rad, self.vis_radius_m, margin_m)
+
+    def _me_xy(self) -> XY:
+        return float(self._pose[0]), float(self._pose[1])
+
+    # ------------------------------------------------------------------ the step
+    def step(self, obs: Observation) -> tuple[Action, list[Message]]:
+        """One step (see the module docstring)."""
+        try:
+            self._scan = obs.scans[self.params.laser]
+        except KeyError:
+            raise ValueError(
+                f"observation of robot {obs.robot_id} must carry scan {self.params.laser!r}, has {sorted(obs.scans)}"
+            ) from None
+        self._pose = np.asarray(obs.odom_pose, dtype=np.float64).copy()
+        sightings = {}
+        for det in obs.detections:
+            if det.robot_id is None or det.robot_id == self.me:
+                continue  # without an identity a teammate cannot be paired with its messages
+            sightings[int(det.robot_id)] = (float(det.range_m), float(det.bearing_rad))
+        self._history[int(obs.step)] = (self._pose.copy(), sightings)
+        for old in [k for k in self._history if k <= obs.step - _HISTORY_STEPS]:
+            del self._history[old]
+        self._seen_now = {rid: self._body_to_odom(self._pose, r * math.cos(b), r * math.sin(b))
+                          for rid, (r, b) in sightings.items()}
+
+        if self.params.goal_sharing:
+            self.sharing.begin_step()
+        self._advance_task()
+        self._receive(obs)
+        me = self._me_xy()
+        if self.params.goal_sharing:
+            self.sharing.refresh(me, self._prev_xy, self._sees, int(obs.step))
+        action = self._decide(obs)
+        if action.direction_rad is not None:
+            self.moves += 1
+        outbox = self._broadcast(obs, sightings)
+        self._prev_xy = me
+        return action, outbox
+
+    def _advance_task(self) -> None:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def _decide(self, obs: Observation) -> Action:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    # ------------------------------------------------------------------ receive path (§3.1)
+    def _receive(self, obs: Observation) -> None:
+        """Read the inbox: frames from mutual bearings, Id rule, D arbitration, Tr bits."""
+        self._teammate_tr = {}
+        for msg in obs.inbox:
+            body = msg.body
+            if not isinstance(body, LosHelpMsg) or msg.sender == self.me:
+                continue
+            self.msgs_received += 1
+            s = int(msg.sender)
+            if body.trouble is not None:
+                self._teammate_tr[s] = bool(body.trouble)
+            if not self.params.goal_sharing:
+                continue
+            hist = self._history.get(int(body.step))
+            if hist is None or s not in hist[1]:
+                continue  # I did not see the sender when it sent: no frame
+            back = next((sg for sg in body.sightings if sg.robot_id == self.me), None)
+            if back is None:
+                continue  # the sender did not see me: no mutual bearing
+            pose_k, seen_k = hist
+            rng_m, bearing = seen_k[s]
+            sender_xy = self._body_to_odom(pose_k, rng_m * math.cos(bearing), rng_m * math.sin(bearing))
+            for g in body.goals:
+                if g.owner == self.me:
+                    continue
+                gxy = goal_in_own_frame((g.gx_m, g.gy_m), pose_k, bearing, back.bearing_rad, rng_m)
+                self.sharing.receive_goal(g.owner, g.goal_id, gxy)
+            me_k = (float(pose_k[0]), float(pose_k[1]))
+            for r in body.reports:
+                self.sharing.receive_report(r.owner, r.goal_id, s, sender_xy, r.d_m, me_xy=me_k, step=int(body.step))
+
+    # ------------------------------------------------------------------ broadcast (§4.4)
+    def _broadcast(self, obs: Observation, sightings: dict[int, tuple[float, float]]) -> list[Message]:
+        p = self.params
+        if not sightings or not (p.goal_sharing or p.state_sharing):
+            return []
+        goals: tuple[GoalShare, ...] = ()
+        reports: tuple[VisReport, ...] = ()
+        sights: tuple[Sighting, ...] = ()
+        if p.goal_sharing:
+            sights = tuple(Sighting(rid, b, r) for rid, (r, b) in sorted(sightings.items()))
+            goals = tuple(GoalShare(owner, gid, *self._odom_to_body(x, y)) for owner, gid, x, y in self.sharing.shares())
+            reports = tuple(VisReport(owner, gid, d) for owner, gid, d in self.sharing.reports(self._me_xy()))
+        body = LosHelpMsg(int(obs.step), sights, goals, reports, bool(self.trouble.tr) if p.state_sharing else None)
+        msg = Message(self.me, float(obs.time_s), body, kind=MESSAGE_KIND)
+        self.msgs_sent += 1
+        self.bytes_sent += msg.size_bytes()
+        return [msg]
+
+    # ------------------------------------------------------------------ motion
+    def _navigator(self):
+        if self._nav is None:
+            self._nav = make_navigator(self.params.navigator, dict(self.params.navigator_params), rng=self._rng,
+                                       step_length_m=self.step_m, radius_m=self.radius_m)
+        return self._nav
+
+    def _navigate(self, target: XY) -> tuple[Action, bool]:
+        """A heading from the navigator towards ``target`` (own frame); (action, progressing)."""
+        nav = self._navigator()
+        if self._nav_goal is None or self._nav_goal != target:
+            nav.set_goal(np.array(target, dtype=np.float64))
+            self._nav_goal = target
+        heading = nav.direction(self._pose.copy(), self._scan)
+        progressing = bool(nav.progressing)
+        if heading is None:
+            return Action(), progressing
+        return Action(direction_rad=float(wrap_angle(heading - self._pose[2]))), progressing
+
+    def _step_clear(self, heading_rad: float) -> bool:
+        """Whether a straight step along ``heading_rad`` (own frame) keeps the body off every return."""
+        scan = self._scan
+        r = np.asarray(scan.ranges_m, dtype=np.float64)
+        hit = r < float(scan.max_range_m) * (1.0 - 1e-9)
+        if not hit.any():
+            return True
+        rel = np.asarray(scan.angles_rad, dtype=np.float64)[hit] + self._pose[2] - heading_rad
+        along = r[hit] * np.cos(rel)
+        across = np.abs(r[hit] * np.sin(rel))
+        t = np.clip(along, 0.0, self.step_m)
+        dist = np.hypot(along - t, across)
+        return bool(dist.min() >= self.radius_m * 1.05)
+
+    def _head_to(self, target: XY, key: Any, *, stop_within_m: float = 0.0) -> tuple[Action, bool]:
+        """Head for a visible point: straight (§2 point 4) unless blocked, then via the navigator."""
+        me = self._me_xy()
+        dist = math.hypot(target[0] - me[0], target[1] - me[1])
+        last = self._last_target
+        progressing = True
+        if last is not None and last[0] == key:
+            progressing = dist < last[2] - self.params.progress_min_fraction * self.step_m
+        self._last_target = (key, target, dist)
+        if dist <= stop_within_m:
+            return Action(), True
+        heading = math.atan2(target[1] - me[1], target[0] - me[0])
+        if self.params.straight_when_visible and self._step_clear(heading):
+            return Action(direction_rad=float(wrap_angle(heading - self._pose[2]))), progressing
+        action, _ = self._navigate(target)
+        return action, progressing
+
+    def _drive(self, target: XY) -> tuple[Action, bool]:
+        """Drive towards an unseen target with the navigator (algorithm A)."""
+        self._last_target = None
+        return self._navigate(target)
+
+    # ------------------------------------------------------------------ logs
+    def _layers(self) -> dict[str, Any]:
+        if not self.params.log_layers:
+            return {}
+        goal = self.sharing.own_goal
+        ghosts = [(p.px_m, p.py_m) for p in self.sharing.points() if p.kind != "direct"]
+        return {
+            "los_goal": {"kind": "markers", "frame": "odom", "hold": True,
+                         "data": np.array([goal], dtype=np.float64) if goal is not None else np.zeros((0, 2)),
+                         "description": "Sgorbissa & Arkin: the robot's current goal (target or patrol waypoint)"},
+            "los_ghosts": {"kind": "markers", "frame": "odom", "hold": True,
+                           "data": np.array(ghosts, dtype=np.float64).reshape(-1, 2),
+                           "description": "Sgorbissa & Arkin §4: ghost robots and own past viewpoints kept for goals"},
+        }
+
+    def _common_log(self) -> dict[str, Any]:
+        own = self.sharing.path(self.me)
+        return {
+            "mode": self.mode,
+            "moves": int(self.moves),
+            "tr": bool(self.trouble.tr),
+            "pr": int(self.trouble.pr),
+            "nt": int(self.trouble.nt),
+            "msgs_sent": int(self.msgs_sent),
+            "bytes_sent": int(self.bytes_sent),
+            "msgs_received": int(self.msgs_received),
+            "known_goals": len(self.sharing.known),
+            "ghosts": sum(1 for p in self.sharing.points() if p.kind != "direct"),
+            "own_d_m": float(own.distance_m(self._me_xy())) if own is not None else -1.0,
+        }
+
+
+class LosExplorer(_LosBrain):
+    """R1: reaches its targets in sequence, helped by teammates (``los-explorer-v1``).
+
+    Attributes
+    ----------
+    finished : bool
+        True once the last target is reached (immediately with no targets).
+    target_index : int
+        Index (0-based) of the current target; ``len(targets_xy)`` when finished.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from teamnav.control import Observation, RangeScan, RobotInfo, SensorInfo
+    >>> angles = np.linspace(-np.pi, np.pi, 360, endpoint=False)
+    >>> info = RobotInfo(0, 2, 0.2, "holonomic_step", 0.5, 1.5, 0.1, 0.1,
+    ...                  sensors={"laser": SensorInfo("laser", "laser", angles, 8.0)})
+    >>> brain = LosExplorer(LosExplorer.Params(targets_xy=[(2.0, 0.0)]), np.random.default_rng(0), info)
+    >>> scan = RangeScan(np.full(360, 8.0), angles, 8.0)
+    >>> action, outbox = brain.step(Observation(0, 0, 0.0, np.zeros(3), np.zeros(3), scans={"laser": scan}))
+    >>> round(action.direction_rad, 6), brain.mode, outbox
+    (0.0, 'own_goal', [])
+    """
+
+    Params = LosExplorerParams
+
+    def __init__(self, params: LosExplorerParams, rng: np.random.Generator, info: RobotInfo) -> None:
+        super().__init__(params, rng, info)
+        self.targets = [(float(x), float(y)) for x, y in params.targets_xy]
+        self.target_index = 0
+        self.targets_reached = 0
+        self.finished = not self.targets
+        self._set_goal()
+
+    def _set_goal(self) -> None:
+        if self.finished:
+            self.sharing.set_own_goal(None)
+            self.mode = "done"
+        else:
+            self.sharing.set_own_goal(self.target_index + 1, self.targets[self.target_index])
+
+    def _advance_task(self) -> None:
+        """§2: the current goal is reached when dist < ε; then the next one becomes current."""
+        while not self.finished:
+            gx, gy = self.targets[self.target_index]
+            if math.hypot(gx - self._pose[0], gy - self._pose[1]) >= self.params.goal_tolerance_m:
+                return
+            self.target_index += 1
+            self.targets_reached += 1
+            self.finished = self.target_index >= len(self.targets)
+            self._set_goal()
+            self._last_target = None
+            if self.params.reset_trouble_on_target:
+                self.trouble.reset()
+
+    def _decide(self, obs: Observation) -> Action:
+        if self.finished:
+            self.mode = "done"
+            return Action()
+        p = self.params
+        goal = self.targets[self.target_index]
+        path = self.sharing.path(self.me) if p.goal_sharing else None
+        action: Action | None = None
+        progressing = True
+        if path is not None and path.kind == "direct":
+            self.mode = "own_goal"  # §2 point 4: it sees its goal, A is suppressed
+            action, progressing = self._head_to(goal, ("goal", self.target_index))
+        elif path is not None and path.kind in ("ghost", "self") and not path.reached:
+            point = (path.px_m, path.py_m)
+            # the mirror itself still stands where it promised (§3), or only its ghost does (§4.2)
+            seen = self._seen_now.get(path.source)
+            live = seen is not None and math.hypot(seen[0] - point[0], seen[1] - point[1]) <= 2.0 * self.radius_m + self.step_m
+            reach = max(p.goal_tolerance_m, 2.0 * self.radius_m + self.step_m) if live else p.goal_tolerance_m
+            me = self._me_xy()
+            if math.hypot(point[0] - me[0], point[1] - me[1]) < reach:
+                # §4.2: at the ghost without seeing the goal: explore again with A, keeping the
+                # promise only to arbitrate later reports
+                self.sharing.mark_reached(self.me)
+            else:
+                self.mode = "follow_teammate" if live else "ghost"
+                action, progressing = self._head_to(point, ("path", path.source, path.step))
+        if action is None and p.state_sharing and self.trouble.tr:
+            cands = [(rid, xy[0], xy[1], self._teammate_tr.get(rid)) for rid, xy in self._seen_now.items()]
+            helper = choose_helper(True, self._me_xy(), cands)
+            if helper is not None:  # §5 rule 3: head to a teammate that is not in trouble
+                self.mode = "trouble_follow"
+                action, progressing = self._head_to(self._seen_now[helper], ("helper", helper),
+                                                    stop_within_m=2.0 * self.radius_m + self.step_m)
+        if action is None:
+            self.mode = "own_goal"
+            action, progressing = self._drive(goal)
+        self.trouble.update(progressing)
+        return action
+
+    def log(self) -> dict[str, Any]:
+        """Per-step values (keep these keys stable; experiments read them).
+
+        ``target_index`` (0-based current target), ``targets_reached``, ``moves`` (motion
+        steps commanded so far), ``mode`` (``"own_goal"`` | ``"follow_teammate"`` |
+        ``"ghost"`` | ``"trouble_follow"`` | ``"done"``), ``tr``, ``pr``, ``nt`` (§5),
+        ``msgs_sent``, ``bytes_sent``, ``msgs_received`` (§4.4 traffic, cumulative),
+        ``known_goals`` and ``ghosts`` (memory, §4.4), ``own_d_m`` (D to its own goal, -1
+        when none), ``finished``; and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
+        the odometry frame (when ``log_layers``).
+        """
+        out = self._common_log()
+        out.update(target_index=int(self.target_index), targets_reached=int(self.targets_reached),
+                   finished=bool(self.finished))
+        layers = self._layers()
+        if layers:
+            out["layers"] = layers
+        return out
+
+
+class LosHelper(_LosBrain):
+    """R2..R4: patrols its waypoints and helps by sharing only (``los-helper-v1``).
+
+    It has no ``finished`` attribute (a run with ``stop_when_finished`` waits for R1 only).
+    """
+
+    Params = LosHelperParams
+
+    def __init__(self, params: LosHelperParams, rng: np.random.Generator, info: RobotInfo) -> None:
+        super().__init__(params, rng, info)
+        self.patrol = [(float(x), float(y)) for x, y in params.patrol_xy]
+        self.waypoint_index = 0
+        self._dir = 1
+        self.waypoints_reached = 0
+        self._k = 1
+        self.mode = "patrol" if self.patrol else "stay"
+        if self.patrol:
+            self.sharing.set_own_goal(self._k, self.patrol[0])
+
+    def _advance_task(self) -> None:
+        """Next waypoint when within ε; each new waypoint is a new goal k (new Id = k·M)."""
+        if not self.patrol:
+            return
+        wx, wy = self.patrol[self.waypoint_index]
+        if math.hypot(wx - self._pose[0], wy - self._pose[1]) >= self.params.goal_tolerance_m:
+            return
+        if len(self.patrol) == 1:
+            return  # one waypoint: it stays there
+        n = len(self.patrol)
+        if self.params.patrol_mode == "cycle":
+            self.waypoint_index = (self.waypoint_index + 1) % n
+        else:
+            if not 0 <= self.waypoint_index + self._dir < n:
+                self._dir = -self._dir
+            self.waypoint_index += self._dir
+        self.waypoints_reached += 1
+        self._k += 1
+        self._last_target = None
+        self.sharing.set_own_goal(self._k, self.patrol[self.waypoint_index])
+        if self.params.reset_trouble_on_target:
+            self.trouble.reset()
+
+    def _decide(self, obs: Observation) -> Action:
+        if not self.patrol:
+            self.mode = "stay"
+            return Action()
+        wp = self.patrol[self.waypoint_index]
+        me = self._me_xy()
+        if len(self.patrol) == 1 and math.hypot(wp[0] - me[0], wp[1] - me[1]) < self.params.goal_tolerance_m:
+            self.mode = "stay"
+            return Action()
+        self.mode = "patrol"
+        if self._sees(*wp):
+            action, progressing = self._head_to(wp, ("waypoint", self._k))
+        else:
+            action, progressing = self._drive(wp)
+        self.trouble.update(progressing)
+        return action
+
+    def log(self) -> dict[str, Any]:
+        """As :meth:`LosExplorer.log` where meaningful: ``mode`` is ``"patrol"`` or ``"stay"``;
+        ``target_index`` is the current waypoint index and ``targets_reached`` counts waypoints
+        reached."""
+        out = self._common_log()
+        out.update(target_index=int(self.waypoint_index), targets_reached=int(self.waypoints_reached))
+        layers = self._layers()
+        if layers:
+            out["layers"] = layers
+        return out

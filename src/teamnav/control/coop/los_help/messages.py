@@ -1,0 +1,83 @@
+"""Message bodies of the line-of-sight help system (Sgorbissa & Arkin §3.1, §4.4, §5).
+
+One robot broadcasts one :class:`LosHelpMsg` per step while it sees at least one teammate
+(the radio in ``line_of_sight`` mode delivers it one step later only to robots in sight).
+Its parts are exactly the terms §4.4 counts, so a message is O(M) for a team of M robots:
+
+- ``sightings``: for every teammate the sender sees, the direction (and range) at which it sees
+  it, in the sender's body frame. §3.1 item 2 ("the angle α_2i, corresponding to the
+  direction in which R_1 sees R_i"): the receiver combines it with its own bearing of the
+  sender to compute the frame between the two (θ21 = 180° + α21 − α12).
+- ``goals``: "(G_ik, α, Id_ik)" terms: the sender's own current goal with ``Id = k·M`` and the
+  goals of other robots it knows, relayed with ``Id − 1`` (§3.1, rule 2), each in the
+  sender's *body* frame at the sending step (gap filled here: the paper says "with respect to
+  F_1", a frame centred on the robot; the body frame is the one the bearings are measured in).
+- ``reports``: "(Id_ik, D_ik)" pairs: for every goal the sender sees directly, by reflection
+  (V_R) or with delay (V_D), its estimated path length D to that goal (§3 rule 3, §4.2).
+- ``trouble``: the one-bit internal state Tr of §5 (None when state sharing is off).
+
+All fields are plain numbers so :meth:`teamnav.control.types.Message.size_bytes` counts them
+(8 bytes per number, 1 per bool).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["GoalShare", "LosHelpMsg", "Sighting", "VisReport", "MESSAGE_KIND"]
+
+#: ``Message.kind`` of the system's messages (per-kind traffic counts).
+MESSAGE_KIND = "los_help"
+
+
+@dataclass(frozen=True, slots=True)
+class Sighting:
+    """A teammate the sender sees: its id, bearing [rad] and range [m] in the sender's body frame."""
+
+    robot_id: int
+    bearing_rad: float
+    range_m: float
+
+
+@dataclass(frozen=True, slots=True)
+class GoalShare:
+    """Robot ``owner``'s goal, identifier ``goal_id`` (Id = k·M, minus one per hop), at
+    (``gx_m``, ``gy_m``) in the *sender's* body frame at the sending step."""
+
+    owner: int
+    goal_id: int
+    gx_m: float
+    gy_m: float
+
+
+@dataclass(frozen=True, slots=True)
+class VisReport:
+    """The sender sees (directly, reflected or delayed) goal ``goal_id`` of ``owner`` with
+    estimated path length ``d_m`` [m] from the sender to the goal (§3 rule 3, §4.2 D_1j)."""
+
+    owner: int
+    goal_id: int
+    d_m: float
+
+
+@dataclass(frozen=True, slots=True)
+class LosHelpMsg:
+    """One step's broadcast of a robot (see the module docstring).
+
+    Attributes
+    ----------
+    step : int
+        The sender's step index when it sent (robots' clocks agree); the receiver pairs the
+        message with its own sighting of the sender at that step.
+    sightings : tuple of Sighting
+    goals : tuple of GoalShare
+    reports : tuple of VisReport
+    trouble : bool or None
+        Tr of §5, None when the sender does not share its state.
+    """
+
+    step: int
+    sightings: tuple[Sighting, ...] = ()
+    goals: tuple[GoalShare, ...] = ()
+    reports: tuple[VisReport, ...] = ()
+    trouble: bool | None = None
