@@ -92,6 +92,7 @@ def test_fake_section_renders_every_block_and_second_build_reuses_the_sweep(tmp_
     res2 = report.run_report("fake-demo", out, quick=True, workers=1, progress=False)
     assert res2.ok and "OURS-n=2" in res2.index.read_text(encoding="utf-8")
     assert res2.sections[0].sweeps[0]["run"] == 0 and res2.sections[0].sweeps[0]["reused"] == 2
+    assert "<td class='num'>0</td><td class='num'>2</td></tr>" in res2.index.read_text(encoding="utf-8")  # footer: run, reused
     assert _store_rows(out) == first
 
     # the full version shares the sweep folder but sees only its own trial (seed 1, reused)

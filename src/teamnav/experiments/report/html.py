@@ -7,7 +7,7 @@ of every :class:`~teamnav.experiments.report.model.Comparison` (claim | paper | 
 ``data:image/png;base64`` URIs, drawn by :mod:`teamnav.viz.report_figures`), paragraphs, and
 missing blocks as grey boxes "not measured: WHAT — WHY", never as numbers. A footer gives
 the teamnav version, the git commit when the package runs from a checkout, the date, the mode
-and the wall time of each section.
+and, per section, its wall time and how many trials it ran and reused.
 
 All text from sections is escaped. A figure that cannot be drawn becomes a missing block
 naming the error, so one bad figure never loses the report.
@@ -220,11 +220,15 @@ def render_report(sections: Sequence[Any], meta: dict[str, Any]) -> str:
     commit = git_commit()
     workers = meta.get("workers") or "all CPUs"
     executor = meta.get("executor", "local") + (f" at {meta['address']}" if meta.get("address") else "")
-    times = "".join(f"<tr><td>{_e(s.key)}</td><td>{_e(s.status)}</td><td class='num'>{s.wall_s:.1f}</td></tr>" for s in sections)
+    times = "".join(
+        f"<tr><td>{_e(s.key)}</td><td>{_e(s.status)}</td><td class='num'>{s.wall_s:.1f}</td>"
+        f"<td class='num'>{sum(w.get('run', 0) for w in s.sweeps)}</td><td class='num'>{sum(w.get('reused', 0) for w in s.sweeps)}</td></tr>"
+        for s in sections
+    )
     footer = (
         f"<footer><p>teamnav {_e(__version__)}" + (f" · git {_e(commit)}" if commit else "") + f" · {_e(now)} · {_e(mode)} · "
         f"executor {_e(executor)}, workers {_e(workers)} · total {float(meta.get('wall_s', 0.0)):.1f} s</p>"
-        f"<table><thead><tr><th>section</th><th>status</th><th>wall time [s]</th></tr></thead><tbody>{times}</tbody></table>"
+        f"<table><thead><tr><th>section</th><th>status</th><th>wall time [s]</th><th>trials run</th><th>trials reused</th></tr></thead><tbody>{times}</tbody></table>"
         "</footer>"
     )
     return (
