@@ -14,7 +14,7 @@ Baselines beside them: one optimal robot (route-follow-v1), one exploring robot
 (blazing-trail-v1 alone), the team without communication. Figures: units over time (Fig. 5
 left), units per 10 min (Fig. 5 right), breakdown time vs drift.
 
-Quick mode: 600 s runs, 2 seeds, drift 0 and 4 deg/min only; full: the paper's 30 min, 10
+Quick mode: 450 s runs (drift sweep 300 s), 2 seeds, drift 0 and 4 deg/min only; full: the paper's 30 min, 10
 seeds, drift 0..4 deg/min for 1 h.
 """
 
@@ -38,8 +38,8 @@ def build(ctx) -> list:
         return [missing]
     quick = bool(ctx.quick)
     seeds = 2 if quick else 10
-    dur = 600.0 if quick else 1800.0
-    drift_dur = 600.0 if quick else 3600.0
+    dur = 450.0 if quick else 1800.0
+    drift_dur = 300.0 if quick else 3600.0
     drifts = [0.0, 4.0] if quick else [0.0, 0.5, 1.0, 2.0, 4.0]
 
     paper = T.ok(ctx.sweep("blazing-paper", seeds=seeds, duration_s=dur))
