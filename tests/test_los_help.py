@@ -1,0 +1,442 @@
+"""Line-of-sight help (Sgorbissa & Arkin): the rules of §3–§5 on hand-made situations, the
+brains on synthetic observations, and one short run through the experiment runner."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from pydantic import ValidationError
+
+from teamnav.control import Detection, Message, Observation, RangeScan, RobotInfo, SensorInfo
+from teamnav.control.coop.los_help import brain as brain_mod
+from teamnav.control.coop.los_help.brain import LosExplorer, LosHelper
+from teamnav.control.coop.los_help.goal_sharing import (
+    GoalSharing,
+    accept_goal_id,
+    can_relay,
+    goal_id,
+    goal_index,
+    hops,
+    point_visible,
+    relayed_id,
+)
+from teamnav.control.coop.los_help.messages import MESSAGE_KIND, GoalShare, LosHelpMsg, Sighting, VisReport
+from teamnav.control.coop.los_help.state_sharing import TroubleState, choose_helper
+from teamnav.geometry import wrap_angle
+from teamnav.geometry.se2 import relative, transform_points
+
+N_BEAMS = 360
+ANGLES = np.linspace(-np.pi, np.pi, N_BEAMS, endpoint=False)
+MAX_RANGE = 8.0
+
+
+# ---------------------------------------------------------------------------- test doubles
+class StraightNav:
+    """Algorithm A stand-in: heads straight at the goal; ``stuck`` makes it report no progress."""
+
+    name = "straight"
+
+    def __init__(self, stuck: bool = False) -> None:
+        self.goal = None
+        self.stuck = stuck
+        self.progressing = True
+
+    def set_goal(self, goal_xy) -> None:
+        self.goal = np.asarray(goal_xy, dtype=float)
+
+    def direction(self, pose, scan):
+        self.progressing = not self.stuck
+        if self.goal is None:
+            return None
+        return math.atan2(self.goal[1] - pose[1], self.goal[0] - pose[0])
+
+
+@pytest.fixture
+def straight_nav(monkeypatch):
+    made = []
+
+    def make(name, params, *, rng, step_length_m, radius_m):
+        nav = StraightNav()
+        made.append(nav)
+        return nav
+
+    monkeypatch.setattr(brain_mod, "make_navigator", make)
+    return made
+
+
+def info(robot_id: int = 0, team_size: int = 4) -> RobotInfo:
+    laser = SensorInfo("laser", "laser", ANGLES, MAX_RANGE)
+    return RobotInfo(robot_id, team_size, 0.2, "holonomic_step", 0.5, 1.5, 0.1, 0.1, sensors={"laser": laser})
+
+
+def scan(walls=()) -> RangeScan:
+    """Omnidirectional scan, free to MAX_RANGE except ``walls``: (bearing_rad, half_width_rad, range_m)."""
+    r = np.full(N_BEAMS, MAX_RANGE)
+    for b, hw, rng in walls:
+        r[np.abs(wrap_angle(ANGLES - b)) <= hw] = rng
+    return RangeScan(r, ANGLES.copy(), MAX_RANGE)
+
+
+def obs(step, pose=(0.0, 0.0, 0.0), *, walls=(), seen=(), inbox=(), robot_id=0) -> Observation:
+    dets = tuple(Detection(float(r), float(b), int(i)) for i, r, b in seen)
+    return Observation(robot_id, step, 0.1 * step, np.array(pose, float), np.zeros(3), scans={"laser": scan(walls)},
+                       detections=dets, stalled=False, inbox=tuple(inbox))
+
+
+def msg(sender, step, *, sightings=(), goals=(), reports=(), trouble=None) -> Message:
+    return Message(sender, 0.1 * step, LosHelpMsg(step, tuple(sightings), tuple(goals), tuple(reports), trouble),
+                   kind=MESSAGE_KIND)
+
+
+def polar(xy_from, xy_to, heading=0.0):
+    dx, dy = xy_to[0] - xy_from[0], xy_to[1] - xy_from[1]
+    return math.hypot(dx, dy), float(wrap_angle(math.atan2(dy, dx) - heading))
+
+
+# ---------------------------------------------------------------------------- identifiers (§3.1)
+def test_goal_identifiers_follow_section_3_1():
+    m = 4
+    assert goal_id(3, m) == 12 and relayed_id(12) == 11
+    # k = 1 + (Id - 1) / M still names goal 3 after M - 1 relays; Nr counts down from M
+    assert [goal_index(i, m) for i in (12, 11, 10, 9)] == [3, 3, 3, 3]
+    assert [hops(i, m) for i in (12, 11, 10, 9)] == [4, 3, 2, 1]
+    assert can_relay(10, m) and not can_relay(9, m)  # Id 8 would name goal 2
+    with pytest.raises(ValueError, match="k and team_size"):
+        goal_id(0, m)
+
+
+def test_id_arbitration_second_hand_never_overrides_first_hand():
+    """§3.1 / Fig. 5: a report is accepted only if its Id >= the stored one."""
+    gs = GoalSharing(0, 4)
+    assert gs.receive_goal(1, goal_id(2, 4), (5.0, 1.0))  # directly from R2 (owner 1)
+    assert not gs.receive_goal(1, relayed_id(goal_id(2, 4)), (9.0, 9.0))  # via R3: rejected
+    assert gs.goal_of(1) == (8, 5.0, 1.0)
+    assert gs.receive_goal(1, goal_id(2, 4), (5.1, 1.0))  # the same Id again: accepted (fresher frame)
+    assert gs.goal_of(1)[1] == pytest.approx(5.1)
+    # the owner's next goal (k = 3) replaces goal 2 even second-hand: 12 - 1 > 8
+    assert gs.receive_goal(1, relayed_id(goal_id(3, 4)), (-2.0, 0.0))
+    assert gs.goal_of(1) == (11, -2.0, 0.0)
+    assert accept_goal_id(None, 1) and not accept_goal_id(12, 11)
+    # a robot never takes a report of its own goal
+    assert not gs.receive_goal(0, 100, (0.0, 0.0))
+
+
+def test_relay_decrements_id_and_stops_at_last_hop():
+    gs = GoalSharing(2, 3)
+    gs.set_own_goal(1, (0.0, 0.0))
+    gs.receive_goal(0, goal_id(1, 3), (1.0, 1.0))  # first hand from robot 0: Nr = 3
+    gs.receive_goal(1, goal_id(1, 3) - 2, (2.0, 2.0))  # already relayed twice: Nr = 1
+    shared = {owner: gid for owner, gid, _, _ in gs.shares()}
+    assert shared == {2: 3, 0: 2}  # own goal k·M; robot 0's with Id - 1; robot 1's not relayed
+
+
+# ---------------------------------------------------------------------------- visibility (§2)
+def test_point_visible_reads_the_beam_towards_the_point():
+    s = scan(walls=[(0.0, 0.05, 2.0)])
+    assert point_visible((1.9, 0.0), s.ranges_m, s.angles_rad, 8.0)
+    assert not point_visible((2.5, 0.0), s.ranges_m, s.angles_rad, 8.0)
+    assert point_visible((2.5, 0.0), s.ranges_m, s.angles_rad, 8.0, margin_m=0.6)  # a robot stands there
+    assert point_visible((0.0, 5.0), s.ranges_m, s.angles_rad, 8.0)
+    assert not point_visible((0.0, 5.0), s.ranges_m, s.angles_rad, 4.0)  # beyond the visibility radius
+    half = np.linspace(-np.pi / 2, np.pi / 2, 181)
+    assert not point_visible((-3.0, 0.0), np.full(181, 8.0), half, 8.0)  # behind a 180° laser
+
+
+# ---------------------------------------------------------------------------- D arbitration (§3–§4)
+def test_mirror_chain_rules_shortest_distance_wins():
+    """Fig. 3: R1 takes R2's reflection, then R3's when dist + D is shorter, never a longer one."""
+    gs = GoalSharing(0, 4)
+    gs.set_own_goal(1, (10.0, 0.0))
+    me = (0.0, 0.0)
+    assert gs.receive_report(0, 4, 1, (0.0, 4.0), 11.0, me_xy=me, step=1)  # D = 4 + 11 = 15
+    assert gs.path(0).source == 1 and gs.path(0).distance_m(me) == pytest.approx(15.0)
+    assert not gs.receive_report(0, 4, 2, (0.0, -3.0), 13.0, me_xy=me, step=2)  # 16 > 15
+    assert gs.receive_report(0, 4, 3, (3.0, 0.0), 7.0, me_xy=me, step=2)  # 10 < 15
+    assert gs.path(0).source == 3
+    assert not gs.receive_report(0, 8, 1, (1.0, 0.0), 0.5, me_xy=me, step=3)  # report of goal 2: wrong goal
+    # a direct view beats everything and is never replaced by a report
+    gs.refresh(me, me, lambda x, y, m: (x, y) == (10.0, 0.0), step=4)
+    assert gs.path(0).kind == "direct"
+    assert not gs.receive_report(0, 4, 3, (9.0, 0.0), 0.1, me_xy=me, step=4)
+
+
+def test_reflected_visibility_only_forgets_reports_each_step():
+    gs = GoalSharing(0, 2, delayed=False)
+    gs.set_own_goal(1, (10.0, 0.0))
+    gs.receive_report(0, 2, 1, (0.0, 4.0), 11.0, me_xy=(0.0, 0.0), step=1)
+    assert gs.path(0) is not None
+    gs.begin_step()
+    assert gs.path(0) is None
+
+
+def test_ghost_kept_when_the_helper_walks_away():
+    """§4.2 / Fig. 7: R2 later promises a longer path: R1 keeps its ghost R2(t1)."""
+    gs = GoalSharing(0, 2)
+    gs.set_own_goal(1, (10.0, 0.0))
+    me = (0.0, 0.0)
+    gs.receive_report(0, 2, 1, (4.0, 0.0), 6.0, me_xy=me, step=1)  # D11(t1) = 10
+    me = (1.0, 0.0)
+    assert not gs.receive_report(0, 2, 1, (0.0, 5.0), 10.5, me_xy=me, step=2)  # walked away: 15.6 > 9
+    p = gs.path(0)
+    assert (p.kind, p.source, p.px_m, p.py_m, p.step) == ("ghost", 1, 4.0, 0.0, 1)
+    # the owner keeps its ghost even when out of sight (it heads there)
+    gs.refresh(me, (0.0, 0.0), lambda x, y, m: False, step=3)
+    assert gs.path(0).kind == "ghost"
+
+
+def test_distance_bookkeeping_of_section_4_3():
+    """Fig. 8: a helper that saw R1's goal and moved on reports D(t1) + dist(me, R_i(t1)); when
+    R_i(t1) leaves its view, R_i(t2) and D(t2) replace them."""
+    gs = GoalSharing(1, 2)  # the helper R2 (id 1) knows R1's goal
+    goal = (5.0, 0.0)
+    gs.receive_goal(0, goal_id(1, 2), goal)
+    visible = {goal: True}
+
+    def sees(x, y, margin):
+        return visible.get((x, y), False)
+
+    p0 = (0.0, 0.0)
+    gs.refresh(p0, None, sees, step=0)
+    assert gs.reports(p0) == [(0, 2, pytest.approx(5.0))]  # direct: dist(R2, G)
+    visible[goal] = False  # t1: the helper turned a corner
+    visible[p0] = True
+    p1 = (0.0, 2.0)
+    gs.refresh(p1, p0, sees, step=1)
+    p = gs.path(0)
+    assert (p.kind, p.px_m, p.py_m, p.d_point_m) == ("self", 0.0, 0.0, pytest.approx(5.0))
+    assert gs.reports(p1)[0][2] == pytest.approx(5.0 + 2.0)  # D(t1) + dist(R2, R2(t1))
+    visible[p1] = True
+    p2 = (1.0, 3.0)
+    gs.refresh(p2, p1, sees, step=2)  # R2(t1) still in view: only the distance grows
+    assert gs.reports(p2)[0][2] == pytest.approx(5.0 + math.hypot(1.0, 3.0))
+    visible[p0] = False  # R2(t1) out of view: substitute the last position it was seen from
+    p3 = (2.0, 4.0)
+    gs.refresh(p3, p2, sees, step=3)
+    p = gs.path(0)
+    d_t2 = 5.0 + math.hypot(1.0, 3.0)
+    assert (p.px_m, p.py_m, p.d_point_m) == (1.0, 3.0, pytest.approx(d_t2))
+    assert gs.reports(p3)[0][2] == pytest.approx(d_t2 + math.hypot(1.0, 1.0))
+
+
+# ---------------------------------------------------------------------------- state sharing (§5)
+def test_trouble_sequence_of_fig_10():
+    """Pr += Nt when stuck, -1 when progressing, bound Nt·Cr; Tr at the bound, back at 0, Nt + 1."""
+    s = TroubleState(cr=3)
+    trace = []
+    for progressing in [False] * 3 + [True] * 3 + [False] * 4 + [True] * 6:
+        s.update(progressing)
+        trace.append((s.pr, s.tr, s.nt))
+    assert trace == [
+        (1, False, 1), (2, False, 1), (3, True, 1),  # stuck: Tr after Cr steps
+        (2, True, 1), (1, True, 1), (0, False, 2),  # follows R2, recovers: Nt = 2
+        (2, False, 2), (4, False, 2), (6, True, 2), (6, True, 2),  # +Nt, bound 2·Cr
+        (5, True, 2), (4, True, 2), (3, True, 2), (2, True, 2), (1, True, 2), (0, False, 3),  # twice as long
+    ]
+    s.reset()
+    assert (s.pr, s.tr, s.nt) == (0, False, 1)
+    with pytest.raises(ValueError, match="cr must be"):
+        TroubleState(cr=0)
+
+
+def test_choose_helper_picks_nearest_not_in_trouble():
+    mates = [(3, 1.0, 0.0, True), (2, 4.0, 0.0, False), (1, 3.0, 0.0, False), (4, 0.5, 0.0, None)]
+    assert choose_helper(True, (0.0, 0.0), mates) == 1
+    assert choose_helper(False, (0.0, 0.0), mates) is None
+
+
+# ---------------------------------------------------------------------------- brains on synthetic observations
+def test_brain_mirror_chain_heads_to_r2_then_r3(straight_nav):
+    """R1 cannot see its goal (a wall ahead); R2 reports it sees it: R1 heads to R2; R3 then
+    reports a shorter D: R1 turns to R3 (§3 rule 5, Fig. 3)."""
+    goal = (6.0, 0.0)
+    r2, r3 = (0.0, 4.0), (3.0, -3.0)
+    wall = [(0.0, 0.1, 2.0)]
+    m = 4
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[goal]), np.random.default_rng(0), info(0, m))
+    seen = [(1, *polar((0, 0), r2)), (2, *polar((0, 0), r3))]
+    a, out = r1.step(obs(0, walls=wall, seen=seen))
+    assert r1.mode == "own_goal" and a.direction_rad == pytest.approx(0.0)  # A heads at the goal
+    assert len(out) == 1 and out[0].kind == MESSAGE_KIND  # it sees teammates: it talks
+    back2 = Sighting(0, polar(r2, (0, 0))[1], 4.0)  # R2 faces +x in this test
+    d2 = math.dist(r2, goal)
+    a, _ = r1.step(obs(1, walls=wall, seen=seen, inbox=[
+        msg(1, 0, sightings=[back2], reports=[VisReport(0, goal_id(1, m), d2)])]))
+    assert r1.mode == "follow_teammate"
+    assert a.direction_rad == pytest.approx(math.pi / 2, abs=1e-9)
+    back3 = Sighting(0, polar(r3, (0, 0))[1], math.dist(r3, (0, 0)))
+    d3 = math.dist(r3, goal)
+    assert math.dist((0, 0), r3) + d3 < 4.0 + d2
+    a, _ = r1.step(obs(2, walls=wall, seen=seen, inbox=[
+        msg(1, 1, sightings=[back2], reports=[VisReport(0, goal_id(1, m), d2)]),
+        msg(2, 1, sightings=[back3], reports=[VisReport(0, goal_id(1, m), d3)])]))
+    assert r1.mode == "follow_teammate" and r1.sharing.path(0).source == 2
+    assert a.direction_rad == pytest.approx(-math.pi / 4, abs=1e-9)
+    # without a mutual bearing (R3 did not see R1) there is no frame: the report is ignored
+    r1b = LosExplorer(LosExplorer.Params(targets_xy=[goal]), np.random.default_rng(0), info(0, m))
+    r1b.step(obs(0, walls=wall, seen=seen))
+    r1b.step(obs(1, walls=wall, seen=seen, inbox=[msg(2, 0, reports=[VisReport(0, goal_id(1, m), d3)])]))
+    assert r1b.sharing.path(0) is None and r1b.mode == "own_goal"
+
+
+def test_brain_keeps_ghost_and_falls_back_to_a_when_there(straight_nav):
+    goal = (6.0, 0.0)
+    wall = [(0.0, 0.3, 2.0)]
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[goal], goal_tolerance_m=0.3), np.random.default_rng(0), info(0, 2))
+    r2 = (0.0, 3.0)
+    r1.step(obs(0, walls=wall, seen=[(1, *polar((0, 0), r2))]))
+    r1.step(obs(1, walls=wall, seen=[(1, *polar((0, 0), r2))], inbox=[
+        msg(1, 0, sightings=[Sighting(0, -math.pi / 2, 3.0)], reports=[VisReport(0, 2, 6.7)])]))
+    assert r1.mode == "follow_teammate"
+    # R2 walks away out of sight: R1 keeps heading to where R2 promised (a ghost)
+    a, _ = r1.step(obs(2, pose=(0.0, 1.0, 0.0), walls=wall))
+    assert r1.mode == "ghost" and a.direction_rad == pytest.approx(math.pi / 2)
+    # at the ghost, without a view of the goal: back to A, the promise kept only to arbitrate
+    a, _ = r1.step(obs(3, pose=(0.0, 2.9, 0.0), walls=[(-0.45, 0.2, 1.0)]))
+    assert r1.mode == "own_goal" and r1.sharing.path(0).reached
+    assert straight_nav and straight_nav[0].goal.tolist() == [6.0, 0.0]
+
+
+def test_brain_state_sharing_follows_teammate_not_in_trouble(monkeypatch):
+    """Fig. 10: stuck R1 (A makes no progress) is in trouble after Cr steps, heads to R2 which
+    is not, recovers (Pr back to 0, Nt = 2) and returns to its own goal."""
+    stuck = StraightNav(stuck=True)
+    monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
+    cr = 3
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False),
+                     np.random.default_rng(0), info(0, 2))
+    wall = [(0.0, 0.1, 0.5)]
+    for k in range(cr):
+        r1.step(obs(k, walls=wall))
+    assert r1.trouble.tr and r1.mode == "own_goal"  # in trouble, nobody in sight
+    # R2 comes in sight, not in trouble: follow it while getting closer
+    y = 5.0
+    k = cr
+    modes = []
+    while r1.trouble.tr:
+        pose = (0.0, 5.0 - y, 0.0)
+        inbox = [msg(1, k - 1, trouble=False)]
+        a, _ = r1.step(obs(k, pose=pose, walls=wall, seen=[(1, y, math.pi / 2)], inbox=inbox))
+        modes.append(r1.mode)
+        y -= 0.1
+        k += 1
+    assert modes[0] == "trouble_follow" and set(modes[:-1]) == {"trouble_follow"}
+    assert len(modes) == cr and r1.trouble.nt == 2 and r1.trouble.pr == 0
+    a, _ = r1.step(obs(k, pose=(0.0, 5.0 - y, 0.0), walls=wall, seen=[(1, y, math.pi / 2)],
+                       inbox=[msg(1, k - 1, trouble=False)]))
+    assert r1.mode == "own_goal"
+    # a teammate in trouble is no help
+    r1.trouble.tr, r1.trouble.pr = True, r1.trouble.bound
+    r1.step(obs(k + 1, walls=wall, seen=[(1, 3.0, 1.0)], inbox=[msg(1, k, trouble=True)]))
+    assert r1.mode == "own_goal"
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.tuples(st.floats(-20, 20), st.floats(-20, 20), st.floats(-math.pi, math.pi)),
+    st.tuples(st.floats(-20, 20), st.floats(-20, 20), st.floats(-math.pi, math.pi)),
+    st.tuples(st.floats(-20, 20), st.floats(-20, 20), st.floats(-math.pi, math.pi)),
+    st.tuples(st.floats(-20, 20), st.floats(-20, 20)),
+)
+def test_receive_path_maps_goals_through_mutual_bearings(start1, p1, p2, g):
+    """§3.1: with exact bearings, R2's goal sent in R2's body frame lands where it is in R1's own
+    (odometry) frame, for any two poses and any start frame of R1."""
+    d = math.dist(p1[:2], p2[:2])
+    if d < 0.05:
+        return
+    m = 3
+    r1 = LosExplorer(LosExplorer.Params(), np.random.default_rng(0), info(0, m))
+    odom1 = relative(np.array(start1), np.array(p1))  # R1's pose in its own frame
+    _, b21 = polar(p1, p2, p1[2])
+    _, b12 = polar(p2, p1, p2[2])
+    g_in_2 = transform_points(relative(np.array(p2), np.zeros(3)), np.array(g))  # world -> R2 body
+    r1.step(obs(0, pose=odom1, seen=[(1, d, b21)]))
+    r1.step(obs(1, pose=odom1, seen=[(1, d, b21)], inbox=[
+        msg(1, 0, sightings=[Sighting(0, b12, d)], goals=[GoalShare(1, goal_id(1, m), *g_in_2)])]))
+    want = transform_points(relative(np.array(start1), np.zeros(3)), np.array(g))  # world -> R1 odom
+    got = r1.sharing.goal_of(1)
+    assert got is not None and got[0] == goal_id(1, m)
+    np.testing.assert_allclose(got[1:], want, atol=1e-6)
+
+
+def test_broadcast_shares_goals_relays_and_counts_bytes(straight_nav):
+    m = 3
+    r = LosHelper(LosHelper.Params(patrol_xy=[(1.0, 0.0), (5.0, 0.0)]), np.random.default_rng(0), info(2, m))
+    seen = [(0, 2.0, math.pi / 2)]
+    _, first = r.step(obs(0, seen=seen, robot_id=2))
+    # robot 0 (2 m to the left, facing +x: it sees this robot at -90°) shares its goal 3 m to its right
+    _, out = r.step(obs(1, seen=seen, robot_id=2, inbox=[
+        msg(0, 0, sightings=[Sighting(2, -math.pi / 2, 2.0)], goals=[GoalShare(0, goal_id(1, m), 0.0, -3.0)])]))
+    (message,) = out
+    body = message.body
+    assert body.sightings == (Sighting(0, math.pi / 2, 2.0),)
+    by_owner = {g.owner: g for g in body.goals}
+    assert by_owner[2].goal_id == goal_id(1, m) and by_owner[0].goal_id == goal_id(1, m) - 1
+    assert (by_owner[0].gx_m, by_owner[0].gy_m) == pytest.approx((0.0, -1.0))  # in this robot's body frame
+    # it sees robot 0's goal directly (1 m away) and reports D
+    assert body.reports == (VisReport(0, goal_id(1, m), pytest.approx(1.0)),)
+    log = r.log()
+    assert log["msgs_sent"] == 2 and log["bytes_sent"] == first[0].size_bytes() + message.size_bytes()
+    assert message.size_bytes() > first[0].size_bytes()  # one more goal, one report
+    assert log["mode"] == "patrol" and log["known_goals"] == 1
+
+
+def test_params_are_validated():
+    with pytest.raises(ValidationError):
+        LosExplorer.Params(targets=[(1, 2)])
+    with pytest.raises(ValidationError):
+        LosHelper.Params(navigator="a_star")
+    with pytest.raises(ValueError, match="laser must name"):
+        LosExplorer(LosExplorer.Params(laser="lidar"), np.random.default_rng(0), info())
+
+
+def test_empty_targets_finish_at_once_and_stay():
+    r = LosExplorer(LosExplorer.Params(), np.random.default_rng(0), info())
+    a, out = r.step(obs(0))
+    assert r.finished and a.direction_rad is None and out == []
+    assert r.log()["mode"] == "done" and r.log()["moves"] == 0
+
+
+# ---------------------------------------------------------------------------- end to end
+@pytest.mark.parametrize("navigator", ["potential_field", "visbug21"])
+def test_end_to_end_r1_reaches_a_target_seen_through_a_helper(navigator):
+    """office_simple: R1 in the corridor, its target in room S2 out of its sight; a helper
+    standing inside the room's door sees the target and R1: R1 heads to the helper (mirror),
+    sees its target, reaches it, and the run stops early (``stop_when_finished``)."""
+    pytest.importorskip("teamnav.control.nav.local")
+    from teamnav.experiments.runner import run
+    from teamnav.experiments.spec import Scenario
+
+    # world frame: room S2 spans x 6.0-11.8, y 0.2-5.6; its door x 6.6-7.8 at y 5.6-5.8
+    start1 = (6.4, 7.4, 0.0)
+    target_world = (6.5, 1.0)  # hidden from the start by the wall west of the door
+    helper_at = (7.5, 5.0, 0.0)
+    target_own = (target_world[0] - start1[0], target_world[1] - start1[1])  # R1's frame: its start pose
+    laser = {"kind": "laser", "n_beams": 360, "fov_deg": 360, "max_range_m": 8.0, "noise_std_m": 0.0}
+    det = {"fov_deg": 360, "max_range_m": 8.0, "noise_model": "gaussian"}
+    common = {"radius_m": 0.2, "kinematics": "holonomic_step", "step_length_m": 0.1, "sensors": [laser],
+              "detector": det}
+    scen = Scenario.model_validate({
+        "name": "los-e2e", "map": {"builtin": "office_simple"}, "duration_s": 30.0, "dt_s": 0.1,
+        "stop_when_finished": True, "metrics": [],
+        "radio": {"mode": "line_of_sight", "range_m": 8.0},
+        "robots": [
+            {**common, "name": "r1", "controller": "los-explorer-v1", "start": {"poses": [start1]},
+             "params": {"navigator": navigator, "targets_xy": [target_own], "goal_tolerance_m": 0.3}},
+            {**common, "name": "helper", "controller": "los-helper-v1", "start": {"poses": [helper_at]},
+             "params": {"navigator": navigator, "patrol_xy": []}},
+        ],
+    })
+    data = run(scen, progress=False).data
+    assert data.finished, "the run should stop once R1 reached its target"
+    assert data.n_steps < 150  # of a 300-step budget
+    r1_logs = [e["values"] for e in data.logs if e["robot"] == 0]
+    modes = [v["mode"] for v in r1_logs]
+    assert modes[2] == "follow_teammate" and modes[-1] == "done"
+    assert "own_goal" in modes[modes.index("follow_teammate"):]  # then it sees the target itself
+    assert r1_logs[-1]["targets_reached"] == 1 and r1_logs[-1]["msgs_sent"] > 0
+    assert math.dist(data.true_pose[-1, 0, :2], target_world) < 0.3 + 1e-3
+    assert data.true_pose[-1, 1, :2].tolist() == pytest.approx(helper_at[:2], abs=1e-5)  # never left its post
