@@ -89,3 +89,109 @@ def test_crumb_list_grows_and_can_be_capped():
     np.testing.assert_array_equal(capped.xy_m[:, 0], [2.0, 3.0, 4.0])
     with pytest.raises(ValueError, match="xy_m has 2 rows"):
         CrumbBatch(np.zeros((2, 2)), np.zeros(3))
+
+
+# ---------------------------------------------------------------------------- the brain
+class _RecordingNav:
+    """Stands in for Navigate: records the preferred headings it is handed."""
+
+    def __init__(self, params, rng, info, laser="laser"):
+        self.headings = []
+        self.mode = "fake"
+
+    def step(self, obs, preferred_heading_rad=None):
+        self.headings.append(preferred_heading_rad)
+        return 0.3, 0.0
+
+
+def _obs(robot_id, step, pose, events=(), inbox=()):
+    from teamnav.control.types import Observation, RangeScan
+
+    angles = np.linspace(-np.pi / 2, np.pi / 2, 181)
+    scan = RangeScan(np.full(181, 8.0), angles, 8.0)
+    return Observation(robot_id, step, step * 0.1, np.asarray(pose, float), np.zeros(3), scans={"laser": scan},
+                       events=tuple(events), inbox=tuple(inbox))
+
+
+def _brains(monkeypatch, n=2, **params):
+    from teamnav.control.check import synthetic_infos
+    from teamnav.control.coop import blazing_trail as B
+
+    monkeypatch.setattr(B, "Navigate", _RecordingNav)
+    infos = synthetic_infos(n)
+    p = B.BlazingTrail.Params(**params)
+    return [B.BlazingTrail(p, np.random.default_rng(i), infos[i]) for i in range(n)]
+
+
+def test_brain_waggle_dance_reaches_the_team_and_steers_both_ways(monkeypatch):
+    a, b = _brains(monkeypatch, crumb_interval_s=1.0, radius_m=1.5)
+    # robot a drives east along y = 0 for 10 s, dropping a crumb per second, then reaches the source
+    for k in range(100):
+        _, out = a.step(_obs(0, k, [0.04 * k, 0.0, 0.0]))
+        assert out == []
+    assert len(a.private) == 10 and len(a.global_crumbs) == 0
+    _, out = a.step(_obs(0, 100, [4.0, 0.0, 0.0], events=["took_resource"]))
+    assert a.carrying and len(a.private) == 0 and len(a.global_crumbs) == 11  # + the crumb at the source
+    assert len(out) == 1 and out[0].kind == "crumbs" and len(out[0].body) == 11
+    # the teammate seeking the source near the trail prefers east; a (carrying) prefers west
+    b.step(_obs(1, 101, [1.0, 0.5, 2.0], inbox=out))
+    assert len(b.global_crumbs) == 11 and b.nav.headings[-1] == pytest.approx(0.0)
+    a.step(_obs(0, 101, [3.0, 0.0, 0.0]))
+    assert abs(a.nav.headings[-1]) == pytest.approx(math.pi)
+    # home again with the unit: one delivery, another broadcast (the homebound crumbs)
+    _, out = a.step(_obs(0, 102, [0.0, 0.0, np.pi], events=["given_resource"]))
+    assert not a.carrying and a.log()["trips"] == 1 and len(out) == 1
+    log = b.log()
+    assert {"carrying", "trips", "place_index", "n_crumbs", "following", "mode"} <= set(log)
+    assert log["following"] and log["n_crumbs"] == 11 and "crumbs" in log["layers"]
+    assert "layers" not in b.log()  # drawn at most once per layer_every_steps
+
+
+def test_brain_without_communication_follows_only_its_own_crumbs(monkeypatch):
+    a, b = _brains(monkeypatch, communicate=False)
+    for k in range(30):
+        a.step(_obs(0, k, [0.1 * k, 0.0, 0.0]))
+    _, out = a.step(_obs(0, 30, [3.0, 0.0, 0.0], events=["took_resource"]))
+    assert out == [] and len(a.global_crumbs) == 4
+    from teamnav.control.types import Message
+
+    b.step(_obs(1, 31, [1.0, 0.0, 0.0], inbox=[Message(0, 3.0, a.global_crumbs.to_batch(), kind="crumbs")]))
+    assert len(b.global_crumbs) == 0 and b.nav.headings[-1] is None
+
+
+# ---------------------------------------------------------------------------- closed loop
+def trail_scenario(controller: str, params: dict, duration_s: float = 40.0):
+    """trail_office, robot 0 starting 2.4 m west of the source facing it, robot 1 at home."""
+    from teamnav.experiments.spec import Scenario, load_scenario
+
+    robot = {"radius_m": 0.25, "max_v_mps": 0.5, "max_omega_degps": 100, "controller": controller, "params": params,
+             "sensors": [{"kind": "laser", "n_beams": 181, "fov_deg": 180, "max_range_m": 8.0, "noise_std_m": 0.01}],
+             "odometry": {"frame": "world", "heading_drift_deg_per_min": 1.0, "alpha": [0.01, 0.005, 0.01, 0.005]}}
+    return load_scenario(Scenario.model_validate({
+        "name": "trail-closed-loop", "map": {"builtin": "trail_office"}, "duration_s": duration_s, "seed": 2,
+        "record_every": 5, "metrics": [],
+        "places": [{"place": "home", "radius_m": 1.0, "event": "given_resource"},
+                   {"place": "source", "radius_m": 1.0, "event": "took_resource"}],
+        "robots": [{**robot, "name": "near_source", "count": 1, "start": {"poses": [[22.0, 15.9, 0.0]]}},
+                   {**robot, "name": "at_home", "count": 1, "start": {"near": "home", "spread_m": 0.3}}],
+        "radio": {"mode": "broadcast"},
+    }))
+
+
+def test_closed_loop_waggle_dance_on_trail_office():
+    from teamnav.experiments.runner import run
+
+    res = run(trail_scenario("blazing-trail-v1", {}), progress=False)
+    got = [(e["robot"], e["event"]) for e in res.data.event_log]
+    assert got and got[0] == (0, "took_resource")
+    t_found = res.data.event_log[0]["t_s"]
+    assert t_found < 20.0
+    logs = {r: [x for x in res.data.logs if x["robot"] == r] for r in (0, 1)}
+    for rows in logs.values():
+        assert {"carrying", "trips", "place_index", "n_crumbs", "following", "mode"} <= set(rows[-1]["values"])
+    after = [x["values"] for x in logs[1] if x["t_s"] > t_found + 0.5]
+    # the teammate at home heard the dance: its global list holds robot 0's private list
+    assert after and after[0]["n_crumbs"] == [x["values"] for x in logs[0] if x["t_s"] > t_found + 0.5][0]["n_crumbs"]
+    assert after[0]["n_crumbs"] > 0 and not after[0]["carrying"]
+    assert [x["values"] for x in logs[0]][-1]["carrying"]  # robot 0 carries its unit
+    assert "crumbs" in res.sim.recorder.layer_names

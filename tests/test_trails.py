@@ -167,3 +167,123 @@ def test_place_round_with_three_places():
 def test_trail_message_rejects_mismatched_columns():
     with pytest.raises(ValueError, match="must have one length"):
         TrailMessage(("A",), np.zeros((1, 2)), ("A", "A"), np.zeros((1, 2)), np.zeros(1), np.zeros(1))
+
+
+# ---------------------------------------------------------------------------- the brain
+class _RecordingNav:
+    """Stands in for Navigate: records the preferred headings it is handed."""
+
+    def __init__(self, params, rng, info, laser="laser"):
+        self.headings = []
+        self.mode = "fake"
+
+    def step(self, obs, preferred_heading_rad=None):
+        self.headings.append(preferred_heading_rad)
+        return 0.3, 0.0
+
+
+def _obs(robot_id, step, pose, events=(), inbox=()):
+    from teamnav.control.types import Observation, RangeScan
+
+    angles = np.linspace(-np.pi / 2, np.pi / 2, 181)
+    scan = RangeScan(np.full(181, 8.0), angles, 8.0)
+    return Observation(robot_id, step, step * 0.1, np.asarray(pose, float), np.zeros(3), scans={"laser": scan},
+                       events=tuple(events), inbox=tuple(inbox))
+
+
+def _brains(monkeypatch, n=2, **params):
+    from teamnav.control.check import synthetic_infos
+    from teamnav.control.coop import trail_share as TS
+
+    monkeypatch.setattr(TS, "Navigate", _RecordingNav)
+    infos = synthetic_infos(n)
+    p = TS.TrailShare.Params(**params)
+    return [TS.TrailShare(p, np.random.default_rng(i), infos[i]) for i in range(n)]
+
+
+def test_brain_shares_time_to_place_crumbs_across_rotated_frames(monkeypatch):
+    """Robot a's frame is robot b's rotated by 90 deg: a trail a lays from the source towards home
+    steers b, seeking the source, along the right direction in b's own frame (§2.1.5, §2.3)."""
+    a, b = _brains(monkeypatch, round=["home", "source"], broadcast_interval_s=2.0, radius_m=3.0)
+    rot = Similarity(1.0, math.pi / 2, 0.0, 0.0)  # b's frame -> a's frame
+    # b's world: home at (0, 0), source at (20, 0); both start at home and reach the source
+    b.step(_obs(1, 0, [0.0, 0.0, 0.0]))
+    b.step(_obs(1, 1, [20.0, 0.0, 0.0], events=["source"]))
+    a.step(_obs(0, 0, [0.0, 0.0, 0.0]))
+    xa, ya = rot.apply([20.0, 0.0])
+    _, out = a.step(_obs(0, 1, [xa, ya, 0.0], events=["source"]))
+    # a drives from the source back home (b's frame: x from 20 down to 0), broadcasting every 2 s
+    sent = []
+    for k in range(2, 200):
+        xa, ya = rot.apply([20.0 - 0.1 * k, 0.0])
+        _, out = a.step(_obs(0, k, [xa, ya, 0.0]))
+        sent += out
+    # one every 2 s while moving: t = 2, 4, ..., 18 s
+    assert len(sent) == 9 and all(m.kind == "trail" and len(m.body.crumb_place) == 1 for m in sent)
+    assert {m.body.crumb_place[0] for m in sent} == {"source"}
+    # b, now at home again and seeking the source, hears them
+    b.step(_obs(1, 300, [0.0, 0.0, math.pi], events=["home"]))
+    assert b.round.goal == "source"
+    b.step(_obs(1, 301, [8.0, 0.0, 0.0], inbox=sent))
+    assert b.combined == 9 and b.refused == 0
+    # the crumbs landed on b's x axis, and b heads to the lowest time-to-source one: east
+    np.testing.assert_allclose(b.trail.crumb_xy_m[b.trail.place_mask("source")][:, 1], 0.0, atol=1e-9)
+    assert b.nav.headings[-1] == pytest.approx(0.0, abs=1e-9)
+    log = b.log()
+    assert log["following"] and log["place_index"] == 1 and log["trips"] == 2
+
+
+def test_brain_pessimistic_refuses_before_two_places_optimistic_uses(monkeypatch):
+    for policy, n_used in (("pessimistic", 0), ("optimistic", 1)):
+        a, b = _brains(monkeypatch, round=["home", "source"], policy=policy)
+        a.step(_obs(0, 0, [0.0, 0.0, 0.0]))
+        a.step(_obs(0, 1, [20.0, 0.0, 0.0], events=["source"]))
+        _, out = a.step(_obs(0, 30, [19.0, 0.0, 0.0]))
+        assert len(out) == 1
+        b.step(_obs(1, 0, [0.0, 0.0, 0.0]))  # knows only home
+        b.step(_obs(1, 31, [1.0, 0.0, 0.0], inbox=out))
+        assert b.combined == n_used and ("source" in b.trail.places) == bool(n_used)
+
+
+def test_brain_broadcasts_only_while_moving_and_expires_old_crumbs(monkeypatch):
+    (a,) = _brains(monkeypatch, n=1, crumb_max_age_s=10.0)
+    sent = []
+    for k in range(100):  # standing still at home for 10 s: one trail at t = 0, then none
+        sent += a.step(_obs(0, k, [0.0, 0.0, 0.0]))[1]
+    assert len(sent) == 1
+    for k in range(100, 400):
+        sent += a.step(_obs(0, k, [0.05 * (k - 100), 0.0, 0.0]))[1]
+    assert len(sent) == 1 + 14  # t = 12, 14, ..., 38 s (at t = 10 s it had not moved yet)
+    assert len(a.trail) == 5 and a.trail.crumb_t.min() >= 40.0 - 10.0  # only the last 10 s kept
+
+
+def test_brain_without_communication_sends_and_reads_nothing(monkeypatch):
+    a, b = _brains(monkeypatch, communicate=False)
+    _, out = a.step(_obs(0, 0, [0.0, 0.0, 0.0]))
+    assert out == [] and len(a.trail) == 1
+    msg = temporary_trail(a.trail, "given_resource", 1.0, 0.0, 3.0, 0.0)
+    from teamnav.control.types import Message
+
+    b.step(_obs(1, 0, [0.0, 0.0, 0.0], inbox=[Message(0, 0.0, msg, kind="trail")]))
+    assert len(b.trail) == 1  # only its own crumb
+
+
+# ---------------------------------------------------------------------------- closed loop
+def test_closed_loop_trail_sharing_on_trail_office():
+    from test_crumbs import trail_scenario
+
+    from teamnav.experiments.runner import run
+
+    for policy in ("optimistic", "pessimistic"):
+        res = run(trail_scenario("trail-share-v1", {"policy": policy}), progress=False)
+        assert res.data.event_log[0]["robot"] == 0 and res.data.event_log[0]["event"] == "took_resource"
+        finder, home = res.sim.brains[0][0], res.sim.brains[1][0]
+        assert finder.round.goal == "given_resource" and finder.round.trips == 1
+        last = [x["values"] for x in res.data.logs if x["robot"] == 1][-1]
+        assert {"carrying", "trips", "place_index", "n_crumbs", "following", "mode"} <= set(last)
+        assert last["n_crumbs"] == len(home.trail) > 0
+        if policy == "optimistic":  # one common Place (home): translated in, the source learnt
+            assert home.refused == 0 and "took_resource" in home.trail.places
+            assert home.trail.place_mask("took_resource").sum() > 0
+        else:  # the finder knows two Places, the robot at home one: refused
+            assert home.refused > 0 and "took_resource" not in home.trail.places

@@ -183,6 +183,7 @@ class Trail:
         self._p = np.empty(capacity, dtype=np.int32)
         self._xys = np.empty((capacity, 4), dtype=np.float64)  # x, y, s, t
         self._n = 0
+        self._t_min = math.inf  # oldest crumb's time: expire() is O(1) while nothing is due
 
     # ------------------------------------------------------------------ storage
     def __len__(self) -> int:
@@ -257,6 +258,7 @@ class Trail:
         self._xys[sl, 2] = s_arr
         self._xys[sl, 3] = t_arr
         self._n += k
+        self._t_min = min(self._t_min, float(t_arr.min()))
 
     def combine(self, msg: TrailMessage, policy: Policy, *, use_transforms: bool = True) -> Similarity | None:
         """Combine a received trail into this one (§2.1.5, §2.2 step 3).
@@ -300,16 +302,16 @@ class Trail:
         int
             How many were removed.
         """
-        if self._n == 0:
+        cutoff = now_s - max_age_s
+        if self._n == 0 or self._t_min >= cutoff:
             return 0
-        keep = self._xys[: self._n, 3] >= now_s - max_age_s
+        keep = self._xys[: self._n, 3] >= cutoff
         k = int(keep.sum())
-        if k == self._n:
-            return 0
         removed = self._n - k
         self._p[:k] = self._p[: self._n][keep]
         self._xys[:k] = self._xys[: self._n][keep]
         self._n = k
+        self._t_min = float(self._xys[:k, 3].min()) if k else math.inf
         return removed
 
     def best_crumb(self, goal: str, x_odom_m: float, y_odom_m: float, radius_m: float) -> tuple[int, float] | None:

@@ -1,0 +1,201 @@
+"""Brain ``blazing-trail-v1``: trail laying with crumbs and the waggle dance.
+
+Vaughan, Støy, Sukhatme & Matarić, "Blazing a trail: insect-inspired resource transportation by
+a robot team" (DARS 2000), §4.1 (the three decision processes of Fig. 2) over §4.2's Navigate:
+
+1. **Task** (:class:`~teamnav.control.coop.forager.PlaceRound` over home and source): robots
+   start at home and seek the source; "On reaching the resource, they receive a unit of resource
+   and must return home with it, then return to fetch more". ``carrying`` flips on the source
+   event (``source_event``) and back on the home event (``home_event``); ``trips`` counts the
+   units delivered home.
+2. **Crumb dropping**: every ``crumb_interval_s`` the robot records its position and heading
+   estimate (its own odometry pose, ``obs.odom_pose``) on its private list
+   (:class:`~teamnav.control.coop.crumbs.CrumbList`; crumbs dropped while carrying point back
+   to the source, see :mod:`teamnav.control.coop.crumbs`).
+3. **Waggle dance**: on reaching the resource, and on reaching home with it, the robot
+   broadcasts its private list (a ``Message`` of kind ``"crumbs"`` whose body is a
+   :class:`~teamnav.control.coop.crumbs.CrumbBatch`); "All the robots (including the sender)"
+   append it to their global list; the sender clears its private list. The radio never delivers
+   a message to its sender, so the sender appends its own batch directly.
+4. **Trail following**: each step, the average heading of the global crumbs within ``radius_m``
+   of the position estimate (the opposite when carrying) is the preferred heading handed to
+   :class:`~teamnav.control.nav.navigate.Navigate`, which turns into openings on that side and
+   makes a 180° turn when heading against it; with no crumb near, Navigate explores (wall
+   following, 50 % turns at openings).
+
+``communicate=False`` is the no-communication baseline: nothing is sent or read; the robot
+appends its own private list to its own global list on arrival (it follows only its own trail).
+
+Choices where the paper is silent: crumb interval 1 s and radius 2 m (the paper gives neither;
+1.8 m corridors, a radius about a corridor wide, reaches the crumbs of the corridor the robot is
+in and the corner it approaches); the global list is unbounded as in the paper unless
+``max_global_crumbs`` caps it (oldest dropped).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from teamnav.control.coop.crumbs import CrumbBatch, CrumbList, preferred_heading
+from teamnav.control.coop.forager import PlaceRound
+from teamnav.control.nav.navigate import Navigate, NavigateParams
+from teamnav.control.protocol import RobotInfo
+from teamnav.control.types import Action, Message, Observation
+
+__all__ = ["BlazingTrail", "BlazingTrailParams", "navigate_params"]
+
+
+def navigate_params(navigate: dict[str, Any], cruise_speed_mps: float) -> NavigateParams:
+    """NavigateParams from a brain's ``navigate`` dict, with the brain's cruise speed.
+
+    Raises
+    ------
+    ValueError
+        ``navigate`` holds an unknown key or a bad value (pydantic's message), or sets
+        ``cruise_speed_mps`` itself (the brain's own parameter sets it).
+    """
+    if "cruise_speed_mps" in navigate:
+        raise ValueError("navigate must not set cruise_speed_mps; set the brain's cruise_speed_mps instead")
+    return NavigateParams(**{**navigate, "cruise_speed_mps": cruise_speed_mps})
+
+
+class BlazingTrailParams(BaseModel):
+    """Parameters of ``blazing-trail-v1`` (units in the names; rules in the module docstring).
+
+    Attributes
+    ----------
+    home_event, source_event : str
+        Task events fired at home and at the source.
+    communicate : bool
+        False: the no-communication baseline.
+    crumb_interval_s : float
+        Crumb dropping period [s].
+    radius_m : float
+        Neighbourhood of the position estimate whose crumbs are averaged [m].
+    cruise_speed_mps : float
+        Navigate's forward speed [m/s].
+    max_global_crumbs : int or None
+        Cap on the global list (None: unbounded, as in the paper).
+    sensor : str
+        The laser Navigate reads.
+    layer_every_steps : int
+        Draw the global crumbs in the replay at most once per this many steps.
+    navigate : dict
+        Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    home_event: str = Field("given_resource", min_length=1)
+    source_event: str = Field("took_resource", min_length=1)
+    communicate: bool = True
+    crumb_interval_s: float = Field(1.0, gt=0.0, le=600.0)
+    radius_m: float = Field(2.0, gt=0.0, le=100.0)
+    cruise_speed_mps: float = Field(0.25, gt=0.0, le=10.0)
+    max_global_crumbs: int | None = Field(None, ge=1, le=10_000_000)
+    sensor: str = Field("laser", min_length=1)
+    layer_every_steps: int = Field(50, ge=1, le=1_000_000)
+    navigate: dict[str, Any] = Field(default_factory=dict)
+
+    @model_validator(mode="after")
+    def _check(self) -> "BlazingTrailParams":
+        if self.home_event == self.source_event:
+            raise ValueError(f"home_event and source_event must differ, both are {self.home_event!r}")
+        navigate_params(self.navigate, self.cruise_speed_mps)
+        return self
+
+
+class BlazingTrail:
+    """One robot's ``blazing-trail-v1`` brain (a :class:`~teamnav.control.protocol.Controller`).
+
+    Parameters
+    ----------
+    params : BlazingTrailParams
+    rng : numpy.random.Generator
+        The robot's own stream (Navigate's random turns).
+    info : RobotInfo
+    """
+
+    Params = BlazingTrailParams
+
+    def __init__(self, params: BlazingTrailParams, rng: np.random.Generator, info: RobotInfo) -> None:
+        if not isinstance(params, BlazingTrailParams):
+            raise ValueError(f"params must be a BlazingTrail.Params, got {type(params).__name__}")
+        self.params = params
+        self.info = info
+        self.nav = Navigate(navigate_params(params.navigate, params.cruise_speed_mps), rng, info,
+                            laser=params.sensor)
+        self.round = PlaceRound([params.home_event, params.source_event], start_index=0)
+        self.private = CrumbList()
+        self.global_crumbs = CrumbList(max_crumbs=params.max_global_crumbs)
+        self.deliveries = 0
+        self.broadcasts = 0
+        self._next_crumb_s = 0.0
+        self._following = False
+        self._step = 0
+        self._last_layer_step: int | None = None
+
+    @property
+    def carrying(self) -> bool:
+        """Whether the robot holds a unit of resource (it seeks home)."""
+        return self.round.goal == self.params.home_event
+
+    def _waggle_dance(self, obs: Observation) -> list[Message]:
+        """Broadcast the private list, append it to the own global list, clear it (§4.1)."""
+        body = self.private.to_batch()
+        self.private.clear()
+        self.global_crumbs.extend(body)
+        self.broadcasts += 1
+        if not self.params.communicate:
+            return []
+        return [Message(self.info.robot_id, float(obs.time_s), body, kind="crumbs")]
+
+    def step(self, obs: Observation) -> tuple[Action, list[Message]]:
+        """One control step: task events, the inbox, crumb dropping, the preferred heading, Navigate."""
+        p = self.params
+        self._step = int(obs.step)
+        t = float(obs.time_s)
+        x, y, th = (float(v) for v in obs.odom_pose)
+        outbox: list[Message] = []
+        if t >= self._next_crumb_s:  # before the events: a crumb dropped on arrival goes out with the list
+            self.private.drop(x, y, th, outbound=not self.carrying)
+            self._next_crumb_s = t + p.crumb_interval_s - 1e-9
+        for reached in self.round.observe(obs.events, t):
+            if reached == p.home_event:
+                self.deliveries += 1
+            outbox += self._waggle_dance(obs)
+        if p.communicate:
+            for msg in obs.inbox:
+                if msg.kind == "crumbs" and isinstance(msg.body, CrumbBatch) and msg.sender != self.info.robot_id:
+                    self.global_crumbs.extend(msg.body)
+        mean = self.global_crumbs.average_heading(x, y, p.radius_m)
+        pref = preferred_heading(mean, self.carrying)
+        self._following = pref is not None
+        v, w = self.nav.step(obs, preferred_heading_rad=pref)
+        return Action(float(v), float(w)), outbox
+
+    def log(self) -> dict[str, Any]:
+        """``carrying``, ``trips`` (units delivered), ``place_index``, ``n_crumbs`` (global list),
+        ``following``, ``mode`` (Navigate's), and every ``layer_every_steps`` a ``crumbs`` layer
+        (global crumbs, odometry frame)."""
+        out: dict[str, Any] = {
+            "carrying": self.carrying,
+            "trips": self.deliveries,
+            "place_index": self.round.index,
+            "n_crumbs": len(self.global_crumbs),
+            "n_private": len(self.private),
+            "following": self._following,
+            "mode": str(getattr(self.nav, "mode", "")),
+        }
+        if self._last_layer_step is None or self._step - self._last_layer_step >= self.params.layer_every_steps:
+            self._last_layer_step = self._step
+            xy = self.global_crumbs.xy_m
+            if xy.shape[0] > 2000:
+                xy = xy[:: int(math.ceil(xy.shape[0] / 2000))]
+            out["layers"] = {"crumbs": {"data": xy.copy(), "kind": "points", "frame": "odom",
+                                        "description": "global crumb list (own odometry frame)"}}
+        return out

@@ -1,0 +1,226 @@
+"""Brain ``trail-share-v1``: Places, time-to-place Crumbs and Trails shared between frames.
+
+Vaughan, Støy, Sukhatme & Matarić, "Try to see it my way: using task-level features to
+transform between reference frames in robot teams" (2002), §2.2 trail laying, §2.3 trail using,
+§3.5 procedure, over the Navigate behaviour of §3.3 (:class:`~teamnav.control.nav.navigate.Navigate`):
+
+- **Round** (:class:`~teamnav.control.coop.forager.PlaceRound`): ``round`` lists the event names
+  of the places visited in cyclic order (N >= 2, §2.1; home and source by default); each event
+  name is also its Place's name P. "On start-up each robot is told it is at Home/A, so it
+  creates a Place with name A at the origin" (§3.5): with ``start_at_first_place`` the robot
+  creates Place ``round[0]`` at its first pose and seeks ``round[1]``.
+- §2.2 step 1: on any task event the Place of that name is created or moved to the current
+  position estimate.
+- §2.2 step 2: every ``broadcast_interval_s`` (S = 2 s), if the robot is moving, a temporary
+  trail (copies of all Places plus one Crumb: the last Place visited, the time since, the
+  current time) is broadcast (``Message`` kind ``"trail"``, body a
+  :class:`~teamnav.control.coop.trails.TrailMessage`) and combined into the robot's own Trail.
+  The radio never delivers a message to its sender, so the own trail is combined directly
+  (the same frame: what the two-common-Places rule gives, the identity).
+- §2.2 step 3: a received trail is combined into the local Trail by the §2.1.5 rules: the
+  similarity fixed by two common Places, else the ``policy`` (pessimistic: refuse; optimistic:
+  copy as-is, or translate by the one common Place). ``use_place_transforms=False`` combines as
+  if all frames agreed (the ablation).
+- §2.3 step 1: the preferred heading points at the Crumb with the lowest time-to-place among
+  those for the current goal within ``radius_m``; none near: Navigate explores.
+- §2.3 step 2: Crumbs older than ``crumb_max_age_s`` (4 min) are destroyed every step.
+
+``communicate=False`` is the no-communication baseline: nothing is sent or read; the robot uses
+its own trail only.
+
+Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
+``min_move_m`` since the previous temporary trail; radius 2 m (about a corridor's width);
+``crumbs_for="every_place"`` is the §2.2 alternative the paper names for future work (one Crumb
+per Place the robot has visited, each with the time since that visit), useful for rounds of
+N > 2 places where the next place is never the previous one.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from teamnav.control.coop.blazing_trail import navigate_params
+from teamnav.control.coop.forager import PlaceRound
+from teamnav.control.coop.trails import Trail, TrailMessage, temporary_trail
+from teamnav.control.nav.navigate import Navigate
+from teamnav.control.protocol import RobotInfo
+from teamnav.control.types import Action, Message, Observation
+
+__all__ = ["TrailShare", "TrailShareParams"]
+
+
+class TrailShareParams(BaseModel):
+    """Parameters of ``trail-share-v1`` (units in the names; rules in the module docstring).
+
+    Attributes
+    ----------
+    round : list of str
+        Event names of the places in visiting order (N >= 2, unique); also the Places' names.
+    communicate : bool
+        False: the no-communication baseline.
+    broadcast_interval_s : float
+        S, the temporary-trail period [s] (paper: 2 s).
+    radius_m : float
+        Crumb neighbourhood of the trail-using rule [m].
+    cruise_speed_mps : float
+        Navigate's forward speed [m/s].
+    policy : {"pessimistic", "optimistic"}
+        Combining with fewer than two common Places (§2.1.5; the paper's robots used optimistic).
+    crumb_max_age_s : float
+        Crumb expiry age [s] (paper: 4 min).
+    use_place_transforms : bool
+        False: combine trails as if every frame agreed (ablation).
+    start_at_first_place : bool
+        The robot starts at ``round[0]`` and knows it (§3.5).
+    crumbs_for : {"last_place", "every_place"}
+        One Crumb for the last Place visited (the paper), or one per visited Place (§2.2 alternative).
+    min_move_m : float
+        Odometry motion since the last temporary trail below which the robot is not "moving" [m].
+    sensor : str
+        The laser Navigate reads.
+    layer_every_steps : int
+        Draw the trail in the replay at most once per this many steps.
+    navigate : dict
+        Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    round: list[str] = Field(default_factory=lambda: ["given_resource", "took_resource"], min_length=2,
+                             max_length=100)
+    communicate: bool = True
+    broadcast_interval_s: float = Field(2.0, gt=0.0, le=600.0)
+    radius_m: float = Field(2.0, gt=0.0, le=100.0)
+    cruise_speed_mps: float = Field(0.25, gt=0.0, le=10.0)
+    policy: Literal["pessimistic", "optimistic"] = "pessimistic"
+    crumb_max_age_s: float = Field(240.0, gt=0.0, le=1e7)
+    use_place_transforms: bool = True
+    start_at_first_place: bool = True
+    crumbs_for: Literal["last_place", "every_place"] = "last_place"
+    min_move_m: float = Field(0.05, ge=0.0, le=100.0)
+    sensor: str = Field("laser", min_length=1)
+    layer_every_steps: int = Field(50, ge=1, le=1_000_000)
+    navigate: dict[str, Any] = Field(default_factory=dict)
+
+    @model_validator(mode="after")
+    def _check(self) -> "TrailShareParams":
+        if len(set(self.round)) != len(self.round) or not all(self.round):
+            raise ValueError(f"round must list distinct non-empty event names, got {self.round!r}")
+        navigate_params(self.navigate, self.cruise_speed_mps)
+        return self
+
+
+class TrailShare:
+    """One robot's ``trail-share-v1`` brain (a :class:`~teamnav.control.protocol.Controller`).
+
+    Parameters
+    ----------
+    params : TrailShareParams
+    rng : numpy.random.Generator
+        The robot's own stream (Navigate's random turns).
+    info : RobotInfo
+    """
+
+    Params = TrailShareParams
+
+    def __init__(self, params: TrailShareParams, rng: np.random.Generator, info: RobotInfo) -> None:
+        if not isinstance(params, TrailShareParams):
+            raise ValueError(f"params must be a TrailShare.Params, got {type(params).__name__}")
+        self.params = params
+        self.info = info
+        self.nav = Navigate(navigate_params(params.navigate, params.cruise_speed_mps), rng, info,
+                            laser=params.sensor)
+        self.round = PlaceRound(params.round, start_index=0)
+        self.trail = Trail()
+        self.visits_s: dict[str, float] = {}
+        self.combined = 0
+        self.refused = 0
+        self._started = False
+        self._next_broadcast_s = 0.0
+        self._last_broadcast_xy: np.ndarray | None = None
+        self._following = False
+        self._step = 0
+        self._last_layer_step: int | None = None
+
+    def _temporary_trail(self, x: float, y: float, t: float) -> TrailMessage:
+        """§2.2 step 2: all Places plus one Crumb (or one per visited Place)."""
+        if self.params.crumbs_for == "last_place":
+            return temporary_trail(self.trail, self.round.last_place, x, y, t - self.round.last_place_time_s, t)
+        names = tuple(self.trail.places)
+        visited = [n for n in names if n in self.visits_s]
+        k = len(visited)
+        return TrailMessage(names, np.array([self.trail.places[n] for n in names]).reshape(-1, 2), tuple(visited),
+                            np.tile([x, y], (k, 1)), np.array([t - self.visits_s[n] for n in visited]),
+                            np.full(k, t))
+
+    def step(self, obs: Observation) -> tuple[Action, list[Message]]:
+        """One control step: §2.2 steps 1-3, §2.3 steps 1-2, then Navigate."""
+        p = self.params
+        self._step = int(obs.step)
+        t = float(obs.time_s)
+        x, y = float(obs.odom_pose[0]), float(obs.odom_pose[1])
+        outbox: list[Message] = []
+        if not self._started:
+            self._started = True
+            self.round.last_place_time_s = t
+            if p.start_at_first_place:
+                self.trail.set_place(p.round[0], x, y)
+                self.visits_s[p.round[0]] = t
+        for e in obs.events:  # §2.2 step 1
+            self.trail.set_place(e, x, y)
+            self.visits_s[e] = t
+        self.round.observe(obs.events, t)
+        if p.communicate:  # §2.2 step 3
+            for msg in obs.inbox:
+                if msg.kind == "trail" and isinstance(msg.body, TrailMessage) and msg.sender != self.info.robot_id:
+                    if self.trail.combine(msg.body, p.policy, use_transforms=p.use_place_transforms) is None:
+                        self.refused += 1
+                    else:
+                        self.combined += 1
+        self.trail.expire(t, p.crumb_max_age_s)  # §2.3 step 2
+        if t >= self._next_broadcast_s:  # §2.2 step 2
+            here = np.array([x, y])
+            moving = self._last_broadcast_xy is None or float(np.hypot(*(here - self._last_broadcast_xy))) >= p.min_move_m
+            if moving and self.trail.places:
+                tmp = self._temporary_trail(x, y, t)
+                self.trail.add_crumbs(tmp.crumb_place, tmp.crumb_xy_m, tmp.crumb_s, tmp.crumb_t)
+                if p.communicate:
+                    outbox.append(Message(self.info.robot_id, t, tmp, kind="trail"))
+            self._last_broadcast_xy = here
+            self._next_broadcast_s = t + p.broadcast_interval_s - 1e-9
+        heading = self.trail.heading_to_best(self.round.goal, x, y, p.radius_m)  # §2.3 step 1
+        self._following = heading is not None
+        v, w = self.nav.step(obs, preferred_heading_rad=heading)
+        return Action(float(v), float(w)), outbox
+
+    def log(self) -> dict[str, Any]:
+        """``carrying`` (seeking ``round[0]``, i.e. home), ``trips`` (places reached in order),
+        ``place_index``, ``n_crumbs`` (local Trail size), ``following``, ``mode`` (Navigate's),
+        and every ``layer_every_steps`` a ``crumbs`` layer (the Trail's crumbs) and a ``places``
+        layer, both in the own odometry frame."""
+        out: dict[str, Any] = {
+            "carrying": self.round.index == 0,
+            "trips": self.round.trips,
+            "place_index": self.round.index,
+            "n_crumbs": len(self.trail),
+            "following": self._following,
+            "mode": str(getattr(self.nav, "mode", "")),
+            "refused": self.refused,
+        }
+        if self._last_layer_step is None or self._step - self._last_layer_step >= self.params.layer_every_steps:
+            self._last_layer_step = self._step
+            xy = self.trail.crumb_xy_m
+            if xy.shape[0] > 2000:
+                xy = xy[:: int(math.ceil(xy.shape[0] / 2000))]
+            places = np.array(list(self.trail.places.values())).reshape(-1, 2)
+            out["layers"] = {
+                "crumbs": {"data": xy.copy(), "kind": "points", "frame": "odom",
+                           "description": "the robot's Trail: crumbs in its own odometry frame"},
+                "places": {"data": places, "kind": "markers", "frame": "odom",
+                           "description": "the robot's Places (own odometry frame)"},
+            }
+        return out
