@@ -1,0 +1,117 @@
+"""Potential field plus Avoid-Past: algorithm A = 2 of Sgorbissa & Arkin §6.
+
+Sgorbissa & Arkin §6 run "a potential field algorithm to which the Avoid Past schema [17] has
+been added" (Balch & Arkin 1993, "Avoiding the past: a simple but effective strategy for
+reactive navigation", ICRA, pp. 678-685). Balch & Arkin add a local spatial memory to the
+motor-schema navigator: a grid of visit counts, and an *avoid-past* schema that pushes the
+robot away from the cells it has visited often, so that a box canyon (a local minimum of the
+field) fills up with visits until the robot is pushed out of it.
+
+Here:
+
+- memory: a grid of square cells of side ``cell_m`` in the robot's **own odometry frame**
+  (a dict keyed by cell index, so it grows with the explored area); every :meth:`direction`
+  call adds one visit to the cell under the robot. The memory belongs to the robot, not to a
+  goal: a new goal keeps it (Balch & Arkin's memory is of places, not of a task);
+- avoid-past vector: ``avoid_gain · Σ_c n_c · (1 − d_c / memory_radius_m) · (x − c) / d_c``
+  over the cells ``c`` whose centre is within ``memory_radius_m`` of the robot (``n_c`` visits,
+  ``d_c`` distance from the cell centre to the robot ``x``): a discrete, distance-weighted
+  estimate of minus the gradient of the visit density. Balch & Arkin describe the schema as a
+  repulsion from visited places that grows with the visits; the linear distance weighting
+  is our choice (their paper does not fix one we could read). The vector is unbounded in the
+  counts: given time it outweighs move-to-goal, which is how the trap is left;
+- the rest (move-to-goal, avoid-static-obstacle, collision guard, progress estimate) is the
+  potential field of :mod:`teamnav.control.nav.local.potential_field` with the same parameters.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydantic import Field
+
+from teamnav.control.nav.local.potential_field import PotentialField, PotentialFieldParams
+
+__all__ = ["AvoidPast", "AvoidPastParams", "avoid_past_vector"]
+
+
+class AvoidPastParams(PotentialFieldParams):
+    """Potential-field parameters plus the avoid-past schema's (Balch & Arkin 1993).
+
+    Attributes
+    ----------
+    cell_m : float, default 0.3
+        Side of a memory cell [m].
+    memory_radius_m : float, default 2.0
+        Cells within this distance of the robot push it [m].
+    avoid_gain : float, default 0.1
+        Avoid-past magnitude per visit of a cell next to the robot.
+    avoid_max : float, default 2.0
+        Largest avoid-past magnitude (saturation; see the module docstring).
+    """
+
+    cell_m: float = Field(0.3, gt=0.0, le=10.0)
+    memory_radius_m: float = Field(2.0, gt=0.0, le=50.0)
+    avoid_gain: float = Field(0.1, ge=0.0, le=100.0)
+    avoid_max: float = Field(2.0, ge=0.0, le=1000.0)
+
+
+def avoid_past_vector(xy: np.ndarray, visits: dict[tuple[int, int], float], cell_m: float,
+                      memory_radius_m: float, avoid_gain: float, avoid_max: float = math.inf) -> np.ndarray:
+    """The avoid-past schema's vector at ``xy`` (own frame), shape (2,).
+
+    Examples
+    --------
+    >>> v = avoid_past_vector(np.array([0.25, 0.25]), {(0, 0): 10.0}, 0.5, 1.0, 0.1)
+    >>> v.round(6).tolist()   # the visited cell is centred under the robot: no push
+    [0.0, 0.0]
+    >>> avoid_past_vector(np.array([1.0, 0.25]), {(0, 0): 10.0}, 0.5, 1.0, 0.1).round(6).tolist()
+    [0.25, 0.0]
+    """
+    k = int(math.ceil(memory_radius_m / cell_m)) + 1
+    ci, cj = int(math.floor(xy[0] / cell_m)), int(math.floor(xy[1] / cell_m))
+    cells = [(i, j, n) for i in range(ci - k, ci + k + 1) for j in range(cj - k, cj + k + 1)
+             if (n := visits.get((i, j), 0.0)) > 0.0]
+    if not cells:
+        return np.zeros(2)
+    arr = np.asarray(cells, dtype=np.float64)
+    away = xy - (arr[:, :2] + 0.5) * cell_m
+    d = np.hypot(away[:, 0], away[:, 1])
+    w = np.where((d < memory_radius_m) & (d > 1e-12), arr[:, 2] * (1.0 - d / memory_radius_m), 0.0)
+    v = avoid_gain * ((w / np.maximum(d, 1e-12)) @ away)
+    norm = math.hypot(v[0], v[1])
+    return v * (avoid_max / norm) if norm > avoid_max else v
+
+
+class AvoidPast(PotentialField):
+    """Potential field with the avoid-past schema (Sgorbissa & Arkin §6, algorithm 2).
+
+    Same constructor and protocol as :class:`~teamnav.control.nav.local.potential_field.PotentialField`;
+    ``visits`` is the robot's memory (cell index in the own frame -> visit count).
+
+    Examples
+    --------
+    >>> from teamnav.control.types import RangeScan
+    >>> nav = AvoidPast(AvoidPastParams(), np.random.default_rng(0), 0.1, 0.25)
+    >>> nav.set_goal(np.array([2.15, 0.15]))
+    >>> scan = RangeScan(np.full(72, 4.0), np.linspace(-np.pi, np.pi, 72, endpoint=False), 4.0)
+    >>> abs(round(nav.direction(np.array([0.15, 0.15, 0.0]), scan), 3)), nav.visits   # at a cell centre
+    (0.0, {(0, 0): 1.0})
+    """
+
+    name = "avoid_past"
+    Params = AvoidPastParams
+
+    def __init__(self, params: AvoidPastParams, rng: np.random.Generator, step_length_m: float,
+                 radius_m: float) -> None:
+        super().__init__(params, rng, step_length_m, radius_m)
+        self.visits: dict[tuple[int, int], float] = {}
+
+    def _vector(self, pose: np.ndarray, points: np.ndarray, n_beams: int) -> np.ndarray:
+        p: AvoidPastParams = self.params  # type: ignore[assignment]
+        key = (int(math.floor(pose[0] / p.cell_m)), int(math.floor(pose[1] / p.cell_m)))
+        self.visits[key] = self.visits.get(key, 0.0) + 1.0
+        v = super()._vector(pose, points, n_beams)
+        return v + avoid_past_vector(pose[:2], self.visits, p.cell_m, p.memory_radius_m, p.avoid_gain,
+                                     p.avoid_max)

@@ -1,0 +1,229 @@
+"""Pieces shared by the local navigation algorithms of Sgorbissa & Arkin's set A (§2, §6).
+
+Sgorbissa & Arkin §2: a local navigation algorithm *A* "returns, at each computation step,
+what is considered as the best choice for reaching the goal" from the goal and the robot's
+current perception only. Here that is :class:`LocalNavigator`: the goal in the robot's own
+odometry frame, the pose in that frame, one omnidirectional range scan in the body frame, and
+back the heading of the next fixed-length motion step (§6: "at each motion step, the distance
+traveled by the simulated robots is fixed, since only the direction of motion changes").
+
+Also here:
+
+- :func:`scan_points` — the scan's returns as obstacle points in the own frame;
+- :func:`safe_heading` — the collision guard every navigator applies last: the step's swept
+  disc must stay ``hard_clearance_m`` away from every sensed point, else the nearest heading
+  (in 5° increments) whose step does is taken. It is a guard against touching a wall (a touch
+  stalls the robot in the simulator), not an escape heuristic: it only ever removes headings
+  that would hit something;
+- :class:`ProgressMonitor` — the "am I progressing?" estimate §5 asks each algorithm for
+  (the ``Tr``/``Pr``/``Cr``/``Nt`` counters of §5 are built on top of it by the brains).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from teamnav.control.types import RangeScan
+from teamnav.geometry import wrap_angle
+
+__all__ = [
+    "GOAL_SAME_TOL_M", "LocalNavigator", "ProgressMonitor", "check_goal", "check_pose", "check_scan",
+    "safe_heading", "scan_points", "segment_clearance",
+]
+
+#: Two goals closer than this [m] are "the same goal" for :meth:`LocalNavigator.set_goal`.
+GOAL_SAME_TOL_M: float = 1e-6
+#: Angular increment [rad] of the collision guard's search for a safe heading.
+GUARD_STEP_RAD: float = math.radians(5.0)
+
+
+@runtime_checkable
+class LocalNavigator(Protocol):
+    """A local navigation algorithm *A* of Sgorbissa & Arkin §2 (one robot, own frame).
+
+    Attributes
+    ----------
+    name : str
+        Registry key (``"potential_field"``, ``"avoid_past"``, ``"visbug21"``).
+    """
+
+    name: str
+
+    def set_goal(self, goal_xy: np.ndarray) -> None:
+        """Set the current goal ``G_icurr`` (x, y) [m] in the robot's own odometry frame.
+
+        Setting the same goal again (within ``GOAL_SAME_TOL_M``) changes nothing; a different
+        goal restarts goal-specific memory (progress estimate, VisBug's M-line and hit point),
+        not Avoid-Past's memory of visited places.
+        """
+
+    def direction(self, pose: np.ndarray, scan: RangeScan) -> float | None:
+        """Heading [rad, own frame, wrapped] of the next fixed-length step, or None to stay.
+
+        ``pose`` is (x [m], y [m], theta [rad]) in the own odometry frame and ``scan`` an
+        omnidirectional range scan with beam angles in the body frame. None before any goal
+        is set (and, for VisBug-21, once the goal is proved unreachable).
+        """
+
+    @property
+    def progressing(self) -> bool:
+        """After the last :meth:`direction` call: is the robot making progress to the goal (§5)?"""
+
+
+# ---------------------------------------------------------------------------- input checks
+def check_goal(goal_xy) -> np.ndarray:
+    """``goal_xy`` as a finite float (2,) array, or ValueError."""
+    g = np.asarray(goal_xy, dtype=np.float64).reshape(-1)
+    if g.shape != (2,) or not np.all(np.isfinite(g)):
+        raise ValueError(f"goal_xy must be two finite numbers (x, y) in metres, got {goal_xy!r}")
+    return g
+
+
+def check_pose(pose) -> np.ndarray:
+    """``pose`` as a finite float (3,) array, or ValueError."""
+    p = np.asarray(pose, dtype=np.float64).reshape(-1)
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ValueError(f"pose must be three finite numbers (x [m], y [m], theta [rad]), got {pose!r}")
+    return p
+
+
+def check_scan(scan) -> RangeScan:
+    """``scan`` if it is a RangeScan with matching beams, or ValueError."""
+    if not isinstance(scan, RangeScan):
+        raise ValueError(f"scan must be a RangeScan, got {type(scan).__name__}")
+    if np.shape(scan.ranges_m) != np.shape(scan.angles_rad) or np.ndim(scan.ranges_m) != 1:
+        raise ValueError(
+            f"scan.ranges_m and scan.angles_rad must be 1-D of one length, got {np.shape(scan.ranges_m)} "
+            f"and {np.shape(scan.angles_rad)}"
+        )
+    return scan
+
+
+# ---------------------------------------------------------------------------- geometry
+def scan_points(pose: np.ndarray, scan: RangeScan) -> np.ndarray:
+    """Obstacle points (x, y) [m] in the own frame of every beam that returned.
+
+    Beams reading ``max_range_m`` (no return) give no point.
+
+    Returns
+    -------
+    ndarray of shape (K, 2), float64
+
+    Examples
+    --------
+    >>> s = RangeScan(np.array([1.0, 5.0]), np.array([0.0, np.pi]), 5.0)
+    >>> scan_points(np.array([1.0, 2.0, np.pi / 2]), s).round(6).tolist()
+    [[1.0, 3.0]]
+    """
+    r = np.asarray(scan.ranges_m, dtype=np.float64)
+    a = np.asarray(scan.angles_rad, dtype=np.float64)
+    hit = r < float(scan.max_range_m) * (1.0 - 1e-9)
+    ang = pose[2] + a[hit]
+    return np.column_stack((pose[0] + r[hit] * np.cos(ang), pose[1] + r[hit] * np.sin(ang)))
+
+
+def segment_clearance(points: np.ndarray, start_xy: np.ndarray, ends_xy: np.ndarray) -> np.ndarray:
+    """Smallest distance [m] from ``points`` (K, 2) to each segment ``start -> ends[j]``.
+
+    Returns ``inf`` per segment when there are no points.
+
+    Parameters
+    ----------
+    points : ndarray of shape (K, 2)
+    start_xy : ndarray of shape (2,)
+    ends_xy : ndarray of shape (J, 2)
+
+    Returns
+    -------
+    ndarray of shape (J,)
+    """
+    ends_xy = np.atleast_2d(ends_xy)
+    if points.shape[0] == 0:
+        return np.full(ends_xy.shape[0], np.inf)
+    d = ends_xy - start_xy  # (J, 2)
+    len2 = np.maximum(np.einsum("ij,ij->i", d, d), 1e-24)
+    rel = points - start_xy  # (K, 2)
+    t = np.clip((rel @ d.T) / len2, 0.0, 1.0)  # (K, J)
+    cx = start_xy[0] + t * d[:, 0]
+    cy = start_xy[1] + t * d[:, 1]
+    dist2 = (points[:, :1] - cx) ** 2 + (points[:, 1:] - cy) ** 2
+    return np.sqrt(dist2.min(axis=0))
+
+
+def safe_heading(heading_rad: float, xy: np.ndarray, points: np.ndarray, step_length_m: float,
+                 hard_clearance_m: float) -> float:
+    """The collision guard: ``heading_rad`` if its step stays clear, else the nearest clear one.
+
+    The step is the segment from ``xy`` of length ``step_length_m``; it is clear when every
+    sensed point is at least ``hard_clearance_m`` from it. Otherwise headings ``heading ± k·5°``
+    are tried, nearest first (ties: counter-clockwise first); if none is clear the heading whose
+    step keeps the largest clearance is returned (with a robot already too close that is the
+    step straight away from the nearest point).
+    """
+    if points.shape[0] == 0:
+        return float(wrap_angle(heading_rad))
+    n = int(round(math.pi / GUARD_STEP_RAD))
+    k = np.arange(1, n + 1)
+    offs = np.concatenate(([0.0], np.column_stack((k, -k)).reshape(-1) * GUARD_STEP_RAD))
+    heads = heading_rad + offs
+    ends = xy + step_length_m * np.column_stack((np.cos(heads), np.sin(heads)))
+    near = points[np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1]) < step_length_m + hard_clearance_m + 1e-9]
+    clear = segment_clearance(near, xy, ends)
+    ok = np.flatnonzero(clear >= hard_clearance_m)
+    if ok.size:
+        return float(wrap_angle(heads[ok[0]]))
+    # everything is too close already: the step whose end is farthest from the sensed points
+    d_end = np.hypot(near[:, None, 0] - ends[None, :, 0], near[:, None, 1] - ends[None, :, 1]).min(axis=0)
+    return float(wrap_angle(heads[int(np.argmax(d_end))]))
+
+
+# ---------------------------------------------------------------------------- progress (§5)
+class ProgressMonitor:
+    """Is the robot getting closer to its goal? (Sgorbissa & Arkin §5, "Evaluate my progress").
+
+    §5 leaves the measure to the algorithm ("in a simple potential field approach ... it is easy
+    for the robot to evaluate its progress to the goal and to realize when it is stuck in a
+    local minimum"). This one: a *reference distance* starts at the distance when the goal is
+    set; whenever the distance to the goal falls below the reference by more than
+    ``fraction × step_length_m``, the reference drops to it and the robot counts as having
+    progressed at that step. ``progressing`` is True while the last such improvement is at most
+    ``window_steps`` steps old (so also for the first ``window_steps`` steps after a new goal).
+    A robot oscillating in a local minimum never beats its reference again: after
+    ``window_steps`` steps it is not progressing.
+
+    Parameters
+    ----------
+    window_steps : int
+    fraction : float
+        Of a step; the least improvement that counts.
+    step_length_m : float
+    """
+
+    def __init__(self, window_steps: int, fraction: float, step_length_m: float) -> None:
+        self.window_steps = int(window_steps)
+        self.min_gain_m = float(fraction) * float(step_length_m)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the goal: the next :meth:`update` starts a new reference."""
+        self.ref_m = math.inf
+        self.steps = 0
+        self.last_gain_step = 0
+
+    def update(self, distance_m: float) -> bool:
+        """Record one step at ``distance_m`` from the goal; returns :attr:`progressing`."""
+        if self.ref_m == math.inf:
+            self.ref_m = distance_m
+            self.last_gain_step = self.steps
+        elif distance_m < self.ref_m - self.min_gain_m:
+            self.ref_m = distance_m
+            self.last_gain_step = self.steps
+        self.steps += 1
+        return self.progressing
+
+    @property
+    def progressing(self) -> bool:
+        return self.steps - 1 - self.last_gain_step <= self.window_steps

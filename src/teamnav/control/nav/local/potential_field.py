@@ -1,0 +1,200 @@
+"""The standard potential field: algorithm A = 1 of Sgorbissa & Arkin §6.
+
+Sgorbissa & Arkin §6 run R1 with "a standard potential field algorithm", which "does not
+guarantee the robot to reach its target without the help of other robots because of the
+presence of local minima in the potential fields" (Koren & Borenstein 1991, their [6]). Their
+simulator is MissionLab, whose navigation is Arkin's motor schemas (Arkin 1989, "Motor
+schema-based mobile robot navigation", IJRR 8(4), their [1]); this module follows those
+schemas, with the obstacles being the points of an omnidirectional range scan:
+
+- *move-to-goal*: a vector of constant magnitude ``attraction_gain`` towards the goal;
+- *avoid-static-obstacle*, for every beam that returned a point at distance ``d`` from the
+  robot's centre: a vector pointing from the point to the robot, of magnitude
+
+  - 0 when ``d > S`` (outside the sphere of influence ``S = R + influence_m``),
+  - ``repulsion_gain · (S − d) / (S − R)`` when ``R < d ≤ S``,
+  - ``INSIDE_GAIN · repulsion_gain`` (standing for Arkin's infinity) when ``d ≤ R``,
+
+  where ``R = radius_m + safety_margin_m``. Arkin's obstacles are discrete circles; a scan
+  returns many points per wall, so each beam is weighted by the angle it stands for,
+  ``2π / n_beams`` (a gap we fill: the field of a wall then does not depend on the beam count).
+
+The heading of the next step is the angle of the sum. There is **no escape heuristic**: the
+only randomness is a perturbation of relative size ``perturbation`` (default 1e-6) added to the
+sum so that an exactly symmetric situation (a zero vector) still gives a heading. With fixed
+steps a robot in a local minimum oscillates around it by about one step for ever; that is the
+failure §6 reports ("potential field alone fails"). A collision guard
+(:func:`~teamnav.control.nav.local.base.safe_heading`) removes headings whose step would come
+closer than ``radius_m + guard_margin_m`` to a sensed point; it never adds a new way out.
+
+``progressing`` (§5 "Evaluate my progress") is
+:class:`~teamnav.control.nav.local.base.ProgressMonitor`: True while the distance to the goal
+has beaten its best-so-far reference for this goal by at least ``progress_fraction`` of a step
+within the last ``progress_window_steps`` steps. In a local minimum it turns False after
+``progress_window_steps`` steps.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from teamnav.control.nav.local.base import (
+    GOAL_SAME_TOL_M,
+    ProgressMonitor,
+    check_goal,
+    check_pose,
+    check_scan,
+    safe_heading,
+    scan_points,
+)
+from teamnav.control.types import RangeScan
+
+__all__ = ["INSIDE_GAIN", "PotentialField", "PotentialFieldParams", "field_vector"]
+
+#: Magnitude (relative to ``repulsion_gain``) of a point inside the safety radius: Arkin's ∞.
+INSIDE_GAIN: float = 1000.0
+
+
+class PotentialFieldParams(BaseModel):
+    """Parameters of the potential field (units in the names; module docstring gives the law).
+
+    Attributes
+    ----------
+    attraction_gain : float, default 1.0
+        Magnitude of move-to-goal.
+    repulsion_gain : float, default 1.0
+        Avoid-obstacle magnitude per radian of scan at the safety radius.
+    influence_m : float, default 1.0
+        Sphere of influence beyond the safety radius [m].
+    safety_margin_m : float, default 0.1
+        Safety radius ``R`` = robot radius + this [m].
+    guard_margin_m : float, default 0.03
+        The collision guard keeps each step this far beyond the robot's radius from sensed points [m].
+    perturbation : float, default 1e-6
+        Relative size of the random symmetry-breaking perturbation of the sum.
+    progress_window_steps : int, default 30
+        Steps without beating the reference distance before ``progressing`` turns False.
+    progress_fraction : float, default 0.5
+        Least improvement of the reference distance that counts, as a fraction of a step.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    attraction_gain: float = Field(1.0, gt=0.0, le=100.0)
+    repulsion_gain: float = Field(1.0, ge=0.0, le=1000.0)
+    influence_m: float = Field(1.0, gt=0.0, le=20.0)
+    safety_margin_m: float = Field(0.1, ge=0.0, le=2.0)
+    guard_margin_m: float = Field(0.03, ge=0.0, le=1.0)
+    perturbation: float = Field(1e-6, ge=0.0, le=0.1)
+    progress_window_steps: int = Field(30, ge=1, le=100_000)
+    progress_fraction: float = Field(0.5, gt=0.0, le=10.0)
+
+
+def field_vector(pose: np.ndarray, goal_xy: np.ndarray, points: np.ndarray, n_beams: int,
+                 params: PotentialFieldParams, radius_m: float) -> np.ndarray:
+    """Move-to-goal plus avoid-static-obstacle (Arkin 1989) at ``pose``; shape (2,), own frame.
+
+    Parameters
+    ----------
+    pose : ndarray of shape (3,)
+    goal_xy : ndarray of shape (2,)
+    points : ndarray of shape (K, 2)
+        Sensed obstacle points (:func:`~teamnav.control.nav.local.base.scan_points`).
+    n_beams : int
+        Beams of the scan (each point stands for ``2π / n_beams`` rad).
+    params : PotentialFieldParams
+    radius_m : float
+        Robot radius.
+
+    Examples
+    --------
+    >>> p = PotentialFieldParams()
+    >>> field_vector(np.zeros(3), np.array([3.0, 4.0]), np.zeros((0, 2)), 72, p, 0.25).tolist()
+    [0.6, 0.8]
+    """
+    to_goal = goal_xy - pose[:2]
+    dist = math.hypot(to_goal[0], to_goal[1])
+    v = params.attraction_gain * to_goal / dist if dist > 0.0 else np.zeros(2)
+    if points.shape[0]:
+        r_safe = radius_m + params.safety_margin_m
+        s_inf = r_safe + params.influence_m
+        away = pose[:2] - points
+        d = np.hypot(away[:, 0], away[:, 1])
+        mag = np.where(d <= r_safe, INSIDE_GAIN, (s_inf - d) / (s_inf - r_safe))
+        mag = np.where(d > s_inf, 0.0, mag) * (params.repulsion_gain * 2.0 * math.pi / max(n_beams, 1))
+        v = v + (mag / np.maximum(d, 1e-9)) @ away
+    return v
+
+
+class PotentialField:
+    """Potential-field local navigator (Sgorbissa & Arkin §6, algorithm 1).
+
+    Parameters
+    ----------
+    params : PotentialFieldParams
+    rng : numpy.random.Generator
+        For the symmetry-breaking perturbation only.
+    step_length_m : float
+        Length of one motion step [m].
+    radius_m : float
+        Robot radius [m].
+
+    Examples
+    --------
+    >>> nav = PotentialField(PotentialFieldParams(), np.random.default_rng(0), 0.1, 0.25)
+    >>> nav.set_goal(np.array([0.0, 2.0]))
+    >>> scan = RangeScan(np.full(72, 4.0), np.linspace(-np.pi, np.pi, 72, endpoint=False), 4.0)
+    >>> round(nav.direction(np.array([0.0, 0.0, 1.0]), scan), 4), nav.progressing
+    (1.5708, True)
+    """
+
+    name = "potential_field"
+    Params = PotentialFieldParams
+
+    def __init__(self, params: PotentialFieldParams, rng: np.random.Generator, step_length_m: float,
+                 radius_m: float) -> None:
+        self.params = params
+        self.rng = rng
+        self.step_length_m = float(step_length_m)
+        self.radius_m = float(radius_m)
+        self.goal_xy: np.ndarray | None = None
+        self._monitor = ProgressMonitor(params.progress_window_steps, params.progress_fraction, self.step_length_m)
+
+    # ------------------------------------------------------------------ protocol
+    def set_goal(self, goal_xy: np.ndarray) -> None:
+        """Set the goal (own frame); a different goal restarts the progress estimate."""
+        g = check_goal(goal_xy)
+        if self.goal_xy is not None and math.hypot(*(g - self.goal_xy)) <= GOAL_SAME_TOL_M:
+            return
+        self.goal_xy = g
+        self._new_goal()
+
+    def direction(self, pose: np.ndarray, scan: RangeScan) -> float | None:
+        """Angle of the field's sum at ``pose`` (guarded against collisions); None without a goal."""
+        pose = check_pose(pose)
+        scan = check_scan(scan)
+        if self.goal_xy is None:
+            return None
+        self._monitor.update(math.hypot(*(self.goal_xy - pose[:2])))
+        points = scan_points(pose, scan)
+        v = self._vector(pose, points, len(scan.ranges_m))
+        scale = max(math.hypot(v[0], v[1]), self.params.attraction_gain)
+        v = v + self.params.perturbation * scale * self.rng.standard_normal(2)
+        heading = math.atan2(v[1], v[0])
+        return safe_heading(heading, pose[:2], points, self.step_length_m, self.radius_m + self.params.guard_margin_m)
+
+    @property
+    def progressing(self) -> bool:
+        """Distance to the goal beat its reference within the window (see module docstring)."""
+        return self._monitor.progressing
+
+    # ------------------------------------------------------------------ hooks for subclasses
+    def _new_goal(self) -> None:
+        self._monitor.reset()
+
+    def _vector(self, pose: np.ndarray, points: np.ndarray, n_beams: int) -> np.ndarray:
+        assert self.goal_xy is not None
+        return field_vector(pose, self.goal_xy, points, n_beams, self.params, self.radius_m)

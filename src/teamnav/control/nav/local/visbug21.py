@@ -1,0 +1,335 @@
+"""VisBug-21: algorithm A = 3 of Sgorbissa & Arkin §6.
+
+Sgorbissa & Arkin §6 run "the VisBug21 algorithm [7]" (Lumelsky & Skewis 1990, "Incorporating
+range sensing in the robot navigation function", IEEE Trans. SMC 20(5), pp. 1058-1068), which
+"is guaranteed to find a path to the goal (whenever it exists) even when no helping robots
+are present". VisBug-21 is Bug2 with a range sensor of radius ``r``: the robot keeps the
+*M-line* from its start S to the target T and repeatedly moves to an *intermediate target*
+``Ti`` computed from what it sees.
+
+Our version, on an omnidirectional range scan and fixed-length steps:
+
+Step 1 (``MODE_TO_GOAL``, "move towards Ti")
+    ``Ti`` is the point of the M-line nearest T (sampled every ``mline_sample_m``, and not
+    behind the last leave point) that the robot sees with a free corridor: the segment from
+    the robot to it passes at least ``R = radius_m + safety_margin_m`` from every sensed
+    point and is no longer than the sensor's range minus ``R``. When T itself is such a
+    point the robot heads straight for it. When no such ``Ti`` lies at least one step away,
+    an obstacle blocks the M-line: the robot's position is the *hit point* H (distance
+    ``d_H`` to T) and Step 2 starts.
+Step 2 (``MODE_FOLLOW``, "follow the boundary in the local direction")
+    The robot follows the obstacle boundary, keeping it on its right (``turn="left"``, the
+    default) or left, at ``R + follow_margin_m``: heading = tangent at the nearest sensed
+    point, turned towards or away from the obstacle in proportion to the distance error.
+    At every step it looks for a *leave point*: a point Q of the M-line with
+    ``|QT| < d_H − leave_margin_m`` seen through a free corridor as above but wider, of
+    half-width ``R + follow_margin_m`` (hysteresis: a point at the edge of visibility would
+    otherwise make the robot leave and hit again at every step), and at least a step away
+    or T itself (``d_H`` is the
+    smallest hit distance so far for this goal: a robot stopped short of a leave point
+    can hit farther from T than it left, and Bug2's progress argument needs every leave
+    point closer than all earlier hit points). When there is
+    one it takes the nearest to T as ``Ti`` and returns to Step 1 (VisBug-21's shortcut:
+    range sensing lets the robot leave the boundary for a visible M-line point ahead instead
+    of walking the boundary to it). If it walks back to within ``return_tol_m`` of H after
+    having been ``2·return_tol_m`` or more away, T is unreachable (Bug2's termination
+    test): :meth:`direction` then returns None until a new goal is set.
+
+Where we deviate: Lumelsky & Skewis also let ``Ti`` be the farthest visible point of the
+obstacle boundary in the local direction (so a robot cuts across concave stretches of the
+boundary); we follow the boundary reactively at a constant offset instead, since the
+boundary is only known as scan points. The M-line shortcut above keeps VisBug's main gain
+(leaving early for a visible M-line point). On a grid map and with fixed steps the
+convergence proof does not carry over exactly; the leave margin keeps every leave point
+strictly closer to T than its hit point, as in Bug2.
+
+A new goal (:meth:`set_goal` with a goal more than 1 µm away from the current one) restarts
+the algorithm: the M-line runs from wherever the robot is at the next :meth:`direction`
+call (Sgorbissa & Arkin §3: a robot heading for a teammate resets its goal often; each time
+VisBug starts over).
+
+``progressing`` (§5): in Step 1, the distance to T beats its best-so-far for this goal
+within ``progress_window_steps`` steps (as for the potential field); in Step 2, the walk
+along the boundary since H is shorter than ``follow_patience_m`` (Lumelsky's progress is
+made at leave points, each closer to T than its hit point; a boundary walk much longer
+than expected is "trouble"); False once T is found unreachable.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from teamnav.control.nav.local.base import (
+    GOAL_SAME_TOL_M,
+    ProgressMonitor,
+    check_goal,
+    check_pose,
+    check_scan,
+    safe_heading,
+    scan_points,
+    segment_clearance,
+)
+from teamnav.control.types import RangeScan
+
+__all__ = ["MODE_FOLLOW", "MODE_TO_GOAL", "MODE_UNREACHABLE", "VisBug21", "VisBugParams", "boundary_heading"]
+
+MODE_TO_GOAL = 0
+MODE_FOLLOW = 1
+MODE_UNREACHABLE = 2
+
+
+class VisBugParams(BaseModel):
+    """Parameters of VisBug-21 (units in the names; the module docstring gives the rules).
+
+    Attributes
+    ----------
+    turn : {"left", "right", "random"}, default "left"
+        Local direction at a hit point ("left": the obstacle stays on the robot's right).
+        "random": drawn (fair coin from the robot's ``rng``) at every new goal and kept for
+        that goal, so a map whose doors all sit on one side of the rooms does not favour
+        or punish the algorithm systematically.
+    safety_margin_m : float, default 0.1
+        Free corridors keep ``R = radius + this`` from sensed points [m].
+    follow_margin_m : float, default 0.1
+        The boundary is followed at ``R + this`` [m].
+    follow_gain : float, default 1.5
+        Heading correction per relative distance error while following (rad per unit).
+    leave_margin_m : float, default 0.1
+        A leave point must be this much closer to the goal than the hit point [m].
+    mline_sample_m : float, default 0.1
+        Spacing of the M-line points tested as intermediate targets [m].
+    return_tol_m : float, default 0.3
+        Back within this of the hit point (after leaving it) = goal unreachable [m].
+    guard_margin_m : float, default 0.03
+        Collision guard: each step keeps radius + this from sensed points [m].
+    follow_patience_m : float, default 20.0
+        Boundary walk after which the robot no longer counts as progressing [m].
+    progress_window_steps : int, default 30
+    progress_fraction : float, default 0.5
+        As for the potential field (Step 1's progress estimate).
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    turn: Literal["left", "right", "random"] = "left"
+    safety_margin_m: float = Field(0.1, ge=0.0, le=2.0)
+    follow_margin_m: float = Field(0.1, ge=0.0, le=2.0)
+    follow_gain: float = Field(1.5, ge=0.0, le=20.0)
+    leave_margin_m: float = Field(0.1, ge=0.0, le=10.0)
+    mline_sample_m: float = Field(0.1, gt=0.0, le=5.0)
+    return_tol_m: float = Field(0.3, gt=0.0, le=10.0)
+    guard_margin_m: float = Field(0.03, ge=0.0, le=1.0)
+    follow_patience_m: float = Field(20.0, gt=0.0, le=10_000.0)
+    progress_window_steps: int = Field(30, ge=1, le=100_000)
+    progress_fraction: float = Field(0.5, gt=0.0, le=10.0)
+
+
+def boundary_heading(xy: np.ndarray, points: np.ndarray, follow_distance_m: float, side: int,
+                     gain: float) -> float | None:
+    """Heading [rad] that follows the boundary through the nearest sensed point.
+
+    ``side = +1`` keeps the obstacle on the right, ``-1`` on the left. The heading is the
+    tangent at the nearest point, turned away from the obstacle by
+    ``gain · (follow_distance − d) / follow_distance`` (clipped to ±60°) when closer than
+    ``follow_distance_m`` and towards it when farther. None when nothing is sensed.
+
+    Examples
+    --------
+    >>> pts = np.array([[0.0, -0.5], [1.0, -0.5]])   # a wall 0.5 m to the right
+    >>> round(boundary_heading(np.zeros(2), pts, 0.5, +1, 1.5), 6)
+    0.0
+    """
+    if points.shape[0] == 0:
+        return None
+    rel = points - xy
+    d2 = np.einsum("ij,ij->i", rel, rel)
+    i = int(np.argmin(d2))
+    d = math.sqrt(d2[i])
+    err = max(-1.0, min(1.0, (follow_distance_m - d) / follow_distance_m))
+    corr = max(-math.pi / 3, min(math.pi / 3, gain * err))
+    return math.atan2(rel[i, 1], rel[i, 0]) + side * (0.5 * math.pi + corr)
+
+
+class VisBug21:
+    """VisBug-21 local navigator (Sgorbissa & Arkin §6, algorithm 3; Lumelsky & Skewis 1990).
+
+    Parameters
+    ----------
+    params : VisBugParams
+    rng : numpy.random.Generator
+        Used only with ``turn="random"`` (one draw per new goal).
+    step_length_m : float
+    radius_m : float
+
+    Attributes
+    ----------
+    mode : int
+        ``MODE_TO_GOAL``, ``MODE_FOLLOW`` or ``MODE_UNREACHABLE``.
+    side : int
+        +1: the followed obstacle is kept on the right (turn left at a hit), -1: on the left.
+    mline : tuple of ndarray or None
+        (S, T) of the current M-line, own frame.
+    hit_xy : ndarray or None
+        The current hit point H.
+
+    Examples
+    --------
+    >>> nav = VisBug21(VisBugParams(), np.random.default_rng(0), 0.1, 0.25)
+    >>> nav.set_goal(np.array([3.0, 0.0]))
+    >>> scan = RangeScan(np.full(72, 4.0), np.linspace(-np.pi, np.pi, 72, endpoint=False), 4.0)
+    >>> round(nav.direction(np.array([0.0, 0.0, 2.0]), scan), 6), nav.mode
+    (0.0, 0)
+    """
+
+    name = "visbug21"
+    Params = VisBugParams
+
+    def __init__(self, params: VisBugParams, rng: np.random.Generator, step_length_m: float,
+                 radius_m: float) -> None:
+        self.params = params
+        self.rng = rng
+        self.step_length_m = float(step_length_m)
+        self.radius_m = float(radius_m)
+        self.goal_xy: np.ndarray | None = None
+        self.side = 1 if params.turn == "left" else -1
+        self._monitor = ProgressMonitor(params.progress_window_steps, params.progress_fraction, self.step_length_m)
+        self._restart()
+
+    def _restart(self) -> None:
+        self.mode = MODE_TO_GOAL
+        self.mline: tuple[np.ndarray, np.ndarray] | None = None
+        self.hit_xy: np.ndarray | None = None
+        self.hit_dist_m = math.inf
+        self._t_anchor = 0.0
+        self._walked_m = 0.0
+        self._left_hit = False
+        self._last_xy: np.ndarray | None = None
+        self._monitor.reset()
+
+    # ------------------------------------------------------------------ protocol
+    def set_goal(self, goal_xy: np.ndarray) -> None:
+        """Set the goal (own frame); a different goal restarts VisBug (new M-line, no hit point)."""
+        g = check_goal(goal_xy)
+        if self.goal_xy is not None and math.hypot(*(g - self.goal_xy)) <= GOAL_SAME_TOL_M:
+            return
+        self.goal_xy = g
+        self._restart()
+        if self.params.turn == "random":
+            self.side = 1 if self.rng.random() < 0.5 else -1
+
+    def direction(self, pose: np.ndarray, scan: RangeScan) -> float | None:
+        """Heading of the next step (Step 1 or Step 2 above); None without a goal or once unreachable."""
+        pose = check_pose(pose)
+        scan = check_scan(scan)
+        if self.goal_xy is None or self.mode == MODE_UNREACHABLE:
+            return None
+        xy = pose[:2]
+        goal = self.goal_xy
+        if self.mline is None:
+            self.mline = (xy.copy(), goal.copy())
+        if self._last_xy is not None and self.mode == MODE_FOLLOW:
+            self._walked_m += math.hypot(*(xy - self._last_xy))
+        self._last_xy = xy.copy()
+        self._monitor.update(math.hypot(*(goal - xy)))
+        p = self.params
+        points = scan_points(pose, scan)
+        r_safe = self.radius_m + p.safety_margin_m
+        reach_m = float(scan.max_range_m) - r_safe
+
+        heading: float | None = None
+        if self.mode == MODE_FOLLOW:
+            ti = self._leave_point(xy, points, r_safe + p.follow_margin_m, reach_m)
+            if ti is not None:
+                self.mode = MODE_TO_GOAL
+                self._monitor.reset()
+            else:
+                d_hit = math.hypot(*(xy - self.hit_xy))
+                if d_hit >= 2.0 * p.return_tol_m:
+                    self._left_hit = True
+                elif self._left_hit and d_hit <= p.return_tol_m:
+                    self.mode = MODE_UNREACHABLE
+                    return None
+                heading = boundary_heading(xy, points, r_safe + p.follow_margin_m, self.side, p.follow_gain)
+                if heading is None:  # nothing sensed at all: the obstacle is gone
+                    self.mode = MODE_TO_GOAL
+        if self.mode == MODE_TO_GOAL:
+            ti = self._intermediate_target(xy, points, r_safe, reach_m)
+            if ti is None:
+                self._hit(xy)
+                heading = boundary_heading(xy, points, r_safe + p.follow_margin_m, self.side, p.follow_gain)
+                if heading is None:
+                    heading = math.atan2(goal[1] - xy[1], goal[0] - xy[0])
+            else:
+                heading = math.atan2(ti[1] - xy[1], ti[0] - xy[0])
+        assert heading is not None
+        return safe_heading(heading, xy, points, self.step_length_m, self.radius_m + p.guard_margin_m)
+
+    @property
+    def progressing(self) -> bool:
+        """Step 1: distance beats its reference within the window; Step 2: walk since H < patience."""
+        if self.mode == MODE_UNREACHABLE:
+            return False
+        if self.mode == MODE_FOLLOW:
+            return self._walked_m < self.params.follow_patience_m
+        return self._monitor.progressing
+
+    # ------------------------------------------------------------------ steps
+    def _hit(self, xy: np.ndarray) -> None:
+        """Step 1 -> Step 2 at hit point ``xy``."""
+        self.mode = MODE_FOLLOW
+        self.hit_xy = xy.copy()
+        self.hit_dist_m = min(self.hit_dist_m, math.hypot(*(self.goal_xy - xy)))
+        self._walked_m = 0.0
+        self._left_hit = False
+
+    def _mline_samples(self, t_from: float) -> tuple[np.ndarray, np.ndarray]:
+        """M-line points with parameter t in [t_from, 1] (goal last), and their t."""
+        s, g = self.mline
+        length = math.hypot(*(g - s))
+        n = max(1, int(math.ceil(length / self.params.mline_sample_m)))
+        t = np.linspace(0.0, 1.0, n + 1)
+        t = t[t >= t_from - 1e-12]
+        return s + t[:, None] * (g - s), t
+
+    def _visible(self, xy: np.ndarray, pts: np.ndarray, cand: np.ndarray, r_safe: float, reach_m: float) -> np.ndarray:
+        """Which candidate points the robot reaches through a free corridor of half-width ``r_safe``."""
+        dist = np.hypot(cand[:, 0] - xy[0], cand[:, 1] - xy[1])
+        ok = dist <= reach_m
+        if ok.any() and pts.shape[0]:
+            near = pts[np.hypot(pts[:, 0] - xy[0], pts[:, 1] - xy[1]) <= reach_m + 2.0 * r_safe]
+            idx = np.flatnonzero(ok)
+            ok[idx] = segment_clearance(near, xy, cand[idx]) >= r_safe
+        return ok
+
+    def _intermediate_target(self, xy, points, r_safe, reach_m) -> np.ndarray | None:
+        """Step 1's Ti: the visible M-line point nearest the goal, at least one step away (else None)."""
+        cand, t = self._mline_samples(self._t_anchor)
+        ok = self._visible(xy, points, cand, r_safe, reach_m)
+        if not ok.any():
+            return None
+        j = int(np.flatnonzero(ok)[-1])
+        ti = cand[j]
+        if t[j] >= 1.0 - 1e-12 or math.hypot(*(ti - xy)) >= self.step_length_m:
+            return ti
+        return None
+
+    def _leave_point(self, xy, points, r_safe, reach_m) -> np.ndarray | None:
+        """Step 2's leave test: a visible M-line point closer to the goal than H by the margin."""
+        cand, t = self._mline_samples(0.0)
+        closer = np.hypot(cand[:, 0] - self.goal_xy[0], cand[:, 1] - self.goal_xy[1]) < self.hit_dist_m - self.params.leave_margin_m
+        if not closer.any():
+            return None
+        cand, t = cand[closer], t[closer]
+        ok = self._visible(xy, points, cand, r_safe, reach_m)
+        if not ok.any():
+            return None
+        j = int(np.flatnonzero(ok)[-1])
+        # moving to it must be possible: it is at least a step away, or it is the goal
+        if t[j] < 1.0 - 1e-12 and math.hypot(*(cand[j] - xy)) < self.step_length_m:
+            return None
+        self._t_anchor = float(t[j])
+        return cand[j]
