@@ -1,0 +1,279 @@
+"""Line-of-sight help experiments (Sgorbissa & Arkin §6): tasks, frames, scenario files,
+metrics and the report section's verdicts on hand-made rows."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from teamnav.control import registry as controllers
+from teamnav.experiments import los_tasks as L
+from teamnav.experiments.metric_sets.los_help import los_help
+from teamnav.experiments.metrics import RunData
+from teamnav.experiments.report.model import Comparison, Missing, Plot, Table
+from teamnav.experiments.report.sections import los_help as S
+from teamnav.world import builtin_map
+from teamnav.world.distance import distance_field
+
+BRAINS = {"los-explorer-v1", "los-helper-v1"} <= set(controllers.names())
+needs_brains = pytest.mark.skipif(not BRAINS, reason="los-explorer-v1 / los-helper-v1 not registered yet")
+
+
+# ---------------------------------------------------------------------------- tasks
+@pytest.mark.parametrize("m", list(L.MAPS))
+def test_tasks_are_deterministic_distinct_and_never_repeat_a_room_twice_in_a_row(m):
+    tasks = [L.task_rooms(m, t) for t in range(1, L.N_TASKS + 1)]
+    assert tasks[0] == L.task_rooms(m, 1)  # same list on every call
+    assert len({tuple(t) for t in tasks}) == L.N_TASKS  # 5 different random target sets
+    rooms = set(L.room_centres(m))
+    for t in tasks:
+        assert len(t) == L.N_TARGETS and set(t) == rooms  # 200 targets visit every room
+        assert all(a != b for a, b in zip(t, t[1:]))
+        # roughly uniform: every room between 1/3 and 3x its share
+        counts = np.array([t.count(r) for r in rooms])
+        assert counts.min() > L.N_TARGETS / len(rooms) / 3 and counts.max() < 3 * L.N_TARGETS / len(rooms)
+    assert L.task_rooms(m, 2, 7) == tasks[1][:7]  # a quick task is a prefix of the full one
+
+
+def test_the_first_targets_are_pinned_so_shipped_files_cannot_drift():
+    assert L.task_rooms("simple", 1, 4) == ["room_N2", "room_N1", "room_S4", "room_S2"]
+    assert L.task_rooms("complex", 1, 3) == L.task_rooms("complex", 1, 3)
+
+
+@pytest.mark.parametrize("m", list(L.MAPS))
+def test_targets_sit_in_free_space_in_the_middle_of_rooms(m):
+    env = builtin_map(L.MAPS[m])
+    clear = distance_field(env.grid)
+    pts = L.task_targets_world(m, 3)
+    for x, y in pts:
+        r, c = env.grid.world_to_cell((x, y))
+        assert clear[r, c] >= 1.0, (x, y)  # a metre from any wall or obstacle
+    centres = {tuple(v) for v in L.room_centres(m).values()}
+    assert {tuple(p) for p in pts.tolist()} <= centres
+
+
+@pytest.mark.parametrize("m", list(L.MAPS))
+def test_patrol_routes_and_starts_lie_in_the_corridors_with_clearance(m):
+    env = builtin_map(L.MAPS[m])
+    clear = distance_field(env.grid)
+    corridors = [v for k, v in env.regions.items() if k.startswith("corridor")]
+    lay = L.LAYOUTS[m]
+    pts = [lay.r1_start[:2]] + [p for start, route in lay.helpers for p in (start[:2], *route)]
+    for x, y in pts:
+        r, c = env.grid.world_to_cell((x, y))
+        assert clear[r, c] >= L.RADIUS_M + 0.3, (x, y)
+        assert any(x0 <= x <= x1 and y0 <= y <= y1 for x0, y0, x1, y1 in corridors), (x, y)
+
+
+# ---------------------------------------------------------------------------- frames
+poses = st.tuples(st.floats(-50, 50), st.floats(-50, 50), st.floats(-360, 360))
+points = st.lists(st.tuples(st.floats(-100, 100), st.floats(-100, 100)), min_size=1, max_size=5)
+
+
+@settings(max_examples=200, deadline=None)
+@given(poses, points)
+def test_start_frame_conversion_round_trips_and_keeps_distances(pose, pts):
+    local = L.world_to_frame(pose, pts)
+    np.testing.assert_allclose(L.frame_to_world(pose, local), np.asarray(pts), atol=1e-9)
+    d_world = np.hypot(*(np.asarray(pts) - np.asarray(pose[:2])).T)
+    np.testing.assert_allclose(np.hypot(*local.T), d_world, atol=1e-9)
+
+
+@settings(max_examples=100, deadline=None)
+@given(poses, st.floats(0.1, 20))
+def test_a_point_straight_ahead_of_the_start_is_on_the_frames_x_axis(pose, d):
+    x, y, th = pose
+    ahead = (x + d * math.cos(math.radians(th)), y + d * math.sin(math.radians(th)))
+    np.testing.assert_allclose(L.world_to_frame(pose, [ahead])[0], [d, 0.0], atol=1e-9)
+
+
+def test_targets_xy_are_the_world_targets_in_r1s_start_frame():
+    xy = np.array(L.task_targets_xy("complex", 2, 10))
+    np.testing.assert_allclose(L.frame_to_world(L.LAYOUTS["complex"].r1_start, xy), L.task_targets_world("complex", 2, 10),
+                               atol=1e-4)
+    # R1 starts facing 90 deg: its frame is not the world's, so the numbers must differ
+    assert not np.allclose(xy, L.task_targets_world("complex", 2, 10), atol=1.0)
+
+
+# ---------------------------------------------------------------------------- files
+def test_shipped_scenario_and_sweep_files_are_what_the_generator_writes(tmp_path):
+    from teamnav.experiments.registry import SCENARIO_DIR
+    from teamnav.experiments.sweep import SWEEP_DIR
+
+    (tmp_path / "sc").mkdir()
+    (tmp_path / "sw").mkdir()
+    for p in L.write_files(tmp_path / "sc", tmp_path / "sw"):
+        shipped = (SCENARIO_DIR if p.parent.name == "sc" else SWEEP_DIR) / p.name
+        assert shipped.read_text(encoding="utf-8") == p.read_text(encoding="utf-8"), (
+            f"{shipped.name} is stale: run python -m teamnav.experiments.los_tasks")
+
+
+@needs_brains
+@pytest.mark.parametrize("name", ["los-help-simple", "los-help-complex", "los-help-noise"])
+def test_every_los_help_scenario_validates_with_the_robots_in_their_roles(name):
+    from teamnav.experiments.spec import load_scenario
+
+    scn = load_scenario(name)
+    assert [g.controller for g in scn.robots] == ["los-explorer-v1"] + ["los-helper-v1"] * 3
+    assert [g.count for g in scn.robots] == [1, 1, 1, 1]
+    assert all(g.kinematics == "holonomic_step" and g.odometry.frame == "start" for g in scn.robots)
+    assert all(g.detector.noise_model == "occlusion" and g.detector.fov_deg == 360 for g in scn.robots)
+    assert scn.radio.mode == "line_of_sight" and scn.stop_when_finished
+    assert len(scn.robots[0].params["targets_xy"]) == L.N_TARGETS
+
+
+@needs_brains
+def test_one_override_sets_err_max_of_every_robot_and_helpers_can_be_dropped():
+    from teamnav.experiments.spec import load_scenario
+
+    scn = load_scenario("los-help-complex", overrides={"robots.0.detector.err_max": 0.3, "robots.2.count": 0})
+    assert [g.detector.err_max for g in scn.robots] == [0.3] * 4
+    assert [g.count for g in scn.robots] == [1, 1, 0, 1]
+    assert load_scenario("los-help-noise").robots[3].detector.err_max == 0.2
+
+
+def test_sweeps_grid_what_the_paper_varies():
+    from teamnav.experiments.sweep import load_sweep
+
+    t1 = load_sweep("los-table1")
+    assert t1.n_trials == 3 * 8 * L.N_TASKS
+    assert t1.grid["robots.0.params.targets_xy"][4] == L.task_targets_xy("simple", 5)
+    noise = load_sweep("los-noise-complex")
+    assert noise.grid[S.ERR_KEY] == list(L.ERR_MAX) and noise.scenario == "los-help-complex"
+    assert load_sweep("los-ablation").n_trials == 3 * 4 * L.N_TASKS
+
+
+# ---------------------------------------------------------------------------- metrics
+def _data(logs, *, finished, n_steps):
+    z = np.zeros((1, 2, 3))
+    return RunData(t_s=np.zeros(1), true_pose=z, odom_pose=z, stalled=np.zeros((1, 2), bool),
+                   radius_m=np.full(2, 0.2), grid=None, n_steps=n_steps, logs=logs, finished=finished)
+
+
+def _log(step, robot, **values):
+    return {"step": step, "t_s": step * 0.1, "robot": robot, "values": values}
+
+
+def test_metrics_read_r1s_last_log_and_add_the_unrecorded_tail_of_a_finished_run():
+    logs = [
+        _log(0, 0, targets_reached=0, finished=False, moves=0, msgs_sent=0, bytes_sent=0, tr=False),
+        _log(0, 1, targets_reached=0, moves=0, msgs_sent=0, bytes_sent=0),  # a helper: no "finished"
+        _log(10, 0, targets_reached=1, finished=False, moves=9, msgs_sent=4, bytes_sent=400, tr=True),
+        _log(10, 1, targets_reached=7, moves=10, msgs_sent=6, bytes_sent=800),
+    ]
+    m = los_help(_data(logs, finished=True, n_steps=13))
+    assert m["los_finished"] == 1 and m["los_steps"] == 9 + 3 and m["los_targets_reached"] == 1
+    assert m["los_msgs_r1"] == 4 and m["los_msgs_per_robot"] == 5.0 and m["los_bytes_per_robot"] == 600.0
+    assert m["los_trouble_frac"] == 0.5
+    unfinished = los_help(_data(logs, finished=False, n_steps=500))
+    assert unfinished["los_finished"] == 0 and unfinished["los_steps"] == 500  # the budget
+
+
+def test_metrics_are_empty_without_an_explorer_log():
+    assert los_help(_data([_log(0, 1, targets_reached=3, moves=2)], finished=False, n_steps=5)) == {}
+
+
+# ---------------------------------------------------------------------------- section verdicts
+def _row(nav, steps, finished=1, **params):
+    return {"status": "ok", "params": {S.NAV_KEY: nav, **params},
+            "metrics": {"los_steps": steps, "los_finished": finished, "los_msgs_per_robot": 10.0,
+                        "los_bytes_per_robot": 1000.0}}
+
+
+def _by_team(falling=True):
+    out = {}
+    for h in range(4):
+        rows = []
+        for task in range(2):
+            base = {"avoid_past": 500, "visbug21": 800, "potential_field": 600}
+            for nav, s in base.items():
+                f = (s / (h + 1) if falling else s * (1 + 0.1 * h)) + 5 * task
+                rows.append(_row(nav, 9999 if (nav == "potential_field" and h == 0) else f,
+                                 finished=0 if (nav == "potential_field" and h == 0) else 1))
+        out[h] = rows
+    return out
+
+
+def test_table_cells_mean_and_relative_std_and_failures():
+    assert S.cell(np.array([100.0, 120.0]), np.array([1.0, 1.0])) == "110 (12.9 %)"
+    assert S.cell(np.array([5000.0, 5000.0]), np.array([0.0, 0.0])) == "fails (0/2 finished)"
+    assert S.cell(np.array([100.0, 5000.0]), np.array([1.0, 0.0])) == "100 (0.0 %, 1/2 finished)"
+
+
+def test_comparisons_hold_when_steps_fall_and_pf_fails_alone_and_not_otherwise():
+    by_team = _by_team(True)
+    tab, means = S.table_block("simple", by_team)
+    assert isinstance(tab, Table) and tab.rows[0][2] == "fails (0/2 finished)"
+    comps = S.table_comparisons("simple", means, by_team)
+    assert [c.holds for c in comps] == [True, True, True, True]
+    bad = _by_team(False)
+    comps = S.table_comparisons("complex", S.table_block("complex", bad)[1], bad)
+    assert [c.holds for c in comps[:3]] == [False, False, False]
+    assert comps[3].holds is True  # PF alone still fails, finishes with helpers
+    assert comps[4].claim.startswith("Table 2: with 3 helpers")
+
+
+def test_noise_verdicts_follow_the_paper_rows():
+    alone = {"avoid_past": 500.0, "visbug21": 800.0, "potential_field": float("nan")}
+    rows = [_row(nav, s, **{S.ERR_KEY: e}) for nav, base in (("avoid_past", 200), ("visbug21", 300))
+            for e, s in ((0.0, base), (0.4, base * 1.5))]
+    plot, means = S.noise_plot("simple", rows, alone)
+    assert isinstance(plot, Plot) and len(plot.hlines) == 2
+    grow, below = S.noise_comparisons("simple", means, alone)
+    assert grow.holds is True and below.holds is True
+    grow, fade = S.noise_comparisons("complex", means, alone)
+    assert fade.holds is False  # gain 300 -> 200 keeps more than half: help did not fade
+
+
+class _FakeCtx:
+    """A ctx whose sweeps return hand-made rows (no simulation)."""
+
+    quick = True
+
+    def __init__(self):
+        self.calls = []
+
+    def sweep(self, sweep_name, **kw):
+        name = sweep_name
+        self.calls.append((name, kw))
+        h = sum(v for k, v in (kw.get("set") or {}).items() if k.endswith(".count"))
+        rows = [r for r in _by_team(True)[h]] if "table" in name else [
+            _row(nav, 300 + 100 * e, **{S.ERR_KEY: e}) for nav in L.NAVIGATORS for e in (0.0, 0.4)]
+
+        class R:
+            def rows(self):
+                return rows
+
+        return R()
+
+
+@needs_brains
+def test_build_asks_for_nested_teams_and_returns_tables_plots_and_comparisons():
+    ctx = _FakeCtx()
+    blocks = S.build(ctx)
+    names = [c[0] for c in ctx.calls]
+    assert names.count("los-table1") == len(S._teams("simple", True))
+    sets = [c[1]["set"] for c in ctx.calls if c[0] == "los-table1"]
+    assert {"robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0} in sets  # R1+R2, not R1+R3
+    kinds = {type(b) for b in blocks}
+    assert {Table, Plot, Comparison, Missing} <= kinds
+    assert any(isinstance(b, Comparison) and b.holds for b in blocks)
+
+
+# ---------------------------------------------------------------------------- a real run
+@needs_brains
+def test_a_one_target_run_finishes_with_steps_proportional_to_the_path():
+    from teamnav.experiments.runner import run
+    from teamnav.experiments.spec import load_scenario
+
+    goal = L.world_to_frame(L.LAYOUTS["simple"].r1_start, [(7.0, 7.0)]).tolist()  # 6 m down the corridor, in view
+    scn = load_scenario("los-help-simple", overrides={"robots.0.params.targets_xy": goal, "robots.1.count": 0,
+                                                      "robots.2.count": 0, "robots.3.count": 0}, duration_s=20.0)
+    m = run(scn, progress=False).metrics
+    assert m["los_finished"] == 1
+    # 6 m in 0.2 m steps, stopping within eps = 0.5 m: 28..31 steps
+    assert 6.0 - L.GOAL_TOLERANCE_M <= m["los_steps"] * L.STEP_LENGTH_M <= 6.0 + 2 * L.STEP_LENGTH_M
