@@ -54,6 +54,9 @@ register("wander-batched-v1", "teamnav.control.nav.wander:WanderBatched")
 # Trail experiments baseline (Vaughan et al.; helper H7): the single optimal robot
 register("route-follow-v1", "teamnav.control.nav.route_follow:RouteFollow")
 
+# Fox, Burgard, Kruppa & Thrun: collaborative multi-robot MCL (helper H5)
+register("mcl-wander-v1", "teamnav.control.localizing:MCLWander")
+
 # Vaughan et al. trail papers: low-level Navigate + Panic, random exploration (helper H3)
 register("explore-v1", "teamnav.control.nav.explore:Explore")
 

@@ -333,6 +333,31 @@ class DensityTree:
             stack.append((c + 1, r_lo, hi))
         return np.array(los), np.array(his), np.array(dens)
 
+    def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        """``n`` points drawn from the tree's density: a leaf by its mass (density x volume),
+        then uniformly inside its box. Circular dimensions are wrapped to ``[-pi, pi)``.
+
+        Examples
+        --------
+        >>> rng = np.random.default_rng(0)
+        >>> t = DensityTree.fit(rng.normal(size=(4000, 2)), min_samples=40)
+        >>> pts = t.sample(2000, rng)
+        >>> pts.shape, bool(abs(pts[:, 0].mean()) < 0.1)
+        ((2000, 2), True)
+        """
+        n = int(n)
+        if n < 0:
+            raise ValueError(f"n must be >= 0, got {n}")
+        lo, hi, dens = self.leaves()
+        mass = dens * np.prod(hi - lo, axis=1)
+        if not mass.sum() > 0:
+            raise ValueError("the tree has no mass to sample from")
+        leaf = rng.choice(mass.shape[0], size=n, p=mass / mass.sum())
+        pts = lo[leaf] + rng.random((n, lo.shape[1])) * (hi[leaf] - lo[leaf])
+        for k in np.flatnonzero(self.circular):
+            pts[:, k] = (pts[:, k] + math.pi) % (2 * math.pi) - math.pi
+        return pts
+
     def integral(self) -> float:
         """``sum density x volume`` over the leaves (1 up to float32 rounding)."""
         lo, hi, dens = self.leaves()

@@ -516,6 +516,37 @@ class MCL:
         self._weighted = True
         return True
 
+    def replace_samples(self, poses) -> None:
+        """Replace randomly chosen samples by ``poses``, each with the set's mean weight.
+
+        Sensor resetting (Lenser & Veloso 2000; Thrun et al. 2001 Mixture-MCL), not in Fox et
+        al.: a detection can only reweight samples that already exist (eq. 14), so a belief
+        whose samples all lie elsewhere cannot take it in; drawing a few samples from the
+        detection's density gives the evidence somewhere to land.
+
+        Parameters
+        ----------
+        poses : array_like of shape (k, 3)
+            ``k <= n`` poses [m, m, rad].
+        """
+        self._require_particles("replace_samples")
+        q = array("poses", poses, (-1, 3))
+        n = self._particles.shape[0]
+        k = q.shape[0]
+        if k > n:
+            raise ValueError(f"poses must hold at most {n} rows (the sample count), got {k}")
+        if k == 0:
+            return
+        where = self.rng.choice(n, size=k, replace=False)
+        p = self._particles.copy()
+        p[where] = q
+        p[:, 2] = wrap_angle(p[:, 2])
+        w = self._weights.copy()
+        w[where] = 1.0 / n
+        self._particles = np.ascontiguousarray(p)
+        self._weights = w / w.sum()
+        self._weighted = True
+
     # ------------------------------------------------------------------ estimates
     def estimate(self) -> Estimate:
         """Weighted mean and covariance, and the heaviest cluster's mean (see :class:`Estimate`)."""

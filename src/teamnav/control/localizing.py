@@ -1,0 +1,531 @@
+"""A robot that wanders while it localizes itself, alone or with its team (Fox et al.).
+
+Fox, Burgard, Kruppa & Thrun, "A probabilistic approach to collaborative multi-robot
+localization", Autonomous Robots 8(3), 2000. The brain ``mcl-wander-v1``:
+
+- *moves* with the wanderer of :mod:`teamnav.control.nav.wander` (wall following, random
+  turns at openings, obstacle avoidance from the range scan; the paper's robots are driven
+  by an operator or a random walk, §5);
+- *localizes* with its own :class:`~teamnav.localization.MCL` (§3.1): global initialisation
+  uniform over the free space of ``info.known_map`` (§2.2, Fig. 4a), odometry motion model,
+  beam model of its sensor (sonar cones or laser, Fig. 1) or the likelihood field, a few
+  uniform random samples per step, KLD-adaptive sample count (§3.1 "MCL determines the
+  sample set size on-the-fly");
+- with ``collaborate`` it *synchronises* beliefs on detections (§2.3, §3.2, eqs. 10, 13, 14)
+  through :class:`~teamnav.localization.BeliefSync`: a detection becomes a density tree of
+  the seen robot's position, sent over the radio (its bytes counted by ``Message.size_bytes``);
+  the seen robot multiplies it into its weights and answers with its own position tree so that
+  the observer is constrained too; negative sights are ignored and a robot is not used again
+  until the user has travelled ``min_travel_m`` = 2.5 m (§2.3 rules 1 and 2).
+
+Detections are looked at once per ``detection_period_s`` (1 s: "images are analyzed at a
+rate of 1 Hz", §4.1); the simulator's detector reports every step, so its false-positive rate
+per step is the rate per camera frame as the brain sees it.
+
+Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report section):
+
+``false_positive_filter`` (§7.2: "a rate of 3.5 % ... turns out to cause major problems")
+    Three gates, two at the observer and one at the detected robot:
+
+    1. *map consistency*: the detected position, sampled through the detection model from
+       the observer's belief, must fall in free space of the known map with at least
+       ``fp_min_free_mass`` of the belief's weight (a phantom at a uniform range and bearing
+       lands in a wall or outside the building most of the time in hallways);
+    2. *confirmation*: a detection is used only when the same robot was also seen on the
+       previous camera frame (at most ``fp_confirm_window_s`` before) at a consistent place:
+       the two detected points, each expressed in the observer's odometry frame, lie within
+       ``fp_confirm_gate_m`` of each other. Phantoms are independent per frame with random
+       identities and positions, so two consistent phantoms are rare (≈ p_fp² × gate area /
+       field area), while a true teammate is seen on consecutive frames;
+    3. *belief agreement* (at the detected robot): the posterior probability that the
+       detection is real, ``(1 - p_fp) E / ((1 - p_fp) E + p_fp / A)`` with
+       ``E = sum_i w_i tree(x_i)`` the tree's density under the own belief and ``A`` the free
+       area, must be at least ``fp_min_real_prob``; otherwise the message is dropped instead
+       of being multiplied in (a phantom otherwise hands all weight to the few random samples
+       that happen to lie in the phantom's tree).
+
+``identity`` = ``"withheld"`` handling (§7.2 "Identification of robots": the factorial
+    representation "cannot deal with measurements such as 'either robot A or robot B'"): a
+    detection with ``robot_id`` None is *associated by belief*. The observer broadcasts its tree
+    as a query (``kind="assoc_query"``); every robot that hears it answers with the tree's
+    density under its own belief, ``E_n = sum_i w_i tree(x_i)`` (one float). On the next
+    step the observer picks the robot with the largest ``E_n``, provided it beats the uniform
+    density ``1 / A`` by ``assoc_min_ratio`` and the runner-up by ``assoc_margin``, and sends it
+    the ordinary detection message (the tree it kept). Ambiguous detections (every robot still
+    globally uncertain, or two robots equally plausible) are dropped. With ``anonymous="ignore"``
+    the brain does what the paper's method does with anonymous sights: nothing.
+
+The filter never sees a true pose; experiments score it from what :meth:`MCLWander.log`
+records (a weighted subsample of the particles every recorded step, see
+:mod:`teamnav.experiments.metric_sets.localization`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from teamnav.control.nav.wander import Wander, WanderParams
+from teamnav.control.protocol import RobotInfo
+from teamnav.control.types import Action, Message, Observation
+from teamnav.localization import (
+    BeamModelParams, BeliefSync, DetectionModel, KLDParams, LikelihoodFieldParams, MCL, MCLParams, MotionParams,
+    SyncMessage, SyncParams,
+)
+from teamnav.localization.density_tree import DensityTree
+from teamnav.localization.resample import low_variance_kernel
+from teamnav.localization.sync import SYNC_KIND, detection_tree
+from teamnav.world.grid import FREE
+
+__all__ = ["MCLWander", "MCLWanderParams", "load_detection_model", "MODEL_DIR"]
+
+#: Folder of the detection models shipped with teamnav (``detection_model: default`` is
+#: ``MODEL_DIR / "detection-default.json"``).
+MODEL_DIR: Path = Path(str(resources.files("teamnav.localization"))) / "models"
+
+#: ``Message.kind`` of identity-association traffic.
+ASSOC_KIND = "mcl_assoc"
+
+
+def load_detection_model(name: str) -> DetectionModel:
+    """A detection model by name (``MODEL_DIR/detection-NAME.json``) or by file path."""
+    p = Path(name)
+    if p.suffix.lower() != ".json":
+        p = MODEL_DIR / f"detection-{name}.json"
+    if not p.is_file():
+        known = sorted(q.stem.removeprefix("detection-") for q in MODEL_DIR.glob("detection-*.json"))
+        raise ValueError(f"detection_model must name a shipped model ({', '.join(known)}) or a .json file, "
+                         f"got {name!r} (no file {p})")
+    return DetectionModel.load(p)
+
+
+@dataclass(frozen=True)
+class _AssocQuery:
+    """Broadcast: "whose belief fits this tree of the robot I saw?" (identity withheld)."""
+
+    qid: int
+    observer: int
+    tree: DensityTree
+
+
+@dataclass(frozen=True)
+class _AssocAnswer:
+    """Answer to :class:`_AssocQuery`: the tree's density under the answering robot's belief."""
+
+    qid: int
+    observer: int
+    evidence: float
+
+
+class MCLWanderParams(BaseModel):
+    """Parameters of ``mcl-wander-v1`` (units in the names; see the module docstring).
+
+    Attributes
+    ----------
+    sensor : str or None
+        Range sensor used for localization and for avoiding obstacles (None: the first).
+    wander : WanderParams
+        The wanderer (cruise speed, wall following, ...).
+    max_particles, min_particles : int
+        KLD-sampling bounds (global initialisation draws ``max_particles``).
+    adaptive : bool
+        KLD-sampling on (else a fixed ``max_particles``).
+    kld_epsilon : float
+        KLD error bound.
+    random_fraction : float
+        Share of samples replaced per step by uniform ones (§3.1).
+    sensor_model : {"beam", "likelihood_field"}
+    beam, likelihood_field, motion
+        Model parameters (the library's).
+    beam_stride : int
+        Use every n-th beam.
+    likelihood_exponent : float
+        Tempering of ``P(o | l)`` against correlated beams.
+    resample_ess_fraction : float
+        Resample only when the effective sample size ``1 / sum w²`` is below this share of
+        the set (selective resampling, Doucet et al. 2000; 1: every update as in §3.1).
+        Fewer resamplings keep the modes of a symmetric belief from dying out by drift.
+    sonar_rays_per_cone : int
+        Rays cast across a sonar cone by the filter (its expected range is their minimum).
+    init_clearance_m : float
+        Uniform samples only where the map's clearance is at least this [m] (the robot's
+        body cannot be closer to a wall).
+    min_update_m, min_update_deg : float
+        Filter update (motion + scan) only once odometry accumulated this much motion; the
+        odometry steps in between are composed into one (as AMCL's ``update_min_d``).
+    motion_mode : {"wander", "stay"}
+        Wander, or stand still (Marian in §5.1 "operating in the lab facing towards the
+        opening of the hallway").
+    init_pose : (x_m, y_m, theta_deg) or None
+        None: global localization (uniform over free space); else position tracking from a
+        known start, a Gaussian of ``init_std_m`` / ``init_std_deg`` (the paper's training
+        runs and its localized robot in §5.1 start so).
+    collaborate : bool
+        Synchronise beliefs on detections (§3.2); False: single-robot MCL.
+    send_min_cluster_weight : float
+        Beyond the paper (§7.2 "Delayed integration" suggests holding back updates when
+        both robots are highly uncertain): a detection is sent only when the observer's
+        heaviest belief cluster holds at least this weight; 0 (default): always, as in §3.2.
+    inject_fraction : float
+        Beyond the paper: on a received detection tree, this share of the samples is first
+        replaced by draws from the tree (uniform heading) before eq. 14 reweights them all
+        (:meth:`MCL.replace_samples`: sensor resetting). 0 (default): pure eq. 14. Needed
+        with our sample sets (thousands, not the paper's "very large" ones) when the belief
+        has no sample near the detected position.
+    detection_model : str
+        Shipped model name or a path to a model file (:func:`load_detection_model`).
+    detection_period_s : float
+        Camera frame period: detections are looked at once per period [s].
+    min_travel_m : float
+        §2.3 rule 2.
+    tree_min_samples, tree_max_depth : int
+        Density-tree stopping rule.
+    false_positive_filter : bool
+        The three gates of the module docstring.
+    fp_min_free_mass, fp_confirm_window_s, fp_confirm_gate_m, fp_min_real_prob
+        Their thresholds.
+    anonymous : {"associate", "ignore"}
+        What to do with detections without identity.
+    assoc_min_ratio, assoc_margin : float
+        Association thresholds.
+    log_points : int
+        Particles (drawn by weight) logged every recorded step for scoring.
+    layer_every : int
+        Every this many log() calls, a ``particles`` layer of ``layer_points`` for the replay.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    sensor: str | None = Field(None, min_length=1)
+    wander: WanderParams = WanderParams(cruise_speed_mps=0.3, turn_rate_radps=0.8)
+    max_particles: int = Field(5000, ge=10, le=1_000_000)
+    min_particles: int = Field(300, ge=10, le=1_000_000)
+    adaptive: bool = True
+    kld_epsilon: float = Field(0.05, gt=0.0, le=1.0)
+    random_fraction: float = Field(0.005, ge=0.0, le=0.5)
+    sensor_model: Literal["beam", "likelihood_field"] = "beam"
+    beam: BeamModelParams = BeamModelParams(z_hit=0.7, z_short=0.1, z_max=0.1, z_rand=0.1, sigma_hit_m=0.2)
+    likelihood_field: LikelihoodFieldParams = LikelihoodFieldParams()
+    motion: MotionParams = MotionParams(alpha=(0.1, 0.05, 0.05, 0.05))
+    beam_stride: int = Field(1, ge=1, le=64)
+    likelihood_exponent: float = Field(0.5, gt=0.0, le=1.0)
+    resample_ess_fraction: float = Field(0.5, gt=0.0, le=1.0)
+    sonar_rays_per_cone: int = Field(3, ge=1, le=64)
+    init_clearance_m: float = Field(0.2, ge=0.0, le=10.0)
+    min_update_m: float = Field(0.2, ge=0.0, le=10.0)
+    min_update_deg: float = Field(15.0, ge=0.0, le=360.0)
+    motion_mode: Literal["wander", "stay"] = "wander"
+    init_pose: tuple[float, float, float] | None = None
+    init_std_m: float = Field(0.3, gt=0.0, le=100.0)
+    init_std_deg: float = Field(10.0, gt=0.0, le=360.0)
+    collaborate: bool = False
+    send_min_cluster_weight: float = Field(0.0, ge=0.0, le=1.0)
+    inject_fraction: float = Field(0.0, ge=0.0, le=0.5)
+    detection_model: str = Field("default", min_length=1)
+    detection_period_s: float = Field(1.0, ge=0.0, le=60.0)
+    min_travel_m: float = Field(2.5, ge=0.0, le=1000.0)
+    tree_min_samples: int = Field(20, ge=1, le=100_000)
+    tree_max_depth: int = Field(20, ge=1, le=64)
+    false_positive_filter: bool = False
+    fp_min_free_mass: float = Field(0.5, ge=0.0, le=1.0)
+    fp_confirm_window_s: float = Field(2.5, gt=0.0, le=60.0)
+    fp_confirm_gate_m: float = Field(1.5, gt=0.0, le=100.0)
+    fp_min_real_prob: float = Field(0.5, ge=0.0, le=1.0)
+    anonymous: Literal["associate", "ignore"] = "associate"
+    assoc_min_ratio: float = Field(5.0, ge=1.0, le=1e9)
+    assoc_margin: float = Field(3.0, ge=1.0, le=1e9)
+    log_points: int = Field(64, ge=1, le=1000)
+    layer_every: int = Field(20, ge=1, le=100_000)
+    layer_points: int = Field(200, ge=1, le=1000)
+
+    def mcl_params(self) -> MCLParams:
+        """The library's filter parameters these stand for."""
+        return MCLParams(
+            n_particles=self.max_particles, sensor_model=self.sensor_model, beam=self.beam,
+            likelihood_field=self.likelihood_field, motion=self.motion, beam_stride=self.beam_stride,
+            likelihood_exponent=self.likelihood_exponent, recovery="fixed" if self.random_fraction > 0 else "none",
+            random_fraction=self.random_fraction, adaptive=self.adaptive,
+            kld=KLDParams(epsilon=self.kld_epsilon, min_particles=min(self.min_particles, self.max_particles),
+                          max_particles=self.max_particles),
+            sonar_rays_per_cone=self.sonar_rays_per_cone, init_clearance_m=self.init_clearance_m,
+        )
+
+
+def _to_odom(odom_pose: np.ndarray, range_m: float, bearing_rad: float) -> np.ndarray:
+    """A detection's point in the observer's odometry frame."""
+    a = float(odom_pose[2]) + bearing_rad
+    return np.array([odom_pose[0] + range_m * math.cos(a), odom_pose[1] + range_m * math.sin(a)])
+
+
+class MCLWander:
+    """``mcl-wander-v1``: wander and localize, optionally with the team (see the module docstring).
+
+    Parameters
+    ----------
+    params : MCLWanderParams
+    rng : numpy.random.Generator
+    info : RobotInfo
+        Must carry ``known_map`` (scenario ``give_map: true``) and the range sensor.
+    """
+
+    Params = MCLWanderParams
+
+    def __init__(self, params: MCLWanderParams, rng: np.random.Generator, info: RobotInfo) -> None:
+        if not isinstance(params, MCLWanderParams):
+            raise ValueError(f"params must be an MCLWander.Params, got {type(params).__name__}")
+        if info.known_map is None:
+            raise ValueError(f"robot {info.robot_id}: mcl-wander-v1 needs a map; set 'give_map: true' in the scenario")
+        self.params = params
+        self.info = info
+        self.robot_id = int(info.robot_id)
+        self.rng = rng
+        self.wander = Wander(params.wander.model_copy(update={"sensor": params.sensor}), rng, info)
+        self.sensor = info.sensors[self.wander.sensor]
+        self.mcl = MCL(params.mcl_params(), info.known_map, self.sensor, rng)
+        if params.init_pose is None:
+            self.mcl.init_global()
+        else:
+            x, y, th = params.init_pose
+            self.mcl.init_pose([x, y, math.radians(th)], np.diag([params.init_std_m ** 2, params.init_std_m ** 2,
+                                                                  math.radians(params.init_std_deg) ** 2]))
+        self.model = load_detection_model(params.detection_model) if params.collaborate else None
+        self.sync = (BeliefSync(self.robot_id, self.model, SyncParams(min_travel_m=params.min_travel_m,
+                                                                      tree_min_samples=params.tree_min_samples,
+                                                                      tree_max_depth=params.tree_max_depth), rng)
+                     if params.collaborate else None)
+        self._free = (info.known_map.cells == FREE)
+        self._next_frame_s = 0.0
+        self._last_seen: dict[Any, tuple[float, np.ndarray]] = {}  # id -> (time, point in odom frame)
+        self._pending: dict[int, dict] = {}  # association queries: query id -> {"tree", "det", "scores", "t"}
+        self._query_seq = 0
+        self._odom = np.zeros(3)
+        self._acc = np.zeros(3)  # odometry composed since the last filter update
+        self._stepped = False
+        self._min_rot = math.radians(params.min_update_deg)
+        self._n_log = 0
+        self._time_s = 0.0
+        #: Counters for logs: detections seen / sent, phantoms filtered, messages dropped, associations.
+        self.stats = {"seen": 0, "sent": 0, "filtered": 0, "rejected": 0, "assoc": 0, "assoc_dropped": 0}
+
+    # ------------------------------------------------------------------ step
+    def step(self, obs: Observation) -> tuple[Action, list[Message]]:
+        """Localize (motion + scan), apply teammates' messages, look for teammates, wander."""
+        p = self.params
+        self._odom = np.asarray(obs.odom_pose, dtype=float)
+        self._time_s = float(obs.time_s)
+        scan = obs.scans[self.wander.sensor]
+        self._accumulate(np.asarray(obs.odom_delta, dtype=float))
+        acc = self._acc
+        if not self._stepped or math.hypot(acc[0], acc[1]) >= p.min_update_m or abs(acc[2]) >= self._min_rot:
+            self._filter_step(acc, scan.ranges_m)
+            self._acc = np.zeros(3)
+            self._stepped = True
+        out: list[Message] = []
+        if self.sync is not None:
+            self.sync.travel(obs.odom_delta)
+            for msg in obs.inbox:
+                out += self._on_message(msg, obs)
+            if obs.time_s + 1e-9 >= self._next_frame_s:
+                self._next_frame_s = obs.time_s + p.detection_period_s
+                out += self._on_detections(obs)
+            out += self._close_queries(obs)
+        action, _ = self.wander.step(obs)
+        if p.motion_mode == "stay":
+            action = Action.stop()
+        return action, out
+
+    def _filter_step(self, odom_delta: np.ndarray, ranges: np.ndarray) -> None:
+        """Resample (only when the effective sample size fell below ``resample_ess_fraction``
+        of the set), predict, weight: :meth:`MCL.step` with selective resampling."""
+        w = self.mcl.weights
+        if self._stepped and 1.0 / float(np.dot(w, w)) < self.params.resample_ess_fraction * w.shape[0]:
+            self.mcl.resample()
+        self.mcl.predict(odom_delta)
+        self.mcl.update(ranges)
+
+    def _accumulate(self, d: np.ndarray) -> None:
+        """Compose this step's odometry ``d`` (previous body frame) onto the pending motion."""
+        a = self._acc
+        c, s_ = math.cos(a[2]), math.sin(a[2])
+        th = a[2] + d[2]
+        self._acc = np.array([a[0] + c * d[0] - s_ * d[1], a[1] + s_ * d[0] + c * d[1],
+                              math.atan2(math.sin(th), math.cos(th))])
+
+    # ------------------------------------------------------------------ detections
+    def _free_mass(self, det) -> float:
+        """Weight of the observer's belief that puts the detected robot in free space (gate 1)."""
+        pos = self.model.sample_positions(self.mcl.particles, det.range_m, det.bearing_rad, self.rng)
+        g = self.info.known_map
+        ix = np.floor((pos[:, 0] - g.origin_xy_m[0]) / g.resolution_m).astype(np.int64)
+        iy = np.floor((pos[:, 1] - g.origin_xy_m[1]) / g.resolution_m).astype(np.int64)
+        h, w = self._free.shape
+        inside = (ix >= 0) & (ix < w) & (iy >= 0) & (iy < h)
+        ok = np.zeros(pos.shape[0], dtype=bool)
+        ok[inside] = self._free[iy[inside], ix[inside]]
+        return float(np.dot(self.mcl.weights, ok))
+
+    def _confirmed(self, key, det, t_s: float) -> bool:
+        """Gate 2: the same robot seen on a recent frame at a consistent place (odometry frame)."""
+        pt = _to_odom(self._odom, det.range_m, det.bearing_rad)
+        prev = self._last_seen.get(key)
+        self._last_seen[key] = (t_s, pt)
+        if prev is None or t_s - prev[0] > self.params.fp_confirm_window_s:
+            return False
+        return bool(np.hypot(*(pt - prev[1])) <= self.params.fp_confirm_gate_m)
+
+    def _on_detections(self, obs: Observation) -> list[Message]:
+        p = self.params
+        out: list[Message] = []
+        keep = []
+        for det in obs.detections:
+            self.stats["seen"] += 1
+            if det.robot_id is not None and det.robot_id == self.robot_id:
+                continue
+            if p.false_positive_filter:
+                key = det.robot_id if det.robot_id is not None else ("anon", self._anon_key(det))
+                if not self._confirmed(key, det, obs.time_s) or self._free_mass(det) < p.fp_min_free_mass:
+                    self.stats["filtered"] += 1
+                    continue
+            keep.append(det)
+        if p.send_min_cluster_weight > 0 and self.mcl.estimate().cluster_weight < p.send_min_cluster_weight:
+            return out
+        named = [d for d in keep if d.robot_id is not None]
+        if named:
+            msgs = self.sync.on_detections(self.mcl, named, obs.time_s)
+            self.stats["sent"] += len(msgs)
+            out += msgs
+        if p.anonymous == "associate":
+            for det in keep:
+                if det.robot_id is None:
+                    out += self._query(det, obs)
+        return out
+
+    def _anon_key(self, det) -> int:
+        """Anonymous detections are matched to the previous frame's nearest one (gate 2)."""
+        pt = _to_odom(self._odom, det.range_m, det.bearing_rad)
+        best, best_d = None, math.inf
+        for key, (_, q) in self._last_seen.items():
+            if isinstance(key, tuple) and key[0] == "anon":
+                d = float(np.hypot(*(pt - q)))
+                if d < best_d:
+                    best, best_d = key[1], d
+        if best is not None and best_d <= self.params.fp_confirm_gate_m:
+            return best
+        self._query_seq += 1
+        return -self._query_seq
+
+    # ------------------------------------------------------------------ identity by belief
+    def _query(self, det, obs: Observation) -> list[Message]:
+        """Broadcast the detection tree; teammates answer with its density under their beliefs."""
+        if not self.sync.detect_gate.allowed(-1):  # one anonymous use per min_travel_m
+            return []
+        tree = detection_tree(self.mcl.particles, self.mcl.weights, det.range_m, det.bearing_rad, self.model,
+                              self.rng, self.sync.params)
+        self._query_seq += 1
+        qid = self._query_seq
+        self._pending[qid] = {"tree": tree, "det": det, "scores": {}, "t": obs.time_s}
+        return [Message(self.robot_id, float(obs.time_s), _AssocQuery(qid, self.robot_id, tree), to=None,
+                        kind=ASSOC_KIND)]
+
+    def _close_queries(self, obs: Observation) -> list[Message]:
+        """Pick the robot an anonymous detection was of, once the answers are in (one step later)."""
+        out: list[Message] = []
+        p = self.params
+        for qid in [q for q, v in self._pending.items() if obs.time_s > v["t"] + 1e-9]:
+            pend = self._pending.pop(qid)
+            scores = sorted(pend["scores"].items(), key=lambda kv: -kv[1])
+            uniform = 1.0 / self.mcl.free_area_m2
+            if not scores or scores[0][1] < p.assoc_min_ratio * uniform or (
+                    len(scores) > 1 and scores[0][1] < p.assoc_margin * scores[1][1]):
+                self.stats["assoc_dropped"] += 1
+                continue
+            rid = int(scores[0][0])
+            if not self.sync.detect_gate.allowed(rid):
+                continue
+            det = pend["det"]
+            body = SyncMessage("detection", self.robot_id, rid, float(det.range_m), float(det.bearing_rad),
+                               float(self.model.p_false_positive), pend["tree"])
+            out.append(Message(self.robot_id, float(obs.time_s), body, to=rid, kind=SYNC_KIND))
+            self.sync.detect_gate.use(rid)
+            self.sync.detect_gate.use(-1)
+            self.stats["assoc"] += 1
+            self.stats["sent"] += 1
+        return out
+
+    # ------------------------------------------------------------------ messages
+    def _evidence(self, tree) -> float:
+        """``E = sum_i w_i tree(x_i)``: the tree's density under this robot's belief [1/m²]."""
+        return float(np.dot(self.mcl.weights, tree(self.mcl.particles[:, :2])))
+
+    def _on_message(self, msg: Message, obs: Observation) -> list[Message]:
+        p = self.params
+        body = msg.body
+        if msg.kind == ASSOC_KIND:
+            if isinstance(body, _AssocQuery) and body.observer != self.robot_id:
+                return [Message(self.robot_id, float(obs.time_s), _AssocAnswer(body.qid, body.observer,
+                                                                                self._evidence(body.tree)),
+                                to=body.observer, kind=ASSOC_KIND)]
+            if isinstance(body, _AssocAnswer) and body.observer == self.robot_id and body.qid in self._pending:
+                self._pending[body.qid]["scores"][msg.sender] = body.evidence
+            return []
+        if msg.kind != SYNC_KIND or not isinstance(body, SyncMessage):
+            return []
+        if p.false_positive_filter and body.kind == "detection" and body.target == self.robot_id:
+            e = self._evidence(body.tree)
+            pf = body.p_false_positive
+            real = (1 - pf) * e / ((1 - pf) * e + pf / self.mcl.free_area_m2) if pf > 0 else 1.0
+            if real < p.fp_min_real_prob:
+                self.stats["rejected"] += 1
+                return []
+        if (p.inject_fraction > 0 and body.kind == "detection" and body.target == self.robot_id
+                and self.sync.receive_gate.allowed(body.observer)):
+            k = int(round(p.inject_fraction * self.mcl.n_particles))
+            xy = body.tree.sample(k, self.rng)
+            th = self.rng.uniform(-math.pi, math.pi, size=k)
+            self.mcl.replace_samples(np.column_stack([xy, th]))
+        return self.sync.on_message(self.mcl, msg, obs.time_s)
+
+    # ------------------------------------------------------------------ logs
+    def _subsample(self, k: int) -> np.ndarray:
+        """``k`` particles drawn by weight (low-variance), so their plain mean is the weighted one."""
+        w = self.mcl.weights
+        k = min(k, w.shape[0])
+        idx = low_variance_kernel(w, k, float(self.rng.random()), np.empty(k, dtype=np.int64))
+        return self.mcl.particles[idx]
+
+    def log(self) -> dict[str, Any]:
+        """Belief summary every recorded step; a particle layer every ``layer_every`` calls.
+
+        ``pts``: ``log_points`` particles drawn by weight, flattened ``[x0, y0, x1, y1, ...]`` [m]
+        rounded to cm: the metric's estimate of the paper's "average distance of all samples
+        from the reference position" (§5.1) is their mean distance to the true position.
+        """
+        p = self.params
+        est = self.mcl.estimate()
+        sub = self._subsample(p.log_points)
+        out: dict[str, Any] = {
+            "est_x": round(float(est.cluster_pose[0]), 3),
+            "est_y": round(float(est.cluster_pose[1]), 3),
+            "est_th": round(float(est.cluster_pose[2]), 3),
+            "n_particles": int(est.n_particles),
+            "spread_m": round(float(math.sqrt(max(0.0, est.cov[0, 0] + est.cov[1, 1]))), 3),
+            "syncs": int(sum(self.sync.applied.values())) if self.sync is not None else 0,
+            "pts": [round(float(v), 2) for v in sub[:, :2].ravel()],
+        }
+        if self._n_log == 0:
+            out["sensor_kind"] = self.sensor.kind
+            out["group"] = str(self.info.extras.get("group", ""))
+        if self.sync is not None and self._n_log % p.layer_every == 0:
+            out.update({k: v for k, v in self.stats.items()})
+        if self._n_log % p.layer_every == 0:
+            pts = self._subsample(p.layer_points)[:, :2].astype(np.float32)
+            out["layers"] = {"particles": {"data": pts, "kind": "points", "frame": "world", "hold": True,
+                                           "description": "MCL samples (drawn by weight), map frame"}}
+        self._n_log += 1
+        return out
