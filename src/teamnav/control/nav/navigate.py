@@ -22,11 +22,14 @@ One step, in priority order:
    preferred heading; afterwards no second reversal for ``reverse_cooldown_s``.
 4. **Openings** (:mod:`teamnav.control.nav.openings`): "If the robot detects a corridor and it
    is not already turning, there is a 50% chance that the robot will decide to take the new
-   corridor and make a sharp 90° turn into the corridor" (exploring; ``p_take_opening``). With a
+   corridor and make a sharp 90° turn into the corridor" (exploring; ``p_take_opening``). The
+   robot drives on to the opening's centre, then turns on the spot until it faces square to
+   the wall the opening is cut into (90 deg when it was driving parallel to the wall). With a
    trail, "the corridor-seeking behaviour is overridden by a trail-following component if the
    trail points away from the opening": the robot takes the direction, among continuing
-   straight (when the way ahead is clear for ``straight_clear_m``) and the detected openings
-   (current heading +-90 deg), closest to the preferred heading. This is our reading; the
+   straight along the corridor (when some beam within ``straight_half_angle_deg`` of it reads
+   ``straight_clear_m``) and the detected openings (square to the wall, left or right), closest
+   to the preferred heading. This is our reading; the
    paper's results paragraph (§5.1) says the robot turns "if the average heading of the crumbs
    points to the side where the opening is detected", i.e. within 90 deg of the opening
    direction; ``trail_rule="side"`` gives that rule instead (any preferred heading more than
@@ -48,7 +51,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from teamnav.control.nav.openings import Opening, OpeningDetector
 from teamnav.control.nav.panic import Panic
-from teamnav.control.nav.wall_follow import BoxCommand, SlidingBox, box_exit_ranges
+from teamnav.control.nav.wall_follow import BoxCommand, SlidingBox
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Observation
 
@@ -79,6 +82,7 @@ class NavigateParams(BaseModel):
     wall_side: Literal["left", "right"] = "left"
     box_margin_m: float = Field(0.15, ge=0.0, le=5.0)
     box_length_m: float = Field(1.0, gt=0.0, le=20.0)
+    box_near_m: float = Field(0.1, ge=-1.0, le=20.0)
     box_reach_m: float = Field(1.2, gt=0.0, le=20.0)
     slide_step_m: float = Field(0.05, gt=0.0, le=1.0)
     p_take_opening: float = Field(0.5, ge=0.0, le=1.0)
@@ -89,14 +93,15 @@ class NavigateParams(BaseModel):
     opening_sector_deg: float = Field(80.0, gt=0.0, le=180.0)
     opening_wall_tolerance_m: float = Field(0.4, ge=0.0, le=10.0)
     opening_cooldown_m: float = Field(1.5, ge=0.0, le=50.0)
-    straight_clear_m: float = Field(2.0, ge=0.0, le=50.0)
+    straight_clear_m: float = Field(3.0, ge=0.0, le=1000.0)
+    straight_half_angle_deg: float = Field(20.0, gt=0.0, le=90.0)
     trail_rule: Literal["closest", "side"] = "closest"
     side_rule_min_deg: float = Field(20.0, ge=0.0, le=90.0)
     reverse_threshold_deg: float = Field(135.0, ge=90.0, le=180.0)
     reverse_cooldown_s: float = Field(5.0, ge=0.0, le=600.0)
     turn_tolerance_deg: float = Field(3.0, gt=0.0, le=45.0)
     turn_timeout_s: float = Field(8.0, gt=0.0, le=600.0)
-    panic_clearance_m: float = Field(0.08, gt=0.0, le=5.0)
+    panic_clearance_m: float = Field(0.12, gt=0.0, le=5.0)
     panic_half_angle_deg: float = Field(60.0, gt=0.0, le=180.0)
     panic_free_m: float = Field(0.8, gt=0.0, le=20.0)
     panic_forward_s: float = Field(2.0, ge=0.0, le=60.0)
@@ -109,6 +114,8 @@ class NavigateParams(BaseModel):
                 f"opening_sector_deg must be >= opening_extreme_deg ({self.opening_extreme_deg}), "
                 f"got {self.opening_sector_deg}"
             )
+        if self.box_near_m >= self.box_length_m:
+            raise ValueError(f"box_near_m must be < box_length_m ({self.box_length_m}), got {self.box_near_m}")
         return self
 
 
@@ -170,7 +177,7 @@ class Navigate:
         self.side_sign = 1.0 if p.wall_side == "left" else -1.0
         radius = float(info.radius_m)
         width = 2.0 * radius + 2.0 * p.box_margin_m
-        self.box = SlidingBox(self.angles_rad, width, p.box_length_m, max(p.slide_step_m, p.box_reach_m - 0.5 * width),
+        self.box = SlidingBox(self.angles_rad, width, p.box_length_m, p.box_near_m, max(p.slide_step_m, p.box_reach_m - 0.5 * width),
                               p.slide_step_m, self.cruise_mps, p.steer_gain_per_s, self.turn_rate_radps,
                               p.min_speed_fraction, p.wall_side)
         self.openings = OpeningDetector(self.angles_rad, p.opening_near_m, p.opening_jump_m,
@@ -179,9 +186,7 @@ class Navigate:
         self.panic = Panic(self.angles_rad, radius, p.panic_clearance_m, p.panic_half_angle_deg, width,
                            p.panic_free_m, self.cruise_mps, self.turn_rate_radps, p.panic_forward_s,
                            p.panic_turn_timeout_s, self.dt_s)
-        half = 0.5 * width
-        self._straight_exit = box_exit_ranges(self.angles_rad, -0.01, max(p.straight_clear_m, 1e-3),
-                                              np.array([-half]), np.array([half]))[0]
+        self._straight_half_rad = math.radians(p.straight_half_angle_deg)
         self._reverse_rad = math.radians(p.reverse_threshold_deg)
         self._side_rule_rad = math.radians(p.side_rule_min_deg)
         self._turn_tol_rad = math.radians(p.turn_tolerance_deg)
@@ -195,6 +200,7 @@ class Navigate:
         self.panic.reset()
         self.box.reset()
         self.box_state = "open"
+        self.box_offset_m = math.nan
         self.last_opening: str | None = None
         self._odo_m = 0.0  # odometry path length so far [m]
         self._last_pose: tuple[float, float, float] | None = None
@@ -208,6 +214,7 @@ class Navigate:
         self._advance_steps = 0
         self._advance_max_steps = 0
         self._pending_dir = 0.0
+        self._pending_heading_rad = 0.0
 
     def _cool(self, extra_m: float) -> None:
         self._cool_until_m = [self._odo_m + extra_m, self._odo_m + extra_m]
@@ -230,9 +237,11 @@ class Navigate:
         rate = self.turn_rate_radps * min(1.0, max(0.3, remaining / 0.3))
         return 0.0, self._turn_dir * rate
 
-    def _straight_ok(self, ranges_m: np.ndarray) -> bool:
-        """The way ahead is clear for ``straight_clear_m``: continuing straight is an option."""
-        return not bool((ranges_m < self._straight_exit).any())
+    def _straight_ok(self, ranges_m: np.ndarray, along_rad: float) -> bool:
+        """Continuing straight on is an option: some beam within ``straight_half_angle_deg`` of the
+        corridor's direction ``along_rad`` (body frame) reads at least ``straight_clear_m``."""
+        near = np.abs(self.angles_rad - along_rad) <= self._straight_half_rad
+        return bool(near.any()) and float(ranges_m[near].max()) >= self.params.straight_clear_m
 
     def _choose_opening(self, found: list[Opening], ranges_m: np.ndarray, heading_rad: float,
                         preferred_rad: float | None) -> Opening | None:
@@ -244,14 +253,15 @@ class Navigate:
             if len(taken) > 1:
                 return taken[int(self.rng.integers(len(taken)))]
             return taken[0] if taken else None
+        along = found[0].wall_rad  # straight on = along the corridor's wall
         if self.params.trail_rule == "side":
-            rel = _wrap(preferred_rad - heading_rad)
+            rel = _wrap(preferred_rad - heading_rad - along)
             for o in found:
                 if o.side * rel > self._side_rule_rad:
                     return o
             return None
         best: Opening | None = None
-        best_err = abs(_wrap(preferred_rad - heading_rad)) if self._straight_ok(ranges_m) else math.inf
+        best_err = abs(_wrap(preferred_rad - heading_rad - along)) if self._straight_ok(ranges_m, along) else math.inf
         for o in found:
             err = abs(_wrap(preferred_rad - (heading_rad + o.direction_rad)))
             if err < best_err:
@@ -319,14 +329,15 @@ class Navigate:
         elif self.mode == "advance":
             self._advance_steps += 1
             if self._odo_m >= self._advance_to_m or self._advance_steps > self._advance_max_steps:
-                self._start_turn(self._pending_dir, 0.5 * math.pi)
+                # Square to the wall: the heading chosen when the opening was seen (odometry frame).
+                self._start_turn(self._pending_dir, max(0.0, self._pending_dir * _wrap(self._pending_heading_rad - th)))
                 cmd = self._turn_command()
                 if cmd is not None:
                     return self._clip(*cmd)
                 self.mode = "navigate"
             else:
                 box = self.box.command(r)
-                self.box_state = box.state
+                self.box_state, self.box_offset_m = box.state, box.offset_m
                 return self._clip(box.v_mps, box.omega_radps)
 
         # 3. Heading against the trail: a sharp 180 deg right turn.
@@ -340,7 +351,7 @@ class Navigate:
             self.mode = "navigate"
 
         box: BoxCommand = self.box.command(r)
-        self.box_state = box.state
+        self.box_state, self.box_offset_m = box.state, box.offset_m
         # 4. Openings: decided once each, not while the box has the robot turning on the spot.
         if box.state != "blocked":
             left, right = self.openings.detect(r)
@@ -356,6 +367,7 @@ class Navigate:
                     self.last_opening = "left" if choice.side > 0 else "right"
                     self.mode = "advance"
                     self._pending_dir = float(choice.side)
+                    self._pending_heading_rad = th + choice.direction_rad
                     self._advance_to_m = self._odo_m + choice.advance_m
                     self._advance_steps = 0
                     self._advance_max_steps = int(round((choice.advance_m / self.cruise_mps + 3.0) / self.dt_s))

@@ -15,15 +15,17 @@ Read here, per side, walking the beams from the outermost one (+90 deg on the le
    ``jump_m`` further: the near edge of an opening, ``P1``;
 2. *an opening wide enough*: the first beam past the jump whose return lies back on the wall
    line (its lateral distance at most ``wall_tolerance_m`` beyond ``P1``'s) is the far edge
-   ``P2``; the opening's width is the distance along the heading from ``P1`` to ``P2``
-   (infinite when the wall does not come back within the side sector, e.g. a hall), and it
-   counts when at least ``min_width_m`` (the robot's diameter plus a margin).
+   ``P2``; the wall's direction is that from ``P1`` to the furthest return back on the wall
+   line; the opening's width is ``P1 -> P2`` measured along the wall (infinite when the wall
+   does not come back within the side sector, e.g. a hall), and it counts when at least
+   ``min_width_m`` (the robot's diameter plus a margin).
 
 The detection fires while the near edge is beside the robot (the extreme beams), so the
-opening's centre lies ``advance_m`` ahead along the heading: that is where the robot should make
-its sharp 90 deg turn. Gaps the paper leaves open: the three thresholds and the width measure
-(along the heading, which assumes the walls run roughly parallel to the robot, as they do while
-it follows a wall); a passing place shallower than ``jump_m`` is not an opening.
+opening's centre lies ``advance_m`` ahead along the wall (``P1 -> P2``): that is where the robot
+should make its sharp 90 deg turn, square to the wall (so a robot still angled towards the
+wall it follows turns into the corridor, not into the door post). Gaps the paper leaves open:
+the three thresholds and the width measure; a passing place shallower than ``jump_m`` is not an
+opening.
 
 All per-beam work is NumPy over the side's beams (index arrays precomputed from the sensor's
 angles): no Python loop over beams.
@@ -48,17 +50,24 @@ class Opening:
     side : int
         +1 left, -1 right.
     direction_rad : float
-        Direction into the opening in the body frame [rad]: ``side * pi / 2``.
+        Direction into the opening in the body frame [rad]: square to the wall,
+        ``wall_rad + side * pi / 2``.
+    wall_rad : float
+        Direction of the wall the opening is cut into (from its near to its far edge) in the
+        body frame [rad]: 0 when the robot drives parallel to it (or the far edge is not in
+        sight); the robot's way straight on along the corridor.
     width_m : float
-        Width along the heading [m] (``inf`` when the far edge is not in sight).
+        Width from the near to the far edge [m] (``inf`` when the far edge is not in sight).
     advance_m : float
-        Distance ahead to the opening's centre [m]: drive this far, then turn 90 deg.
+        Distance ahead, along the wall, to the opening's centre [m]: drive this far, then
+        make the sharp turn into it.
     lateral_m : float
         Lateral distance of the wall whose edge was found [m].
     """
 
     side: int
     direction_rad: float
+    wall_rad: float
     width_m: float
     advance_m: float
     lateral_m: float
@@ -122,17 +131,25 @@ class OpeningDetector:
         x = r * cos_a
         y = r * sin_a  # lateral distance towards this side
         x1, y1 = float(x[j]), float(y[j])
-        back = np.flatnonzero((y[j + 1:] <= y1 + self.wall_tolerance_m) & (x[j + 1:] > x1))
+        on_wall = (y[j + 1:] <= y1 + self.wall_tolerance_m) & (x[j + 1:] > x1)
+        back = np.flatnonzero(on_wall)
         if back.size:
-            x2 = float(x[j + 1 + int(back[0])])
-            width = x2 - x1
-            advance = 0.5 * (x1 + x2)
+            # The wall runs from P1 to the furthest return back on its line: measure along it.
+            k, last = j + 1 + int(back[0]), j + 1 + int(back[-1])
+            dx, dy = float(x[last]) - x1, float(y[last]) - y1
+            norm = math.hypot(dx, dy)
+            ux, uy = (dx / norm, dy / norm) if norm > 1e-9 else (1.0, 0.0)
+            wall_rad = side * math.atan2(uy, ux)
+            x2, y2 = float(x[k]), float(y[k])
+            width = (x2 - x1) * ux + (y2 - y1) * uy
+            advance = 0.5 * ((x1 + x2) * ux + (y1 + y2) * uy)
         else:
             width = math.inf
+            wall_rad = 0.0
             advance = x1 + 0.5 * self.min_width_m
         if width < self.min_width_m:
             return None
-        return Opening(side, side * 0.5 * math.pi, width, max(0.0, advance), y1)
+        return Opening(side, wall_rad + side * 0.5 * math.pi, wall_rad, width, max(0.0, advance), y1)
 
     def detect(self, ranges_m: np.ndarray) -> tuple[Opening | None, Opening | None]:
         """(left, right) openings in one scan (``ranges_m`` of shape (B,), no return = max range)."""

@@ -11,7 +11,7 @@ reused unchanged in *Try to see it my way* §3.3):
     the control system turns the robot in the opposite direction of the nearest obstacle."
 
 Geometry (body frame, x forward, y left, laser at the robot's centre): the box spans
-``x in [-0.01, box_length_m]`` ahead and ``box_width_m`` across; its lateral centre slides from
+``x in [box_near_m, box_length_m]`` ahead and ``box_width_m`` across; its lateral centre slides from
 ``+offset_max_m`` (left) to ``-offset_max_m`` (right) in steps of ``slide_step_m``. The robot
 keeps the wall at about half a box width (its radius plus the box margin): the box is just
 clear of the wall when its centre lies straight ahead.
@@ -28,6 +28,12 @@ Gaps the paper leaves open, filled here:
 - **Speed.** "Constant speed" while the chosen box lies ahead; the speed scales with the cosine
   of the heading error (at least ``min_speed_fraction``) so sharp steering does not swing the
   robot into the wall; when no box is free it turns on the spot.
+- **Near edge.** The box starts ``box_near_m`` (default 0.1 m) ahead of the laser, not at it,
+  and returns short of that line (beside the robot) neither block nor hide a box: the end of
+  the wall the robot is passing at an opening is not in its way. Counting it made the robot
+  curl round every left corner: the passed corner hides the first box while smaller boxes
+  further right already fit into the side corridor, so the robot steered into it, and turning
+  left made the side beams see more of the passed wall.
 - **Hysteresis.** The on-the-spot turn keeps the direction it started with until a box is
   free: the nearest obstacle changes side as the robot turns, and re-deciding every step would
   make it rock in place.
@@ -45,9 +51,6 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["BoxCommand", "SlidingBox", "box_exit_ranges"]
-
-#: box near edge [m]: a hair behind the laser so the beams at +-90 deg lie inside
-_X_NEAR_M = -0.01
 
 
 def box_exit_ranges(angles_rad: np.ndarray, x0_m: float, x1_m: float, y0_m: np.ndarray, y1_m: np.ndarray) -> np.ndarray:
@@ -129,7 +132,9 @@ class SlidingBox:
         Box width across the heading [m] ("a little bigger than the robot": the caller passes
         the robot's diameter plus twice a margin).
     box_length_m : float
-        Box depth ahead of the robot [m].
+        Far edge of the box ahead of the robot [m].
+    box_near_m : float
+        Near edge of the box ahead of the robot [m].
     offset_max_m : float
         Lateral centre of the first (leftmost) box [m]; the box slides to ``-offset_max_m``.
     slide_step_m : float
@@ -144,12 +149,13 @@ class SlidingBox:
     Examples
     --------
     >>> angles = np.linspace(-np.pi / 2, np.pi / 2, 181)
-    >>> box = SlidingBox(angles, 0.8, 1.0, 0.8, 0.05, 0.4, 2.0, 1.5, 0.25)
+    >>> box = SlidingBox(angles, 0.8, 1.0, 0.1, 0.8, 0.05, 0.4, 2.0, 1.5, 0.25)
     >>> box.command(np.full(181, 8.0)).state      # nothing in sight: straight on
     'open'
     """
 
-    def __init__(self, angles_rad: np.ndarray, box_width_m: float, box_length_m: float, offset_max_m: float,
+    def __init__(self, angles_rad: np.ndarray, box_width_m: float, box_length_m: float, box_near_m: float,
+                 offset_max_m: float,
                  slide_step_m: float, cruise_speed_mps: float, steer_gain_per_s: float, turn_rate_radps: float,
                  min_speed_fraction: float, side: str = "left") -> None:
         if side not in ("left", "right"):
@@ -157,6 +163,9 @@ class SlidingBox:
         self.angles_rad = np.asarray(angles_rad, dtype=np.float64).copy()
         self.box_width_m = float(box_width_m)
         self.box_length_m = float(box_length_m)
+        self.box_near_m = float(box_near_m)
+        if not self.box_near_m < self.box_length_m:
+            raise ValueError(f"box_near_m must be < box_length_m ({self.box_length_m}), got {self.box_near_m}")
         self.cruise_speed_mps = float(cruise_speed_mps)
         self.steer_gain_per_s = float(steer_gain_per_s)
         self.turn_rate_radps = float(turn_rate_radps)
@@ -168,8 +177,9 @@ class SlidingBox:
         half = 0.5 * self.box_width_m
         centres = np.concatenate([self.offsets_m, [0.0]])  # last row: the box straight ahead
         #: (K + 1, B) exit distances; row K is the box straight ahead
-        self.exit_m = box_exit_ranges(self.angles_rad, _X_NEAR_M, self.box_length_m, centres - half, centres + half)
+        self.exit_m = box_exit_ranges(self.angles_rad, self.box_near_m, self.box_length_m, centres - half, centres + half)
         self._sin = np.sin(self.angles_rad)
+        self._cos = np.cos(self.angles_rad)
         self._away = 0.0  # turn direction kept while no box is free (0: none yet)
 
     def reset(self) -> None:
@@ -177,8 +187,12 @@ class SlidingBox:
         self._away = 0.0
 
     def blocked(self, ranges_m: np.ndarray) -> np.ndarray:
-        """(K + 1,) bool: each slide position (in slide order), then the box straight ahead, blocked."""
-        return (ranges_m[None, :] < self.exit_m).any(axis=1)
+        """(K + 1,) bool: each slide position (in slide order), then the box straight ahead, blocked.
+
+        Returns that end short of the near edge (beside the robot) neither block nor hide a box.
+        """
+        r = np.where(ranges_m * self._cos < self.box_near_m, np.inf, ranges_m)
+        return (r[None, :] < self.exit_m).any(axis=1)
 
     def command(self, ranges_m: np.ndarray) -> BoxCommand:
         """The sliding-box command for one scan (``ranges_m`` of shape (B,), no-return = max range).
@@ -202,7 +216,7 @@ class SlidingBox:
             return BoxCommand(0.0, self._away * self.turn_rate_radps, math.nan, "blocked")
         self._away = 0.0
         offset = float(self.offsets_m[free[0]])
-        err = math.atan2(offset, 0.5 * self.box_length_m)
+        err = math.atan2(offset, 0.5 * (self.box_near_m + self.box_length_m))
         omega = max(-self.turn_rate_radps, min(self.turn_rate_radps, self.steer_gain_per_s * err))
         v = self.cruise_speed_mps * max(self.min_speed_fraction, math.cos(err))
         return BoxCommand(v, omega, offset, "follow")
