@@ -232,7 +232,8 @@ def test_four_robots_one_simulated_hour_wall_time(brain):
         pytest.skip(f"{brain} not registered")
     scn = load_scenario("trail-team", duration_s=3600.0,
                         overrides={"robots.0.controller": brain, "robots.0.odometry.heading_drift_deg_per_min": 1.0,
-                                   "robots.0.params": {"cruise_speed_mps": 0.4, "communicate": True}})
+                                   "robots.0.params": {"cruise_speed_mps": 0.4, "communicate": True,
+                                                       "layer_every_steps": 100000}})
     t0 = time.perf_counter()
     res = run(scn, progress=False)
     wall = time.perf_counter() - t0
@@ -249,7 +250,7 @@ def test_trail_share_memory_flat_over_ten_hours():
                         overrides={"robots.0.controller": "trail-share-v1", "record_every": 200,
                                    "robots.0.odometry.heading_drift_deg_per_min": 1.0,
                                    "robots.0.params": {"cruise_speed_mps": 0.4, "communicate": True,
-                                                       "policy": "optimistic"}})
+                                                       "policy": "optimistic", "layer_every_steps": 100000}})
     t0 = time.perf_counter()
     res = run(scn, progress=False)
     m = res.metrics
