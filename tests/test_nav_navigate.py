@@ -394,3 +394,23 @@ def test_preferred_heading_along_the_corridor_makes_progress(monkeypatch):
     assert odom[-1, 0] - odom[0, 0] > 15.0  # ~0.4 m/s east for most of a minute
     assert np.all(np.abs(odom[odom.shape[0] // 4:, 1] - 4.9) < 0.9)  # stayed in C1, passed the doors
     assert result.metrics["collisions_wall"] == 0
+
+
+# ------------------------------------------------------------------------ kernels vs NumPy references
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), scale=st.sampled_from([0.5, 1.5, 4.0]))
+def test_kernels_match_their_numpy_references(seed, scale):
+    from teamnav.control.nav.openings import any_near_edge
+    from teamnav.control.nav.wall_follow import first_free_box
+
+    rng = np.random.default_rng(seed)
+    r = np.minimum(rng.exponential(scale, 181), MAX_R)
+    box = sliding_box()
+    ref = box.blocked(r)
+    free = np.flatnonzero(~ref[:-1])
+    assert first_free_box(r, np.cos(ANGLES), box.box_near_m, box.exit_m) == (int(free[0]) if free.size else -1, bool(ref[-1]))
+    det = detector()
+    quick = any_near_edge(r, det._head, det.near_m, det.jump_m)
+    assert quick or det.detect_side(r, 0) is None and det.detect_side(r, 1) is None  # never misses a near edge
+    p = Panic(ANGLES, RADIUS, 0.12, 60.0, WIDTH, 0.8, 0.3, 1.0, 2.0, 8.0, 0.1)
+    assert p.critical(r) == bool((r[np.abs(ANGLES) <= math.radians(60.0)] < RADIUS + 0.12).any())

@@ -300,7 +300,7 @@ class Navigate:
             raise ValueError(f"scan {self.laser!r} must have {self.angles_rad.size} beams, got shape {r.shape}")
         if not np.isfinite(r).all():
             r = np.where(np.isfinite(r), r, self.max_range_m)
-        x, y, th = (float(v) for v in obs.odom_pose[:3])
+        x, y, th = np.asarray(obs.odom_pose, dtype=np.float64)[:3].tolist()
         if self._last_pose is not None:
             lx, ly, lth = self._last_pose
             self._odo_m += math.hypot(x - lx, y - ly)

@@ -37,8 +37,24 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
-__all__ = ["Opening", "OpeningDetector"]
+__all__ = ["Opening", "OpeningDetector", "any_near_edge"]
+
+
+@njit(cache=True)
+def any_near_edge(ranges_m: np.ndarray, head: np.ndarray, near_m: float, jump_m: float) -> bool:
+    """True when either side's extreme beams show a nearby return followed by a large jump.
+
+    ``head`` (2, n) holds each side's extreme beam indices, outermost first. The quick test
+    before :meth:`OpeningDetector.detect_side` (its NumPy reference) looks closer.
+    """
+    for s in range(head.shape[0]):
+        for j in range(head.shape[1] - 1):
+            r0 = ranges_m[head[s, j]]
+            if r0 < near_m and ranges_m[head[s, j + 1]] - r0 > jump_m:
+                return True
+    return False
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,6 +132,12 @@ class OpeningDetector:
             order = keep[np.argsort(-sa[keep], kind="stable")]  # outermost first
             n_ext = int(np.count_nonzero(sa[order] >= outer - math.radians(extreme_deg)))
             self._sides.append((side, order, np.cos(a[order]), side * np.sin(a[order]), max(0, min(n_ext, order.size - 1))))
+        # Both sides' extreme beams in one index array (outermost first), for a quick first test.
+        n = max(s[4] for s in self._sides)
+        self._quick = n > 0
+        if self._quick:
+            self._head = np.stack([s[1][: n + 1] if s[4] == n else np.resize(s[1][: s[4] + 1], n + 1)
+                                   for s in self._sides])
 
     def detect_side(self, ranges_m: np.ndarray, k: int) -> Opening | None:
         """The opening on side ``k`` (0 left, 1 right), or None."""
@@ -153,4 +175,8 @@ class OpeningDetector:
 
     def detect(self, ranges_m: np.ndarray) -> tuple[Opening | None, Opening | None]:
         """(left, right) openings in one scan (``ranges_m`` of shape (B,), no return = max range)."""
+        if not self._quick:
+            return None, None
+        if not any_near_edge(ranges_m, self._head, self.near_m, self.jump_m):
+            return None, None  # the usual case: no near edge in either extreme
         return self.detect_side(ranges_m, 0), self.detect_side(ranges_m, 1)

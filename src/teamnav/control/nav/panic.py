@@ -27,10 +27,20 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from teamnav.control.nav.wall_follow import box_exit_ranges
 
 __all__ = ["Panic"]
+
+
+@njit(cache=True)
+def _any_below(ranges_m: np.ndarray, idx: np.ndarray, limit_m: float) -> bool:
+    """``(ranges_m[idx] < limit_m).any()`` without the temporaries (the emergency-stop test)."""
+    for i in idx:
+        if ranges_m[i] < limit_m:
+            return True
+    return False
 
 
 class Panic:
@@ -84,7 +94,7 @@ class Panic:
 
     def critical(self, ranges_m: np.ndarray) -> bool:
         """An obstacle critically close to the front: the emergency-stop condition."""
-        return bool(self._front.size) and bool((ranges_m[self._front] < self.critical_m).any())
+        return _any_below(ranges_m, self._front, self.critical_m)
 
     def free_ahead(self, ranges_m: np.ndarray) -> bool:
         """The box straight ahead is free (every beam crossing it leaves it before its return)."""

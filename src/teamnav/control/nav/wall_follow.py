@@ -49,8 +49,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
-__all__ = ["BoxCommand", "SlidingBox", "box_exit_ranges"]
+__all__ = ["BoxCommand", "SlidingBox", "box_exit_ranges", "first_free_box"]
 
 
 def box_exit_ranges(angles_rad: np.ndarray, x0_m: float, x1_m: float, y0_m: np.ndarray, y1_m: np.ndarray) -> np.ndarray:
@@ -97,6 +98,41 @@ def box_exit_ranges(angles_rad: np.ndarray, x0_m: float, x1_m: float, y0_m: np.n
     t_in = np.maximum(np.maximum(tx_in, ty_in), 0.0)
     t_out = np.minimum(tx_out, ty_out)
     return np.where(t_out > t_in, t_out, -np.inf)
+
+
+@njit(cache=True)
+def first_free_box(ranges_m: np.ndarray, cos_a: np.ndarray, near_m: float, exit_m: np.ndarray) -> tuple[int, bool]:
+    """Slide the box: the first free slide position, and whether the box straight ahead is blocked.
+
+    Kernel twin of :meth:`SlidingBox.blocked` (which is its NumPy reference): box ``k`` of
+    ``exit_m`` (rows 0..K-1 in slide order, row K straight ahead) is blocked when a beam whose
+    return lies at or beyond the near edge (``range * cos >= near_m``) ends before leaving it.
+    Stops at the first free position, so a robot in the open checks one box.
+
+    Returns
+    -------
+    (int, bool)
+        Index of the first free slide position (-1: none), and "straight ahead blocked".
+    """
+    n_rows, n_beams = exit_m.shape
+    first = -1
+    for k in range(n_rows - 1):
+        free = True
+        for b in range(n_beams):
+            r = ranges_m[b]
+            if r * cos_a[b] >= near_m and r < exit_m[k, b]:
+                free = False
+                break
+        if free:
+            first = k
+            break
+    ahead = False
+    for b in range(n_beams):
+        r = ranges_m[b]
+        if r * cos_a[b] >= near_m and r < exit_m[n_rows - 1, b]:
+            ahead = True
+            break
+    return first, ahead
 
 
 @dataclass(frozen=True, slots=True)
@@ -201,13 +237,11 @@ class SlidingBox:
         turn towards its centre; first box free and the way ahead free: straight; no free box:
         turn on the spot away from the nearest obstacle.
         """
-        blocked = self.blocked(ranges_m)
-        slide = blocked[:-1]
-        if not slide[0] and not blocked[-1]:
+        first, ahead_blocked = first_free_box(ranges_m, self._cos, self.box_near_m, self.exit_m)
+        if first == 0 and not ahead_blocked:
             self._away = 0.0
             return BoxCommand(self.cruise_speed_mps, 0.0, float(self.offsets_m[0]), "open")
-        free = np.flatnonzero(~slide)
-        if free.size == 0:
+        if first < 0:
             if self._away == 0.0:
                 nearest = int(np.argmin(ranges_m))
                 side = self._sin[nearest]
@@ -215,7 +249,7 @@ class SlidingBox:
                 self._away = -math.copysign(1.0, side) if abs(side) > 1e-9 else -self.sign
             return BoxCommand(0.0, self._away * self.turn_rate_radps, math.nan, "blocked")
         self._away = 0.0
-        offset = float(self.offsets_m[free[0]])
+        offset = float(self.offsets_m[first])
         err = math.atan2(offset, 0.5 * (self.box_near_m + self.box_length_m))
         omega = max(-self.turn_rate_radps, min(self.turn_rate_radps, self.steer_gain_per_s * err))
         v = self.cruise_speed_mps * max(self.min_speed_fraction, math.cos(err))
