@@ -172,8 +172,9 @@ class _FakeCtx:
     progress = False
     out_dir = Path(".")
 
-    def __init__(self, table):
+    def __init__(self, table, quick=True):
         self.table = table
+        self.quick = quick
         self.calls = []
 
     def sweep(self, name, **kw):
@@ -197,7 +198,7 @@ def test_blazing_section_verdicts_follow_the_data():
             return [_row(2, 150.0, extra={"params": {"robots.0.params.communicate": False}})]
         return [_row(9, 100.0), _row(10, 90.0)]
 
-    blocks = SECTION.build(_FakeCtx(table))
+    blocks = SECTION.build(_FakeCtx(table, quick=False))
     comps = {b.claim: b for b in blocks if isinstance(b, Comparison)}
     assert len(comps) == 3
     verdicts = [c.holds for c in comps.values()]
