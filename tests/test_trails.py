@@ -287,3 +287,21 @@ def test_closed_loop_trail_sharing_on_trail_office():
             assert home.trail.place_mask("took_resource").sum() > 0
         else:  # the finder knows two Places, the robot at home one: refused
             assert home.refused > 0 and "took_resource" not in home.trail.places
+
+
+def test_brain_three_place_round_seeks_each_place_in_turn(monkeypatch):
+    """N = 3 (a mail round, §2.1): the goal cycles depot -> a -> b -> depot; the trail rule reads
+    only the crumbs of the current goal; ``every_place`` lays one crumb per visited Place."""
+    (r,) = _brains(monkeypatch, n=1, round=["depot", "a", "b"], crumbs_for="every_place", radius_m=5.0)
+    _, out = r.step(_obs(0, 0, [0.0, 0.0, 0.0]))
+    r.step(_obs(0, 50, [10.0, 0.0, 0.0], events=["a"]))
+    assert r.round.goal == "b" and set(r.trail.places) == {"depot", "a"}
+    r.trail.add_crumbs(["b", "depot"], [[12.0, 2.0], [8.0, -2.0]], [1.0, 0.5], [5.0, 5.0])
+    r.step(_obs(0, 51, [10.0, 0.0, 0.0]))
+    assert r.nav.headings[-1] == pytest.approx(math.pi / 4)  # to the "b" crumb, not the lower-s "depot" one
+    _, out = r.step(_obs(0, 80, [11.0, 1.0, 0.0]))
+    assert out[0].body.crumb_place == ("depot", "a")  # one crumb per visited Place
+    np.testing.assert_allclose(out[0].body.crumb_s, [8.0, 3.0])  # time since each visit
+    r.step(_obs(0, 100, [12.0, 2.0, 0.0], events=["b"]))
+    r.step(_obs(0, 150, [0.0, 0.0, 0.0], events=["depot"]))
+    assert r.round.goal == "a" and r.round.trips == 3 and r.log()["place_index"] == 1

@@ -46,11 +46,19 @@ from teamnav.control.nav.navigate import Navigate, NavigateParams
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, Message, Observation
 
-__all__ = ["BlazingTrail", "BlazingTrailParams", "navigate_params"]
+__all__ = ["NAVIGATE_DEFAULTS", "BlazingTrail", "BlazingTrailParams", "navigate_params"]
+
+
+#: Navigate settings of the trail brains unless their ``navigate`` dict says otherwise. Blazing
+#: §5.1: "When the robot detects an opening it turns into the opening if the average heading of
+#: the crumbs points to the side where the opening is detected" (Navigate's ``trail_rule="side"``;
+#: with "closest" the averaged heading lags at corners and robots overshoot into the next door).
+NAVIGATE_DEFAULTS: dict[str, Any] = {"trail_rule": "side"}
 
 
 def navigate_params(navigate: dict[str, Any], cruise_speed_mps: float) -> NavigateParams:
-    """NavigateParams from a brain's ``navigate`` dict, with the brain's cruise speed.
+    """NavigateParams from a brain's ``navigate`` dict over :data:`NAVIGATE_DEFAULTS`, with the
+    brain's cruise speed.
 
     Raises
     ------
@@ -60,7 +68,7 @@ def navigate_params(navigate: dict[str, Any], cruise_speed_mps: float) -> Naviga
     """
     if "cruise_speed_mps" in navigate:
         raise ValueError("navigate must not set cruise_speed_mps; set the brain's cruise_speed_mps instead")
-    return NavigateParams(**{**navigate, "cruise_speed_mps": cruise_speed_mps})
+    return NavigateParams(**{**NAVIGATE_DEFAULTS, **navigate, "cruise_speed_mps": cruise_speed_mps})
 
 
 class BlazingTrailParams(BaseModel):
@@ -85,7 +93,8 @@ class BlazingTrailParams(BaseModel):
     layer_every_steps : int
         Draw the global crumbs in the replay at most once per this many steps.
     navigate : dict
-        Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields.
+        Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields, over
+        ``NAVIGATE_DEFAULTS`` (``trail_rule="side"``, Blazing §5.1).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)

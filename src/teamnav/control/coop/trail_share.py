@@ -85,7 +85,8 @@ class TrailShareParams(BaseModel):
     layer_every_steps : int
         Draw the trail in the replay at most once per this many steps.
     navigate : dict
-        Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields.
+        Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields, over
+        ``NAVIGATE_DEFAULTS`` (``trail_rule="side"``, Blazing §5.1).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
