@@ -23,10 +23,19 @@ from teamnav.control.coop.los_help.goal_sharing import (
     hops,
     point_visible,
     relayed_id,
+    sender_frame,
 )
-from teamnav.control.coop.los_help.messages import MESSAGE_KIND, GoalShare, LosHelpMsg, Sighting, VisReport
+from teamnav.control.coop.los_help.messages import (
+    MESSAGE_KIND,
+    GoalShare,
+    LosHelpMsg,
+    Sighting,
+    VisReport,
+    message_size_bytes,
+)
 from teamnav.control.coop.los_help.state_sharing import TroubleState, choose_helper
 from teamnav.geometry import wrap_angle
+from teamnav.geometry.bearings import relative_frame_from_bearings
 from teamnav.geometry.se2 import relative, transform_points
 
 N_BEAMS = 360
@@ -362,6 +371,19 @@ def test_receive_path_maps_goals_through_mutual_bearings(start1, p1, p2, g):
     np.testing.assert_allclose(got[1:], want, atol=1e-6)
 
 
+@settings(max_examples=200, deadline=None)
+@given(st.floats(-10, 10), st.floats(-10, 10), st.floats(0, 50))
+def test_scalar_frame_equals_relative_frame_from_bearings(b21, b12, d):
+    np.testing.assert_allclose(sender_frame(b21, b12, d), relative_frame_from_bearings(b21, b12, d), atol=1e-9)
+
+
+@pytest.mark.parametrize("n", [0, 1, 3])
+def test_message_size_formula_matches_message_size_bytes(n):
+    body = LosHelpMsg(7, tuple(Sighting(i, 0.1, 2.0) for i in range(n)), tuple(GoalShare(i, 4, 1.0, 2.0) for i in range(n)),
+                      tuple(VisReport(i, 4, 3.0) for i in range(n)), None if n == 1 else bool(n))
+    assert message_size_bytes(body) == Message(0, 0.0, body, kind=MESSAGE_KIND).size_bytes()
+
+
 def test_broadcast_shares_goals_relays_and_counts_bytes(straight_nav):
     m = 3
     r = LosHelper(LosHelper.Params(patrol_xy=[(1.0, 0.0), (5.0, 0.0)]), np.random.default_rng(0), info(2, m))
@@ -382,6 +404,32 @@ def test_broadcast_shares_goals_relays_and_counts_bytes(straight_nav):
     assert log["msgs_sent"] == 2 and log["bytes_sent"] == first[0].size_bytes() + message.size_bytes()
     assert message.size_bytes() > first[0].size_bytes()  # one more goal, one report
     assert log["mode"] == "patrol" and log["known_goals"] == 1
+
+
+def test_navigator_that_gives_up_is_started_afresh(monkeypatch):
+    class GiveUp(StraightNav):
+        def direction(self, pose, scan):
+            return None
+
+    made = []
+
+    def make(*a, **k):
+        made.append(GiveUp() if not made else StraightNav())
+        return made[-1]
+
+    monkeypatch.setattr(brain_mod, "make_navigator", make)
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)]), np.random.default_rng(0), info(0, 1))
+    wall = [(0.0, 0.3, 2.0)]
+    a, _ = r1.step(obs(0, walls=wall))
+    assert a.direction_rad is None and r1.log()["nav_restarts"] == 1 and r1.moves == 0
+    a, _ = r1.step(obs(1, walls=wall))
+    assert len(made) == 2 and a.direction_rad == pytest.approx(0.0) and r1.moves == 1
+    stay = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], restart_navigator_on_give_up=False),
+                       np.random.default_rng(0), info(0, 1))
+    made.clear()
+    stay.step(obs(0, walls=wall))
+    stay.step(obs(1, walls=wall))
+    assert len(made) == 1 and stay.moves == 0
 
 
 def test_params_are_validated():

@@ -55,10 +55,18 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from teamnav.control.coop.los_help.goal_sharing import (
     GoalSharing,
-    goal_in_own_frame,
+    max_beam_gap,
     point_visible,
+    sender_frame,
 )
-from teamnav.control.coop.los_help.messages import MESSAGE_KIND, GoalShare, LosHelpMsg, Sighting, VisReport
+from teamnav.control.coop.los_help.messages import (
+    MESSAGE_KIND,
+    GoalShare,
+    LosHelpMsg,
+    Sighting,
+    VisReport,
+    message_size_bytes,
+)
 from teamnav.control.coop.los_help.state_sharing import TroubleState, choose_helper
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, Message, Observation, RangeScan
@@ -121,6 +129,9 @@ class _CommonParams(BaseModel):
         Head straight to a visible target, suppressing A (§2 point 4); False asks A.
     log_layers : bool
         Add the ``"layers"`` entry (goal and ghost points) to :meth:`log`.
+    restart_navigator_on_give_up : bool
+        When A returns no heading for a target (VisBug-21 found it "unreachable"), build A
+        afresh so it starts over from the current position (gap filled; False: stay).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
@@ -139,6 +150,7 @@ class _CommonParams(BaseModel):
     progress_min_fraction: float = Field(0.25, ge=0.0, le=1.0)
     straight_when_visible: bool = True
     log_layers: bool = True
+    restart_navigator_on_give_up: bool = True
 
 
 class LosExplorerParams(_CommonParams):
@@ -203,11 +215,14 @@ class _LosBrain:
         self._last_target: tuple[str, Any, float] | None = None
         self.mode = "own_goal"
         self.moves = 0
+        self.nav_restarts = 0
         self.msgs_sent = 0
         self.bytes_sent = 0
         self.msgs_received = 0
         self._pose = np.zeros(3)
         self._scan: RangeScan | None = None
+        self._gap_for: Any = None
+        self._gap_rad = 0.0
 
     # ------------------------------------------------------------------ sensing helpers
     def _odom_to_body(self, x: float, y: float) -> XY:
@@ -225,7 +240,10 @@ class _LosBrain:
         if self._scan is None:
             return False
         bx, by = self._odom_to_body(x, y)
-        return point_visible((bx, by), self._scan.ranges_m, self._scan.angles_rad, self.vis_radius_m, margin_m)
+        angles = self._scan.angles_rad
+        if self._gap_for is not angles:  # the beam layout rarely changes: measure its gaps once
+            self._gap_for, self._gap_rad = angles, max_beam_gap(np.asarray(angles, dtype=np.float64))
+        return point_visible((bx, by), self._scan.ranges_m, angles, self.vis_radius_m, margin_m, self._gap_rad)
 
     def _me_xy(self) -> XY:
         return float(self._pose[0]), float(self._pose[1])
@@ -293,11 +311,14 @@ class _LosBrain:
                 continue  # the sender did not see me: no mutual bearing
             pose_k, seen_k = hist
             rng_m, bearing = seen_k[s]
-            sender_xy = self._body_to_odom(pose_k, rng_m * math.cos(bearing), rng_m * math.sin(bearing))
+            # §3.1: the sender's body frame in mine (at the sending step), θ21 = 180° + α21 − α12
+            rel = sender_frame(bearing, back.bearing_rad, rng_m)
+            sender_xy = self._body_to_odom(pose_k, float(rel[0]), float(rel[1]))
+            c, sn = math.cos(rel[2]), math.sin(rel[2])
             for g in body.goals:
                 if g.owner == self.me:
                     continue
-                gxy = goal_in_own_frame((g.gx_m, g.gy_m), pose_k, bearing, back.bearing_rad, rng_m)
+                gxy = self._body_to_odom(pose_k, rel[0] + c * g.gx_m - sn * g.gy_m, rel[1] + sn * g.gx_m + c * g.gy_m)
                 self.sharing.receive_goal(g.owner, g.goal_id, gxy)
             me_k = (float(pose_k[0]), float(pose_k[1]))
             for r in body.reports:
@@ -318,7 +339,7 @@ class _LosBrain:
         body = LosHelpMsg(int(obs.step), sights, goals, reports, bool(self.trouble.tr) if p.state_sharing else None)
         msg = Message(self.me, float(obs.time_s), body, kind=MESSAGE_KIND)
         self.msgs_sent += 1
-        self.bytes_sent += msg.size_bytes()
+        self.bytes_sent += message_size_bytes(body)
         return [msg]
 
     # ------------------------------------------------------------------ motion
@@ -337,6 +358,11 @@ class _LosBrain:
         heading = nav.direction(self._pose.copy(), self._scan)
         progressing = bool(nav.progressing)
         if heading is None:
+            if self.params.restart_navigator_on_give_up:
+                # gap filled: A gave up on this target (VisBug's "unreachable", which on a grid
+                # with a robot radius can be wrong): start A afresh from here next step
+                self._nav, self._nav_goal = None, None
+                self.nav_restarts += 1
             return Action(), progressing
         return Action(direction_rad=float(wrap_angle(heading - self._pose[2]))), progressing
 
@@ -402,6 +428,7 @@ class _LosBrain:
             "msgs_sent": int(self.msgs_sent),
             "bytes_sent": int(self.bytes_sent),
             "msgs_received": int(self.msgs_received),
+            "nav_restarts": int(self.nav_restarts),
             "known_goals": len(self.sharing.known),
             "ghosts": sum(1 for p in self.sharing.points() if p.kind != "direct"),
             "own_d_m": float(own.distance_m(self._me_xy())) if own is not None else -1.0,
@@ -509,6 +536,7 @@ class LosExplorer(_LosBrain):
         steps commanded so far), ``mode`` (``"own_goal"`` | ``"follow_teammate"`` |
         ``"ghost"`` | ``"trouble_follow"`` | ``"done"``), ``tr``, ``pr``, ``nt`` (§5),
         ``msgs_sent``, ``bytes_sent``, ``msgs_received`` (§4.4 traffic, cumulative),
+        ``nav_restarts`` (times A gave up and was started afresh),
         ``known_goals`` and ``ghosts`` (memory, §4.4), ``own_d_m`` (D to its own goal, -1
         when none), ``finished``; and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
         the odometry frame (when ``log_layers``).

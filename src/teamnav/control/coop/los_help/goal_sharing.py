@@ -55,7 +55,6 @@ from typing import Callable, Iterable
 
 import numpy as np
 
-from teamnav.geometry.angles import wrap_angle
 from teamnav.geometry.bearings import relative_frame_from_bearings, transform_goal
 from teamnav.geometry.se2 import compose, transform_points
 
@@ -65,11 +64,13 @@ __all__ = [
     "KnownGoal",
     "accept_goal_id",
     "goal_in_own_frame",
+    "sender_frame",
     "sender_pose_in_own_frame",
     "can_relay",
     "goal_id",
     "goal_index",
     "hops",
+    "max_beam_gap",
     "point_visible",
     "relayed_id",
 ]
@@ -138,6 +139,25 @@ def sender_pose_in_own_frame(own_pose, bearing_sender_in_me_rad: float, bearing_
     return compose(np.asarray(own_pose, dtype=np.float64), rel)
 
 
+def sender_frame(bearing_sender_in_me_rad: float, bearing_me_in_sender_rad: float,
+                 distance_m: float) -> tuple[float, float, float]:
+    """Scalar twin of :func:`teamnav.geometry.bearings.relative_frame_from_bearings` (same formula,
+    §3.1 θ21 = 180° + α21 − α12): the sender's body frame (x, y, θ) in the receiver's body frame.
+
+    The brains call it once per received message; the tests check it equals the array version.
+
+    Examples
+    --------
+    >>> [round(v, 12) for v in sender_frame(0.0, 0.0, 2.0)]
+    [2.0, 0.0, 3.14159265359]
+    """
+    theta = math.pi + bearing_sender_in_me_rad - bearing_me_in_sender_rad
+    theta = math.atan2(math.sin(theta), math.cos(theta))
+    if theta <= -math.pi:
+        theta = math.pi
+    return (distance_m * math.cos(bearing_sender_in_me_rad), distance_m * math.sin(bearing_sender_in_me_rad), theta)
+
+
 def goal_in_own_frame(goal_in_sender_body, own_pose, bearing_sender_in_me_rad: float,
                       bearing_me_in_sender_rad: float, distance_m: float) -> np.ndarray:
     """A point the sender gave in its body frame, in the receiver's own odometry frame (§3.1).
@@ -195,16 +215,16 @@ def point_visible(point_body_xy, ranges_m: np.ndarray, angles_rad: np.ndarray, r
     if d < 1e-9:
         return True
     b = math.atan2(y, x)
-    diff = np.abs(wrap_angle(np.asarray(angles_rad, dtype=np.float64) - b))
+    diff = np.abs(np.mod(np.asarray(angles_rad, dtype=np.float64) - b + math.pi, 2 * math.pi) - math.pi)
     i = int(np.argmin(diff))
     if max_gap_rad is None:
-        max_gap_rad = _max_gap(np.asarray(angles_rad, dtype=np.float64))
+        max_gap_rad = max_beam_gap(np.asarray(angles_rad, dtype=np.float64))
     if diff[i] > max_gap_rad:
         return False
     return bool(ranges_m[i] >= d - margin_m)
 
 
-def _max_gap(angles: np.ndarray) -> float:
+def max_beam_gap(angles: np.ndarray) -> float:
     """Largest gap [rad] between adjacent beams (the blind sector of a limited field of view excluded)."""
     if angles.size < 2:
         return math.radians(2.0)
