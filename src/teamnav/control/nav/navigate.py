@@ -33,8 +33,10 @@ One step, in priority order:
    paper's results paragraph (§5.1) says the robot turns "if the average heading of the crumbs
    points to the side where the opening is detected", i.e. within 90 deg of the opening
    direction; ``trail_rule="side"`` gives that rule instead (any preferred heading more than
-   ``side_rule_min_deg`` to that side). Each opening is decided once: a side is not looked at
-   again until the robot has driven ``opening_cooldown_m`` (or the opening's width) further.
+   ``side_rule_min_deg`` to that side). Exploring, each opening is decided once: a side is not
+   looked at again until the robot has driven ``opening_cooldown_m`` (or the opening's width)
+   further; with a trail, an opening passed by is looked at again while it stays in sight (a
+   trail's hint changes as the robot nears a corner), and the cooldown follows a turn.
 5. Otherwise **wall following** with the sliding box (:mod:`teamnav.control.nav.wall_follow`).
 
 Odometry is used only as the robot's own dead reckoning over short spans (how far it has turned,
@@ -359,10 +361,13 @@ class Navigate:
                      if o is not None and self._odo_m >= self._cool_until_m[k]]
             if found:
                 choice = self._choose_opening(found, r, th, preferred_heading_rad)
-                for o in found:
-                    k = 0 if o.side > 0 else 1
-                    span = o.width_m if math.isfinite(o.width_m) else 0.0
-                    self._cool_until_m[k] = self._odo_m + max(self.params.opening_cooldown_m, span)
+                # A random decision is made once per opening; a trail decision is looked at
+                # again while the opening stays in sight (the hint may change meanwhile).
+                if preferred_heading_rad is None or choice is not None:
+                    for o in found:
+                        k = 0 if o.side > 0 else 1
+                        span = o.width_m if math.isfinite(o.width_m) else 0.0
+                        self._cool_until_m[k] = self._odo_m + max(self.params.opening_cooldown_m, span)
                 if choice is not None:
                     self.last_opening = "left" if choice.side > 0 else "right"
                     self.mode = "advance"
