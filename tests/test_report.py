@@ -121,6 +121,24 @@ def test_a_raising_section_is_shown_as_missing_with_its_error_and_the_cli_exits_
     assert statuses == {"fake-boom": "error", "fake-fine": "ok"}
 
 
+def test_the_report_is_written_after_every_section_with_the_rest_pending(tmp_path, sections):
+    seen: dict[str, str] = {}
+
+    def second(ctx):
+        seen["index"] = (ctx.out_dir / "index.html").read_text(encoding="utf-8")
+        seen["json"] = (ctx.out_dir / "report.json").read_text(encoding="utf-8")
+        return [Text("SECOND-DONE")]
+
+    sections("fake-first", lambda ctx: [Text("FIRST-DONE")])
+    sections("fake-second", second)
+    res = report.run_report(["fake-first", "fake-second"], tmp_path / "r", progress=False)
+    assert "FIRST-DONE" in seen["index"] and "SECOND-DONE" not in seen["index"]
+    assert "not built yet: the report is still running" in seen["index"]
+    assert [s["status"] for s in json.loads(seen["json"])["sections"]] == ["ok", "pending"]
+    final = res.index.read_text(encoding="utf-8")
+    assert "SECOND-DONE" in final and 'class="status-pending"' not in final and "still running" not in final
+
+
 def test_a_section_returning_something_else_than_blocks_is_an_error(tmp_path, sections):
     sections("fake-wrong", lambda ctx: [Text("ok"), {"not": "a block"}])
     res = report.run_report("fake-wrong", tmp_path / "r", progress=False)

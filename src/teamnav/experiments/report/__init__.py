@@ -11,7 +11,9 @@
    already there (the store is resumable, so a report killed half-way resumes too);
 3. render the blocks into ``DIR/index.html`` (:mod:`teamnav.experiments.report.html`), written
    under a temporary name and renamed, plus ``DIR/report.json`` (what each section returned:
-   status, wall time, comparisons, sweeps run and reused).
+   status, wall time, comparisons, sweeps run and reused). Both are rewritten after every
+   section, the sections still to come shown as pending, so a long full run can be read
+   while it goes and a killed one leaves a truthful report of what it finished.
 
 The four papers of EXPERIMENTS.md are always in ``all`` (:data:`EXPECTED_SECTIONS`): while a
 paper's section module does not exist, the report shows it as missing ("system not built
@@ -220,9 +222,10 @@ class SectionOutcome:
     ----------
     key, title, paper : str
         From the SectionSpec (or :data:`EXPECTED_SECTIONS` for a paper not built yet).
-    status : {"ok", "missing", "error"}
+    status : {"ok", "missing", "error", "pending"}
         ``missing``: no section module yet; ``error``: its build raised (the blocks then hold
-        one Missing block with the error).
+        one Missing block with the error); ``pending``: not built yet in a report that is
+        still running (only in the index.html written between sections).
     blocks : list
         The blocks to render, in order.
     wall_s : float
@@ -244,6 +247,7 @@ class SectionOutcome:
     traceback: str = ""
     summary: str = ""
     sweeps: list[dict[str, Any]] = field(default_factory=list)
+    html_cache: str = field(default="", repr=False)
 
     @property
     def comparisons(self) -> list[Comparison]:
@@ -386,7 +390,6 @@ def run_report(
     """
     from teamnav.experiments.executors import make_executor
     from teamnav.experiments.report.context import SweepContext
-    from teamnav.experiments.report.html import render_report
     from teamnav.experiments.sweep import SweepError
 
     t_start = time.perf_counter()
@@ -410,14 +413,32 @@ def run_report(
     def make_ctx(key: str) -> SweepContext:
         return SweepContext(out, quick=quick, executor=executor, workers=workers, address=address, progress=progress, section=key)
 
-    outcomes = [_build_one(key, sections[key], make_ctx, say) for key in keys]
-    wall = time.perf_counter() - t_start
-    meta = {"quick": quick, "executor": executor, "workers": workers, "address": address, "wall_s": wall}
-    html_text = render_report(outcomes, meta)
     index = out / "index.html"
-    _write_atomic(index, html_text)
-    from teamnav import __version__
+    outcomes: list[SectionOutcome] = []
+    for i, key in enumerate(keys):
+        outcomes.append(_build_one(key, sections[key], make_ctx, say))
+        # rewrite the report after every section: a long full run shows what it has so far,
+        # and the sections still to come are marked as pending, not left out
+        pending = [_pending(k, sections[k]) for k in keys[i + 1 :]]
+        _write_outputs(out, index, outcomes + pending, quick, executor, workers, address, time.perf_counter() - t_start)
+    if not keys:  # pragma: no cover - resolve_names never returns an empty list
+        _write_outputs(out, index, [], quick, executor, workers, address, time.perf_counter() - t_start)
+    return ReportResult(index=index, sections=outcomes, quick=quick, wall_s=time.perf_counter() - t_start)
 
+
+def _pending(key: str, spec: SectionSpec | None) -> SectionOutcome:
+    title, paper = (spec.title, spec.paper) if spec is not None else EXPECTED_SECTIONS[key][:2]
+    return SectionOutcome(key, title, paper, "pending", [Missing(what="this section", why="not built yet: the report is still running")])
+
+
+def _write_outputs(out: Path, index: Path, outcomes: list[SectionOutcome], quick: bool, executor: str,
+                   workers: int | None, address: str | None, wall_s: float) -> None:
+    """Write index.html and report.json (each atomically)."""
+    from teamnav import __version__
+    from teamnav.experiments.report.html import render_report
+
+    meta = {"quick": quick, "executor": executor, "workers": workers, "address": address, "wall_s": wall_s}
+    _write_atomic(index, render_report(outcomes, meta))
     summary = {
         "teamnav_version": __version__,
         "written_at": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
@@ -425,7 +446,6 @@ def run_report(
         "sections": [_outcome_json(s) for s in outcomes],
     }
     _write_atomic(out / "report.json", json.dumps(summary, indent=2, default=str) + "\n")
-    return ReportResult(index=index, sections=outcomes, quick=quick, wall_s=time.perf_counter() - t_start)
 
 
 def build_report(

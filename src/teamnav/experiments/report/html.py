@@ -45,7 +45,7 @@ td.holds { text-align: center; font-weight: bold; font-size: 1.1em; }
 .error { border-color: #cf222e; }
 figure { margin: 1em 0; } figure img { max-width: 100%; border: 1px solid #eaeef2; }
 figcaption, .note { color: #59636e; font-size: 0.9em; }
-.status-ok { color: #1a7f37; } .status-missing { color: #8c959f; } .status-error { color: #cf222e; }
+.status-ok { color: #1a7f37; } .status-missing { color: #8c959f; } .status-error { color: #cf222e; } .status-pending { color: #9a6700; }
 footer { margin-top: 3em; border-top: 1px solid #d0d7de; color: #59636e; font-size: 0.88em; }
 nav ol { padding-left: 1.4em; }
 """
@@ -167,6 +167,18 @@ def _verdicts(comps: Sequence[Comparison]) -> str:
 
 
 def _section(s: Any) -> str:
+    """A section's HTML, drawn once per outcome (cached on it: the report is rewritten after
+    every section, and figures are the slow part)."""
+    cached = getattr(s, "html_cache", None)
+    if cached:
+        return cached
+    text = _section_html(s)
+    if hasattr(s, "html_cache") and s.status != "pending":
+        s.html_cache = text
+    return text
+
+
+def _section_html(s: Any) -> str:
     out = [f'<section id="sec-{_e(s.key)}">', f"<h2>{_e(s.title)}</h2>"]
     paper = f"paper: <code>{_e(s.paper)}</code>" if s.paper else "paper: —"
     out.append(f'<p class="sub">{paper} · section <code>{_e(s.key)}</code> · '
