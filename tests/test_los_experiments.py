@@ -232,9 +232,8 @@ def test_noise_verdicts_follow_the_paper_rows():
 class _FakeCtx:
     """A ctx whose sweeps return hand-made rows (no simulation)."""
 
-    quick = True
-
-    def __init__(self):
+    def __init__(self, quick):
+        self.quick = quick
         self.calls = []
 
     def sweep(self, sweep_name, **kw):
@@ -242,7 +241,8 @@ class _FakeCtx:
         self.calls.append((name, kw))
         h = sum(v for k, v in (kw.get("set") or {}).items() if k.endswith(".count"))
         rows = [r for r in _by_team(True)[h]] if "table" in name else [
-            _row(nav, 300 + 100 * e, **{S.ERR_KEY: e}) for nav in L.NAVIGATORS for e in (0.0, 0.4)]
+            _row(nav, 300 + 100 * e, **{S.ERR_KEY: e, S.DELAYED_KEY: True, S.STATE_KEY: True})
+            for nav in L.NAVIGATORS for e in (0.0, 0.4)]
 
         class R:
             def rows(self):
@@ -252,16 +252,27 @@ class _FakeCtx:
 
 
 @needs_brains
-def test_build_asks_for_nested_teams_and_returns_tables_plots_and_comparisons():
-    ctx = _FakeCtx()
+def test_full_build_asks_for_nested_teams_and_every_sweep_and_returns_every_block_kind():
+    ctx = _FakeCtx(quick=False)
     blocks = S.build(ctx)
     names = [c[0] for c in ctx.calls]
-    assert names.count("los-table1") == len(S._teams("simple", True))
+    assert names.count("los-table1") == names.count("los-table2") == 4
+    assert {"los-noise-simple", "los-noise-complex", "los-ablation"} <= set(names)
     sets = [c[1]["set"] for c in ctx.calls if c[0] == "los-table1"]
     assert {"robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0} in sets  # R1+R2, not R1+R3
-    kinds = {type(b) for b in blocks}
-    assert {Table, Plot, Comparison, Missing} <= kinds
-    assert any(isinstance(b, Comparison) and b.holds for b in blocks)
+    assert {Table, Plot, Comparison} <= {type(b) for b in blocks}
+    assert not any(isinstance(b, Missing) for b in blocks)
+    verdicts = {b.claim: b.holds for b in blocks if isinstance(b, Comparison)}
+    assert verdicts["Table 1: Av. Past steps fall as helpers are added (R1, R1,2, R1,2,3, R1,2,3,4)"] is True
+
+
+@needs_brains
+def test_quick_build_runs_short_tasks_and_says_what_it_left_out():
+    ctx = _FakeCtx(quick=True)
+    blocks = S.build(ctx)
+    assert all(len(c[1]["grid"][S.TARGETS_KEY][0]) == S.QUICK_TARGETS for c in ctx.calls)
+    assert {b.what.split(" (")[0] for b in blocks if isinstance(b, Missing)} >= {"Table 2 / Fig. 14", "Fig. 17"}
+    assert all("quick mode" in b.differs for b in blocks if isinstance(b, Comparison) and b.holds is not None)
 
 
 # ---------------------------------------------------------------------------- a real run
