@@ -24,6 +24,12 @@ Deviation (said in the section too): the paper ran the state-sharing rule only w
 potential field; we keep it on for all three algorithms (one sweep grids the algorithm; a
 grid cannot tie two keys) and the ablation shows what it changes for Avoid-Past and VisBug.
 
+Running it: ``teamnav report los-help --out DIR`` (full) runs 2 x 4 x 15 table trials, 2 x 75
+noise trials and 60 ablation trials; ``teamnav sweep los-table1 --out DIR`` alone grids every
+subset of R2, R3, R4 (8 teams, 120 trials). Set ``NUMBA_NUM_THREADS=1`` for sweeps on a small
+box: the line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread
+launch costs more than the work for four robots.
+
 Quick mode (CI): the simple map only, the first target of task 1 with a 300-step budget,
 teams {R1, R1..R4}, err_max 0.4 (err_max 0 is the tables' R1..R4 run), no ablation: 9 short
 runs.
@@ -348,7 +354,8 @@ def ablation_block(rows: list[dict]) -> Table:
         table_rows.append([NAV_LABEL[nav], *cells])
     return Table("Ablation (office_simple, R1..R4): what each rule buys — R1's steps, mean (std %)",
                  ["algorithm", *(v[1] for v in variants)], table_rows,
-                 "Goal sharing on in every column; the tables use the third column.")
+                 "Goal sharing on in every column; the tables use the third column. The flags are R1's: the "
+                 "helpers keep their §4.3 bookkeeping in every column (one grid key cannot set four robots' flags).")
 
 
 def traffic_block(rows_by_map: dict[str, list[dict]]) -> Table:
