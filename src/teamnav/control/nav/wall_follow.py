@@ -39,8 +39,14 @@ Gaps the paper leaves open, filled here:
   make it rock in place.
 - ``side="right"`` mirrors the rule (slide from the right) for right-hand wall following.
 
+Known limitation: the boxes are aligned with the robot's heading, so a robot closing in on its
+wall at an angle (e.g. from the middle of a corridor after a turn) can find a box that fits
+diagonally through a door right ahead on that side, and follow it into the room; driving
+parallel to the wall it passes doors and side corridors (then the opening rules decide).
+
 Every exit distance is precomputed once per sensor (:func:`box_exit_ranges`), so one step is a
-single ``(boxes, beams)`` comparison, no Python loop over beams.
+compiled scan (:func:`first_free_box`, stopping at the first free box) with
+:meth:`SlidingBox.blocked` as its NumPy reference; no Python loop over beams.
 """
 
 from __future__ import annotations
