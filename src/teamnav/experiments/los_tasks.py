@@ -299,7 +299,7 @@ def scenario_data(map_key: str, *, name: str | None = None, task: int = 1, n_tar
         "seed": 0,
         "record_every": RECORD_EVERY,
         "stop_when_finished": True,
-        "metrics": ["los_help", "steps", "messages", "collisions"],
+        "metrics": ["los_help", "steps", "path_length", "messages", "collisions"],
         "robots": groups,
         "radio": {"mode": "line_of_sight", "range_m": VISIBILITY_M},
     }
