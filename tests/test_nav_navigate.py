@@ -408,7 +408,8 @@ def test_kernels_match_their_numpy_references(seed, scale):
     box = sliding_box()
     ref = box.blocked(r)
     free = np.flatnonzero(~ref[:-1])
-    assert first_free_box(r, np.cos(ANGLES), box.box_near_m, box.exit_m) == (int(free[0]) if free.size else -1, bool(ref[-1]))
+    expected = (int(free[0]) if free.size else -1, bool(ref[-1]))
+    assert first_free_box(r, np.cos(ANGLES), box.box_near_m, box.exit_m) == expected
     det = detector()
     quick = any_near_edge(r, det._head, det.near_m, det.jump_m)
     assert quick or det.detect_side(r, 0) is None and det.detect_side(r, 1) is None  # never misses a near edge

@@ -72,7 +72,18 @@ class NavigateParams(BaseModel):
 
     Speeds and turn rates above the robot's limits are capped at construction. Defaults follow
     the papers where they give a number: cruise 0.25 m/s (*Try to see it my way* §3.6), a 50 %
-    chance at openings (*Blazing* §4.2), a box "a little bigger than the robot".
+    chance at openings (*Blazing* §4.2), a box "a little bigger than the robot"; the rest are
+    ours, tuned on the trail office (1.8 m corridors, 1 m doors, Pioneer-sized robots).
+
+    Groups: sliding box (``box_*``, ``slide_step_m``, ``steer_gain_per_s``,
+    ``min_speed_fraction``, ``wall_side``; the box is the robot's diameter plus two
+    ``box_margin_m`` wide, spans ``box_near_m``..``box_length_m`` ahead, and its first position
+    reaches ``box_reach_m`` to the followed side: walls further away than that are not
+    followed); openings (``opening_*``, ``p_take_opening``; an opening must be the robot's
+    diameter plus ``opening_margin_m`` wide); trail (``trail_rule``, ``side_rule_min_deg``,
+    ``straight_*``, ``reverse_*``); sharp turns (``turn_rate_radps``, ``turn_tolerance_deg``,
+    ``turn_timeout_s``); Panic (``panic_*``: critical within ``panic_clearance_m`` of the body
+    inside ``±panic_half_angle_deg``; free when a box ``panic_free_m`` deep is clear ahead).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
@@ -179,7 +190,8 @@ class Navigate:
         self.side_sign = 1.0 if p.wall_side == "left" else -1.0
         radius = float(info.radius_m)
         width = 2.0 * radius + 2.0 * p.box_margin_m
-        self.box = SlidingBox(self.angles_rad, width, p.box_length_m, p.box_near_m, max(p.slide_step_m, p.box_reach_m - 0.5 * width),
+        offset_max = max(p.slide_step_m, p.box_reach_m - 0.5 * width)
+        self.box = SlidingBox(self.angles_rad, width, p.box_length_m, p.box_near_m, offset_max,
                               p.slide_step_m, self.cruise_mps, p.steer_gain_per_s, self.turn_rate_radps,
                               p.min_speed_fraction, p.wall_side)
         self.openings = OpeningDetector(self.angles_rad, p.opening_near_m, p.opening_jump_m,

@@ -131,7 +131,8 @@ class OpeningDetector:
             keep = np.flatnonzero(sa >= outer - math.radians(sector_deg))
             order = keep[np.argsort(-sa[keep], kind="stable")]  # outermost first
             n_ext = int(np.count_nonzero(sa[order] >= outer - math.radians(extreme_deg)))
-            self._sides.append((side, order, np.cos(a[order]), side * np.sin(a[order]), max(0, min(n_ext, order.size - 1))))
+            n_ext = max(0, min(n_ext, order.size - 1))
+            self._sides.append((side, order, np.cos(a[order]), side * np.sin(a[order]), n_ext))
         # Both sides' extreme beams in one index array (outermost first), for a quick first test.
         n = max(s[4] for s in self._sides)
         self._quick = n > 0

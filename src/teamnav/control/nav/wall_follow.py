@@ -219,7 +219,8 @@ class SlidingBox:
         half = 0.5 * self.box_width_m
         centres = np.concatenate([self.offsets_m, [0.0]])  # last row: the box straight ahead
         #: (K + 1, B) exit distances; row K is the box straight ahead
-        self.exit_m = box_exit_ranges(self.angles_rad, self.box_near_m, self.box_length_m, centres - half, centres + half)
+        self.exit_m = box_exit_ranges(self.angles_rad, self.box_near_m, self.box_length_m,
+                                      centres - half, centres + half)
         self._sin = np.sin(self.angles_rad)
         self._cos = np.cos(self.angles_rad)
         self._away = 0.0  # turn direction kept while no box is free (0: none yet)
