@@ -79,6 +79,32 @@ def test_carrying_robot_follows_the_opposite_heading_home():
     assert preferred_heading(None, carrying=True) is None
 
 
+def test_loops_are_cut_from_the_private_list():
+    """Out to a dead end and back, then on north: the out-and-back detour is cut, and a robot
+    turning on the spot (no path) cuts nothing."""
+    c = CrumbList()
+    path = 0.0
+    pts = [(0.5 * k, 0.0, 0.0) for k in range(21)]  # east to x = 10 (the junction is at x = 5)
+    pts += [(10.0 - 0.5 * k, 0.3, math.pi) for k in range(1, 11)]  # back west to x = 5
+    pts += [(5.0, 0.5 * k, math.pi / 2) for k in range(1, 11)]  # north from the junction
+    cut = 0
+    last = pts[0]
+    for x, y, h in pts:
+        path += math.hypot(x - last[0], y - last[1])
+        last = (x, y)
+        cut += c.drop_pruning_loops(x, y, h, outbound=True, path_m=path, radius_m=1.0, min_loop_m=4.0)
+    assert cut > 0
+    xy = c.xy_m
+    assert xy[:, 0].max() <= 6.0  # the dead-end leg (x > 6) is gone
+    assert (c.heading_rad[xy[:, 1] < 0.5] == 0.0).all()  # no westbound crumb left on the way in
+    assert (np.abs(c.heading_rad[xy[:, 1] > 1.0] - math.pi / 2) < 1e-12).all()
+    still = CrumbList()
+    for k in range(20):
+        assert not still.drop_pruning_loops(0.0, 0.0, 0.3 * k, outbound=True, path_m=0.0, radius_m=1.0,
+                                            min_loop_m=4.0)
+    assert len(still) == 20
+
+
 def test_crumb_list_grows_and_can_be_capped():
     c = CrumbList()
     c.extend(CrumbBatch(np.arange(2000.0).repeat(2).reshape(-1, 2), np.zeros(2000)))

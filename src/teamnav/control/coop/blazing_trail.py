@@ -26,6 +26,14 @@ a robot team" (DARS 2000), §4.1 (the three decision processes of Fig. 2) over �
 ``communicate=False`` is the no-communication baseline: nothing is sent or read; the robot
 appends its own private list to its own global list on arrival (it follows only its own trail).
 
+Loop pruning (``prune_loops``, on by default; a deviation): a robot back within
+``prune_radius_m`` of a crumb of its own private list that lies at least ``prune_min_loop_m``
+of path behind deletes the crumbs after it
+(:meth:`~teamnav.control.coop.crumbs.CrumbList.drop_pruning_loops`). The paper's robots worked
+"only in the corridors" (§6); in an office with rooms and dead ends the explorer's list holds
+circles and out-and-back detours whose headings make followers circle or dither (observed on
+``trail_office``); ``prune_loops=False`` is the paper's rule as written.
+
 Choices where the paper is silent: crumb interval 1 s and radius 2 m (the paper gives neither;
 1.8 m corridors, a radius about a corridor wide, reaches the crumbs of the corridor the robot is
 in and the corner it approaches); the global list is unbounded as in the paper unless
@@ -88,6 +96,10 @@ class BlazingTrailParams(BaseModel):
         Navigate's forward speed [m/s].
     max_global_crumbs : int or None
         Cap on the global list (None: unbounded, as in the paper).
+    prune_loops : bool
+        Cut loops out of the private list (module docstring; False: the paper as written).
+    prune_radius_m, prune_min_loop_m : float
+        Back within this distance [m] of an own crumb at least this much path behind [m] = a loop.
     sensor : str
         The laser Navigate reads.
     layer_every_steps : int
@@ -106,6 +118,9 @@ class BlazingTrailParams(BaseModel):
     radius_m: float = Field(2.0, gt=0.0, le=100.0)
     cruise_speed_mps: float = Field(0.25, gt=0.0, le=10.0)
     max_global_crumbs: int | None = Field(None, ge=1, le=10_000_000)
+    prune_loops: bool = True
+    prune_radius_m: float = Field(1.0, gt=0.0, le=100.0)
+    prune_min_loop_m: float = Field(4.0, gt=0.0, le=1000.0)
     sensor: str = Field("laser", min_length=1)
     layer_every_steps: int = Field(50, ge=1, le=1_000_000)
     navigate: dict[str, Any] = Field(default_factory=dict)
@@ -144,6 +159,9 @@ class BlazingTrail:
         self.deliveries = 0
         self.broadcasts = 0
         self._next_crumb_s = 0.0
+        self._path_m = 0.0
+        self._last_xy: tuple[float, float] | None = None
+        self.loops_cut = 0
         self._following = False
         self._step = 0
         self._last_layer_step: int | None = None
@@ -170,8 +188,16 @@ class BlazingTrail:
         t = float(obs.time_s)
         x, y, th = (float(v) for v in obs.odom_pose)
         outbox: list[Message] = []
+        if self._last_xy is not None:
+            self._path_m += math.hypot(x - self._last_xy[0], y - self._last_xy[1])
+        self._last_xy = (x, y)
         if t >= self._next_crumb_s:  # before the events: a crumb dropped on arrival goes out with the list
-            self.private.drop(x, y, th, outbound=not self.carrying)
+            if p.prune_loops:
+                self.loops_cut += self.private.drop_pruning_loops(
+                    x, y, th, outbound=not self.carrying, path_m=self._path_m, radius_m=p.prune_radius_m,
+                    min_loop_m=p.prune_min_loop_m)
+            else:
+                self.private.drop(x, y, th, outbound=not self.carrying, path_m=self._path_m)
             self._next_crumb_s = t + p.crumb_interval_s - 1e-9
         for reached in self.round.observe(obs.events, t):
             if reached == p.home_event:

@@ -89,7 +89,7 @@ class CrumbList:
         if max_crumbs is not None and (not isinstance(max_crumbs, int) or max_crumbs < 1):
             raise ValueError(f"max_crumbs must be None or an int >= 1, got {max_crumbs!r}")
         self.max_crumbs = max_crumbs
-        self._buf = np.empty((64, 3), dtype=np.float64)
+        self._buf = np.empty((64, 4), dtype=np.float64)  # x, y, heading, odometric path length
         self._n = 0
 
     def __len__(self) -> int:
@@ -109,7 +109,7 @@ class CrumbList:
         need = self._n + extra
         if need > self._buf.shape[0]:
             cap = max(need, 2 * self._buf.shape[0])
-            buf = np.empty((cap, 3), dtype=np.float64)
+            buf = np.empty((cap, 4), dtype=np.float64)
             buf[: self._n] = self._buf[: self._n]
             self._buf = buf
 
@@ -119,17 +119,52 @@ class CrumbList:
             self._buf[: self.max_crumbs] = self._buf[drop: self._n]
             self._n = self.max_crumbs
 
-    def drop(self, x_odom_m: float, y_odom_m: float, heading_rad: float, *, outbound: bool = True) -> None:
+    @property
+    def path_m(self) -> np.ndarray:
+        """Odometric path length at each crumb, shape (n,) [m] (0 for received crumbs; a view)."""
+        return self._buf[: self._n, 3]
+
+    def drop(self, x_odom_m: float, y_odom_m: float, heading_rad: float, *, outbound: bool = True,
+             path_m: float = 0.0) -> None:
         """Drop one crumb at the robot's pose estimate (Blazing §4.1 "crumb dropping").
 
         ``outbound=False`` (the robot carries resource, heading home) stores the opposite
-        heading, so every crumb points towards the source (module docstring).
+        heading, so every crumb points towards the source (module docstring). ``path_m`` is the
+        robot's odometric path length so far [m] (for :meth:`drop_pruning_loops`).
         """
         self._reserve(1)
         h = heading_rad if outbound else heading_rad + math.pi
-        self._buf[self._n] = (x_odom_m, y_odom_m, wrap_angle(h))
+        self._buf[self._n] = (x_odom_m, y_odom_m, wrap_angle(h), path_m)
         self._n += 1
         self._trim()
+
+    def drop_pruning_loops(self, x_odom_m: float, y_odom_m: float, heading_rad: float, *, outbound: bool,
+                           path_m: float, radius_m: float, min_loop_m: float) -> bool:
+        """Drop a crumb unless the robot is back near its own earlier crumb: then cut the loop.
+
+        Gap filled here (the paper does not prune): a private list with loops (a room circled,
+        a dead end entered and left) broadcasts a vortex or a back-and-forth of headings, and
+        robots averaging them circle or dither. If a crumb of this list lies within
+        ``radius_m`` of the robot and at least ``min_loop_m`` of odometric path behind it, the
+        crumbs after the earliest such crumb are deleted and no crumb is dropped: the list keeps
+        the loop-free path (what the paper means by "the most time efficient path yet
+        discovered", Blazing §4.1).
+
+        Returns
+        -------
+        bool
+            True when a loop was cut.
+        """
+        if self._n:
+            b = self._buf[: self._n]
+            dx = b[:, 0] - x_odom_m
+            dy = b[:, 1] - y_odom_m
+            back = (dx * dx + dy * dy <= radius_m * radius_m) & (b[:, 3] <= path_m - min_loop_m)
+            if back.any():
+                self._n = int(np.argmax(back)) + 1
+                return True
+        self.drop(x_odom_m, y_odom_m, heading_rad, outbound=outbound, path_m=path_m)
+        return False
 
     def extend(self, batch: CrumbBatch) -> None:
         """Append a received batch (the global list's "add them", Blazing §4.1)."""
@@ -139,6 +174,7 @@ class CrumbList:
         self._reserve(k)
         self._buf[self._n: self._n + k, :2] = batch.xy_m
         self._buf[self._n: self._n + k, 2] = batch.heading_rad
+        self._buf[self._n: self._n + k, 3] = 0.0
         self._n += k
         self._trim()
 
