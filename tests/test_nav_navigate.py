@@ -457,3 +457,19 @@ def test_trail_hint_takes_both_corners_at_near_cruise_efficiency(monkeypatch, ba
     assert arrived.size, "never reached the goal"
     assert result.data.t_s[arrived[0]] <= 31.5 / 0.4 / 0.85
     assert result.metrics["collisions_wall"] == 0 and result.metrics["stall_fraction"] == 0.0
+
+
+def test_two_robots_meeting_head_on_in_a_corridor_pass_each_other(monkeypatch):
+    """Each keeps to its left wall, so robots driving opposite ways pass (Blazing §4.2: "passing
+    within as little as 40cm of each other")."""
+    monkeypatch.setitem(registry._REGISTRY, "fixed-heading-test-v1", f"{__name__}:FixedHeading")
+    east = trail_office_scenario("fixed-heading-test-v1", 1, 25.0, {"heading_deg": 0.0}, {"poses": [[6.0, 4.9, 0.0]]})
+    west = dict(east["robots"][0], name="w", params={"cruise_speed_mps": 0.4, "heading_deg": 180.0},
+                start={"poses": [[12.5, 4.9, 180.0]]})
+    east["robots"].append(west)
+    result = run_scenario(east)
+    xy = result.data.true_pose[:, :, :2]
+    assert xy[-1, 0, 0] > 12.5 and xy[-1, 1, 0] < 6.0  # each got past the other's start
+    gap = np.hypot(*(xy[:, 0] - xy[:, 1]).T) - 2 * RADIUS
+    assert gap.min() > 0.2
+    assert result.metrics["collisions_robot"] == 0 and result.metrics["stall_fraction"] == 0.0
