@@ -606,7 +606,8 @@ def trail_office(resolution_m: float = 0.1) -> EnvironmentMap:
 
     Centre-line route length 12.9 + 11.0 + 9.5 = 33.4 m; a robot of radius 0.25 m cutting
     the corners drives about 31.5 m, between the two papers' 31 m and 33 m. Rooms open off every corridor through 1 m doors. Each corridor
-    has a 2 m long passing place where it widens to 2.8 m, since the robots (50 cm wide)
+    has a 2 m long passing place where it widens to 2.6–2.8 m (walled off from the room it
+    cuts into), since the robots (50 cm wide)
     must pass each other ("passing within as little as 40 cm of each other", Blazing §4).
     """
     res = _res(resolution_m)
@@ -616,9 +617,7 @@ def trail_office(resolution_m: float = 0.1) -> EnvironmentMap:
     b.clear_rect(14.0, 4.0, 15.8, 23.8)  # C2, x centre 14.9; goes on north past C3 to a dead end
     b.clear_rect(6.0, 15.0, 35.8, 16.8)  # C3, y centre 15.9
     # passing places
-    b.clear_rect(7.0, 5.8, 9.0, 6.8)
-    b.clear_rect(15.8, 9.0, 16.8, 11.0)
-    b.clear_rect(19.0, 16.8, 21.0, 17.8)
+    b.clear_rect(19.0, 16.8, 21.0, 17.8)  # C3's (into the wall below N2, which starts at y = 18)
     # rooms south of C1 (doors on C1)
     for x0, x1 in ((0.2, 5.8), (6.0, 11.8), (16.0, 22.0), (22.2, 28.0), (28.2, 34.0)):
         b.clear_rect(x0, 0.2, x1, 3.8).clear_rect(x0 + 1.0, 3.8, x0 + 2.0, 4.0)
@@ -632,6 +631,12 @@ def trail_office(resolution_m: float = 0.1) -> EnvironmentMap:
     b.clear_rect(16.0, 18.0, 24.0, 23.8).clear_rect(22.0, 17.8, 23.0, 18.0)  # N2
     b.clear_rect(24.2, 17.0, 35.8, 23.8).clear_rect(30.0, 16.8, 31.0, 17.0)  # N3
     b.clear_rect(15.8, 21.0, 16.0, 22.0)  # C2's north end also opens into N2
+    # The passing places on C1 and C2 are pockets cut into rooms W2 and E1: wall them off from
+    # the room (0.2 m walls), so they widen the corridor without opening a 2 m doorway.
+    b.rect(6.8, 6.6, 9.2, 6.8).rect(6.8, 6.0, 7.0, 6.8).rect(9.0, 6.0, 9.2, 6.8)
+    b.clear_rect(7.0, 5.8, 9.0, 6.6)
+    b.rect(16.6, 8.8, 16.8, 11.2).rect(16.0, 8.8, 16.8, 9.0).rect(16.0, 11.0, 16.8, 11.2)
+    b.clear_rect(15.8, 9.0, 16.6, 11.0)
     places = {
         "home": (2.0, 4.9),
         "source": (24.4, 15.9),
