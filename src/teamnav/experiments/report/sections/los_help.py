@@ -30,7 +30,7 @@ subset of R2, R3, R4 (8 teams, 120 trials). Set ``NUMBA_NUM_THREADS=1`` for swee
 box: the line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread
 launch costs more than the work for four robots.
 
-Quick mode (CI): the simple map only, the first target of task 1 with a 300-step budget,
+Quick mode (CI): the simple map only, the first target of task 1 with a 200-step budget,
 teams {R1, R1..R4}, err_max 0.4 (err_max 0 is the tables' R1..R4 run), no ablation: 9 short
 runs.
 """
@@ -138,7 +138,7 @@ def strictly_falling(means: Sequence[float]) -> bool:
 # ---------------------------------------------------------------------------- sweeps
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
-QUICK_BUDGET_STEPS_PER_TARGET = 300
+QUICK_BUDGET_STEPS_PER_TARGET = 200
 #: Maps run in quick mode (the complex map's runs are the longest).
 QUICK_MAPS = ("simple",)
 
