@@ -2,24 +2,27 @@
 
 Sgorbissa & Arkin §6 run "a potential field algorithm to which the Avoid Past schema [17] has
 been added" (Balch & Arkin 1993, "Avoiding the past: a simple but effective strategy for
-reactive navigation", ICRA, pp. 678-685). Balch & Arkin add a local spatial memory to the
-motor-schema navigator: a grid of visit counts, and an *avoid-past* schema that pushes the
-robot away from the cells it has visited often, so that a box canyon (a local minimum of the
-field) fills up with visits until the robot is pushed out of it.
+reactive navigation", ICRA, pp. 678-685). Balch & Arkin add "a local spatial memory [that]
+allows a robot to avoid areas that have already been visited", implemented "within a
+schema-based motor control model", as a solution to box canyons (their abstract). We did not
+have the full paper at hand: the grid of visit counts and the repulsion law below are our
+reading of that description, with our own choices marked.
 
 Here:
 
 - memory: a grid of square cells of side ``cell_m`` in the robot's **own odometry frame**
   (a dict keyed by cell index, so it grows with the explored area); every :meth:`direction`
   call adds one visit to the cell under the robot. The memory belongs to the robot, not to a
-  goal: a new goal keeps it (Balch & Arkin's memory is of places, not of a task);
+  goal: a new goal keeps it (it is a memory of places, not of a task);
 - avoid-past vector: ``avoid_gain · Σ_c n_c · (1 − d_c / memory_radius_m) · (x − c) / d_c``
   over the cells ``c`` whose centre is within ``memory_radius_m`` of the robot (``n_c`` visits,
   ``d_c`` distance from the cell centre to the robot ``x``): a discrete, distance-weighted
-  estimate of minus the gradient of the visit density. Balch & Arkin describe the schema as a
-  repulsion from visited places that grows with the visits; the linear distance weighting
-  is our choice (their paper does not fix one we could read). The vector is unbounded in the
-  counts: given time it outweighs move-to-goal, which is how the trap is left;
+  estimate of minus the gradient of the visit density, so that a box canyon fills up with
+  visits until the robot is pushed out of it (the linear distance weighting is our
+  choice). The vector grows with the counts until its magnitude reaches ``avoid_max`` (our choice, default twice the
+  move-to-goal gain): enough to outweigh move-to-goal so that the trap is left given time,
+  never so much that it pins the robot against a wall (unbounded, it would outgrow
+  avoid-static-obstacle, which we measured trapping the robot on the cup's inner wall);
 - the rest (move-to-goal, avoid-static-obstacle, collision guard, progress estimate) is the
   potential field of :mod:`teamnav.control.nav.local.potential_field` with the same parameters.
 """

@@ -125,32 +125,42 @@ def scan_points(pose: np.ndarray, scan: RangeScan) -> np.ndarray:
     return np.column_stack((pose[0] + r[hit] * np.cos(ang), pose[1] + r[hit] * np.sin(ang)))
 
 
-def segment_clearance(points: np.ndarray, start_xy: np.ndarray, ends_xy: np.ndarray) -> np.ndarray:
+def segment_clearance(points: np.ndarray, start_xy: np.ndarray, ends_xy: np.ndarray,
+                      slack_m: np.ndarray | None = None) -> np.ndarray:
     """Smallest distance [m] from ``points`` (K, 2) to each segment ``start -> ends[j]``.
 
-    Returns ``inf`` per segment when there are no points.
+    Returns ``inf`` per segment when there are no points. With ``slack_m`` (K,), point k
+    counts as ``slack_m[k]`` nearer than it is (an obstacle may hide between two beams).
 
     Parameters
     ----------
     points : ndarray of shape (K, 2)
-    start_xy : ndarray of shape (2,)
+    start_xy : ndarray of shape (2,) or (J, 2)
+        One start for all segments, or one per segment.
     ends_xy : ndarray of shape (J, 2)
 
     Returns
     -------
     ndarray of shape (J,)
+
+    Examples
+    --------
+    >>> segment_clearance(np.array([[1.0, 1.0]]), np.zeros(2), np.array([[2.0, 0.0], [0.0, -2.0]])).tolist()
+    [1.0, 1.4142135623730951]
     """
     ends_xy = np.atleast_2d(ends_xy)
     if points.shape[0] == 0:
         return np.full(ends_xy.shape[0], np.inf)
-    d = ends_xy - start_xy  # (J, 2)
+    starts = np.broadcast_to(np.asarray(start_xy, dtype=np.float64), ends_xy.shape)
+    d = ends_xy - starts  # (J, 2)
     len2 = np.maximum(np.einsum("ij,ij->i", d, d), 1e-24)
-    rel = points - start_xy  # (K, 2)
-    t = np.clip((rel @ d.T) / len2, 0.0, 1.0)  # (K, J)
-    cx = start_xy[0] + t * d[:, 0]
-    cy = start_xy[1] + t * d[:, 1]
-    dist2 = (points[:, :1] - cx) ** 2 + (points[:, 1:] - cy) ** 2
-    return np.sqrt(dist2.min(axis=0))
+    rx = points[:, :1] - starts[:, 0]  # (K, J)
+    ry = points[:, 1:] - starts[:, 1]
+    t = np.clip((rx * d[:, 0] + ry * d[:, 1]) / len2, 0.0, 1.0)
+    dist = np.sqrt((rx - t * d[:, 0]) ** 2 + (ry - t * d[:, 1]) ** 2)
+    if slack_m is not None:
+        dist = dist - np.asarray(slack_m, dtype=np.float64)[:, None]
+    return dist.min(axis=0)
 
 
 def safe_heading(heading_rad: float, xy: np.ndarray, points: np.ndarray, step_length_m: float,

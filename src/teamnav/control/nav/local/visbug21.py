@@ -13,7 +13,9 @@ Step 1 (``MODE_TO_GOAL``, "move towards Ti")
     ``Ti`` is the point of the M-line nearest T (sampled every ``mline_sample_m``, and not
     behind the last leave point) that the robot sees with a free corridor: the segment from
     the robot to it passes at least ``R = radius_m + safety_margin_m`` from every sensed
-    point and is no longer than the sensor's range minus ``R``. When T itself is such a
+    point and is no longer than the sensor's range minus ``R``. A point sensed at range
+    ``ρ`` counts as ``ρ · π / n_beams`` nearer (half the gap between two beams there: a wall
+    corner can hide between two far beams). When T itself is such a
     point the robot heads straight for it. When no such ``Ti`` lies at least one step away,
     an obstacle blocks the M-line: the robot's position is the *hit point* H (distance
     ``d_H`` to T) and Step 2 starts.
@@ -23,15 +25,22 @@ Step 2 (``MODE_FOLLOW``, "follow the boundary in the local direction")
     point, turned towards or away from the obstacle in proportion to the distance error.
     At every step it looks for a *leave point*: a point Q of the M-line with
     ``|QT| < d_H − leave_margin_m`` seen through a free corridor as above but wider, of
-    half-width ``R + follow_margin_m`` (hysteresis: a point at the edge of visibility would
+    half-width ``R + leave_hysteresis_m`` (hysteresis: a point at the edge of visibility would
     otherwise make the robot leave and hit again at every step), and at least a step away
-    or T itself (``d_H`` is the
+    or T itself, and from which the M-line runs on free (corridor half-width R) for
+    ``leave_run_m`` or up to T (Bug2: "the robot can move towards T from Q"; we ask for a
+    finite run, not an infinitesimal one: otherwise an M-line that slips into a door at an
+    angle the robot cannot pass makes it leave, hit a few centimetres further, and walk the
+    whole boundary again, lap after lap) (``d_H`` is the
     smallest hit distance so far for this goal: a robot stopped short of a leave point
     can hit farther from T than it left, and Bug2's progress argument needs every leave
     point closer than all earlier hit points). When there is
     one it takes the nearest to T as ``Ti`` and returns to Step 1 (VisBug-21's shortcut:
     range sensing lets the robot leave the boundary for a visible M-line point ahead instead
-    of walking the boundary to it). If it walks back to within ``return_tol_m`` of H after
+    of walking the boundary to it). It drives to that point before testing the M-line again
+    (within ``2 d / step + 5`` steps), so that a new hit point lies on the M-line and closer
+    to T than the last one, as in Bug2; otherwise a corridor that narrows as the robot moves
+    (a door seen at an angle) could make it hit again before the M-line, farther from T. If it walks back to within ``return_tol_m`` of H after
     having been ``2·return_tol_m`` or more away, T is unreachable (Bug2's termination
     test): :meth:`direction` then returns None until a new goal is set.
 
@@ -61,7 +70,7 @@ import math
 from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from teamnav.control.nav.local.base import (
     GOAL_SAME_TOL_M,
@@ -92,14 +101,22 @@ class VisBugParams(BaseModel):
         "random": drawn (fair coin from the robot's ``rng``) at every new goal and kept for
         that goal, so a map whose doors all sit on one side of the rooms does not favour
         or punish the algorithm systematically.
-    safety_margin_m : float, default 0.1
+    safety_margin_m : float, default 0.05
         Free corridors keep ``R = radius + this`` from sensed points [m].
-    follow_margin_m : float, default 0.1
-        The boundary is followed at ``R + this`` [m].
+    follow_margin_m : float, default 0.08
+        The boundary is followed at ``R + this`` [m]. It must leave room to pass a door:
+        ``2 (R + follow_margin_m)`` below the narrowest door (0.9 m in ``office_complex``;
+        0.76 m with a 0.25 m robot and the defaults).
+    leave_hysteresis_m : float, default 0.03
+        The leave test's free corridor is this much wider than Step 1's [m]; it must be
+        smaller than ``follow_margin_m`` (a robot following at ``R + follow_margin_m`` must
+        be able to see a leave point from where it is).
     follow_gain : float, default 1.5
         Heading correction per relative distance error while following (rad per unit).
     leave_margin_m : float, default 0.1
         A leave point must be this much closer to the goal than the hit point [m].
+    leave_run_m : float, default 0.5
+        From a leave point the M-line must run on free this far (or up to the goal) [m].
     mline_sample_m : float, default 0.1
         Spacing of the M-line points tested as intermediate targets [m].
     return_tol_m : float, default 0.3
@@ -116,16 +133,26 @@ class VisBugParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     turn: Literal["left", "right", "random"] = "left"
-    safety_margin_m: float = Field(0.1, ge=0.0, le=2.0)
-    follow_margin_m: float = Field(0.1, ge=0.0, le=2.0)
+    safety_margin_m: float = Field(0.05, ge=0.0, le=2.0)
+    follow_margin_m: float = Field(0.08, ge=0.0, le=2.0)
+    leave_hysteresis_m: float = Field(0.03, ge=0.0, le=2.0)
     follow_gain: float = Field(1.5, ge=0.0, le=20.0)
     leave_margin_m: float = Field(0.1, ge=0.0, le=10.0)
+    leave_run_m: float = Field(0.5, ge=0.0, le=10.0)
     mline_sample_m: float = Field(0.1, gt=0.0, le=5.0)
     return_tol_m: float = Field(0.3, gt=0.0, le=10.0)
     guard_margin_m: float = Field(0.03, ge=0.0, le=1.0)
     follow_patience_m: float = Field(20.0, gt=0.0, le=10_000.0)
     progress_window_steps: int = Field(30, ge=1, le=100_000)
     progress_fraction: float = Field(0.5, gt=0.0, le=10.0)
+
+    @model_validator(mode="after")
+    def _hysteresis_below_follow(self) -> "VisBugParams":
+        if not self.leave_hysteresis_m < self.follow_margin_m:
+            raise ValueError(
+                f"leave_hysteresis_m must be < follow_margin_m ({self.follow_margin_m}), got {self.leave_hysteresis_m}"
+            )
+        return self
 
 
 def boundary_heading(xy: np.ndarray, points: np.ndarray, follow_distance_m: float, side: int,
@@ -207,7 +234,10 @@ class VisBug21:
         self._t_anchor = 0.0
         self._walked_m = 0.0
         self._left_hit = False
+        self._returns = 0
         self._last_xy: np.ndarray | None = None
+        self._leave_target: np.ndarray | None = None
+        self._leave_steps = 0
         self._monitor.reset()
 
     # ------------------------------------------------------------------ protocol
@@ -237,26 +267,39 @@ class VisBug21:
         self._monitor.update(math.hypot(*(goal - xy)))
         p = self.params
         points = scan_points(pose, scan)
+        self._slack = math.pi / max(len(scan.ranges_m), 1)  # half the beam spacing [rad]
         r_safe = self.radius_m + p.safety_margin_m
         reach_m = float(scan.max_range_m) - r_safe
 
         heading: float | None = None
         if self.mode == MODE_FOLLOW:
-            ti = self._leave_point(xy, points, r_safe + p.follow_margin_m, reach_m)
+            ti = self._leave_point(xy, points, r_safe + p.leave_hysteresis_m, reach_m)
             if ti is not None:
                 self.mode = MODE_TO_GOAL
                 self._monitor.reset()
+                self._leave_target = ti
+                self._leave_steps = 2 * int(math.ceil(math.hypot(*(ti - xy)) / self.step_length_m)) + 5
             else:
                 d_hit = math.hypot(*(xy - self.hit_xy))
                 if d_hit >= 2.0 * p.return_tol_m:
                     self._left_hit = True
                 elif self._left_hit and d_hit <= p.return_tol_m:
-                    self.mode = MODE_UNREACHABLE
-                    return None
+                    self._left_hit = False
+                    self._returns += 1
+                    if self._returns >= 2:
+                        self.mode = MODE_UNREACHABLE
+                        return None
                 heading = boundary_heading(xy, points, r_safe + p.follow_margin_m, self.side, p.follow_gain)
                 if heading is None:  # nothing sensed at all: the obstacle is gone
                     self.mode = MODE_TO_GOAL
-        if self.mode == MODE_TO_GOAL:
+        if self.mode == MODE_TO_GOAL and self._leave_target is not None:
+            # on the way from the boundary to the leave point: go there (Bug2 hits only on the M-line)
+            if math.hypot(*(self._leave_target - xy)) < self.step_length_m or self._leave_steps <= 0:
+                self._leave_target = None
+            else:
+                self._leave_steps -= 1
+                heading = math.atan2(self._leave_target[1] - xy[1], self._leave_target[0] - xy[0])
+        if self.mode == MODE_TO_GOAL and heading is None:
             ti = self._intermediate_target(xy, points, r_safe, reach_m)
             if ti is None:
                 self._hit(xy)
@@ -285,6 +328,7 @@ class VisBug21:
         self.hit_dist_m = min(self.hit_dist_m, math.hypot(*(self.goal_xy - xy)))
         self._walked_m = 0.0
         self._left_hit = False
+        self._returns = 0
 
     def _mline_samples(self, t_from: float) -> tuple[np.ndarray, np.ndarray]:
         """M-line points with parameter t in [t_from, 1] (goal last), and their t."""
@@ -300,9 +344,10 @@ class VisBug21:
         dist = np.hypot(cand[:, 0] - xy[0], cand[:, 1] - xy[1])
         ok = dist <= reach_m
         if ok.any() and pts.shape[0]:
-            near = pts[np.hypot(pts[:, 0] - xy[0], pts[:, 1] - xy[1]) <= reach_m + 2.0 * r_safe]
+            rng_p = np.hypot(pts[:, 0] - xy[0], pts[:, 1] - xy[1])
+            keep = rng_p <= reach_m + 2.0 * r_safe
             idx = np.flatnonzero(ok)
-            ok[idx] = segment_clearance(near, xy, cand[idx]) >= r_safe
+            ok[idx] = segment_clearance(pts[keep], xy, cand[idx], self._slack * rng_p[keep]) >= r_safe
         return ok
 
     def _intermediate_target(self, xy, points, r_safe, reach_m) -> np.ndarray | None:
@@ -325,6 +370,15 @@ class VisBug21:
             return None
         cand, t = cand[closer], t[closer]
         ok = self._visible(xy, points, cand, r_safe, reach_m)
+        # Bug2: from Q the robot must be able to move on towards T (or Q is T)
+        idx = np.flatnonzero(ok & (t < 1.0 - 1e-12))
+        if idx.size and points.shape[0]:
+            s, g = self.mline
+            u = (g - s) / max(math.hypot(*(g - s)), 1e-12)
+            run = np.minimum(self.params.leave_run_m, np.hypot(g[0] - cand[idx, 0], g[1] - cand[idx, 1]))
+            ahead = cand[idx] + run[:, None] * u
+            slack = self._slack * np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1])
+            ok[idx] = segment_clearance(points, cand[idx], ahead, slack) >= r_safe - self.params.leave_hysteresis_m
         if not ok.any():
             return None
         j = int(np.flatnonzero(ok)[-1])
