@@ -197,6 +197,25 @@ def test_ghost_kept_when_the_helper_walks_away():
     assert gs.path(0).kind == "ghost"
 
 
+def test_owner_compares_reports_with_the_stored_promise():
+    """§4.2: R1 stores D11(t1) and takes a later report only if it beats it; after reaching the
+    ghost and wandering off, a promise no better than the followed one does not pull it back."""
+    gs = GoalSharing(0, 2)
+    gs.set_own_goal(1, (10.0, 0.0))
+    gs.receive_report(0, 2, 1, (4.0, 0.0), 6.0, me_xy=(0.0, 0.0), step=1)  # D11(t1) = 10
+    gs.mark_reached(0)
+    far = (4.0, 10.0)  # wandered off: current D = 10 + 6 = 16
+    assert not gs.receive_report(0, 2, 1, (4.0, 5.0), 7.0, me_xy=far, step=9)  # 12: < 16 but not < 10
+    assert gs.receive_report(0, 2, 1, (4.0, 8.0), 2.0, me_xy=far, step=10)  # 4 < 10
+    p = gs.path(0)
+    assert (p.px_m, p.py_m, p.reached, p.d_promised_m) == (4.0, 8.0, False, pytest.approx(4.0))
+    # a relay (R2 for R1's goal) compares with its current D only (§4.3)
+    relay = GoalSharing(1, 3)
+    relay.receive_goal(0, goal_id(1, 3), (10.0, 0.0))
+    relay.receive_report(0, 3, 2, (4.0, 0.0), 6.0, me_xy=(0.0, 0.0), step=1)
+    assert relay.receive_report(0, 3, 2, (4.0, 5.0), 7.0, me_xy=(4.0, 10.0), step=9)
+
+
 def test_distance_bookkeeping_of_section_4_3():
     """Fig. 8: a helper that saw R1's goal and moved on reports D(t1) + dist(me, R_i(t1)); when
     R_i(t1) leaves its view, R_i(t2) and D(t2) replace them."""

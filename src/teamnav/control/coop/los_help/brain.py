@@ -366,22 +366,30 @@ class _LosBrain:
             return Action(), progressing
         return Action(direction_rad=float(wrap_angle(heading - self._pose[2]))), progressing
 
-    def _step_clear(self, heading_rad: float) -> bool:
-        """Whether a straight step along ``heading_rad`` (own frame) keeps the body off every return."""
+    def _corridor_clear(self, heading_rad: float, length_m: float) -> bool:
+        """Whether the robot's body can travel ``length_m`` straight along ``heading_rad`` (own
+        frame) without touching any return of this step's scan (every return at least
+        1.05 radius from the segment), and the laser sees that far."""
+        if length_m > self.vis_radius_m:
+            return False
         scan = self._scan
         r = np.asarray(scan.ranges_m, dtype=np.float64)
         hit = r < float(scan.max_range_m) * (1.0 - 1e-9)
         if not hit.any():
             return True
-        rel = np.asarray(scan.angles_rad, dtype=np.float64)[hit] + self._pose[2] - heading_rad
+        rel = np.asarray(scan.angles_rad, dtype=np.float64)[hit] + (float(self._pose[2]) - heading_rad)
         along = r[hit] * np.cos(rel)
         across = np.abs(r[hit] * np.sin(rel))
-        t = np.clip(along, 0.0, self.step_m)
-        dist = np.hypot(along - t, across)
-        return bool(dist.min() >= self.radius_m * 1.05)
+        t = np.clip(along, 0.0, length_m)
+        return bool(np.hypot(along - t, across).min() >= self.radius_m * 1.05)
 
-    def _head_to(self, target: XY, key: Any, *, stop_within_m: float = 0.0) -> tuple[Action, bool]:
-        """Head for a visible point: straight (§2 point 4) unless blocked, then via the navigator."""
+    def _head_to(self, target: XY, key: Any, *, stop_within_m: float = 0.0,
+                 end_margin_m: float = 0.0) -> tuple[Action, bool]:
+        """Head for a point: straight (§2 point 4) when the robot sees it with a corridor wide
+        enough for its body (up to ``end_margin_m`` short of it: a teammate may stand there),
+        else via the navigator towards it. Checking the whole corridor, not only the next
+        step, keeps the choice the same all along the approach (checking one step made the
+        robot alternate between a straight step and the navigator's way round)."""
         me = self._me_xy()
         dist = math.hypot(target[0] - me[0], target[1] - me[1])
         last = self._last_target
@@ -392,7 +400,7 @@ class _LosBrain:
         if dist <= stop_within_m:
             return Action(), True
         heading = math.atan2(target[1] - me[1], target[0] - me[0])
-        if self.params.straight_when_visible and self._step_clear(heading):
+        if self.params.straight_when_visible and self._corridor_clear(heading, max(self.step_m, dist - end_margin_m)):
             return Action(direction_rad=float(wrap_angle(heading - self._pose[2]))), progressing
         action, _ = self._navigate(target)
         return action, progressing
@@ -501,7 +509,8 @@ class LosExplorer(_LosBrain):
         progressing = True
         if path is not None and path.kind == "direct":
             self.mode = "own_goal"  # §2 point 4: it sees its goal, A is suppressed
-            action, progressing = self._head_to(goal, ("goal", self.target_index))
+            action, progressing = self._head_to(goal, ("goal", self.target_index),
+                                                end_margin_m=0.5 * p.goal_tolerance_m)
         elif path is not None and path.kind in ("ghost", "self") and not path.reached:
             point = (path.px_m, path.py_m)
             # the mirror itself still stands where it promised (§3), or only its ghost does (§4.2)
@@ -515,14 +524,16 @@ class LosExplorer(_LosBrain):
                 self.sharing.mark_reached(self.me)
             else:
                 self.mode = "follow_teammate" if live else "ghost"
-                action, progressing = self._head_to(point, ("path", path.source, path.step))
+                action, progressing = self._head_to(point, ("path", path.source, path.step),
+                                                    end_margin_m=reach)
         if action is None and p.state_sharing and self.trouble.tr:
             cands = [(rid, xy[0], xy[1], self._teammate_tr.get(rid)) for rid, xy in self._seen_now.items()]
             helper = choose_helper(True, self._me_xy(), cands)
             if helper is not None:  # §5 rule 3: head to a teammate that is not in trouble
                 self.mode = "trouble_follow"
-                action, progressing = self._head_to(self._seen_now[helper], ("helper", helper),
-                                                    stop_within_m=2.0 * self.radius_m + self.step_m)
+                near = 2.0 * self.radius_m + self.step_m
+                action, progressing = self._head_to(self._seen_now[helper], ("helper", helper), stop_within_m=near,
+                                                    end_margin_m=near)
         if action is None:
             self.mode = "own_goal"
             action, progressing = self._drive(goal)
@@ -603,7 +614,7 @@ class LosHelper(_LosBrain):
             return Action()
         self.mode = "patrol"
         if self._sees(*wp):
-            action, progressing = self._head_to(wp, ("waypoint", self._k))
+            action, progressing = self._head_to(wp, ("waypoint", self._k), end_margin_m=0.5 * self.params.goal_tolerance_m)
         else:
             action, progressing = self._drive(wp)
         self.trouble.update(progressing)

@@ -278,6 +278,7 @@ class GoalPath:
     source: int
     step: int
     reached: bool = False
+    d_promised_m: float = math.inf
 
     def distance_m(self, me_xy) -> float:
         """``D = dist(me, point) + d_point`` (§4.2, §4.3)."""
@@ -386,9 +387,16 @@ class GoalSharing:
 
         ``reporter`` at ``reporter_xy`` (own frame, where it was when it reported) sees
         ``owner``'s goal with path length ``d_m``. The candidate ``dist(me, reporter) + d_m``
-        replaces the stored path only if it is strictly shorter than the stored path's current
-        ``D`` — also when the same robot reports again later (§4.2: the robot keeps heading to
-        the ghost that promised the shortest path). A direct view is never replaced (§3.1).
+        replaces the stored path only if it is strictly shorter than the stored ``D`` — also
+        when the same robot reports again later (§4.2: the robot keeps heading to the ghost
+        that promised the shortest path). A direct view is never replaced (§3.1).
+
+        The stored ``D``: for the goal's owner, the smaller of the value stored when the path
+        was adopted (§4.2: "R1 stores in its memory D11(t1) ... compares ... > D11(t1)") and its
+        current ``dist(me, point) + d_point`` (it may have come closer since); so an owner that
+        reached a ghost and wandered off with its navigator is not pulled back by a promise no
+        better than the one it already followed (that made robots loop between a ghost and
+        the navigator's detour). For a robot relaying another's goal, its current ``D`` (§4.3).
         Returns whether the report was accepted.
         """
         if not (math.isfinite(d_m) and d_m >= 0.0):
@@ -398,10 +406,14 @@ class GoalSharing:
             return False
         path = self.paths.get(owner)
         cand = math.hypot(reporter_xy[0] - me_xy[0], reporter_xy[1] - me_xy[1]) + float(d_m)
-        if path is not None and (path.kind == "direct" or cand >= path.distance_m(me_xy)):
-            return False
+        if path is not None:
+            if path.kind == "direct":
+                return False
+            now = path.distance_m(me_xy)
+            if cand >= (min(now, path.d_promised_m) if owner == self.me else now):
+                return False
         self.paths[owner] = GoalPath(stored[0], float(reporter_xy[0]), float(reporter_xy[1]), float(d_m), "ghost",
-                                     int(reporter), int(step))
+                                     int(reporter), int(step), d_promised_m=cand)
         return True
 
     def refresh(self, me_xy, prev_me_xy, sees: Callable[[float, float, float], bool], step: int) -> None:
