@@ -48,8 +48,8 @@ Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report sect
     representation "cannot deal with measurements such as 'either robot A or robot B'"): a
     detection with ``robot_id`` None is *associated by belief*. The observer broadcasts its tree
     as a query (``kind="assoc_query"``); every robot that hears it answers with the tree's
-    density under its own belief, ``E_n = sum_i w_i tree(x_i)`` (one float). On the next
-    step the observer picks the robot with the largest ``E_n``, provided it beats the uniform
+    density under its own belief, ``E_n = sum_i w_i tree(x_i)`` (one float). Two steps later
+    (query out, answers back) the observer picks the robot with the largest ``E_n``, provided it beats the uniform
     density ``1 / A`` by ``assoc_min_ratio`` and the runner-up by ``assoc_margin``, and sends it
     the ordinary detection message (the tree it kept). Ambiguous detections (every robot still
     globally uncertain, or two robots equally plausible) are dropped. With ``anonymous="ignore"``
@@ -194,6 +194,9 @@ class MCLWanderParams(BaseModel):
         What to do with detections without identity.
     assoc_min_ratio, assoc_margin : float
         Association thresholds.
+    parallel : bool
+        Let the filter's kernels use numba threads (off by default: a team runs one filter per
+        robot, and on busy cores a thread launch costs more than a serial update).
     log_points : int
         Particles (drawn by weight) logged every recorded step for scoring.
     layer_every : int
@@ -238,8 +241,9 @@ class MCLWanderParams(BaseModel):
     fp_confirm_gate_m: float = Field(1.5, gt=0.0, le=100.0)
     fp_min_real_prob: float = Field(0.5, ge=0.0, le=1.0)
     anonymous: Literal["associate", "ignore"] = "associate"
-    assoc_min_ratio: float = Field(5.0, ge=1.0, le=1e9)
+    assoc_min_ratio: float = Field(1.5, ge=1.0, le=1e9)
     assoc_margin: float = Field(3.0, ge=1.0, le=1e9)
+    parallel: bool = False
     log_points: int = Field(64, ge=1, le=1000)
     layer_every: int = Field(20, ge=1, le=100_000)
     layer_points: int = Field(200, ge=1, le=1000)
@@ -254,6 +258,7 @@ class MCLWanderParams(BaseModel):
             kld=KLDParams(epsilon=self.kld_epsilon, min_particles=min(self.min_particles, self.max_particles),
                           max_particles=self.max_particles),
             sonar_rays_per_cone=self.sonar_rays_per_cone, init_clearance_m=self.init_clearance_m,
+            parallel=self.parallel,
         )
 
 
@@ -429,15 +434,19 @@ class MCLWander:
                               self.rng, self.sync.params)
         self._query_seq += 1
         qid = self._query_seq
-        self._pending[qid] = {"tree": tree, "det": det, "scores": {}, "t": obs.time_s}
+        self._pending[qid] = {"tree": tree, "det": det, "scores": {}, "step": obs.step}
         return [Message(self.robot_id, float(obs.time_s), _AssocQuery(qid, self.robot_id, tree), to=None,
                         kind=ASSOC_KIND)]
 
     def _close_queries(self, obs: Observation) -> list[Message]:
-        """Pick the robot an anonymous detection was of, once the answers are in (one step later)."""
+        """Pick the robot an anonymous detection was of, once the answers are in.
+
+        The query reaches the others one step after it is sent and their answers come back one
+        step later still, so a query is closed two steps after it was sent.
+        """
         out: list[Message] = []
         p = self.params
-        for qid in [q for q, v in self._pending.items() if obs.time_s > v["t"] + 1e-9]:
+        for qid in [q for q, v in self._pending.items() if obs.step >= v["step"] + 2]:
             pend = self._pending.pop(qid)
             scores = sorted(pend["scores"].items(), key=lambda kv: -kv[1])
             uniform = 1.0 / self.mcl.free_area_m2

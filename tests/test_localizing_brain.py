@@ -1,0 +1,170 @@
+"""mcl-wander-v1: localizing from a known start, syncing on detections, the §2.3 rules, the
+false-positive filter and identity association (Fox et al., collaborative MCL)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from teamnav.control import registry
+from teamnav.control.localizing import ASSOC_KIND, MCLWander, MCLWanderParams, load_detection_model
+from teamnav.control.protocol import RobotInfo, SensorInfo
+from teamnav.control.types import Detection, Message, Observation, RangeScan
+from teamnav.experiments.runner import run
+from teamnav.experiments.spec import load_scenario
+from teamnav.localization.sync import SYNC_KIND, SyncMessage
+from teamnav.world import builtin_map
+
+GRID = builtin_map("lab_and_corridor").grid
+ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 19)
+LASER = SensorInfo("laser", "laser", ANGLES, 8.0)
+
+
+def _info(i: int, n: int = 2) -> RobotInfo:
+    return RobotInfo(i, n, 0.25, "unicycle", 0.5, 1.5, 0.1, 0.1, sensors={"laser": LASER}, known_map=GRID,
+                     extras={"group": "g"})
+
+
+def _brain(i: int, seed: int = 0, pose=(20.0, 9.6, 0.0), n: int = 2, **over) -> MCLWander:
+    p = MCLWanderParams(collaborate=True, max_particles=400, min_particles=100, init_pose=pose, **over)
+    return MCLWander(p, np.random.default_rng(seed), _info(i, n))
+
+
+def _obs(i: int, step: int, *, move_m: float = 0.0, dets=(), inbox=()) -> Observation:
+    scan = RangeScan(np.full(ANGLES.shape[0], 8.0), ANGLES, 8.0)
+    return Observation(i, step, step * 0.1, np.array([move_m * step, 0.0, 0.0]), np.array([move_m, 0.0, 0.0]),
+                       scans={"laser": scan}, detections=tuple(dets), inbox=tuple(inbox))
+
+
+def test_registered_and_params_validated():
+    assert registry.lookup("mcl-wander-v1") is MCLWander
+    with pytest.raises(ValueError):
+        MCLWanderParams(collaborat=True)
+    with pytest.raises(ValueError, match="give_map"):
+        MCLWander(MCLWanderParams(), np.random.default_rng(0),
+                  RobotInfo(0, 1, 0.25, "unicycle", 0.5, 1.5, 0.1, 0.1, sensors={"laser": LASER}))
+    with pytest.raises(ValueError, match="detection_model"):
+        load_detection_model("no-such-model")
+
+
+def test_shipped_model_is_the_trained_one():
+    m = load_detection_model("default")
+    assert m.n_detections > 1000
+    assert abs(m.range_std_m - 0.483) < 0.05 and abs(math.degrees(m.bearing_std_rad) - 2.2) < 0.3
+    assert abs(m.p_false_negative - 0.067) < 0.02 and abs(m.p_false_positive - 0.035) < 0.01
+
+
+def test_localizes_from_a_known_start_in_the_lab():
+    """Position tracking: a laser robot wandering the lab from a known start stays within 0.5 m."""
+    scn = load_scenario("collab-mcl-detection", duration_s=20.0, overrides={
+        "robots.0.params.motion_mode": "wander", "robots.0.params.collaborate": False,
+        "robots.0.params.init_pose": [27.0, 4.6, 0.0], "robots.0.start.poses": [[27.0, 4.6, 0.0]],
+        "robots.1.count": 0,
+    })
+    m = run(scn, progress=False).metrics
+    assert m["loc_final_error_m"] < 0.5
+    assert m["loc_localized_fraction"] == 1.0
+
+
+def test_two_robots_sync_when_one_detects_the_other():
+    """Robin right in front of Marian's opening: a detection is sent as a tree (bytes counted)
+    and collapses Robin's global uncertainty (§5.1)."""
+    scn = load_scenario("collab-mcl-detection", duration_s=12.0, overrides={
+        "robots.1.start.region": [23.0, 24.6, 9.3, 9.9], "robots.1.params.max_particles": 4000})
+    res = run(scn, progress=False)
+    m = res.metrics
+    assert m["messages_sent"] >= 2  # Marian's tree + Robin's inverse reply (§2.3 symmetry)
+    assert m["bytes_sent"] > 1000
+    assert m["loc_syncs"] >= 2
+    assert m["loc_final_error_m_g_robin"] < 1.5
+    alone = run(load_scenario(scn, overrides={"robots.1.params.collaborate": False}), progress=False).metrics
+    assert alone["messages_sent"] >= 1 and alone["loc_final_error_m_g_robin"] > 3.0
+
+
+def _exchange(a: MCLWander, b: MCLWander, steps: range, move_m: float, det: Detection):
+    """A sees B on every step while both move ``move_m`` per step; messages go back and forth."""
+    to_a: list[Message] = []
+    to_b: list[Message] = []
+    sent = 0
+    for k in steps:
+        _, out_a = a.step(_obs(0, k, move_m=move_m, dets=[det], inbox=to_a))
+        _, out_b = b.step(_obs(1, k, move_m=move_m, inbox=to_b))
+        sent += sum(1 for m in out_a if m.kind == SYNC_KIND and m.body.kind == "detection")
+        to_b, to_a = out_a, out_b
+    return sent
+
+
+def test_the_2_5_m_rule_blocks_a_second_use_in_a_closed_loop():
+    a, b = _brain(0, 0, detection_period_s=0.0), _brain(1, 1, detection_period_s=0.0)
+    det = Detection(1.5, 0.0, 1)
+    # 30 steps x 0.06 m = 1.8 m of travel: one use only, though B is seen on every step
+    assert _exchange(a, b, range(0, 30), 0.06, det) == 1
+    assert b.sync.applied["detection"] == 1 and a.sync.applied["inverse"] == 1
+    # 30 more steps: 3.6 m in all, past 2.5 m: a second use (B has travelled as far, so it
+    # accepts a second tree from A: the rule holds on the receiving side too)
+    assert _exchange(a, b, range(30, 60), 0.06, det) == 1
+    assert b.sync.applied["detection"] == 2 and a.sync.applied["inverse"] == 2
+
+
+def test_false_positive_filter_needs_a_confirmed_sighting():
+    """Gate 2: a lone (phantom-like) sight is not sent; the same robot seen again next frame
+    at a consistent place is."""
+    a = _brain(0, 0, false_positive_filter=True)
+    _, out = a.step(_obs(0, 0, dets=[Detection(1.5, 0.0, 1)]))
+    assert not [m for m in out if m.kind == SYNC_KIND] and a.stats["filtered"] == 1
+    _, out = a.step(_obs(0, 10, dets=[Detection(1.6, 0.05, 1)]))
+    assert len([m for m in out if m.kind == SYNC_KIND]) == 1
+    b = _brain(0, 0, false_positive_filter=True)
+    b.step(_obs(0, 0, dets=[Detection(1.5, 0.0, 1)]))
+    _, out = b.step(_obs(0, 10, dets=[Detection(4.5, 1.0, 1)]))  # inconsistent: 3+ m away
+    assert not [m for m in out if m.kind == SYNC_KIND]
+    # without the filter the lone sight is used at once
+    c = _brain(0, 0)
+    _, out = c.step(_obs(0, 0, dets=[Detection(1.5, 0.0, 1)]))
+    assert len([m for m in out if m.kind == SYNC_KIND]) == 1
+
+
+def test_receiver_drops_a_tree_its_belief_calls_a_phantom():
+    """Gate 3: a localized robot (at x = 20 m) rejects a tree that puts it 15 m away."""
+    obs_brain = _brain(0, 3, pose=(5.0, 9.6, 0.0))
+    _, out = obs_brain.step(_obs(0, 0, dets=[Detection(1.0, 0.0, 1)]))
+    msg = next(m for m in out if m.kind == SYNC_KIND)
+    strict = _brain(1, 4, false_positive_filter=True)
+    strict.step(_obs(1, 1, inbox=[msg]))
+    assert strict.stats["rejected"] == 1 and strict.sync.applied["detection"] == 0
+    plain = _brain(1, 4)
+    plain.step(_obs(1, 1, inbox=[msg]))
+    assert plain.sync.applied["detection"] == 1
+
+
+def test_identity_withheld_is_associated_by_belief():
+    """An anonymous sight: query broadcast, answers, and the robot whose belief fits gets the tree."""
+    a = _brain(0, 0, n=3)  # at (20, 9.6) facing +x, sees someone 1.5 m ahead
+    b = _brain(1, 1, pose=(21.5, 9.6, 0.0), n=3)  # believes it is there
+    c = _brain(2, 2, pose=(5.0, 9.6, 0.0), n=3)  # believes it is far away
+    _, out = a.step(_obs(0, 0, dets=[Detection(1.5, 0.0, None)]))
+    query = [m for m in out if m.kind == ASSOC_KIND]
+    assert len(query) == 1 and query[0].to is None
+    _, ans_b = b.step(_obs(1, 1, inbox=query))
+    _, ans_c = c.step(_obs(2, 1, inbox=query))
+    assert ans_b[0].body.evidence > 10 * ans_c[0].body.evidence
+    _, out = a.step(_obs(0, 2, inbox=ans_b + ans_c))
+    sync = [m for m in out if m.kind == SYNC_KIND]
+    assert len(sync) == 1 and sync[0].to == 1 and isinstance(sync[0].body, SyncMessage)
+    ignoring = _brain(0, 0, anonymous="ignore")
+    _, out = ignoring.step(_obs(0, 0, dets=[Detection(1.5, 0.0, None)]))
+    assert out == []
+
+
+def test_log_is_small_and_scores_the_belief():
+    a = _brain(0, 0)
+    a.step(_obs(0, 0))
+    first = a.log()
+    assert first["sensor_kind"] == "laser" and "layers" in first
+    assert len(first["pts"]) == 2 * 64 and first["n_particles"] == 400
+    pts = np.asarray(first["pts"]).reshape(-1, 2)
+    assert np.all(np.hypot(pts[:, 0] - 20.0, pts[:, 1] - 9.6) < 1.5)
+    second = a.log()
+    assert "layers" not in second and "sensor_kind" not in second
