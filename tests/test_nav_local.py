@@ -325,9 +325,12 @@ def test_visbug_new_goal_restarts_and_same_goal_does_not():
 
 def test_visbug_gives_up_on_an_enclosed_goal():
     """Bug2's termination test: back at the hit point after a full lap -> unreachable, stay."""
-    b = MapBuilder(12.0, 10.0, 0.1).border(0.2).rect(5.0, 3.0, 8.0, 7.0, filled=False, thickness_m=0.2)
-    loop = Loop(b.build("box"), nav_of("visbug21"), (2.0, 5.0), (6.5, 5.0))
+    # the box leaves a 0.8 m passage to the room's east wall: the robot must keep following the box
+    b = MapBuilder(10.0, 10.0, 0.1).border(0.2).rect(6.0, 3.0, 9.0, 7.0, filled=False, thickness_m=0.2)
+    loop = Loop(b.build("box"), nav_of("visbug21"), (2.0, 5.0), (7.5, 5.0))
     assert loop.run(800) is None
+    ys = [p[1] for p in loop.path]
+    assert 2.4 < min(ys) and max(ys) < 7.6
     assert loop.nav.mode == MODE_UNREACHABLE and not loop.nav.progressing
     assert loop.nav.direction(loop.own_pose(), FREE_SCAN) is None
 

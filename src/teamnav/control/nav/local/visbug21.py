@@ -89,6 +89,8 @@ __all__ = ["MODE_FOLLOW", "MODE_TO_GOAL", "MODE_UNREACHABLE", "VisBug21", "VisBu
 MODE_TO_GOAL = 0
 MODE_FOLLOW = 1
 MODE_UNREACHABLE = 2
+#: Two neighbouring beams' points closer than this [m] (or 2.5 beam gaps) lie on one obstacle.
+FOLLOW_GAP_M: float = 0.3
 
 
 class VisBugParams(BaseModel):
@@ -235,9 +237,11 @@ class VisBug21:
         self._walked_m = 0.0
         self._left_hit = False
         self._returns = 0
+        self._follow_ref = None
         self._last_xy: np.ndarray | None = None
         self._leave_target: np.ndarray | None = None
         self._leave_steps = 0
+        self._follow_ref: np.ndarray | None = None
         self._monitor.reset()
 
     # ------------------------------------------------------------------ protocol
@@ -289,7 +293,8 @@ class VisBug21:
                     if self._returns >= 2:
                         self.mode = MODE_UNREACHABLE
                         return None
-                heading = boundary_heading(xy, points, r_safe + p.follow_margin_m, self.side, p.follow_gain)
+                heading = boundary_heading(xy, self._followed(pose, scan), r_safe + p.follow_margin_m, self.side,
+                                           p.follow_gain)
                 if heading is None:  # nothing sensed at all: the obstacle is gone
                     self.mode = MODE_TO_GOAL
         if self.mode == MODE_TO_GOAL and self._leave_target is not None:
@@ -303,7 +308,8 @@ class VisBug21:
             ti = self._intermediate_target(xy, points, r_safe, reach_m)
             if ti is None:
                 self._hit(xy)
-                heading = boundary_heading(xy, points, r_safe + p.follow_margin_m, self.side, p.follow_gain)
+                heading = boundary_heading(xy, self._followed(pose, scan), r_safe + p.follow_margin_m, self.side,
+                                           p.follow_gain)
                 if heading is None:
                     heading = math.atan2(goal[1] - xy[1], goal[0] - xy[0])
             else:
@@ -329,6 +335,48 @@ class VisBug21:
         self._walked_m = 0.0
         self._left_hit = False
         self._returns = 0
+        self._follow_ref = None
+
+    def _followed(self, pose: np.ndarray, scan: RangeScan) -> np.ndarray:
+        """Sensed points of the obstacle being followed (own frame), shape (K, 2).
+
+        The scan is cut into obstacles: beams adjacent in angle whose points are closer than
+        ``FOLLOW_GAP_M`` (or 2.5 beam gaps at that range) belong to one. The followed one is
+        the obstacle holding the point nearest to last step's followed point; at the hit point
+        (or when that point is lost) the obstacle nearest the robot. Without this, a robot
+        passing between two obstacles (a U in a room, a pillar near a wall) would switch to
+        following the other one, which is not Bug2.
+        """
+        r = np.asarray(scan.ranges_m, dtype=np.float64)
+        a = np.asarray(scan.angles_rad, dtype=np.float64)
+        order = np.argsort(np.mod(a, 2.0 * math.pi), kind="stable")
+        r, a = r[order], a[order]
+        hit = r < float(scan.max_range_m) * (1.0 - 1e-9)
+        if not hit.any():
+            self._follow_ref = None
+            return np.zeros((0, 2))
+        ang = pose[2] + a
+        pts = np.column_stack((pose[0] + r * np.cos(ang), pose[1] + r * np.sin(ang)))
+        nxt = np.roll(np.arange(r.size), -1)
+        gap = np.hypot(*(pts[nxt] - pts).T)
+        allowed = np.maximum(FOLLOW_GAP_M, 2.5 * (2.0 * math.pi / r.size) * np.maximum(r, r[nxt]))
+        joined = hit & hit[nxt] & (gap <= allowed)  # beam i joined to beam i+1
+        # labels: a new obstacle starts after every break; the wrap-around joins last and first
+        labels = np.concatenate(([0], np.cumsum(~joined[:-1])))
+        if joined[-1]:
+            labels[labels == labels[-1]] = labels[0]
+        idx = np.flatnonzero(hit)
+        d_robot = np.hypot(pts[idx, 0] - pose[0], pts[idx, 1] - pose[1])
+        choice = idx[int(np.argmin(d_robot))]
+        if self._follow_ref is not None:
+            d_ref = np.hypot(pts[idx, 0] - self._follow_ref[0], pts[idx, 1] - self._follow_ref[1])
+            k = int(np.argmin(d_ref))
+            if d_ref[k] <= self.step_length_m + FOLLOW_GAP_M:
+                choice = idx[k]
+        members = idx[labels[idx] == labels[choice]]
+        near = members[int(np.argmin(np.hypot(pts[members, 0] - pose[0], pts[members, 1] - pose[1])))]
+        self._follow_ref = pts[near].copy()
+        return pts[members]
 
     def _mline_samples(self, t_from: float) -> tuple[np.ndarray, np.ndarray]:
         """M-line points with parameter t in [t_from, 1] (goal last), and their t."""
