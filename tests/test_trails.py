@@ -305,3 +305,17 @@ def test_brain_three_place_round_seeks_each_place_in_turn(monkeypatch):
     r.step(_obs(0, 100, [12.0, 2.0, 0.0], events=["b"]))
     r.step(_obs(0, 150, [0.0, 0.0, 0.0], events=["depot"]))
     assert r.round.goal == "a" and r.round.trips == 3 and r.log()["place_index"] == 1
+
+
+def test_brain_descends_the_trail_and_explores_at_its_end(monkeypatch):
+    """descend_only: once at the lowest crumb near it, the robot does not turn back to a higher
+    one (the paper's rule as written does: it dithers at the end of a trail)."""
+    for descend, at_end in ((True, None), (False, math.pi)):
+        (r,) = _brains(monkeypatch, n=1, descend_only=descend, radius_m=2.1, broadcast_interval_s=600.0)
+        r.step(_obs(0, 0, [-50.0, 0.0, 0.0]))
+        xs = np.arange(5.0)
+        r.trail.add_crumbs(["took_resource"] * 5, np.c_[xs, np.zeros(5)], 10.0 - 2.0 * xs, np.full(5, 0.0))
+        r.step(_obs(0, 1, [2.0, 0.0, 0.0]))
+        assert r.nav.headings[-1] == pytest.approx(0.0)  # on towards x = 4 (s = 2)
+        r.step(_obs(0, 2, [4.3, 0.0, 0.0]))  # just past the trail's end (s = 2 at x = 4)
+        assert r.nav.headings[-1] == at_end  # the paper's rule turns back to it

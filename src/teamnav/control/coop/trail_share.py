@@ -28,6 +28,15 @@ transform between reference frames in robot teams" (2002), §2.2 trail laying, �
 ``communicate=False`` is the no-communication baseline: nothing is sent or read; the robot uses
 its own trail only.
 
+Descend only (``descend_only``, on by default; a gap filled): the paper's rule has local
+minima where trails of different robots meet (the lowest-s crumb near the robot is the one it
+stands on, then one behind it), and robots dither there (observed on ``trail_office``). The
+robot keeps an upper bound of its own time to the goal: the lowest s of a goal crumb it has
+come within ``reach_m`` of, plus the time since (it could go back the way it came); it only
+heads for crumbs with s below that bound, so it never turns back up a trail, and at a local
+minimum it explores instead of dithering. The bound is reset when the goal changes.
+``descend_only=False`` is the paper's rule as written.
+
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
 ``min_move_m`` since the previous temporary trail; radius 2 m (about a corridor's width);
 ``crumbs_for="every_place"`` is the §2.2 alternative the paper names for future work (one Crumb
@@ -80,6 +89,10 @@ class TrailShareParams(BaseModel):
         One Crumb for the last Place visited (the paper), or one per visited Place (§2.2 alternative).
     min_move_m : float
         Odometry motion since the last temporary trail below which the robot is not "moving" [m].
+    descend_only : bool
+        Head only for crumbs below the robot's own time-to-goal bound (module docstring).
+    reach_m : float
+        A goal crumb this close [m] has been reached (it sets the bound).
     sensor : str
         The laser Navigate reads.
     layer_every_steps : int
@@ -103,6 +116,8 @@ class TrailShareParams(BaseModel):
     start_at_first_place: bool = True
     crumbs_for: Literal["last_place", "every_place"] = "last_place"
     min_move_m: float = Field(0.05, ge=0.0, le=100.0)
+    descend_only: bool = True
+    reach_m: float = Field(0.6, gt=0.0, le=100.0)
     sensor: str = Field("laser", min_length=1)
     layer_every_steps: int = Field(50, ge=1, le=1_000_000)
     navigate: dict[str, Any] = Field(default_factory=dict)
@@ -144,6 +159,8 @@ class TrailShare:
         self._next_broadcast_s = 0.0
         self._last_broadcast_xy: np.ndarray | None = None
         self._following = False
+        self._bound_s = math.inf  # own time-to-goal upper bound when last set [s]
+        self._bound_t = 0.0
         self._step = 0
         self._last_layer_step: int | None = None
 
@@ -174,7 +191,8 @@ class TrailShare:
         for e in obs.events:  # §2.2 step 1
             self.trail.set_place(e, x, y)
             self.visits_s[e] = t
-        self.round.observe(obs.events, t)
+        if self.round.observe(obs.events, t):
+            self._bound_s = math.inf  # a new goal
         if p.communicate:  # §2.2 step 3
             for msg in obs.inbox:
                 if msg.kind == "trail" and isinstance(msg.body, TrailMessage) and msg.sender != self.info.robot_id:
@@ -193,7 +211,15 @@ class TrailShare:
                     outbox.append(Message(self.info.robot_id, t, tmp, kind="trail"))
             self._last_broadcast_xy = here
             self._next_broadcast_s = t + p.broadcast_interval_s - 1e-9
-        heading = self.trail.heading_to_best(self.round.goal, x, y, p.radius_m)  # §2.3 step 1
+        goal = self.round.goal
+        below = math.inf
+        if p.descend_only:
+            near = self.trail.best_crumb(goal, x, y, p.reach_m)
+            bound = self._bound_s + (t - self._bound_t)
+            if near is not None and near[1] < bound:
+                self._bound_s, self._bound_t, bound = near[1], t, near[1]
+            below = bound
+        heading = self.trail.heading_to_best(goal, x, y, p.radius_m, below_s=below)  # §2.3 step 1
         self._following = heading is not None
         v, w = self.nav.step(obs, preferred_heading_rad=heading)
         return Action(float(v), float(w)), outbox

@@ -314,12 +314,19 @@ class Trail:
         self._t_min = float(self._xys[:k, 3].min()) if k else math.inf
         return removed
 
-    def best_crumb(self, goal: str, x_odom_m: float, y_odom_m: float, radius_m: float) -> tuple[int, float] | None:
+    def best_crumb(self, goal: str, x_odom_m: float, y_odom_m: float, radius_m: float, *,
+                   below_s: float = math.inf) -> tuple[int, float] | None:
         """The trail-using rule (§2.3 step 1).
 
         "finds those Crumbs which reference its current goal ... and have a position within a
         fixed radius of the current position. The preferred direction of movement is towards
         the Crumb with the lowest time-to-Place estimate."
+
+        Parameters
+        ----------
+        below_s : float, default inf
+            Consider only crumbs with a time-to-place below this [s] (see :class:`TrailShare
+            <teamnav.control.coop.trail_share.TrailShare>`'s ``descend_only``).
 
         Returns
         -------
@@ -334,15 +341,18 @@ class Trail:
         dx = xys[:, 0] - x_odom_m
         dy = xys[:, 1] - y_odom_m
         ok = (self._p[: self._n] == code) & (dx * dx + dy * dy <= radius_m * radius_m)
+        if below_s != math.inf:
+            ok &= xys[:, 2] < below_s
         if not ok.any():
             return None
         s = np.where(ok, xys[:, 2], np.inf)
         i = int(np.argmin(s))
         return i, float(s[i])
 
-    def heading_to_best(self, goal: str, x_odom_m: float, y_odom_m: float, radius_m: float) -> float | None:
+    def heading_to_best(self, goal: str, x_odom_m: float, y_odom_m: float, radius_m: float, *,
+                        below_s: float = math.inf) -> float | None:
         """Direction [rad] from (x, y) towards :meth:`best_crumb`, or None (no crumb, or on it)."""
-        best = self.best_crumb(goal, x_odom_m, y_odom_m, radius_m)
+        best = self.best_crumb(goal, x_odom_m, y_odom_m, radius_m, below_s=below_s)
         if best is None:
             return None
         cx, cy = self._xys[best[0], :2]
