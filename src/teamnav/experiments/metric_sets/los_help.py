@@ -15,7 +15,7 @@ Keys
     R1's motion steps to finish the task; the run's step budget when it did not finish.
     Logs are kept every ``record_every`` steps, so for a finished run the steps after the
     last kept sample are added as if R1 moved at each (an upper bound, off by less than
-    ``record_every``).
+    ``record_every``, and never more than the steps the run took).
 ``los_steps_per_target``
     ``los_steps`` over the targets reached (over 1 when none was).
 ``los_targets_reached``
@@ -65,7 +65,7 @@ def los_help(data: RunData) -> dict[str, float | int]:
     reached = int(v.get("targets_reached", 0))
     moves = int(v.get("moves", 0))
     if finished:
-        steps = moves + max(0, int(data.n_steps) - v["_step"])
+        steps = min(moves + max(0, int(data.n_steps) - v["_step"]), int(data.n_steps))
     else:
         steps = int(data.n_steps)
     trouble = [bool((e.get("values") or {}).get("tr", False)) for e in data.logs if int(e.get("robot", -1)) == r1]
