@@ -135,3 +135,26 @@ def test_hallway_collaboration_is_faster(tmp_path):
                if r["params"]["robots.0.params.collaborate"] is c] for c in (False, True)}
     assert len(ttl[False]) >= 8 and len(ttl[True]) >= 8
     assert np.mean(ttl[True]) < np.mean(ttl[False])
+
+
+@pytest.mark.slow
+def test_report_section_quick_build(tmp_path):
+    """The section builds in quick mode with a minimal report context (CI budget: about a minute)."""
+    import time
+
+    from teamnav.experiments.report.model import Comparison, Plot
+    from teamnav.experiments.report.sections.collab_mcl import SECTION
+    from teamnav.experiments.sweep import sweep
+
+    class Ctx:
+        quick, out_dir, progress = True, tmp_path, False
+
+        def sweep(self, spec, **kw):
+            return sweep(spec, out_dir=tmp_path / "sweeps" / (kw.get("name") or spec), workers=2, progress=False,
+                         **kw)
+
+    t0 = time.perf_counter()
+    blocks = SECTION.build(Ctx())
+    assert time.perf_counter() - t0 < 120
+    assert sum(isinstance(b, Comparison) for b in blocks) >= 3
+    assert all(len(s.x) > 2 for b in blocks if isinstance(b, Plot) for s in b.series)

@@ -22,6 +22,16 @@ Detections are looked at once per ``detection_period_s`` (1 s: "images are analy
 rate of 1 Hz", §4.1); the simulator's detector reports every step, so its false-positive rate
 per step is the rate per camera frame as the brain sees it.
 
+Where the brain fills gaps of the paper (each a parameter, the paper's behaviour reachable):
+the filter runs once odometry accumulated ``min_update_m`` / ``min_update_deg`` (the steps in
+between are composed, as AMCL does); it resamples only when the effective sample size fell
+below ``resample_ess_fraction`` of the set (1 = every update, as §3.1); the likelihood is
+tempered by ``likelihood_exponent`` (neighbouring beams are not independent); and with
+``inject_fraction`` > 0 a received tree first replaces that share of the samples by draws from
+it (sensor resetting) before eq. 14 reweights them, because our sample sets (thousands per
+robot) lose the true mode of a symmetric belief long before a detection arrives, and eq. 14
+alone cannot move weight onto samples that do not exist.
+
 Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report section):
 
 ``false_positive_filter`` (§7.2: "a rate of 3.5 % ... turns out to cause major problems")
