@@ -169,7 +169,8 @@ def test_metrics_read_r1s_last_log_and_add_the_unrecorded_tail_of_a_finished_run
     assert m["los_finished"] == 1 and m["los_steps"] == 9 + 3 and m["los_targets_reached"] == 1
     assert m["los_msgs_r1"] == 4 and m["los_msgs_per_robot"] == 5.0 and m["los_bytes_per_robot"] == 600.0
     assert m["los_trouble_frac"] == 0.5
-    assert los_help(_data(logs, finished=True, n_steps=11))["los_steps"] == 11  # never more than the run's steps
+    ahead = [_log(10, 0, targets_reached=1, finished=False, moves=11)]  # moves counted at decision time
+    assert los_help(_data(ahead, finished=True, n_steps=11))["los_steps"] == 11  # never more than the run's steps
     unfinished = los_help(_data(logs, finished=False, n_steps=500))
     assert unfinished["los_finished"] == 0 and unfinished["los_steps"] == 500  # the budget
 
