@@ -46,7 +46,7 @@ import math
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from teamnav.control.coop.crumbs import CrumbBatch, CrumbList, preferred_heading
 from teamnav.control.coop.forager import PlaceRound
@@ -186,7 +186,7 @@ class BlazingTrail:
         p = self.params
         self._step = int(obs.step)
         t = float(obs.time_s)
-        x, y, th = (float(v) for v in obs.odom_pose)
+        x, y, th = obs.odom_pose.tolist()[:3]
         outbox: list[Message] = []
         if self._last_xy is not None:
             self._path_m += math.hypot(x - self._last_xy[0], y - self._last_xy[1])

@@ -33,9 +33,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from teamnav.geometry.angles import wrap_angle
 
 __all__ = ["CrumbBatch", "CrumbList", "average_heading", "preferred_heading"]
+
+
+def _wrap_scalar(a_rad: float) -> float:
+    """Scalar twin of :func:`teamnav.geometry.angles.wrap_angle` for the per-step path: (-pi, pi]."""
+    w = math.remainder(a_rad, 2.0 * math.pi)
+    return math.pi if w == -math.pi else w
 
 
 @dataclass(frozen=True)
@@ -134,7 +139,7 @@ class CrumbList:
         """
         self._reserve(1)
         h = heading_rad if outbound else heading_rad + math.pi
-        self._buf[self._n] = (x_odom_m, y_odom_m, wrap_angle(h), path_m)
+        self._buf[self._n] = (x_odom_m, y_odom_m, _wrap_scalar(h), path_m)
         self._n += 1
         self._trim()
 
@@ -239,7 +244,7 @@ def average_heading(xy_m: np.ndarray, heading_rad: np.ndarray, x_odom_m: float, 
     c = float(np.cos(h).sum())
     if math.hypot(s, c) <= 1e-9 * h.shape[0]:
         return None
-    return wrap_angle(math.atan2(s, c))
+    return _wrap_scalar(math.atan2(s, c))
 
 
 def preferred_heading(mean_heading_rad: float | None, carrying: bool) -> float | None:
@@ -248,9 +253,9 @@ def preferred_heading(mean_heading_rad: float | None, carrying: bool) -> float |
 
     Examples
     --------
-    >>> preferred_heading(0.25, carrying=True) == wrap_angle(0.25 + np.pi)
+    >>> round(preferred_heading(0.25, carrying=True), 12) == round(0.25 - np.pi, 12)
     True
     """
     if mean_heading_rad is None:
         return None
-    return wrap_angle(mean_heading_rad + math.pi) if carrying else wrap_angle(mean_heading_rad)
+    return _wrap_scalar(mean_heading_rad + math.pi) if carrying else _wrap_scalar(mean_heading_rad)

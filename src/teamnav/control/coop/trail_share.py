@@ -180,7 +180,7 @@ class TrailShare:
         p = self.params
         self._step = int(obs.step)
         t = float(obs.time_s)
-        x, y = float(obs.odom_pose[0]), float(obs.odom_pose[1])
+        x, y = obs.odom_pose.tolist()[:2]
         outbox: list[Message] = []
         if not self._started:
             self._started = True
