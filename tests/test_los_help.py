@@ -360,6 +360,13 @@ def test_brain_state_sharing_follows_teammate_not_in_trouble(monkeypatch):
     r1.trouble.tr, r1.trouble.pr = True, r1.trouble.bound
     r1.step(obs(k + 1, walls=wall, seen=[(1, 3.0, 1.0)], inbox=[msg(1, k, trouble=True)]))
     assert r1.mode == "own_goal"
+    # a helper that walks out of sight stays the temporary goal at its last seen position
+    r1.step(obs(k + 2, walls=wall, seen=[(1, 3.0, math.pi / 2)], inbox=[msg(1, k + 1, trouble=False)]))
+    assert r1.mode == "trouble_follow"
+    a, _ = r1.step(obs(k + 3, pose=(0.0, 0.5, 0.0), walls=wall))
+    assert r1.mode == "trouble_follow" and a.direction_rad == pytest.approx(math.pi / 2)
+    a, _ = r1.step(obs(k + 4, pose=(0.0, 2.6, 0.0), walls=wall))  # there: nobody in sight, back to A
+    assert r1.mode == "own_goal"
 
 
 @settings(max_examples=60, deadline=None)

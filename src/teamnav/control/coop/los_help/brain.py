@@ -161,9 +161,14 @@ class LosExplorerParams(_CommonParams):
     targets_xy : list of (x, y)
         Targets [m] in the robot's own odometry frame, reached in sequence (§2, §6). Empty:
         finished at once (the robot stays and still relays).
+    keep_trouble_helper : bool
+        In trouble, keep heading to the chosen helper's last seen position when it goes out of
+        sight, until no longer in trouble or the goal is seen (§5 names only these two ends);
+        False follows it only while in sight.
     """
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
+    keep_trouble_helper: bool = True
 
 
 class LosHelperParams(_CommonParams):
@@ -475,6 +480,7 @@ class LosExplorer(_LosBrain):
         self.target_index = 0
         self.targets_reached = 0
         self.finished = not self.targets
+        self._trouble_target: tuple[int, XY] | None = None
         self._set_goal()
 
     def _set_goal(self) -> None:
@@ -526,14 +532,24 @@ class LosExplorer(_LosBrain):
                 self.mode = "follow_teammate" if live else "ghost"
                 action, progressing = self._head_to(point, ("path", path.source, path.step),
                                                     end_margin_m=reach)
+        if not self.trouble.tr:
+            self._trouble_target = None
         if action is None and p.state_sharing and self.trouble.tr:
+            # §5 rule 3: in trouble, a teammate in sight that is not becomes the temporary goal
+            # "until it realizes it is no longer in trouble or ... perceives its own goal": kept
+            # (at its last seen position) when it goes out of sight (gap filled; the paper
+            # names only these two ends)
+            near = 2.0 * self.radius_m + self.step_m
             cands = [(rid, xy[0], xy[1], self._teammate_tr.get(rid)) for rid, xy in self._seen_now.items()]
-            helper = choose_helper(True, self._me_xy(), cands)
-            if helper is not None:  # §5 rule 3: head to a teammate that is not in trouble
+            tt = self._trouble_target
+            if tt is not None and tt[0] in self._seen_now:
+                tt = self._trouble_target = (tt[0], self._seen_now[tt[0]])
+            elif tt is None or math.hypot(tt[1][0] - self._pose[0], tt[1][1] - self._pose[1]) <= near:
+                helper = choose_helper(True, self._me_xy(), cands)
+                tt = self._trouble_target = None if helper is None else (helper, self._seen_now[helper])
+            if tt is not None and (tt[0] in self._seen_now or p.keep_trouble_helper):
                 self.mode = "trouble_follow"
-                near = 2.0 * self.radius_m + self.step_m
-                action, progressing = self._head_to(self._seen_now[helper], ("helper", helper), stop_within_m=near,
-                                                    end_margin_m=near)
+                action, progressing = self._head_to(tt[1], ("helper", tt[0]), stop_within_m=near, end_margin_m=near)
         if action is None:
             self.mode = "own_goal"
             action, progressing = self._drive(goal)
