@@ -175,12 +175,15 @@ def safe_heading(heading_rad: float, xy: np.ndarray, points: np.ndarray, step_le
     """
     if points.shape[0] == 0:
         return float(wrap_angle(heading_rad))
+    near = points[np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1]) < step_length_m + hard_clearance_m + 1e-9]
+    want_end = xy + step_length_m * np.array([[math.cos(heading_rad), math.sin(heading_rad)]])
+    if segment_clearance(near, xy, want_end)[0] >= hard_clearance_m:
+        return float(wrap_angle(heading_rad))
     n = int(round(math.pi / GUARD_STEP_RAD))
     k = np.arange(1, n + 1)
     offs = np.concatenate(([0.0], np.column_stack((k, -k)).reshape(-1) * GUARD_STEP_RAD))
     heads = heading_rad + offs
     ends = xy + step_length_m * np.column_stack((np.cos(heads), np.sin(heads)))
-    near = points[np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1]) < step_length_m + hard_clearance_m + 1e-9]
     clear = segment_clearance(near, xy, ends)
     ok = np.flatnonzero(clear >= hard_clearance_m)
     if ok.size:

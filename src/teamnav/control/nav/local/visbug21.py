@@ -14,35 +14,38 @@ Step 1 (``MODE_TO_GOAL``, "move towards Ti")
     behind the last leave point) that the robot sees with a free corridor: the segment from
     the robot to it passes at least ``R = radius_m + safety_margin_m`` from every sensed
     point and is no longer than the sensor's range minus ``R``. A point sensed at range
-    ``ρ`` counts as ``ρ · π / n_beams`` nearer (half the gap between two beams there: a wall
-    corner can hide between two far beams). When T itself is such a
-    point the robot heads straight for it. When no such ``Ti`` lies at least one step away,
-    an obstacle blocks the M-line: the robot's position is the *hit point* H (distance
-    ``d_H`` to T) and Step 2 starts.
+    ``ρ`` counts as ``ρ · π / n_beams`` nearer (half the gap between two beams there: a
+    wall corner can hide between two far beams). When T itself is such a point the robot
+    heads straight for it. When no such ``Ti`` lies at least one step away, an obstacle
+    blocks the M-line: the robot's position is the *hit point* H and Step 2 starts.
 Step 2 (``MODE_FOLLOW``, "follow the boundary in the local direction")
-    The robot follows the obstacle boundary, keeping it on its right (``turn="left"``, the
-    default) or left, at ``R + follow_margin_m``: heading = tangent at the nearest sensed
-    point, turned towards or away from the obstacle in proportion to the distance error.
-    At every step it looks for a *leave point*: a point Q of the M-line with
-    ``|QT| < d_H − leave_margin_m`` seen through a free corridor as above but wider, of
-    half-width ``R + leave_hysteresis_m`` (hysteresis: a point at the edge of visibility would
-    otherwise make the robot leave and hit again at every step), and at least a step away
-    or T itself, and from which the M-line runs on free (corridor half-width R) for
-    ``leave_run_m`` or up to T (Bug2: "the robot can move towards T from Q"; we ask for a
-    finite run, not an infinitesimal one: otherwise an M-line that slips into a door at an
-    angle the robot cannot pass makes it leave, hit a few centimetres further, and walk the
-    whole boundary again, lap after lap) (``d_H`` is the
-    smallest hit distance so far for this goal: a robot stopped short of a leave point
-    can hit farther from T than it left, and Bug2's progress argument needs every leave
-    point closer than all earlier hit points). When there is
-    one it takes the nearest to T as ``Ti`` and returns to Step 1 (VisBug-21's shortcut:
-    range sensing lets the robot leave the boundary for a visible M-line point ahead instead
-    of walking the boundary to it). It drives to that point before testing the M-line again
-    (within ``2 d / step + 5`` steps), so that a new hit point lies on the M-line and closer
-    to T than the last one, as in Bug2; otherwise a corridor that narrows as the robot moves
-    (a door seen at an angle) could make it hit again before the M-line, farther from T. If it walks back to within ``return_tol_m`` of H after
-    having been ``2·return_tol_m`` or more away, T is unreachable (Bug2's termination
-    test): :meth:`direction` then returns None until a new goal is set.
+    The robot follows the obstacle it hit, keeping it on its right (``turn="left"``, the
+    default) or left, at ``R + follow_margin_m``: heading = tangent at the obstacle's
+    nearest sensed point, turned towards or away from it in proportion to the distance
+    error. The scan is cut into obstacles (neighbouring beams with close points) and the
+    robot keeps following the one it hit, not whichever wall is nearest. At every step it
+    looks for a *leave point* Q on the M-line such that
+
+    - ``|QT| < d_H − leave_margin_m``, where ``d_H`` is the smallest hit distance so far
+      for this goal (Bug2's progress argument needs every leave point closer than all
+      earlier hit points);
+    - Q is seen through a free corridor as in Step 1 but of half-width
+      ``R + leave_hysteresis_m`` (hysteresis: a point at the edge of visibility would
+      otherwise make the robot leave and hit again at every step), and is at least a step
+      away or is T;
+    - the M-line runs on free from Q (corridor half-width R) for ``leave_run_m`` or up to
+      T (Bug2: "the robot can move towards T from Q"; we ask for a finite run: otherwise an
+      M-line slipping into a door at an angle the robot cannot pass makes it leave, hit a
+      few centimetres further on, and walk the whole boundary again, lap after lap).
+
+    It takes the such Q nearest to T (VisBug-21's shortcut: with range sensing the robot
+    leaves for a visible M-line point instead of walking the boundary to it) and drives to
+    Q before testing the M-line again (within ``2 d / step + 5`` steps), so that the next
+    hit point lies on the M-line, closer to T, as in Bug2. Back within ``return_tol_m`` of H
+    (after having been ``2·return_tol_m`` away) for the *second* time, T is unreachable
+    (Bug2's termination test, taken on the second lap because our H lies off the followed
+    path by up to a step: one pass near H while turning into a door next to it is not yet a
+    closed lap); :meth:`direction` then returns None until a new goal is set.
 
 Where we deviate: Lumelsky & Skewis also let ``Ti`` be the farthest visible point of the
 obstacle boundary in the local direction (so a robot cuts across concave stretches of the
