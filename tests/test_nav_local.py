@@ -350,3 +350,22 @@ def test_visbug_random_turn_is_seeded():
 def test_avoid_past_params_extend_the_potential_fields():
     p = AvoidPastParams(influence_m=0.5, avoid_gain=0.3)
     assert isinstance(p, PotentialFieldParams) and p.influence_m == 0.5
+
+
+def test_avoid_past_push_saturates_and_points_away():
+    from teamnav.control.nav.local.avoid_past import avoid_past_vector
+    v = avoid_past_vector(np.array([1.0, 0.25]), {(0, 0): 1e6}, 0.5, 2.0, 0.1, avoid_max=2.0)
+    assert math.hypot(*v) == pytest.approx(2.0) and v[0] > 0 and abs(v[1]) < 1e-9
+    assert not avoid_past_vector(np.array([9.0, 9.0]), {(0, 0): 1e6}, 0.5, 2.0, 0.1).any()  # out of reach
+
+
+@pytest.mark.parametrize("side,d,want_rad", [(1, 0.5, 0.0), (-1, 0.5, math.pi), (1, 0.3, 0.6), (-1, 0.3, math.pi - 0.6),
+                                              (1, 0.8, -0.9), (1, 2.0, -math.pi / 3)])
+def test_boundary_heading_keeps_the_wall_on_the_chosen_side(side, d, want_rad):
+    """A wall d metres to the south, followed at 0.5 m with gain 1.5: +1 (obstacle on the right)
+    drives east, -1 west; too close turns away (north) by 1.5 x relative error, too far towards
+    it, clipped at 60 degrees."""
+    from teamnav.control.nav.local.visbug21 import boundary_heading
+    pts = np.column_stack((np.linspace(-3, 3, 121), np.full(121, -d)))
+    h = boundary_heading(np.zeros(2), pts, 0.5, side, 1.5)
+    assert abs(math.remainder(h - want_rad, 2 * math.pi)) < 1e-9
