@@ -549,7 +549,11 @@ class LosExplorer(_LosBrain):
                 tt = self._trouble_target = None if helper is None else (helper, self._seen_now[helper])
             if tt is not None and (tt[0] in self._seen_now or p.keep_trouble_helper):
                 self.mode = "trouble_follow"
-                action, progressing = self._head_to(tt[1], ("helper", tt[0]), stop_within_m=near, end_margin_m=near)
+                action, _ = self._head_to(tt[1], ("helper", tt[0]), stop_within_m=near, end_margin_m=near)
+                # progress towards a moving teammate seen with noise (eqs. 1-2): its perceived
+                # distance jumps by up to err_max·d, so a step that was not blocked counts
+                # (§5 leaves the measure to the designer)
+                progressing = not obs.stalled
         if action is None:
             self.mode = "own_goal"
             action, progressing = self._drive(goal)
