@@ -141,8 +141,8 @@ def test_unknown_name_and_bad_params_are_refused():
         nav_of("visbug2")
     with pytest.raises(ValueError, match="influence_m"):
         nav_of("potential_field", {"influence_m": -1.0})
-    with pytest.raises(ValueError, match="avoid_gainn"):
-        nav_of("avoid_past", {"avoid_gainn": 1.0})
+    with pytest.raises(ValueError, match="avoid_gain_per_mm"):
+        nav_of("avoid_past", {"avoid_gain_per_mm": 1.0})
     with pytest.raises(ValueError, match="turn"):
         nav_of("visbug21", {"turn": "up"})
     with pytest.raises(ValueError, match="must be a VisBugParams"):
@@ -262,7 +262,7 @@ def test_avoid_past_memory_survives_a_new_goal():
     for _ in range(200):
         loop.step()
     visits = dict(nav.visits)
-    assert sum(visits.values()) == 200
+    assert sum(visits.values()) == pytest.approx(200 * STEP_M)
     nav.set_goal(loop.to_own(np.array([1.0, 1.0])))
     assert nav.visits == visits
     assert nav.progressing  # the progress estimate restarted for the new goal
@@ -348,7 +348,7 @@ def test_visbug_random_turn_is_seeded():
 
 
 def test_avoid_past_params_extend_the_potential_fields():
-    p = AvoidPastParams(influence_m=0.5, avoid_gain=0.3)
+    p = AvoidPastParams(influence_m=0.5, avoid_gain_per_m=0.3)
     assert isinstance(p, PotentialFieldParams) and p.influence_m == 0.5
 
 

@@ -12,10 +12,12 @@ Here:
 
 - memory: a grid of square cells of side ``cell_m`` in the robot's **own odometry frame**
   (a dict keyed by cell index, so it grows with the explored area); every :meth:`direction`
-  call adds one visit to the cell under the robot. The memory belongs to the robot, not to a
+  call adds the step length to the cell under the robot (a visit weighs the path it stands
+  for, so the law below does not change with the step length). The memory belongs to the robot, not to a
   goal: a new goal keeps it (it is a memory of places, not of a task);
-- avoid-past vector: ``avoid_gain · Σ_c n_c · (1 − d_c / memory_radius_m) · (x − c) / d_c``
-  over the cells ``c`` whose centre is within ``memory_radius_m`` of the robot (``n_c`` visits,
+- avoid-past vector: ``avoid_gain_per_m · Σ_c n_c · (1 − d_c / memory_radius_m) · (x − c) / d_c``
+  over the cells ``c`` whose centre is within ``memory_radius_m`` of the robot (``n_c`` metres
+  of path in the cell,
   ``d_c`` distance from the cell centre to the robot ``x``): a discrete, distance-weighted
   estimate of minus the gradient of the visit density, so that a box canyon fills up with
   visits until the robot is pushed out of it (the linear distance weighting is our
@@ -48,20 +50,21 @@ class AvoidPastParams(PotentialFieldParams):
         Side of a memory cell [m].
     memory_radius_m : float, default 2.0
         Cells within this distance of the robot push it [m].
-    avoid_gain : float, default 0.1
-        Avoid-past magnitude per visit of a cell next to the robot.
+    avoid_gain_per_m : float, default 1.0
+        Avoid-past magnitude per metre of path in a cell next to the robot (1.0 is 0.1 per
+        visit with 0.1 m steps).
     avoid_max : float, default 2.0
         Largest avoid-past magnitude (saturation; see the module docstring).
     """
 
     cell_m: float = Field(0.3, gt=0.0, le=10.0)
     memory_radius_m: float = Field(2.0, gt=0.0, le=50.0)
-    avoid_gain: float = Field(0.1, ge=0.0, le=100.0)
+    avoid_gain_per_m: float = Field(1.0, ge=0.0, le=1000.0)
     avoid_max: float = Field(2.0, ge=0.0, le=1000.0)
 
 
 def avoid_past_vector(xy: np.ndarray, visits: dict[tuple[int, int], float], cell_m: float,
-                      memory_radius_m: float, avoid_gain: float, avoid_max: float = math.inf) -> np.ndarray:
+                      memory_radius_m: float, avoid_gain_per_m: float, avoid_max: float = math.inf) -> np.ndarray:
     """The avoid-past schema's vector at ``xy`` (own frame), shape (2,).
 
     Examples
@@ -82,7 +85,7 @@ def avoid_past_vector(xy: np.ndarray, visits: dict[tuple[int, int], float], cell
     away = xy - (arr[:, :2] + 0.5) * cell_m
     d = np.hypot(away[:, 0], away[:, 1])
     w = np.where((d < memory_radius_m) & (d > 1e-12), arr[:, 2] * (1.0 - d / memory_radius_m), 0.0)
-    v = avoid_gain * ((w / np.maximum(d, 1e-12)) @ away)
+    v = avoid_gain_per_m * ((w / np.maximum(d, 1e-12)) @ away)
     norm = math.hypot(v[0], v[1])
     return v * (avoid_max / norm) if norm > avoid_max else v
 
@@ -91,7 +94,7 @@ class AvoidPast(PotentialField):
     """Potential field with the avoid-past schema (Sgorbissa & Arkin §6, algorithm 2).
 
     Same constructor and protocol as :class:`~teamnav.control.nav.local.potential_field.PotentialField`;
-    ``visits`` is the robot's memory (cell index in the own frame -> visit count).
+    ``visits`` is the robot's memory (cell index in the own frame -> metres of path in the cell).
 
     Examples
     --------
@@ -100,7 +103,7 @@ class AvoidPast(PotentialField):
     >>> nav.set_goal(np.array([2.15, 0.15]))
     >>> scan = RangeScan(np.full(72, 4.0), np.linspace(-np.pi, np.pi, 72, endpoint=False), 4.0)
     >>> abs(round(nav.direction(np.array([0.15, 0.15, 0.0]), scan), 3)), nav.visits   # at a cell centre
-    (0.0, {(0, 0): 1.0})
+    (0.0, {(0, 0): 0.1})
     """
 
     name = "avoid_past"
@@ -114,7 +117,7 @@ class AvoidPast(PotentialField):
     def _vector(self, pose: np.ndarray, points: np.ndarray, n_beams: int) -> np.ndarray:
         p: AvoidPastParams = self.params  # type: ignore[assignment]
         key = (int(math.floor(pose[0] / p.cell_m)), int(math.floor(pose[1] / p.cell_m)))
-        self.visits[key] = self.visits.get(key, 0.0) + 1.0
+        self.visits[key] = self.visits.get(key, 0.0) + self.step_length_m
         v = super()._vector(pose, points, n_beams)
-        return v + avoid_past_vector(pose[:2], self.visits, p.cell_m, p.memory_radius_m, p.avoid_gain,
+        return v + avoid_past_vector(pose[:2], self.visits, p.cell_m, p.memory_radius_m, p.avoid_gain_per_m,
                                      p.avoid_max)
