@@ -40,6 +40,13 @@ by at least ``progress_min_fraction`` of a step since the last step" otherwise.
 ``Action(direction_rad=...)`` is a body-frame direction for ``holonomic_step`` kinematics
 (Sgorbissa & Arkin count motion steps); ``Action()`` stays and does not count as a move.
 
+Scenario use: robots need ``kinematics: holonomic_step``, an omnidirectional laser (``fov_deg:
+360``; its name is ``laser``), a ``detector`` that reports identities (``report_identity``,
+the default; detections without an id are ignored) and ``radio: {mode: line_of_sight}``.
+``targets_xy`` / ``patrol_xy`` are in each robot's own odometry frame (``frame: start``): a
+world point ``w`` is ``R(-θ0)(w - p0)`` for a robot starting at ``(p0, θ0)``. With
+``stop_when_finished`` a run ends once R1 is ``finished`` (helpers have no such attribute).
+
 Parameters, log keys and layers are documented on :class:`LosExplorerParams`,
 :meth:`LosExplorer.log` and :class:`LosHelperParams`; keep them stable (experiments and
 the report read them).
