@@ -136,6 +136,22 @@ def test_trail_office_home_source_path_length():
     assert straight < 0.8 * length
 
 
+def test_trail_office_corridors_closes_rooms_but_keeps_the_route_and_wrong_turns():
+    """Blazing §6: "we deliberately worked only in the corridors"."""
+    open_env, closed = builtin_map("trail_office"), builtin_map("trail_office_corridors")
+    route = _shortest_path_m(closed.grid, closed.places["home"], closed.places["source"])
+    assert route == pytest.approx(_shortest_path_m(open_env.grid, open_env.places["home"], open_env.places["source"]))
+    for env, rooms_reachable in ((open_env, True), (closed, False)):
+        labels, _ = ndi.label(_clear_of_obstacles(env.grid))
+        home = labels[tuple(env.grid.world_to_cell(np.array(env.places["home"])))]
+        for room_xy in ((3.0, 10.0), (20.0, 10.0), (20.0, 21.0), (3.0, 2.0)):  # W1, E1, N2, a south room
+            here = labels[tuple(env.grid.world_to_cell(np.array(room_xy)))]
+            assert (here == home) is rooms_reachable, (env.grid.name, room_xy)
+        for wrong_turn in ("c1_dead_end", "c3_west_end", "c3_east_end"):
+            xy = np.array(env.places[wrong_turn])
+            assert labels[tuple(env.grid.world_to_cell(xy))] == home
+
+
 def test_symmetric_hallway_regions_and_mirror_symmetry():
     env = builtin_map("symmetric_hallway")
     assert set(env.regions) == {"A", "B", "C", "D"}

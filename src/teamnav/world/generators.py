@@ -14,6 +14,8 @@ passes through, so a thin wall never leaks a ray or a robot.
 
 from __future__ import annotations
 
+import functools
+
 import difflib
 import math
 from dataclasses import dataclass, field
@@ -587,7 +589,7 @@ def lab_and_corridor(resolution_m: float = 0.1) -> EnvironmentMap:
 
 
 # ---------------------------------------------------------------------------- Vaughan et al.
-def trail_office(resolution_m: float = 0.1) -> EnvironmentMap:
+def trail_office(resolution_m: float = 0.1, *, doors: bool = True) -> EnvironmentMap:
     """Vaughan, Støy, Sukhatme & Matarić: the office used in both trail papers.
 
     "Blazing a trail" §5: "the resource separated from the home position by two corners and
@@ -609,6 +611,10 @@ def trail_office(resolution_m: float = 0.1) -> EnvironmentMap:
     has a 2 m long passing place where it widens to 2.6–2.8 m (walled off from the room it
     cuts into), since the robots (50 cm wide)
     must pass each other ("passing within as little as 40 cm of each other", Blazing §4).
+
+    ``doors=False`` closes every room door (builtin ``trail_office_corridors``): Blazing §6
+    "in these experiments we deliberately worked only in the corridors". The wrong turns at the
+    junctions (C1 on east, C2 on north, C3 west and east) stay, as dead-end corridors.
     """
     res = _res(resolution_m)
     b = MapBuilder(36.0, 24.0, res).fill("wall")
@@ -618,19 +624,32 @@ def trail_office(resolution_m: float = 0.1) -> EnvironmentMap:
     b.clear_rect(6.0, 15.0, 35.8, 16.8)  # C3, y centre 15.9
     # passing places
     b.clear_rect(19.0, 16.8, 21.0, 17.8)  # C3's (into the wall below N2, which starts at y = 18)
+
+    def door(*rect: float) -> None:
+        if doors:
+            b.clear_rect(*rect)
+
     # rooms south of C1 (doors on C1)
     for x0, x1 in ((0.2, 5.8), (6.0, 11.8), (16.0, 22.0), (22.2, 28.0), (28.2, 34.0)):
-        b.clear_rect(x0, 0.2, x1, 3.8).clear_rect(x0 + 1.0, 3.8, x0 + 2.0, 4.0)
+        b.clear_rect(x0, 0.2, x1, 3.8)
+        door(x0 + 1.0, 3.8, x0 + 2.0, 4.0)
     # rooms between C1 and C3, west and east of C2
-    b.clear_rect(0.2, 6.0, 5.8, 14.8).clear_rect(4.6, 5.8, 5.6, 6.0)  # W1, door on C1
-    b.clear_rect(6.0, 6.0, 13.8, 14.8).clear_rect(6.5, 14.8, 7.5, 15.0)  # W2, door on C3
-    b.clear_rect(16.0, 6.0, 24.0, 14.8).clear_rect(16.0, 5.8, 17.0, 6.0)  # E1, door on C1
-    b.clear_rect(24.2, 6.0, 35.8, 14.8).clear_rect(33.0, 14.8, 34.0, 15.0)  # E2, door on C3
+    b.clear_rect(0.2, 6.0, 5.8, 14.8)  # W1, door on C1
+    door(4.6, 5.8, 5.6, 6.0)
+    b.clear_rect(6.0, 6.0, 13.8, 14.8)  # W2, door on C3
+    door(6.5, 14.8, 7.5, 15.0)
+    b.clear_rect(16.0, 6.0, 24.0, 14.8)  # E1, door on C1
+    door(16.0, 5.8, 17.0, 6.0)
+    b.clear_rect(24.2, 6.0, 35.8, 14.8)  # E2, door on C3
+    door(33.0, 14.8, 34.0, 15.0)
     # rooms north of C3
-    b.clear_rect(0.2, 17.0, 13.8, 23.8).clear_rect(8.0, 16.8, 9.0, 17.0)  # N1 (west of C2)
-    b.clear_rect(16.0, 18.0, 24.0, 23.8).clear_rect(22.0, 17.8, 23.0, 18.0)  # N2
-    b.clear_rect(24.2, 17.0, 35.8, 23.8).clear_rect(30.0, 16.8, 31.0, 17.0)  # N3
-    b.clear_rect(15.8, 21.0, 16.0, 22.0)  # C2's north end also opens into N2
+    b.clear_rect(0.2, 17.0, 13.8, 23.8)  # N1 (west of C2)
+    door(8.0, 16.8, 9.0, 17.0)
+    b.clear_rect(16.0, 18.0, 24.0, 23.8)  # N2
+    door(22.0, 17.8, 23.0, 18.0)
+    b.clear_rect(24.2, 17.0, 35.8, 23.8)  # N3
+    door(30.0, 16.8, 31.0, 17.0)
+    door(15.8, 21.0, 16.0, 22.0)  # C2's north end also opens into N2
     # The passing places on C1 and C2 are pockets cut into rooms W2 and E1: wall them off from
     # the room (0.2 m walls), so they widen the corridor without opening a 2 m doorway.
     b.rect(6.8, 6.6, 9.2, 6.8).rect(6.8, 6.0, 7.0, 6.8).rect(9.0, 6.0, 9.2, 6.8)
@@ -652,7 +671,8 @@ def trail_office(resolution_m: float = 0.1) -> EnvironmentMap:
         "corners (C1 east 12.9 m, C2 north 11.0 m, C3 east 9.5 m); every junction offers a wrong "
         "turn into dead ends and rooms; 1.8 m corridors with 2.8 m passing places."
     )
-    return EnvironmentMap(b.build("builtin:trail_office"), places, notes, regions)
+    name = "builtin:trail_office" if doors else "builtin:trail_office_corridors"
+    return EnvironmentMap(b.build(name), places, notes, regions)
 
 
 # ---------------------------------------------------------------------------- registry
@@ -663,6 +683,7 @@ BUILTIN_MAPS: dict[str, Callable[[], EnvironmentMap]] = {
     "hexagon": hexagon,
     "lab_and_corridor": lab_and_corridor,
     "trail_office": trail_office,
+    "trail_office_corridors": functools.partial(trail_office, doors=False),
 }
 
 
