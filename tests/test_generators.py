@@ -146,7 +146,7 @@ def test_trail_office_corridors_closes_rooms_but_keeps_the_route_and_wrong_turns
         home = labels[tuple(env.grid.world_to_cell(np.array(env.places["home"])))]
         for room_xy in ((3.0, 10.0), (20.0, 10.0), (20.0, 21.0), (3.0, 2.0)):  # W1, E1, N2, a south room
             here = labels[tuple(env.grid.world_to_cell(np.array(room_xy)))]
-            assert (here == home) is rooms_reachable, (env.grid.name, room_xy)
+            assert bool(here == home) is rooms_reachable, (env.grid.name, room_xy)
         for wrong_turn in ("c1_dead_end", "c3_west_end", "c3_east_end"):
             xy = np.array(env.places[wrong_turn])
             assert labels[tuple(env.grid.world_to_cell(xy))] == home
