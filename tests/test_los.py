@@ -196,3 +196,21 @@ def test_visible_pairs_respects_walls_and_range():
 def test_bad_input(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_serial_and_parallel_kernels_agree():
+    """Small inputs take the one-thread kernel; both give the same answers."""
+    from teamnav.world import los
+
+    rng = np.random.default_rng(3)
+    blocking = (rng.random((40, 50)) < 0.2).astype(np.uint8)
+    n = los._PARALLEL_MIN_SEGMENTS + 7
+    x0, x1 = rng.uniform(0, 50, n), rng.uniform(0, 50, n)
+    y0, y1 = rng.uniform(0, 40, n), rng.uniform(0, 40, n)
+    a = np.empty(n, np.bool_)
+    b = np.empty(n, np.bool_)
+    los._los_kernel(blocking, 0.0, 0.0, 1.0, x0, y0, x1, y1, a)
+    los._los_kernel_serial(blocking, 0.0, 0.0, 1.0, x0, y0, x1, y1, b)
+    np.testing.assert_array_equal(a, b)
+    assert 0 < a.sum() < n  # both outcomes occur
+    np.testing.assert_array_equal(line_of_sight(blocking, 0.0, 0.0, 1.0, x0[:9], y0[:9], x1[:9], y1[:9]), a[:9])

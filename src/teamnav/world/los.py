@@ -101,12 +101,26 @@ def _segment_visible(blocking, ax, ay, bx, by):
             return False
 
 
+@njit(cache=True, inline="always")
+def _visible_i(blocking, ox, oy, inv, x0, y0, x1, y1, i):
+    return _segment_visible(blocking, (x0[i] - ox) * inv, (y0[i] - oy) * inv, (x1[i] - ox) * inv, (y1[i] - oy) * inv)
+
+
 @njit(cache=True, parallel=True)
 def _los_kernel(blocking, ox, oy, inv, x0, y0, x1, y1, out):
     for i in prange(x0.shape[0]):
-        out[i] = _segment_visible(
-            blocking, (x0[i] - ox) * inv, (y0[i] - oy) * inv, (x1[i] - ox) * inv, (y1[i] - oy) * inv
-        )
+        out[i] = _visible_i(blocking, ox, oy, inv, x0, y0, x1, y1, i)
+
+
+@njit(cache=True)
+def _los_kernel_serial(blocking, ox, oy, inv, x0, y0, x1, y1, out):
+    for i in range(x0.shape[0]):
+        out[i] = _visible_i(blocking, ox, oy, inv, x0, y0, x1, y1, i)
+
+
+#: Below this many segments one thread is faster: waking the thread pool costs more than the
+#: work, and on a loaded machine far more (a 4-robot team paid ~20 ms per call).
+_PARALLEL_MIN_SEGMENTS = 512
 
 
 @njit(cache=True)
@@ -197,7 +211,8 @@ def line_of_sight(blocking, origin_x_m, origin_y_m, resolution_m, x0, y0, x1, y1
     y1 = _check_vec("y1", y1, n)
     out = np.empty(n, dtype=np.bool_)
     if n:
-        _los_kernel(blocking, ox, oy, 1.0 / res, x0, y0, x1, y1, out)
+        kernel = _los_kernel if n >= _PARALLEL_MIN_SEGMENTS else _los_kernel_serial
+        kernel(blocking, ox, oy, 1.0 / res, x0, y0, x1, y1, out)
     return out
 
 
@@ -285,7 +300,8 @@ def visible_pairs(blocking, origin_x_m, origin_y_m, resolution_m, xs, ys, max_ra
     vis = np.zeros((n, n), dtype=np.bool_)
     if i.shape[0]:
         ok = np.empty(i.shape[0], dtype=np.bool_)
-        _los_kernel(blocking, ox, oy, 1.0 / res, xs[i], ys[i], xs[j], ys[j], ok)
+        kernel = _los_kernel if i.shape[0] >= _PARALLEL_MIN_SEGMENTS else _los_kernel_serial
+        kernel(blocking, ox, oy, 1.0 / res, xs[i], ys[i], xs[j], ys[j], ok)
         vis[i[ok], j[ok]] = True
         vis[j[ok], i[ok]] = True
     return vis
