@@ -131,7 +131,7 @@ def test_receiver_drops_a_tree_its_belief_calls_a_phantom():
     obs_brain = _brain(0, 3, pose=(5.0, 9.6, 0.0))
     _, out = obs_brain.step(_obs(0, 0, dets=[Detection(1.0, 0.0, 1)]))
     msg = next(m for m in out if m.kind == SYNC_KIND)
-    strict = _brain(1, 4, false_positive_filter=True)
+    strict = _brain(1, 4, false_positive_filter=True, fp_min_real_prob=0.5)
     strict.step(_obs(1, 1, inbox=[msg]))
     assert strict.stats["rejected"] == 1 and strict.sync.applied["detection"] == 0
     plain = _brain(1, 4)
