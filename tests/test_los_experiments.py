@@ -124,6 +124,7 @@ def test_every_los_help_scenario_validates_with_the_robots_in_their_roles(name):
     assert all(g.detector.noise_model == "occlusion" and g.detector.fov_deg == 360 for g in scn.robots)
     assert scn.radio.mode == "line_of_sight" and scn.stop_when_finished
     assert len(scn.robots[0].params["targets_xy"]) == L.N_TARGETS
+    assert scn.robots[0].params["navigator"] == "visbug21" and scn.robots[0].params["state_sharing"] is False
 
 
 @needs_brains
@@ -140,7 +141,9 @@ def test_sweeps_grid_what_the_paper_varies():
     from teamnav.experiments.sweep import load_sweep
 
     t1 = load_sweep("los-table1")
-    assert t1.n_trials == 3 * 8 * L.N_TASKS
+    assert t1.n_trials == 2 * 8 * L.N_TASKS and t1.set == {"robots.0.params.state_sharing": False}
+    pf = load_sweep("los-table1-pf")  # §6: the potential field with state + goal sharing
+    assert pf.n_trials == 8 * L.N_TASKS and pf.set["robots.0.params.state_sharing"] is True
     assert t1.grid["robots.0.params.targets_xy"][4] == L.task_targets_xy("simple", 5)
     noise = load_sweep("los-noise-complex")
     assert noise.grid[S.ERR_KEY] == list(L.ERR_MAX) and noise.scenario == "los-help-complex"
@@ -245,6 +248,10 @@ class _FakeCtx:
         rows = [r for r in _by_team(True)[h]] if "table" in name else [
             _row(nav, 300 + 100 * e, **{S.ERR_KEY: e, S.DELAYED_KEY: True, S.STATE_KEY: True})
             for nav in L.NAVIGATORS for e in (0.0, 0.4)]
+        pf = name.endswith("-pf")
+        rows = [r for r in rows if (r["params"][S.NAV_KEY] == "potential_field") == pf]
+        if pf:  # the -pf sweeps set the navigator, so their rows do not carry it
+            rows = [{**r, "params": {k: v for k, v in r["params"].items() if k != S.NAV_KEY}} for r in rows]
 
         class R:
             def rows(self):
@@ -258,8 +265,8 @@ def test_full_build_asks_for_nested_teams_and_every_sweep_and_returns_every_bloc
     ctx = _FakeCtx(quick=False)
     blocks = S.build(ctx)
     names = [c[0] for c in ctx.calls]
-    assert names.count("los-table1") == names.count("los-table2") == 4
-    assert {"los-noise-simple", "los-noise-complex", "los-ablation"} <= set(names)
+    assert names.count("los-table1") == names.count("los-table2") == names.count("los-table1-pf") == 4
+    assert {"los-noise-simple", "los-noise-complex-pf", "los-ablation"} <= set(names)
     sets = [c[1]["set"] for c in ctx.calls if c[0] == "los-table1"]
     assert {"robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0} in sets  # R1+R2, not R1+R3
     assert {Table, Plot, Comparison} <= {type(b) for b in blocks}

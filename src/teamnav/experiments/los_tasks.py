@@ -32,7 +32,8 @@ What is ours (the paper leaves it open)
 Files
 -----
 :func:`write_files` (re)writes ``scenarios/los-help-{simple,complex,noise}.yaml`` and the
-sweeps ``sweeps/los-{table1,table2,noise-simple,noise-complex,ablation}.yaml``; run
+sweeps ``sweeps/los-{table1,table2,noise-simple,noise-complex}[-pf].yaml`` and
+``los-ablation.yaml`` (``-pf``: the potential field with state sharing, §6); run
 ``python -m teamnav.experiments.los_tasks`` after changing anything here and commit them.
 """
 
@@ -249,8 +250,16 @@ def _body() -> dict[str, Any]:
 
 
 def r1_params(map_key: str, *, task: int = 1, n_targets: int = N_TARGETS, navigator: str = "visbug21",
-              state_sharing: bool = True, delayed_visibility: bool = True, goal_sharing: bool = True) -> dict[str, Any]:
-    """``los-explorer-v1`` params of R1 for one task."""
+              state_sharing: bool | None = None, delayed_visibility: bool = True,
+              goal_sharing: bool = True) -> dict[str, Any]:
+    """``los-explorer-v1`` params of R1 for one task.
+
+    ``state_sharing`` None: on for the potential field only, as in §6 ("in the case of 1) we
+    implement both the state-sharing strategy ... and the goal-sharing strategy"; Avoid-Past
+    and VisBug use goal sharing only).
+    """
+    if state_sharing is None:
+        state_sharing = navigator == "potential_field"
     return {
         "navigator": navigator,
         "targets_xy": task_targets_xy(map_key, task, n_targets),
@@ -336,35 +345,45 @@ _HEADER = (
 def sweep_data(kind: str) -> dict[str, Any]:
     """The named sweep ``los-<kind>`` as YAML data (see :func:`write_files`)."""
     tasks = lambda m: [task_targets_xy(m, t) for t in range(1, N_TASKS + 1)]  # noqa: E731
-    if kind in ("table1", "table2"):
-        m = "simple" if kind == "table1" else "complex"
+    pf = kind.endswith("-pf")
+    base = kind[:-3] if pf else kind
+    # §6: the potential field runs with state + goal sharing, the others with goal sharing only;
+    # a grid cannot tie the two keys, so the potential field has its own sweeps (``-pf``).
+    nav: dict[str, Any] = ({"set": {"robots.0.params.navigator": "potential_field", "robots.0.params.state_sharing": True}}
+                           if pf else {"set": {"robots.0.params.state_sharing": False}})
+    navs = {} if pf else {"robots.0.params.navigator": [n for n in NAVIGATORS if n != "potential_field"]}
+    who = "the potential field (state + goal sharing)" if pf else "Avoid-Past and VisBug (goal sharing)"
+    if base in ("table1", "table2"):
+        m = "simple" if base == "table1" else "complex"
         return {
             "name": f"los-{kind}",
-            "description": (f"Sgorbissa & Arkin Table {kind[-1]}: R1's steps per algorithm with helpers R2, R3, R4 each "
+            "description": (f"Sgorbissa & Arkin Table {base[-1]}: R1's steps for {who} with helpers R2, R3, R4 each "
                             f"present or not (the paper's rows are R1; R1+R2; R1..R3; R1..R4), 5 tasks of 200 targets."),
             "scenario": SCENARIOS[m],
             "grid": {
-                "robots.0.params.navigator": list(NAVIGATORS),
+                **navs,
                 "robots.1.count": [0, 1],
                 "robots.2.count": [0, 1],
                 "robots.3.count": [0, 1],
                 "robots.0.params.targets_xy": tasks(m),
             },
             "seeds": 1,
+            **nav,
         }
-    if kind in ("noise-simple", "noise-complex"):
-        m = kind.split("-")[1]
+    if base in ("noise-simple", "noise-complex"):
+        m = base.split("-")[1]
         return {
             "name": f"los-{kind}",
             "description": (f"Sgorbissa & Arkin Fig. {16 if m == 'simple' else 17}: R1's steps vs err_max of eqs. 1-2 "
-                            f"(every robot's detector) with all helpers, per algorithm, 5 tasks of 200 targets."),
+                            f"(every robot's detector) with all helpers, {who}, 5 tasks of 200 targets."),
             "scenario": SCENARIOS[m],
             "grid": {
-                "robots.0.params.navigator": list(NAVIGATORS),
+                **navs,
                 "robots.0.detector.err_max": list(ERR_MAX),
                 "robots.0.params.targets_xy": tasks(m),
             },
             "seeds": 1,
+            **nav,
         }
     if kind == "ablation":
         return {
@@ -383,7 +402,8 @@ def sweep_data(kind: str) -> dict[str, Any]:
     raise ValueError(f"unknown los sweep kind {kind!r}")
 
 
-SWEEP_KINDS: tuple[str, ...] = ("table1", "table2", "noise-simple", "noise-complex", "ablation")
+SWEEP_KINDS: tuple[str, ...] = ("table1", "table1-pf", "table2", "table2-pf", "noise-simple", "noise-simple-pf",
+                                "noise-complex", "noise-complex-pf", "ablation")
 
 
 def write_files(scenario_dir: Path | None = None, sweep_dir: Path | None = None) -> list[Path]:

@@ -20,13 +20,13 @@ best and worst mean differ by > 10 %); steps grow with err_max; at err_max = 0.4
 map's steps stay below R1 alone; on the complex map help fades (at 0.4 it keeps less than
 half of its err_max = 0 gain).
 
-Deviation (said in the section too): the paper ran the state-sharing rule only with the
-potential field; we keep it on for all three algorithms (one sweep grids the algorithm; a
-grid cannot tie two keys) and the ablation shows what it changes for Avoid-Past and VisBug.
+As in §6 the potential field runs with state + goal sharing and Avoid-Past and VisBug with
+goal sharing only: a sweep grid cannot tie two keys, so each table and noise sweep has a
+``-pf`` twin for the potential field; the ablation shows what state sharing does to the others.
 
 Running it: ``teamnav report los-help --out DIR`` (full) runs 2 x 4 x 15 table trials, 2 x 75
-noise trials and 60 ablation trials; ``teamnav sweep los-table1 --out DIR`` alone grids every
-subset of R2, R3, R4 (8 teams, 120 trials). Set ``NUMBA_NUM_THREADS=1`` for sweeps on a small
+noise trials and 60 ablation trials; ``teamnav sweep los-table1 --out DIR`` plus
+``los-table1-pf`` alone grid every subset of R2, R3, R4 (8 teams, 80 + 40 trials). Set ``NUMBA_NUM_THREADS=1`` for sweeps on a small
 box: the line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread
 launch costs more than the work for four robots.
 
@@ -165,28 +165,36 @@ def _team_set(h: int) -> dict[str, int]:
     return {f"robots.{k + 1}.count": int(k < h) for k in range(3)}
 
 
+def _both(ctx, sweep: str, suffix: str, **kw: Any) -> list[dict]:
+    """Rows of ``sweep`` (Avoid-Past, VisBug: goal sharing) and ``sweep-pf`` (the potential
+    field: state + goal sharing, §6), each called with ``kw`` and named ``<sweep>[-pf]<suffix>``.
+    The potential field's rows get the navigator key (its sweep sets it)."""
+    rows = ok_rows(ctx.sweep(sweep, name=sweep + suffix, **kw))
+    pf = ok_rows(ctx.sweep(sweep + "-pf", name=sweep + "-pf" + suffix, **kw))
+    return rows + [{**r, "params": {**(r.get("params") or {}), NAV_KEY: "potential_field"}} for r in pf]
+
+
 def run_tables(ctx, map_key: str) -> dict[int, list[dict]]:
-    """Rows of the table sweep per team size (0..3 helpers), one sweep call per size."""
+    """Rows of the table sweeps per team size (0..3 helpers, nested), two sweep calls per size."""
     quick = bool(ctx.quick)
     out: dict[int, list[dict]] = {}
     for h in _teams(map_key, quick):
-        kw: dict[str, Any] = {"set": _team_set(h), "name": f"{TABLE_SWEEP[map_key]}-h{h}" + ("-quick" if quick else "")}
+        kw: dict[str, Any] = {"set": _team_set(h)}
         if quick:
             kw["grid"] = {TARGETS_KEY: _tasks(map_key, True)}
             kw["duration_s"] = _budget_s(map_key, True)
-        out[h] = ok_rows(ctx.sweep(TABLE_SWEEP[map_key], **kw))
+        out[h] = _both(ctx, TABLE_SWEEP[map_key], f"-h{h}" + ("-quick" if quick else ""), **kw)
     return out
 
 
 def run_noise(ctx, map_key: str, all_helpers: list[dict]) -> list[dict]:
-    """Rows of the noise sweep; in quick mode only err_max = 0.4 runs, and the tables' R1..R4
+    """Rows of the noise sweeps; in quick mode only err_max = 0.4 runs, and the tables' R1..R4
     rows (the same configuration at err_max = 0) stand for err_max = 0."""
     if not ctx.quick:
-        return ok_rows(ctx.sweep(NOISE_SWEEP[map_key]))
-    kw = {"grid": {TARGETS_KEY: _tasks(map_key, True), ERR_KEY: [0.4]},
-          "duration_s": _budget_s(map_key, True), "name": NOISE_SWEEP[map_key] + "-quick"}
+        return _both(ctx, NOISE_SWEEP[map_key], "")
+    kw = {"grid": {TARGETS_KEY: _tasks(map_key, True), ERR_KEY: [0.4]}, "duration_s": _budget_s(map_key, True)}
     zero = [{**r, "params": {**r["params"], ERR_KEY: 0.0}} for r in all_helpers]
-    return zero + ok_rows(ctx.sweep(NOISE_SWEEP[map_key], **kw))
+    return zero + _both(ctx, NOISE_SWEEP[map_key], "-quick", **kw)
 
 
 # ---------------------------------------------------------------------------- blocks
@@ -357,7 +365,8 @@ def ablation_block(rows: list[dict]) -> Table:
         table_rows.append([NAV_LABEL[nav], *cells])
     return Table("Ablation (office_simple, R1..R4): what each rule buys — R1's steps, mean (std %)",
                  ["algorithm", *(v[1] for v in variants)], table_rows,
-                 "Goal sharing on in every column; the tables use the third column. The flags are R1's: the "
+                 "Goal sharing on in every column; the tables use '+ state sharing' for the potential field and "
+                 "'+ ghost robots' for the others. The flags are R1's: the "
                  "helpers keep their §4.3 bookkeeping in every column (one grid key cannot set four robots' flags).")
 
 
@@ -389,8 +398,8 @@ def build(ctx) -> list:
         f"the paper: 5 tasks of 200) with a fixed step of {L.STEP_LENGTH_M} m, so steps measure path length. "
         f"Helpers R2..R4 patrol the corridors; every robot sees and talks only within {L.VISIBILITY_M:g} m in line of "
         f"sight; frames are each robot's start pose. A task not finished within {L.BUDGET_STEPS_PER_TARGET} steps per "
-        "target (simple, complex) counts as failed. Deviation: state sharing is on for all three algorithms "
-        "(the paper used it with the potential field only); the ablation shows its effect.")]
+        "target (simple, complex) counts as failed. As in §6, state sharing is used with the potential field "
+        "only; the ablation shows what it does to the others.")]
     tables: dict[str, dict[int, list[dict]]] = {}
     comps: list[Comparison] = []
     alone: dict[str, dict[str, float]] = {}
