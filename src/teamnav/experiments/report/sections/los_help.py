@@ -30,7 +30,7 @@ noise trials and 60 ablation trials; ``teamnav sweep los-table1 --out DIR`` plus
 box: the line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread
 launch costs more than the work for four robots.
 
-Quick mode (CI): the simple map only, the first target of task 1 with a 200-step budget,
+Quick mode (CI): the simple map only, the first target of task 1 with a 400-step budget,
 teams {R1, R1..R4}, err_max 0.4 (err_max 0 is the tables' R1..R4 run), no ablation: 9 short
 runs.
 """
@@ -138,7 +138,7 @@ def strictly_falling(means: Sequence[float]) -> bool:
 # ---------------------------------------------------------------------------- sweeps
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
-QUICK_BUDGET_STEPS_PER_TARGET = 200
+QUICK_BUDGET_STEPS_PER_TARGET = 400
 #: Maps run in quick mode (the complex map's runs are the longest).
 QUICK_MAPS = ("simple",)
 
