@@ -100,7 +100,8 @@ def build(ctx) -> list:
     _, last, last_lo, last_hi = T.per_drift(drift, "units_per_10min_last", np.mean)
     holds3 = None
     if len(xs) >= 2:
-        holds3 = bool(last[-1] < last[0] and bd[-1] <= bd[0])
+        # the drift-free team must work at all before a collapse can be read from the curve
+        holds3 = bool(last[0] >= T.WORKING_UNITS_PER_10MIN and last[-1] < last[0] and bd[-1] <= bd[0])
     paper_bd = T.values(paper, "breakdown_s")
     cens = T.values(paper, "breakdown_censored")
     blocks.append(Comparison(

@@ -95,7 +95,9 @@ def build(ctx) -> list:
     late_blaze = _last_hour_units(blazing, dur)
     holds2 = None
     if late_share.size and late_plain.size and late_blaze.size:
-        holds2 = bool(late_share.mean() >= late_plain.mean() and late_share.mean() > late_blaze.mean())
+        per_10min = late_share.mean() / (0.25 * dur / 600.0)  # the 2002 team must still be working
+        holds2 = bool(per_10min >= T.WORKING_UNITS_PER_10MIN and late_share.mean() >= late_plain.mean()
+                      and late_share.mean() > late_blaze.mean())
     blocks.append(Comparison(
         "Trails are shared despite diverged frames (Place transforms)",
         "frames rotated 0.35–2 deg/min in both directions; trails shared throughout the 188 min",
@@ -112,7 +114,8 @@ def build(ctx) -> list:
     _, last_b, _, _ = T.per_drift(d_blaze, "units_per_10min_last", np.mean)
     holds3 = None
     if xs_s and xs_b and xs_s[-1] == xs_b[-1]:  # at the highest drift both ran
-        holds3 = bool(last_s[-1] > last_b[-1] and (len(xs_s) < 2 or last_s[-1] >= 0.5 * last_s[0]))
+        holds3 = bool(last_s[-1] >= T.WORKING_UNITS_PER_10MIN and last_s[-1] > last_b[-1]
+                      and (len(xs_s) < 2 or last_s[-1] >= 0.5 * last_s[0]))
     blocks.append(Comparison(
         "The 2000 algorithm's throughput collapses as drift grows; the 2002 one keeps working",
         "2000: breaks down at ~27 min; 2002: works for 3 h with 0.35–2 deg/min",
