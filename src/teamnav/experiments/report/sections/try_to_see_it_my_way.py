@@ -142,7 +142,8 @@ def build(ctx) -> list:
     # memory
     first, second = T.values(share, "crumbs_max_first_half"), T.values(share, "crumbs_max_second_half")
     if first.size:
-        flat = bool(second.mean() <= 1.25 * first.mean() + 10)
+        # the 4-min expiry needs the first half to be longer than 4 min before halves can be compared
+        flat = bool(second.mean() <= 1.25 * first.mean() + 10) if dur >= 2 * 240.0 * 2 else None
         blocks.append(Comparison(
             "Memory stays flat (crumbs older than 4 min are destroyed)",
             "34,743 crumbs received by Ant over 188 min, many fewer held at any time",
