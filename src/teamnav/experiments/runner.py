@@ -341,6 +341,9 @@ def check_scenario(scenario: Scenario | str | os.PathLike, *, duration_s: float 
         f"{scn.name}: seeds {scn.seed} and {other.seed} gave the same trajectories"
     )
     for k, v in a.metrics.items():
+        if k.endswith("_series"):  # a time series travels as a JSON string (metric_sets contract)
+            assert type(v) is str and isinstance(json.loads(v), (list, dict)), f"{scn.name}: metric {k} is not JSON"
+            continue
         assert type(v) in (int, float), f"{scn.name}: metric {k} is a {type(v).__name__}, expected int or float"
     for k in ("collisions_wall", "collisions_robot"):
         assert a.metrics.get(k, 0) == 0, f"{scn.name}: {k} = {a.metrics[k]}"
