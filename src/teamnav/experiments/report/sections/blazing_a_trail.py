@@ -55,7 +55,7 @@ def build(ctx) -> list:
     drift0 = T.by_param(drift, T.DRIFT_KEY).get(0.0, [])
 
     blocks: list = [Text(
-        f"Scenario blazing-a-trail: 4 robots on trail_office (home and source ~31.5 m apart through two "
+        f"Scenario blazing-a-trail: 4 robots on trail_office_corridors (home and source ~31.5 m apart through two "
         f"corners), {dur / 60:g} min per run, per-robot heading drift (Ant 1.5, Bee 1.0, Punky 0.3, "
         f"Tanis -0.3 deg/min), cruise {T.CRUISE_MPS} m/s, {seeds} seeds. A unit is delivered when a robot "
         "that reached the source reaches home; breakdown = the last delivery when none followed in the "

@@ -64,7 +64,7 @@ def build(ctx) -> list:
                   set={"metrics": ["path_length", "events", "trails", "trails_series"]}), duration_s=1800.0))
 
     blocks: list = [Text(
-        f"Scenario try-to-see-it-my-way: 4 robots on trail_office, {dur / 60:g} min per run, heading drift "
+        f"Scenario try-to-see-it-my-way: 4 robots on trail_office_corridors, {dur / 60:g} min per run, heading drift "
         "Bug -1, Ant +1, Fly +2, Tanis +0.35 deg/min (§3.6), frames initially aligned, optimistic policy, "
         f"1-crumb trails every 2 s, crumbs expire after 4 min, cruise {T.CRUISE_MPS} m/s, {seeds} seeds. "
         "The same scenario runs the 2000 algorithm (blazing-trail-v1) and trail-share-v1 without Place transforms.")]
