@@ -395,3 +395,12 @@ def test_same_run_on_one_or_all_threads():
     finally:
         numba.set_num_threads(before)
     np.testing.assert_array_equal(runs[0], runs[1])
+
+
+def test_the_final_step_is_recorded_even_between_samples():
+    """record_every=7 over 10 steps samples 0 and 7; the runner also keeps step 10."""
+    from teamnav import load_scenario, run
+
+    res = run(load_scenario("demo", duration_s=1.0, overrides={"record_every": 7}), progress=False)
+    assert res.data.t_s[-1] == pytest.approx(1.0)
+    assert res.data.true_pose.shape[0] == 3

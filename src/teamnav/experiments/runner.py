@@ -284,6 +284,7 @@ def run(
             if bar is not None:
                 bar.close()
         wall_s = time.perf_counter() - t0
+        sim.record_last_step()
         sim.recorder.save(staging)
         data = run_data(staging, scenario, grid, int(sim.step_index), wall_s,
                         finished=bool(scenario.stop_when_finished and all_finished(sim)))

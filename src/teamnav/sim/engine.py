@@ -341,6 +341,13 @@ class Simulation:
             if is_finished is not None and is_finished(self):
                 break
 
+    def record_last_step(self) -> None:
+        """Record the current step if ``record_every`` skipped it (a run that stops early, or
+        whose length is not a multiple of ``record_every``, still ends on its final state)."""
+        steps = self.recorder.steps
+        if steps.shape[0] == 0 or int(steps[-1]) != self.step_index:
+            self._record()
+
     def step(self) -> None:
         """Advance the simulation by one fixed step ``dt_s`` (see the module docstring)."""
         if not self._decided:
