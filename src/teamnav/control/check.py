@@ -5,7 +5,10 @@
 zero odometry, random stall flags, made here from a :class:`RobotInfo`, never from a
 simulator) and checks that
 
-- ``Params`` is a pydantic model that forbids unknown keys and builds with no arguments;
+- ``Params`` is a pydantic model that forbids unknown keys and builds with no arguments, or
+  from the class's example ``check_params`` dict when a field is required (a route's waypoints);
+- a brain that declares ``needs_map = True`` (prior map knowledge, e.g. MCL) gets a walled
+  10 m x 8 m room with a pillar as ``RobotInfo.known_map``;
 - per-robot brains satisfy :class:`Controller`, return ``(Action, list of Message)`` with
   finite numbers, and ``log()`` returns a dict;
 - batched brains satisfy :class:`BatchedController`, name a ``range_sensor`` the robots carry,
@@ -89,10 +92,20 @@ def _check_params(name: str, cls: Any) -> BaseModel:
         raise _fail(name, f"Params must be a pydantic BaseModel subclass, got {params_cls!r}")
     if params_cls.model_config.get("extra") != "forbid":
         raise _fail(name, "Params must forbid unknown keys (model_config extra='forbid')")
+    example = getattr(cls, "check_params", None)
     try:
-        return params_cls()
+        return params_cls(**example) if example is not None else params_cls()
     except Exception as exc:  # noqa: BLE001 - reported as a contract failure
-        raise _fail(name, f"Params() must build from defaults, raised {exc!r}") from exc
+        how = f"Params(**check_params) with {example!r}" if example is not None else "Params() from defaults"
+        raise _fail(name, f"{how} must build (give required fields example values in a class attribute "
+                          f"check_params), raised {exc!r}") from exc
+
+
+def check_map():
+    """The map a ``needs_map`` brain is checked with: a walled 10 m x 8 m room with a pillar."""
+    from teamnav.world.generators import MapBuilder
+
+    return MapBuilder(10.0, 8.0, 0.1).border(0.2).rect(6.0, 3.0, 7.0, 5.0).build("check:room")
 
 
 def _check_action(name: str, step: int, out: Any) -> tuple[Action, list[Message]]:
@@ -161,6 +174,9 @@ def check_brain(name: str, *, seed: int = 0, n_steps: int = 50, n_robots: int = 
     cls = registry.lookup(name)
     params = _check_params(name, cls)
     infos = synthetic_infos(n_robots)
+    if getattr(cls, "needs_map", False):
+        grid = check_map()
+        infos = [dataclasses.replace(info, known_map=grid) for info in infos]
     obs_rng = np.random.default_rng([seed, 1])
 
     if getattr(cls, "batched", False):

@@ -290,6 +290,8 @@ class MCLWander:
     """
 
     Params = MCLWanderParams
+    #: check_brain gives it a small known map (it needs one, like a scenario with give_map: true)
+    needs_map = True
 
     def __init__(self, params: MCLWanderParams, rng: np.random.Generator, info: RobotInfo) -> None:
         if not isinstance(params, MCLWanderParams):

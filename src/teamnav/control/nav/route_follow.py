@@ -134,6 +134,8 @@ class RouteFollow:
     """
 
     Params = RouteFollowParams
+    #: example parameters for check_brain (a route has no sensible default)
+    check_params = {"waypoints_m": [[1.0, 1.0], [4.0, 1.0]]}
 
     def __init__(self, params: RouteFollowParams, rng: np.random.Generator, info: RobotInfo) -> None:
         if not isinstance(params, RouteFollowParams):
