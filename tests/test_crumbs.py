@@ -13,6 +13,8 @@ from hypothesis import strategies as st
 from teamnav.control.coop.crumbs import CrumbBatch, CrumbList, average_heading, preferred_heading
 from teamnav.geometry.angles import angle_diff
 
+from _trail_brain_fakes import make_brains, make_obs
+
 
 def test_average_heading_is_circular_and_ignores_crumbs_outside_the_radius():
     c = CrumbList()
@@ -118,35 +120,13 @@ def test_crumb_list_grows_and_can_be_capped():
 
 
 # ---------------------------------------------------------------------------- the brain
-class _RecordingNav:
-    """Stands in for Navigate: records the preferred headings it is handed."""
-
-    def __init__(self, params, rng, info, laser="laser"):
-        self.headings = []
-        self.mode = "fake"
-
-    def step(self, obs, preferred_heading_rad=None):
-        self.headings.append(preferred_heading_rad)
-        return 0.3, 0.0
-
-
-def _obs(robot_id, step, pose, events=(), inbox=()):
-    from teamnav.control.types import Observation, RangeScan
-
-    angles = np.linspace(-np.pi / 2, np.pi / 2, 181)
-    scan = RangeScan(np.full(181, 8.0), angles, 8.0)
-    return Observation(robot_id, step, step * 0.1, np.asarray(pose, float), np.zeros(3), scans={"laser": scan},
-                       events=tuple(events), inbox=tuple(inbox))
+_obs = make_obs
 
 
 def _brains(monkeypatch, n=2, **params):
-    from teamnav.control.check import synthetic_infos
     from teamnav.control.coop import blazing_trail as B
 
-    monkeypatch.setattr(B, "Navigate", _RecordingNav)
-    infos = synthetic_infos(n)
-    p = B.BlazingTrail.Params(**params)
-    return [B.BlazingTrail(p, np.random.default_rng(i), infos[i]) for i in range(n)]
+    return make_brains(monkeypatch, B, B.BlazingTrail, n, **params)
 
 
 def test_brain_waggle_dance_reaches_the_team_and_steers_both_ways(monkeypatch):

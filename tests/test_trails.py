@@ -14,6 +14,8 @@ from teamnav.control.coop.forager import PlaceRound
 from teamnav.control.coop.trails import Trail, TrailMessage, place_transform, temporary_trail
 from teamnav.geometry.similarity import Similarity
 
+from _trail_brain_fakes import make_brains, make_obs
+
 
 def _msg(places: dict[str, tuple[float, float]], crumbs: list[tuple[str, float, float, float, float]]) -> TrailMessage:
     names = tuple(places)
@@ -170,35 +172,13 @@ def test_trail_message_rejects_mismatched_columns():
 
 
 # ---------------------------------------------------------------------------- the brain
-class _RecordingNav:
-    """Stands in for Navigate: records the preferred headings it is handed."""
-
-    def __init__(self, params, rng, info, laser="laser"):
-        self.headings = []
-        self.mode = "fake"
-
-    def step(self, obs, preferred_heading_rad=None):
-        self.headings.append(preferred_heading_rad)
-        return 0.3, 0.0
-
-
-def _obs(robot_id, step, pose, events=(), inbox=()):
-    from teamnav.control.types import Observation, RangeScan
-
-    angles = np.linspace(-np.pi / 2, np.pi / 2, 181)
-    scan = RangeScan(np.full(181, 8.0), angles, 8.0)
-    return Observation(robot_id, step, step * 0.1, np.asarray(pose, float), np.zeros(3), scans={"laser": scan},
-                       events=tuple(events), inbox=tuple(inbox))
+_obs = make_obs
 
 
 def _brains(monkeypatch, n=2, **params):
-    from teamnav.control.check import synthetic_infos
     from teamnav.control.coop import trail_share as TS
 
-    monkeypatch.setattr(TS, "Navigate", _RecordingNav)
-    infos = synthetic_infos(n)
-    p = TS.TrailShare.Params(**params)
-    return [TS.TrailShare(p, np.random.default_rng(i), infos[i]) for i in range(n)]
+    return make_brains(monkeypatch, TS, TS.TrailShare, n, **params)
 
 
 def test_brain_shares_time_to_place_crumbs_across_rotated_frames(monkeypatch):
