@@ -230,7 +230,7 @@ class RadioConfig(Model):
 # ---------------------------------------------------------------------------- places / events
 class PlaceConfig(Model):
     """A named disc region. A robot entering it (centre within ``radius_m``) fires ``event``
-    for that robot (e.g. "given_resource" at the source, "took_resource" at home); with
+    for that robot (e.g. "took_resource" at the source, "given_resource" at home, as the trail scenarios use them); with
     ``on="inside"`` it fires every step the robot is inside instead of on entry."""
 
     name: str
