@@ -230,8 +230,8 @@ class RadioConfig(Model):
 # ---------------------------------------------------------------------------- places / events
 class PlaceConfig(Model):
     """A named disc region. A robot entering it (centre within ``radius_m``) fires ``event``
-    for that robot (e.g. "took_resource" at the source, "given_resource" at home, as the trail scenarios use them); with
-    ``on="inside"`` it fires every step the robot is inside instead of on entry."""
+    for that robot (the trail scenarios: "took_resource" at the source, "given_resource" at
+    home); with ``on="inside"`` it fires every step the robot is inside instead of on entry."""
 
     name: str
     x_m: float
