@@ -452,3 +452,39 @@ def test_progress_bar_shows_counts_on_stderr(tmp_path, log, capfd):
     sweep("demo", grid={"robots.0.count": [1, 3]}, seeds=1, duration_s=1, out_dir=tmp_path / "o", workers=1,
           trial_fn=fake_trial, progress=False)
     assert capfd.readouterr().err == ""
+
+
+def test_cases_tie_overrides_together_before_the_grid():
+    spec = SweepSpec(
+        scenario="demo", seeds=2, duration_s=1,
+        grid={"radio.p_loss": [0.0, 0.5]},
+        cases=[{"case": "two", "robots.0.count": 2, "robots.0.radius_m": 0.2},
+               {"case": "three", "robots.0.count": 3}],
+    )
+    trials = expand(spec)
+    assert spec.n_trials == len(trials) == 2 * 2 * 2
+    first = trials[0]
+    assert first.params == {"robots.0.count": 2, "robots.0.radius_m": 0.2, "radio.p_loss": 0.0,
+                            "duration_s": 1.0, "case": "two"}
+    assert "case" not in first.overrides and first.load().robots[0].count == 2
+    assert [t.params["case"] for t in trials] == ["two"] * 4 + ["three"] * 4
+    assert trials[-1].load().robots[0].count == 3
+    assert first.label().startswith("case=two ")
+    assert len({t.trial_id for t in trials}) == len(trials)
+
+
+@pytest.mark.parametrize("cases, match", [
+    ([{"robots.0.count": 2}], "label under 'case'"),
+    ([{"case": "a", "robots.0.count": 2}, {"case": "a", "robots.0.count": 3}], "distinct labels"),
+    ([{"case": "a"}], "at least one override"),
+    ([{"case": "a", "radio.p_loss": 0.1}], "also a grid key"),
+])
+def test_bad_cases_get_one_clear_error(cases, match):
+    with pytest.raises(ValueError, match=match):
+        SweepSpec(scenario="demo", grid={"radio.p_loss": [0.0, 0.5]}, cases=cases)
+
+
+def test_an_invalid_case_names_the_case():
+    spec = SweepSpec(scenario="demo", cases=[{"case": "broken", "robots.0.count": -1}])
+    with pytest.raises(SweepError, match="in case 'broken'"):
+        expand(spec)

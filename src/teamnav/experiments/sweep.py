@@ -22,6 +22,14 @@ A sweep can be written as YAML; the files shipped in ``teamnav/experiments/sweep
     set:                              # fixed overrides for every trial
       robots.0.params.cruise_speed_mps: 0.4
     duration_s: 30                    # optional, replaces the scenario's
+    cases:                            # optional: named bundles of overrides that go together
+      - {case: pf, robots.0.params.navigator: potential_field, robots.0.params.state_sharing: true}
+      - {case: visbug, robots.0.params.navigator: visbug21}
+
+``cases`` is an axis of its own (slowest, before the grid): each case is a label ``case`` and
+overrides applied together, for keys that a grid cannot tie (a navigator and the sharing flags
+that go with it; a per-robot drift pattern). Trials are cases x grid x seeds; a trial's
+``params`` carry the case label under ``case`` and its overrides.
 
 Trial identity
 --------------
@@ -115,6 +123,9 @@ class SweepSpec(BaseModel):
         The sweep's name in the results table; default: the sweep file's stem or the scenario.
     description : str
         One line for humans.
+    cases : list of dict
+        Named bundles of overrides (``{"case": label, key: value, ...}``), an axis before
+        the grid; labels are distinct and a case may not use a grid key. Default: none.
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True)
@@ -126,6 +137,25 @@ class SweepSpec(BaseModel):
     duration_s: float | None = Field(None, gt=0.0, le=1e7, allow_inf_nan=False)
     name: str | None = Field(None, min_length=1, max_length=100, pattern=rf"^[{_NAME_CHARS}]+$")
     description: str = ""
+    cases: list[dict[str, Any]] = Field(default_factory=list)
+
+    @field_validator("cases")
+    @classmethod
+    def _check_cases(cls, cases: list[dict[str, Any]]) -> list[dict[str, Any]]:
+        labels: list[str] = []
+        for k, case in enumerate(cases):
+            label = case.get("case")
+            if not isinstance(label, str) or not label:
+                raise ValueError(f"cases[{k}]: expected a non-empty string label under 'case', received {label!r}")
+            if label in labels:
+                raise ValueError(f"cases[{k}]: expected distinct labels, received {label!r} twice")
+            labels.append(label)
+            keys = [key for key in case if key != "case"]
+            if not keys:
+                raise ValueError(f"cases[{k}] ({label!r}): expected at least one override besides 'case'")
+            for key in keys:
+                _check_key(key, f"cases[{k}]")
+        return cases
 
     @field_validator("grid")
     @classmethod
@@ -173,6 +203,9 @@ class SweepSpec(BaseModel):
         both = sorted(set(self.grid) & set(self.set))
         if both:
             raise ValueError(f"set: key {both[0]!r} is also a grid key; expected each key in only one of grid and set")
+        in_cases = sorted({key for case in self.cases for key in case} & set(self.grid))
+        if in_cases:
+            raise ValueError(f"cases: key {in_cases[0]!r} is also a grid key; expected each key in only one of cases and grid")
         if "duration_s" in self.grid and self.duration_s is not None:
             raise ValueError("duration_s: expected either duration_s or a grid over duration_s, received both")
         return self
@@ -191,7 +224,7 @@ class SweepSpec(BaseModel):
 
     @property
     def n_trials(self) -> int:
-        n = len(self.seed_list)
+        n = len(self.seed_list) * max(1, len(self.cases))
         for values in self.grid.values():
             n *= len(values)
         return n
@@ -511,8 +544,8 @@ class Trial:
 
     @property
     def overrides(self) -> dict[str, Any]:
-        """``params`` without ``duration_s`` (what ``load_scenario(overrides=...)`` gets)."""
-        return {k: v for k, v in self.params.items() if k != "duration_s"}
+        """``params`` without ``duration_s`` and the ``case`` label (what ``load_scenario(overrides=...)`` gets)."""
+        return {k: v for k, v in self.params.items() if k not in ("duration_s", "case")}
 
     @property
     def duration_s(self) -> float | None:
@@ -527,6 +560,8 @@ class Trial:
     def label(self) -> str:
         """``robots.0.count=4 seed=2`` (grid values and seed)."""
         shown = " ".join(f"{k}={self.params[k]!r}" for k in self.grid_keys)
+        if "case" in self.params:
+            shown = f"case={self.params['case']} {shown}"
         return f"{shown} seed={self.seed}".strip()
 
 
@@ -565,7 +600,7 @@ def _problem_text(exc) -> str:
 
 
 def expand(spec: SweepSpec) -> list[Trial]:
-    """Every trial of ``spec``: grid combinations (first key slowest) x seeds (fastest).
+    """Every trial of ``spec``: cases (slowest) x grid combinations (first key slowest) x seeds (fastest).
 
     Each combination is loaded and validated with :func:`~teamnav.experiments.spec.load_scenario`
     first, so a bad value fails here, before any trial runs.
@@ -589,9 +624,11 @@ def expand(spec: SweepSpec) -> list[Trial]:
     fixed = dict(spec.set)
     trials: list[Trial] = []
     bad: dict[tuple[str, str], str] = {}
-    for combo in itertools.product(*(spec.grid[k] for k in keys)):
+    cases = spec.cases or [{}]
+    for case, combo in itertools.product(cases, itertools.product(*(spec.grid[k] for k in keys))):
         values = dict(zip(keys, combo))
-        params = {**fixed, **values}
+        bundle = {k: v for k, v in case.items() if k != "case"}
+        params = {**fixed, **bundle, **values}
         duration = spec.duration_s
         if "duration_s" in params:
             duration = params.pop("duration_s")
@@ -601,11 +638,14 @@ def expand(spec: SweepSpec) -> list[Trial]:
             culprit = _blame(exc, keys) if keys else None
             if culprit is None:
                 where = f" with set {fixed}" if fixed else ""
+                where += f" in case {case['case']!r}" if case else ""
                 raise SweepError(f"sweep {spec.sweep_name!r}: the scenario is invalid{where}: {exc}") from None
             bad.setdefault((culprit, _canonical(values[culprit])), f"grid {culprit}={values[culprit]!r}: {_problem_text(exc)}")
             continue
         if duration is not None:
             params["duration_s"] = float(duration)
+        if case:
+            params["case"] = case["case"]
         chash = config_hash(scn)
         for seed in seeds:
             trials.append(
