@@ -488,3 +488,17 @@ def test_an_invalid_case_names_the_case():
     spec = SweepSpec(scenario="demo", cases=[{"case": "broken", "robots.0.count": -1}])
     with pytest.raises(SweepError, match="in case 'broken'"):
         expand(spec)
+
+
+def test_cli_name_option_names_the_sweep(tmp_path):
+    from typer.testing import CliRunner
+
+    from teamnav.cli import app
+
+    res = CliRunner().invoke(app, ["sweep", "demo", "--duration", "0.3", "--name", "demo-renamed", "--out",
+                                   str(tmp_path / "s"), "--workers", "1", "--quiet"])
+    assert res.exit_code == 0, res.output
+    with sqlite3.connect(tmp_path / "s" / "results.sqlite") as con:
+        assert con.execute("select distinct sweep from trials").fetchall() == [("demo-renamed",)]
+    bad = CliRunner().invoke(app, ["sweep", "demo", "--name", "no spaces", "--out", str(tmp_path / "t")])
+    assert bad.exit_code == 2 and "name" in bad.output
