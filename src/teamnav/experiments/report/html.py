@@ -23,6 +23,8 @@ import subprocess
 from pathlib import Path
 from typing import Any, Sequence
 
+import numpy as np
+
 from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, Table, Text
 
 __all__ = ["git_commit", "render_report"]
@@ -88,15 +90,10 @@ def _cell(value: Any) -> tuple[str, bool]:
         if math.isnan(value):
             return "—", False
         return f"{value:.4g}", True
-    try:  # numpy scalars
-        import numpy as np
-
-        if isinstance(value, np.integer):
-            return f"{int(value):d}", True
-        if isinstance(value, np.floating):
-            return _cell(float(value))
-    except ImportError:  # pragma: no cover - numpy is a dependency
-        pass
+    if isinstance(value, np.integer):  # numpy scalars
+        return f"{int(value):d}", True
+    if isinstance(value, np.floating):
+        return _cell(float(value))
     return str(value), False
 
 

@@ -54,6 +54,7 @@ the report read them).
 
 from __future__ import annotations
 
+import abc
 import math
 from typing import Any, Literal
 
@@ -193,7 +194,7 @@ class LosHelperParams(_CommonParams):
     patrol_mode: Literal["ping_pong", "cycle"] = "ping_pong"
 
 
-class _LosBrain:
+class _LosBrain(abc.ABC):
     """What both brains share: sensing, the receive path, sharing rules, motion and logs."""
 
     Params: type[_CommonParams] = _CommonParams
@@ -295,11 +296,13 @@ class _LosBrain:
         self._prev_xy = me
         return action, outbox
 
-    def _advance_task(self) -> None:  # pragma: no cover - overridden
-        raise NotImplementedError
+    @abc.abstractmethod
+    def _advance_task(self) -> None:
+        """Move on along the robot's own task (R1: next target; a helper: next patrol point)."""
 
-    def _decide(self, obs: Observation) -> Action:  # pragma: no cover - overridden
-        raise NotImplementedError
+    @abc.abstractmethod
+    def _decide(self, obs: Observation) -> Action:
+        """This step's motion (R1: own goal, teammate, ghost or trouble helper; a helper: patrol)."""
 
     # ------------------------------------------------------------------ receive path (§3.1)
     def _receive(self, obs: Observation) -> None:
