@@ -404,3 +404,14 @@ def test_the_final_step_is_recorded_even_between_samples():
     res = run(load_scenario("demo", duration_s=1.0, overrides={"record_every": 7}), progress=False)
     assert res.data.t_s[-1] == pytest.approx(1.0)
     assert res.data.true_pose.shape[0] == 3
+
+
+def test_start_poses_longer_than_count_use_the_first_count_and_too_few_is_an_error():
+    poses = ((1.0, 1.0, 0.0), (2.0, 1.0, 90.0), (0.1, 1.0, 0.0))  # the third would overlap a wall
+    cfg = SimConfig(robots=(RobotGroupConfig(name="g", count=2, controller="idle-v1", sensors=(),
+                                             start=StartConfig(poses=poses)),))
+    got = Simulation(_room(), cfg).state.poses()
+    np.testing.assert_allclose(got[:, :2], [[1.0, 1.0], [2.0, 1.0]])
+    np.testing.assert_allclose(got[1, 2], np.pi / 2)
+    with pytest.raises(ValueError, match=r"start.poses must list at least count=3 poses.*got 2"):
+        RobotGroupConfig(name="g", count=3, controller="idle-v1", start=StartConfig(poses=poses[:2]))

@@ -155,7 +155,9 @@ class OdometryConfig(Model):
 
 # ---------------------------------------------------------------------------- start poses
 class StartConfig(Model):
-    """Where a group's robots start: explicit ``poses`` [[x_m, y_m, theta_deg], ...], or
+    """Where a group's robots start: explicit ``poses`` [[x_m, y_m, theta_deg], ...] (robot k
+    takes pose k; a list longer than the group's ``count`` is allowed and its first ``count``
+    poses are used, so a sweep can grid ``count`` over one list of start poses), or
     uniformly at random in free space inside ``region`` [xmin, xmax, ymin, ymax] (or the whole
     map when neither is given), with heading ``theta_deg`` or uniform when None, never
     overlapping a wall or another robot."""
@@ -209,8 +211,11 @@ class RobotGroupConfig(Model):
 
     @model_validator(mode="after")
     def _start_count(self) -> "RobotGroupConfig":
-        if self.start.poses is not None and len(self.start.poses) != self.count:
-            raise ValueError(f"start.poses lists {len(self.start.poses)} poses for count={self.count} robots")
+        if self.start.poses is not None and len(self.start.poses) < self.count:
+            raise ValueError(
+                f"start.poses must list at least count={self.count} poses (the first {self.count} are used), "
+                f"got {len(self.start.poses)}"
+            )
         return self
 
 

@@ -1,6 +1,6 @@
 """Start poses of all robots from their groups' :class:`~teamnav.sim.config.StartConfig`.
 
-- Explicit ``poses`` ([x_m, y_m, theta_deg] per robot) are checked: each disc must lie in free
+- Explicit ``poses`` ([x_m, y_m, theta_deg] per robot; the first ``count`` of the list) are checked: each disc must lie in free
   space inside the map and overlap no other robot's; otherwise a ``ValueError`` names the
   group and the pose index.
 - Otherwise robots are drawn uniformly at random over the free space of ``region`` (or of
@@ -114,8 +114,9 @@ def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator,
         if g.start.poses is None:
             continue
         p = np.array(g.start.poses, dtype=np.float64).reshape(-1, 3)
-        if p.shape[0] != g.count:
-            raise ValueError(f"{label(gi)}.start.poses must list count={g.count} poses, got {p.shape[0]}")
+        if p.shape[0] < g.count:
+            raise ValueError(f"{label(gi)}.start.poses must list at least count={g.count} poses, got {p.shape[0]}")
+        p = p[: g.count]
         hit = discs_hit_walls(blocking, clear_m, geo, p[:, 0], p[:, 1], np.full(g.count, g.radius_m))
         for k in range(g.count):
             x, y, th_deg = (float(v) for v in p[k])
