@@ -50,7 +50,7 @@ from teamnav.localization._checks import array, positive
 
 __all__ = [
     "BeamModelParams", "BeamTable", "beam_density", "beam_table_kernel", "beam_probability", "beam_log_table", "beam_loglik_kernel",
-    "beam_log_likelihood_reference", "max_reading",
+    "beam_log_likelihood_reference", "beam_loglik_kernel_serial", "max_reading",
 ]
 
 #: A reading within this of the maximum range is a max-range reading [m].
@@ -207,6 +207,26 @@ class BeamTable:
                                  p.sigma_hit_m, p.lambda_short_per_m, self.max_range_m, out)
 
 
+@njit(cache=True, inline="always")
+def _beam_row(rays, i, k, table, inv_step):
+    """``sum_b log P(z_b | z*_b)`` of particle ``i`` (see :func:`beam_loglik_kernel`)."""
+    nb = table.shape[0]
+    last = table.shape[1] - 1
+    s = 0.0
+    for b in range(nb):
+        e = rays[i, b * k]
+        for q in range(1, k):
+            e = min(e, rays[i, b * k + q])
+        u = e * inv_step
+        j = int(u)
+        if j >= last:
+            s += table[b, last]
+        else:
+            t0 = table[b, j]
+            s += t0 + (u - j) * (table[b, j + 1] - t0)
+    return s
+
+
 @njit(cache=True, parallel=True)
 def beam_loglik_kernel(rays, k, table, inv_step, exponent, out):
     """Log-likelihood of one scan for every particle, from ray-cast ranges and the table.
@@ -227,22 +247,18 @@ def beam_loglik_kernel(rays, k, table, inv_step, exponent, out):
     out : (P,) float64
         Written: ``exponent * sum_b log P(z_b | z*_b(l))``.
     """
-    nb = table.shape[0]
-    last = table.shape[1] - 1
     for i in prange(rays.shape[0]):
-        s = 0.0
-        for b in range(nb):
-            e = rays[i, b * k]
-            for q in range(1, k):
-                e = min(e, rays[i, b * k + q])
-            u = e * inv_step
-            j = int(u)
-            if j >= last:
-                s += table[b, last]
-            else:
-                t0 = table[b, j]
-                s += t0 + (u - j) * (table[b, j + 1] - t0)
-        out[i] = s * exponent
+        out[i] = _beam_row(rays, i, k, table, inv_step) * exponent
+    return out
+
+
+@njit(cache=True)
+def beam_loglik_kernel_serial(rays, k, table, inv_step, exponent, out):
+    """Serial twin of :func:`beam_loglik_kernel` (small calls on busy cores lose milliseconds
+    to a thread launch). A function of its own: numba's on-disk cache does not key entries by
+    the ``parallel`` flag, so ``njit(beam_loglik_kernel.py_func)`` could load threaded code."""
+    for i in range(rays.shape[0]):
+        out[i] = _beam_row(rays, i, k, table, inv_step) * exponent
     return out
 
 
@@ -252,8 +268,3 @@ def beam_log_likelihood_reference(expected: np.ndarray, measured: np.ndarray, pa
     e = array("expected", expected, (-1, -1))
     z = array("measured", measured, (e.shape[1],))
     return np.log(beam_probability(z[None, :], e, params, max_range_m)).sum(axis=1)
-
-
-#: Serial twin of :func:`beam_loglik_kernel` (same body, no threads): small calls on busy cores
-#: lose milliseconds to thread launch.
-beam_loglik_kernel_serial = njit(cache=True)(beam_loglik_kernel.py_func)

@@ -33,7 +33,8 @@ from pydantic import BaseModel, ConfigDict, Field
 from teamnav.world.distance import distance_field
 from teamnav.world.grid import OccupancyGrid
 
-__all__ = ["LikelihoodFieldParams", "build_log_field", "lf_loglik_kernel", "lf_log_likelihood_reference"]
+__all__ = ["LikelihoodFieldParams", "build_log_field", "lf_loglik_kernel", "lf_loglik_kernel_serial",
+           "lf_log_likelihood_reference"]
 
 
 class LikelihoodFieldParams(BaseModel):
@@ -66,6 +67,32 @@ def build_log_field(grid: OccupancyGrid, blocking: np.ndarray, params: Likelihoo
     return table, outside
 
 
+@njit(cache=True, inline="always")
+def _lf_row(poses, i, ax, ay, table, free, ox, oy, inv_res, outside, worst):
+    """Unscaled log-likelihood of particle ``i`` (see :func:`lf_loglik_kernel`)."""
+    h, w = table.shape
+    nb = ax.shape[0]
+    x = poses[i, 0]
+    y = poses[i, 1]
+    c = int(math.floor((x - ox) * inv_res))
+    r = int(math.floor((y - oy) * inv_res))
+    if r < 0 or r >= h or c < 0 or c >= w or free[r, c] == 0:
+        return worst * nb
+    ct = math.cos(poses[i, 2])
+    st = math.sin(poses[i, 2])
+    s = 0.0
+    for b in range(nb):
+        ex = x + ct * ax[b] - st * ay[b]
+        ey = y + st * ax[b] + ct * ay[b]
+        c = int(math.floor((ex - ox) * inv_res))
+        r = int(math.floor((ey - oy) * inv_res))
+        if r < 0 or r >= h or c < 0 or c >= w:
+            s += outside
+        else:
+            s += table[r, c]
+    return s
+
+
 @njit(cache=True, parallel=True)
 def lf_loglik_kernel(poses, ax, ay, table, free, ox, oy, inv_res, outside, worst, exponent, out):
     """Log-likelihood of one scan for every particle under the likelihood field.
@@ -90,29 +117,18 @@ def lf_loglik_kernel(poses, ax, ay, table, free, ox, oy, inv_res, outside, worst
     out : (P,) float64
         Written.
     """
-    h, w = table.shape
-    nb = ax.shape[0]
     for i in prange(poses.shape[0]):
-        x = poses[i, 0]
-        y = poses[i, 1]
-        c = int(math.floor((x - ox) * inv_res))
-        r = int(math.floor((y - oy) * inv_res))
-        if r < 0 or r >= h or c < 0 or c >= w or free[r, c] == 0:
-            out[i] = worst * nb * exponent
-            continue
-        ct = math.cos(poses[i, 2])
-        st = math.sin(poses[i, 2])
-        s = 0.0
-        for b in range(nb):
-            ex = x + ct * ax[b] - st * ay[b]
-            ey = y + st * ax[b] + ct * ay[b]
-            c = int(math.floor((ex - ox) * inv_res))
-            r = int(math.floor((ey - oy) * inv_res))
-            if r < 0 or r >= h or c < 0 or c >= w:
-                s += outside
-            else:
-                s += table[r, c]
-        out[i] = s * exponent
+        out[i] = _lf_row(poses, i, ax, ay, table, free, ox, oy, inv_res, outside, worst) * exponent
+    return out
+
+
+@njit(cache=True)
+def lf_loglik_kernel_serial(poses, ax, ay, table, free, ox, oy, inv_res, outside, worst, exponent, out):
+    """Serial twin of :func:`lf_loglik_kernel` (small calls on busy cores lose milliseconds to
+    a thread launch). A function of its own: numba's on-disk cache does not key entries by
+    the ``parallel`` flag, so ``njit(lf_loglik_kernel.py_func)`` could load threaded code."""
+    for i in range(poses.shape[0]):
+        out[i] = _lf_row(poses, i, ax, ay, table, free, ox, oy, inv_res, outside, worst) * exponent
     return out
 
 
@@ -136,8 +152,3 @@ def lf_log_likelihood_reference(poses, measured, angles, table, free, origin_xy,
     pin = (pr >= 0) & (pr < h) & (pc >= 0) & (pc < w)
     ok = pin & (free[np.clip(pr, 0, h - 1), np.clip(pc, 0, w - 1)] == 1)
     return np.where(ok, s, worst * z.shape[0])
-
-
-#: Serial twin of :func:`lf_loglik_kernel` (same body, no threads): small calls on busy cores
-#: lose milliseconds to thread launch.
-lf_loglik_kernel_serial = njit(cache=True)(lf_loglik_kernel.py_func)

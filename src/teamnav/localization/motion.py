@@ -34,7 +34,8 @@ from pydantic import BaseModel, ConfigDict, Field
 from teamnav.geometry.angles import wrap_angle
 from teamnav.localization._checks import array, generator
 
-__all__ = ["MotionParams", "decompose_odometry", "sample_motion", "sample_motion_reference", "motion_kernel"]
+__all__ = ["MotionParams", "decompose_odometry", "sample_motion", "sample_motion_reference", "motion_kernel",
+           "motion_kernel_serial"]
 
 _HALF_PI = 0.5 * math.pi
 _Alpha = Annotated[float, Field(ge=0.0, le=10.0)]
@@ -80,6 +81,29 @@ def _decompose(dx, dy, dth):
     return rot1, trans, _wrap(dth - rot1)
 
 
+@njit(cache=True, inline="always")
+def _sigmas(dx, dy, dth, alpha):
+    """Table 5.6 lines 2-4 and the three noise deviations: ``(rot1, trans, rot2, s_r1, s_t, s_r2)``."""
+    rot1, trans, rot2 = _decompose(dx, dy, dth)
+    t2 = trans * trans
+    s_r1 = math.sqrt(alpha[0] * rot1 * rot1 + alpha[1] * t2)
+    s_t = math.sqrt(alpha[2] * t2 + alpha[3] * rot1 * rot1 + alpha[3] * rot2 * rot2)
+    s_r2 = math.sqrt(alpha[0] * rot2 * rot2 + alpha[1] * t2)
+    return rot1, trans, rot2, s_r1, s_t, s_r2
+
+
+@njit(cache=True, inline="always")
+def _move(particles, noise, i, rot1, trans, rot2, s_r1, s_t, s_r2):
+    """Table 5.6 lines 5-10 for particle ``i``, in place."""
+    r1 = rot1 - noise[i, 0] * s_r1
+    t = trans - noise[i, 1] * s_t
+    r2 = rot2 - noise[i, 2] * s_r2
+    th = particles[i, 2]
+    particles[i, 0] += t * math.cos(th + r1)
+    particles[i, 1] += t * math.sin(th + r1)
+    particles[i, 2] = _wrap(th + r1 + r2)
+
+
 @njit(cache=True, parallel=True)
 def motion_kernel(particles, dx, dy, dth, alpha, noise):
     """Move every particle by one draw of Table 5.6, in place.
@@ -95,19 +119,23 @@ def motion_kernel(particles, dx, dy, dth, alpha, noise):
     noise : (n, 3) float64
         Standard normal draws (rot1, trans, rot2) per particle.
     """
-    rot1, trans, rot2 = _decompose(dx, dy, dth)
-    t2 = trans * trans
-    s_r1 = math.sqrt(alpha[0] * rot1 * rot1 + alpha[1] * t2)
-    s_t = math.sqrt(alpha[2] * t2 + alpha[3] * rot1 * rot1 + alpha[3] * rot2 * rot2)
-    s_r2 = math.sqrt(alpha[0] * rot2 * rot2 + alpha[1] * t2)
+    rot1, trans, rot2, s_r1, s_t, s_r2 = _sigmas(dx, dy, dth, alpha)
     for i in prange(particles.shape[0]):
-        r1 = rot1 - noise[i, 0] * s_r1
-        t = trans - noise[i, 1] * s_t
-        r2 = rot2 - noise[i, 2] * s_r2
-        th = particles[i, 2]
-        particles[i, 0] += t * math.cos(th + r1)
-        particles[i, 1] += t * math.sin(th + r1)
-        particles[i, 2] = _wrap(th + r1 + r2)
+        _move(particles, noise, i, rot1, trans, rot2, s_r1, s_t, s_r2)
+
+
+@njit(cache=True)
+def motion_kernel_serial(particles, dx, dy, dth, alpha, noise):
+    """Serial twin of :func:`motion_kernel` (small calls on busy cores lose milliseconds to a
+    thread launch).
+
+    A function of its own, not ``njit(motion_kernel.py_func)``: numba's on-disk cache keys an
+    entry by bytecode and signature but not by the ``parallel`` flag, so a twin built from the
+    same ``py_func`` shares the parallel kernel's cache file and may load its threaded code.
+    """
+    rot1, trans, rot2, s_r1, s_t, s_r2 = _sigmas(dx, dy, dth, alpha)
+    for i in range(particles.shape[0]):
+        _move(particles, noise, i, rot1, trans, rot2, s_r1, s_t, s_r2)
 
 
 def decompose_odometry(odom_delta) -> tuple[float, float, float]:
@@ -165,8 +193,3 @@ def sample_motion_reference(particles, odom_delta, alpha, noise) -> np.ndarray:
     r2 = rot2 - n[:, 2] * math.sqrt(a[0] * rot2**2 + a[1] * trans**2)
     return np.stack([p[:, 0] + t * np.cos(p[:, 2] + r1), p[:, 1] + t * np.sin(p[:, 2] + r1),
                      wrap_angle(p[:, 2] + r1 + r2)], axis=1)
-
-
-#: Serial twin of :func:`motion_kernel` (same body, no threads): small calls on busy cores
-#: lose milliseconds to thread launch.
-motion_kernel_serial = njit(cache=True)(motion_kernel.py_func)
