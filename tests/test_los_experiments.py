@@ -141,10 +141,14 @@ def test_sweeps_grid_what_the_paper_varies():
     from teamnav.experiments.sweep import load_sweep
 
     t1 = load_sweep("los-table1")
-    assert t1.n_trials == 2 * 8 * L.N_TASKS and t1.set == {"robots.0.params.state_sharing": False}
-    pf = load_sweep("los-table1-pf")  # §6: the potential field with state + goal sharing
-    assert pf.n_trials == 8 * L.N_TASKS and pf.set["robots.0.params.state_sharing"] is True
+    assert t1.n_trials == 3 * 8 * L.N_TASKS and not t1.set
+    # §6: the potential field with state + goal sharing, Avoid-Past and VisBug with goal sharing only
+    ties = {c[S.NAV_KEY]: c[S.STATE_KEY] for c in t1.cases}
+    assert ties == {"potential_field": True, "avoid_past": False, "visbug21": False}
     assert t1.grid["robots.0.params.targets_xy"][4] == L.task_targets_xy("simple", 5)
+    from teamnav.experiments.sweep import sweep_names
+
+    assert not [n for n in sweep_names() if n.startswith("los-") and n.endswith("-pf")]  # folded into cases
     noise = load_sweep("los-noise-complex")
     assert noise.grid[S.ERR_KEY] == list(L.ERR_MAX) and noise.scenario == "los-help-complex"
     assert load_sweep("los-ablation").n_trials == 3 * 4 * L.N_TASKS
@@ -175,7 +179,12 @@ def test_metrics_read_r1s_last_log_and_add_the_unrecorded_tail_of_a_finished_run
     ahead = [_log(10, 0, targets_reached=1, finished=False, moves=11)]  # moves counted at decision time
     assert los_help(_data(ahead, finished=True, n_steps=11))["los_steps"] == 11  # never more than the run's steps
     unfinished = los_help(_data(logs, finished=False, n_steps=500))
-    assert unfinished["los_finished"] == 0 and unfinished["los_steps"] == 500  # the budget
+    assert unfinished["los_finished"] == 0 and unfinished["los_steps"] == 9  # what it did, not comparable
+    gave_up = logs[:2] + [_log(10, 0, targets_reached=1, finished=True, gave_up=True, moves=9, steps_ghost=4,
+                               goal_seen_steps=2, temp_switches=3)]
+    m = los_help(_data(gave_up, finished=True, n_steps=11))  # the run stopped on R1's "finished"
+    assert m["los_finished"] == 0 and m["los_gave_up"] == 1
+    assert m["los_frac_ghost"] == 4 / 11 and m["los_frac_goal_seen"] == 2 / 11 and m["los_temp_switches"] == 3
 
 
 def test_metrics_are_empty_without_an_explorer_log():
@@ -248,10 +257,6 @@ class _FakeCtx:
         rows = [r for r in _by_team(True)[h]] if "table" in name else [
             _row(nav, 300 + 100 * e, **{S.ERR_KEY: e, S.DELAYED_KEY: True, S.STATE_KEY: True})
             for nav in L.NAVIGATORS for e in (0.0, 0.4)]
-        pf = name.endswith("-pf")
-        rows = [r for r in rows if (r["params"][S.NAV_KEY] == "potential_field") == pf]
-        if pf:  # the -pf sweeps set the navigator, so their rows do not carry it
-            rows = [{**r, "params": {k: v for k, v in r["params"].items() if k != S.NAV_KEY}} for r in rows]
 
         class R:
             def rows(self):
@@ -265,8 +270,9 @@ def test_full_build_asks_for_nested_teams_and_every_sweep_and_returns_every_bloc
     ctx = _FakeCtx(quick=False)
     blocks = S.build(ctx)
     names = [c[0] for c in ctx.calls]
-    assert names.count("los-table1") == names.count("los-table2") == names.count("los-table1-pf") == 4
-    assert {"los-noise-simple", "los-noise-complex-pf", "los-ablation"} <= set(names)
+    assert names.count("los-table1") == names.count("los-table2") == 4
+    assert {"los-noise-simple", "los-noise-complex", "los-ablation"} <= set(names)
+    assert not any(n.endswith("-pf") for n in names)  # the algorithms are the sweeps' cases
     sets = [c[1]["set"] for c in ctx.calls if c[0] == "los-table1"]
     assert {"robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0} in sets  # R1+R2, not R1+R3
     assert {Table, Plot, Comparison} <= {type(b) for b in blocks}
@@ -280,6 +286,7 @@ def test_quick_build_runs_short_tasks_and_says_what_it_left_out():
     ctx = _FakeCtx(quick=True)
     blocks = S.build(ctx)
     assert all(len(c[1]["grid"][S.TARGETS_KEY][0]) == S.QUICK_TARGETS for c in ctx.calls)
+    assert all(c[1]["set"][S.BUDGET_KEY] == S.QUICK_BUDGET_STEPS_PER_TARGET for c in ctx.calls)
     assert {b.what.split(" (")[0] for b in blocks if isinstance(b, Missing)} >= {"Table 2 / Fig. 14", "Fig. 17"}
     assert all("quick mode" in b.differs for b in blocks if isinstance(b, Comparison) and b.holds is not None)
 

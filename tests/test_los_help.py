@@ -514,3 +514,61 @@ def test_end_to_end_r1_reaches_a_target_seen_through_a_helper(navigator):
     assert r1_logs[-1]["targets_reached"] == 1 and r1_logs[-1]["msgs_sent"] > 0
     assert math.dist(data.true_pose[-1, 0, :2], target_world) < 0.3 + 1e-3
     assert data.true_pose[-1, 1, :2].tolist() == pytest.approx(helper_at[:2], abs=1e-5)  # never left its post
+
+
+# ---------------------------------------------------------------------------- budget, slide, promise
+def test_a_target_not_reached_within_its_step_budget_ends_the_task(straight_nav):
+    p = LosExplorer.Params(targets_xy=[(1.0, 0.0), (100.0, 0.0)], goal_tolerance_m=0.3, max_steps_per_target=5)
+    r1 = LosExplorer(p, np.random.default_rng(0), info(0, 1))
+    for k in range(4):
+        r1.step(obs(k))  # stuck at the start (the test does not move it)
+    r1.step(obs(4, pose=(1.0, 0.0, 0.0)))  # first target reached at step 4: its budget starts again
+    assert r1.target_index == 1 and not r1.finished
+    for k in range(5, 9):
+        a, _ = r1.step(obs(k, pose=(1.0, 0.0, 0.0)))
+        assert not r1.gave_up and a.direction_rad is not None
+    a, _ = r1.step(obs(9, pose=(1.0, 0.0, 0.0)))  # 5 steps on the second target: gives up
+    assert r1.gave_up and r1.finished and r1.mode == "gave_up" and a.direction_rad is None
+    log = r1.log()
+    assert log["gave_up"] and log["finished"] and log["targets_reached"] == 1
+    never = LosExplorer(LosExplorer.Params(targets_xy=[(100.0, 0.0)]), np.random.default_rng(0), info(0, 1))
+    for k in range(50):
+        never.step(obs(k))
+    assert not never.finished  # no budget: never abandons
+
+
+@pytest.mark.parametrize("slide", [True, False])
+def test_a_seen_goal_behind_a_door_jamb_is_reached_by_sliding_not_by_a(straight_nav, slide):
+    # the goal 4 m ahead is in sight (the beam towards it is free), but a jamb 1 m ahead,
+    # 0.1 m to the left of the line, leaves no room for the robot's 0.2 m radius
+    p = LosExplorer.Params(targets_xy=[(4.0, 0.0)], goal_tolerance_m=0.3, slide_when_blocked=slide)
+    r1 = LosExplorer(p, np.random.default_rng(0), info(0, 1))
+    a, _ = r1.step(obs(0, walls=[(0.1, 0.01, 1.0)]))
+    assert r1.mode == "own_goal" and r1.sharing.path(0).kind == "direct"
+    if slide:
+        # the nearest free direction, on the side away from the jamb, within 90 degrees of the goal
+        assert -math.pi / 2 <= a.direction_rad < -0.05 and r1.slide_steps == 1 and not straight_nav
+    else:
+        assert a.direction_rad == pytest.approx(0.0) and r1.slide_steps == 0 and straight_nav  # A decides
+
+
+@pytest.mark.parametrize("d_m, promised", [(6.71, True), (9.0, False)])
+def test_at_a_ghost_that_saw_the_goal_itself_r1_heads_for_the_goal(straight_nav, d_m, promised):
+    goal = (6.0, 0.0)
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[goal], goal_tolerance_m=0.3), np.random.default_rng(0), info(0, 2))
+    wall = [(0.0, 0.3, 2.0)]
+    r2 = (0.0, 3.0)
+    r1.step(obs(0, walls=wall, seen=[(1, *polar((0, 0), r2))]))
+    # R2 at (0, 3) reports D for R1's goal: 6.71 m is the straight distance (it sees the goal), 9 m is not
+    r1.step(obs(1, walls=wall, seen=[(1, *polar((0, 0), r2))], inbox=[
+        msg(1, 0, sightings=[Sighting(0, -math.pi / 2, 3.0)], reports=[VisReport(0, 2, d_m)])]))
+    r1.step(obs(2, pose=(0.0, 1.5, 0.0), walls=wall))
+    # at the ghost, R1's own scan does not show the goal (a return 1 m along its bearing)
+    bearing = math.atan2(-2.95, 6.0)
+    a, _ = r1.step(obs(3, pose=(0.0, 2.95, 0.0), walls=[(bearing, 0.01, 1.0)]))
+    assert r1.mode == "own_goal" and r1.sharing.path(0).reached
+    assert (r1.promised_steps == 1) is promised
+    if not promised:  # explore again with A (§4.2)
+        assert a.direction_rad == pytest.approx(bearing, abs=1e-9)
+    else:  # straight for the goal, sliding past what blocks the line
+        assert a.direction_rad != pytest.approx(bearing, abs=1e-3) and abs(wrap_angle(a.direction_rad - bearing)) < math.pi / 2

@@ -32,8 +32,8 @@ What is ours (the paper leaves it open)
 Files
 -----
 :func:`write_files` (re)writes ``scenarios/los-help-{simple,complex,noise}.yaml`` and the
-sweeps ``sweeps/los-{table1,table2,noise-simple,noise-complex}[-pf].yaml`` and
-``los-ablation.yaml`` (``-pf``: the potential field with state sharing, §6); run
+sweeps ``sweeps/los-{table1,table2,noise-simple,noise-complex}.yaml`` (the algorithms as
+``cases``, :data:`CASES`) and ``los-ablation.yaml``; run
 ``python -m teamnav.experiments.los_tasks`` after changing anything here and commit them.
 """
 
@@ -52,6 +52,7 @@ import yaml
 from teamnav.geometry import se2
 
 __all__ = [
+    "CASES",
     "ERR_MAX",
     "LAYOUTS",
     "MAPS",
@@ -89,10 +90,12 @@ VISIBILITY_M = 8.0  # bounded omnidirectional visibility radius (§2) = laser ra
 GOAL_TOLERANCE_M = 0.5  # ε of §2
 DT_S = 0.1
 RECORD_EVERY = 10
-#: Step budget per target: a run that has not reached all its targets by then "fails"
-#: (the potential field alone, §6). Generous: Avoid-Past alone needed ~570 steps per target on
-#: office_simple (task 1, first 10 targets), ~250 with three helpers.
-BUDGET_STEPS_PER_TARGET: dict[str, int] = {"simple": 800, "complex": 1200}
+#: Step budget per target (R1's ``max_steps_per_target``): a target not reached within this
+#: many steps ends the task, which then counts as failed (the potential field alone, §6). A
+#: budget per target, not per task, ends a trapped run at its first trap (a per-task budget of
+#: 200 x 800 steps made each failing run burn 160 000 steps). Generous: Avoid-Past alone needs
+#: ~100-550 steps per target on office_simple (task 1, first 10 targets).
+BUDGET_STEPS_PER_TARGET: dict[str, int] = {"simple": 1500, "complex": 2500}
 
 
 @dataclass(frozen=True)
@@ -113,9 +116,11 @@ LAYOUTS: dict[str, Layout] = {
     "simple": Layout(
         r1_start=(1.0, 7.0, 90.0),
         helpers=(
-            ((3.0, 6.5, 0.0), ((28.5, 6.5), (3.0, 6.5))),  # R2: whole corridor, west -> east first
-            ((28.5, 7.5, 180.0), ((3.0, 7.5), (28.5, 7.5))),  # R3: whole corridor, east -> west first
-            ((15.0, 7.0, 0.0), ((28.5, 7.0), (3.0, 7.0))),  # R4: whole corridor, from the middle
+            # end to end: a room centre is seen from the corridor only through the room's door,
+            # from a 1.5 m stretch beside it (the doors of S1 and N5 are at the corridor's ends)
+            ((3.0, 6.5, 0.0), ((29.0, 6.5), (1.0, 6.5))),  # R2: whole corridor, west -> east first
+            ((28.5, 7.5, 180.0), ((1.0, 7.5), (29.0, 7.5))),  # R3: whole corridor, east -> west first
+            ((15.0, 7.0, 0.0), ((29.0, 7.0), (1.0, 7.0))),  # R4: whole corridor, from the middle
         ),
     ),
     # corridor H y in [10.8, 13.2], corridor V x in [16.8, 19.2]; base (1, 12)
@@ -269,6 +274,7 @@ def r1_params(map_key: str, *, task: int = 1, n_targets: int = N_TARGETS, naviga
         "state_sharing": state_sharing,
         "laser": "laser",
         "log_layers": False,
+        "max_steps_per_target": BUDGET_STEPS_PER_TARGET[map_key],
     }
 
 
@@ -342,48 +348,51 @@ _HEADER = (
 )
 
 
+#: §6's algorithms as sweep cases: the potential field with state + goal sharing, Avoid-Past
+#: and VisBug with goal sharing only ("in the case of 1) we implement both the state-sharing
+#: strategy ... and the goal-sharing strategy ... in the case of 2) and 3) only the
+#: goal-sharing mechanism is required"); a case ties the navigator to its sharing flag.
+CASES: list[dict[str, Any]] = [
+    {"case": "pot-field", "robots.0.params.navigator": "potential_field", "robots.0.params.state_sharing": True},
+    {"case": "avoid-past", "robots.0.params.navigator": "avoid_past", "robots.0.params.state_sharing": False},
+    {"case": "visbug21", "robots.0.params.navigator": "visbug21", "robots.0.params.state_sharing": False},
+]
+
+
 def sweep_data(kind: str) -> dict[str, Any]:
     """The named sweep ``los-<kind>`` as YAML data (see :func:`write_files`)."""
     tasks = lambda m: [task_targets_xy(m, t) for t in range(1, N_TASKS + 1)]  # noqa: E731
-    pf = kind.endswith("-pf")
-    base = kind[:-3] if pf else kind
-    # §6: the potential field runs with state + goal sharing, the others with goal sharing only;
-    # a grid cannot tie the two keys, so the potential field has its own sweeps (``-pf``).
-    nav: dict[str, Any] = ({"set": {"robots.0.params.navigator": "potential_field", "robots.0.params.state_sharing": True}}
-                           if pf else {"set": {"robots.0.params.state_sharing": False}})
-    navs = {} if pf else {"robots.0.params.navigator": [n for n in NAVIGATORS if n != "potential_field"]}
-    who = "the potential field (state + goal sharing)" if pf else "Avoid-Past and VisBug (goal sharing)"
-    if base in ("table1", "table2"):
-        m = "simple" if base == "table1" else "complex"
+    if kind in ("table1", "table2"):
+        m = "simple" if kind == "table1" else "complex"
         return {
             "name": f"los-{kind}",
-            "description": (f"Sgorbissa & Arkin Table {base[-1]}: R1's steps for {who} with helpers R2, R3, R4 each "
-                            f"present or not (the paper's rows are R1; R1+R2; R1..R3; R1..R4), 5 tasks of 200 targets."),
+            "description": (f"Sgorbissa & Arkin Table {kind[-1]}: R1's steps per algorithm (cases; the potential field "
+                            f"with state + goal sharing, the others with goal sharing) with helpers R2, R3, R4 each "
+                            f"present or not (the paper's rows are R1; R1+R2; R1..R3; R1..R4), 5 tasks of 200 targets, "
+                            f"{BUDGET_STEPS_PER_TARGET[m]} steps per target at most."),
             "scenario": SCENARIOS[m],
+            "cases": copy.deepcopy(CASES),
             "grid": {
-                **navs,
                 "robots.1.count": [0, 1],
                 "robots.2.count": [0, 1],
                 "robots.3.count": [0, 1],
                 "robots.0.params.targets_xy": tasks(m),
             },
             "seeds": 1,
-            **nav,
         }
-    if base in ("noise-simple", "noise-complex"):
-        m = base.split("-")[1]
+    if kind in ("noise-simple", "noise-complex"):
+        m = kind.split("-")[1]
         return {
             "name": f"los-{kind}",
             "description": (f"Sgorbissa & Arkin Fig. {16 if m == 'simple' else 17}: R1's steps vs err_max of eqs. 1-2 "
-                            f"(every robot's detector) with all helpers, {who}, 5 tasks of 200 targets."),
+                            f"(every robot's detector) with all helpers, per algorithm (cases), 5 tasks of 200 targets."),
             "scenario": SCENARIOS[m],
+            "cases": copy.deepcopy(CASES),
             "grid": {
-                **navs,
                 "robots.0.detector.err_max": list(ERR_MAX),
                 "robots.0.params.targets_xy": tasks(m),
             },
             "seeds": 1,
-            **nav,
         }
     if kind == "ablation":
         return {
@@ -402,8 +411,7 @@ def sweep_data(kind: str) -> dict[str, Any]:
     raise ValueError(f"unknown los sweep kind {kind!r}")
 
 
-SWEEP_KINDS: tuple[str, ...] = ("table1", "table1-pf", "table2", "table2-pf", "noise-simple", "noise-simple-pf",
-                                "noise-complex", "noise-complex-pf", "ablation")
+SWEEP_KINDS: tuple[str, ...] = ("table1", "table2", "noise-simple", "noise-complex", "ablation")
 
 
 def write_files(scenario_dir: Path | None = None, sweep_dir: Path | None = None) -> list[Path]:

@@ -9,13 +9,25 @@ number of motion steps it made.
 Keys
 ----
 ``los_finished``
-    1 when R1 reached every target within the step budget (the run stopped early, scenario
-    ``stop_when_finished``), else 0 (§6: the potential field alone "fails").
+    1 when R1 reached every target, each within its step budget (``max_steps_per_target``;
+    the run stopped early, scenario ``stop_when_finished``), else 0 (§6: the potential field
+    alone "fails").
+``los_gave_up``
+    1 when R1 abandoned the task because a target's step budget ran out.
 ``los_steps``
-    R1's motion steps to finish the task; the run's step budget when it did not finish.
+    R1's motion steps to finish the task; for a run that did not finish, the steps it made
+    until it gave up (or the run's end): not comparable, leave failures out of means.
     Logs are kept every ``record_every`` steps, so for a finished run the steps after the
     last kept sample are added as if R1 moved at each (an upper bound, off by less than
     ``record_every``, and never more than the steps the run took).
+``los_frac_<mode>``
+    Where R1's steps went, as fractions of its steps: ``goal_seen`` (own goal in sight,
+    §2 point 4), ``follow_teammate`` (heading to a teammate offering the shortest D, §3),
+    ``ghost`` (to a ghost or own past viewpoint, §4), ``trouble_follow`` (to a teammate not
+    in trouble, §5), ``promised`` (to its goal on a teammate's direct promise), ``slide``
+    (along a side direction to a seen point); the rest is the navigator towards the goal.
+``los_temp_switches``
+    Times R1's temporary goal (teammate, ghost, trouble helper) changed (oscillation).
 ``los_steps_per_target``
     ``los_steps`` over the targets reached (over 1 when none was).
 ``los_targets_reached``
@@ -64,10 +76,16 @@ def los_help(data: RunData) -> dict[str, float | int]:
     finished = bool(data.finished)
     reached = int(v.get("targets_reached", 0))
     moves = int(v.get("moves", 0))
+    gave_up = bool(v.get("gave_up", False))
+    finished = finished and not gave_up
     if finished:
         steps = min(moves + max(0, int(data.n_steps) - v["_step"]), int(data.n_steps))
     else:
-        steps = int(data.n_steps)
+        steps = moves
+    total = max(int(v["_step"]) + 1, 1)
+    frac = {f"los_frac_{k}": float(v.get(src, 0)) / total for k, src in (
+        ("goal_seen", "goal_seen_steps"), ("follow_teammate", "steps_follow_teammate"), ("ghost", "steps_ghost"),
+        ("trouble_follow", "steps_trouble_follow"), ("promised", "promised_steps"), ("slide", "slide_steps"))}
     trouble = [bool((e.get("values") or {}).get("tr", False)) for e in data.logs if int(e.get("robot", -1)) == r1]
     msgs = [int(x["msgs_sent"]) for x in last.values() if "msgs_sent" in x]
     nbytes = [int(x["bytes_sent"]) for x in last.values() if "bytes_sent" in x]
@@ -81,8 +99,12 @@ def los_help(data: RunData) -> dict[str, float | int]:
         "los_msgs_per_robot": float(np.mean(msgs)) if msgs else 0.0,
         "los_bytes_per_robot": float(np.mean(nbytes)) if nbytes else 0.0,
         "los_trouble_frac": float(np.mean(trouble)) if trouble else 0.0,
+        "los_gave_up": int(gave_up),
+        "los_temp_switches": int(v.get("temp_switches", 0)),
+        **frac,
     }
 
 
 register("los_help", los_help,
-         "Sgorbissa & Arkin §6: R1's motion steps to finish its targets (budget if not), targets reached, messages/bytes")
+         "Sgorbissa & Arkin §6: R1's motion steps to finish its targets, whether it gave up, targets reached, "
+         "messages/bytes, where its steps went")

@@ -140,6 +140,23 @@ class _CommonParams(BaseModel):
     restart_navigator_on_give_up : bool
         When A returns no heading for a target (VisBug-21 found it "unreachable"), build A
         afresh so it starts over from the current position (gap filled; False: stay).
+    ghost_tolerance_m : float
+        A ghost point (§4.2) is reached when closer than this (gap filled; the robot must
+        stand where the teammate saw the goal from, often a narrow stretch in front of a
+        door). Should be at least half a step length.
+    slide_when_blocked : bool
+        Heading for a point it sees whose straight corridor is too narrow for its body, step
+        along the nearest free direction (see ``_LosBrain._slide_heading``) instead of asking
+        A (gap filled; False: ask A, the earlier behaviour).
+    slide_lookahead_m : float
+        Length of the corridor that must be clear for a sliding direction [m].
+    trust_direct_promise : bool
+        Explorer only: at a ghost whose teammate saw the goal itself from there (its D is the
+        straight distance), head for the goal straight (sliding past door jambs) even when the
+        robot's own scan does not show it, until the target changes or the robot is in
+        trouble (gap filled: §3 rule 3 lets R1 head to its goal once it perceives it from
+        where R2 stood; our 72-beam scan and 0.2 m tolerance often miss a room centre seen
+        through a door at a slant from a point a few centimetres away; False: explore with A).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
@@ -159,6 +176,10 @@ class _CommonParams(BaseModel):
     straight_when_visible: bool = True
     log_layers: bool = True
     restart_navigator_on_give_up: bool = True
+    ghost_tolerance_m: float = Field(0.2, gt=0.0, le=100.0)
+    slide_when_blocked: bool = True
+    slide_lookahead_m: float = Field(1.0, gt=0.0, le=100.0)
+    trust_direct_promise: bool = True
 
 
 class LosExplorerParams(_CommonParams):
@@ -173,10 +194,18 @@ class LosExplorerParams(_CommonParams):
         In trouble, keep heading to the chosen helper's last seen position when it goes out of
         sight, until no longer in trouble or the goal is seen (§5 names only these two ends);
         False follows it only while in sight.
+    max_steps_per_target : int or None
+        Step budget per target: when the current target is not reached within this many steps
+        (from the step it became current), R1 abandons the task (``gave_up``, and ``finished``
+        so that a run with ``stop_when_finished`` ends). Gap filled: §6 reports the potential
+        field alone as failing without saying after how long; a budget per target, not per
+        task, ends a hopeless run at its first trap instead of burning the whole task's
+        budget. None: never abandon.
     """
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
     keep_trouble_helper: bool = True
+    max_steps_per_target: int | None = Field(None, ge=1, le=100_000_000)
 
 
 class LosHelperParams(_CommonParams):
@@ -236,6 +265,16 @@ class _LosBrain(abc.ABC):
         self._scan: RangeScan | None = None
         self._gap_for: Any = None
         self._gap_rad = 0.0
+        self._step = 0
+        #: steps spent per mode, cumulative (where the steps go: own goal seen, navigator,
+        #: teammate, ghost, trouble helper)
+        self.mode_steps: dict[str, int] = {}
+        #: steps heading straight to a seen point, and steps where its corridor was blocked and
+        #: the robot slid along the free direction nearest to it (see :meth:`_head_to`)
+        self.slide_steps = 0
+        #: times the point headed for (a teammate, a ghost or a trouble helper) changed
+        self.temp_switches = 0
+        self._temp_key: Any = None
 
     # ------------------------------------------------------------------ sensing helpers
     def _odom_to_body(self, x: float, y: float) -> XY:
@@ -271,6 +310,7 @@ class _LosBrain(abc.ABC):
                 f"observation of robot {obs.robot_id} must carry scan {self.params.laser!r}, has {sorted(obs.scans)}"
             ) from None
         self._pose = np.asarray(obs.odom_pose, dtype=np.float64).copy()
+        self._step = int(obs.step)
         sightings = {}
         for det in obs.detections:
             if det.robot_id is None or det.robot_id == self.me:
@@ -292,6 +332,7 @@ class _LosBrain(abc.ABC):
         action = self._decide(obs)
         if action.direction_rad is not None:
             self.moves += 1
+        self.mode_steps[self.mode] = self.mode_steps.get(self.mode, 0) + 1
         outbox = self._broadcast(obs, sightings)
         self._prev_xy = me
         return action, outbox
@@ -399,7 +440,7 @@ class _LosBrain(abc.ABC):
         return bool(np.hypot(along - t, across).min() >= self.radius_m * 1.05)
 
     def _head_to(self, target: XY, key: Any, *, stop_within_m: float = 0.0,
-                 end_margin_m: float = 0.0) -> tuple[Action, bool]:
+                 end_margin_m: float = 0.0, trust: bool = False) -> tuple[Action, bool]:
         """Head for a point: straight (§2 point 4) when the robot sees it with a corridor wide
         enough for its body (up to ``end_margin_m`` short of it: a teammate may stand there),
         else via the navigator towards it. Checking the whole corridor, not only the next
@@ -417,8 +458,35 @@ class _LosBrain(abc.ABC):
         heading = math.atan2(target[1] - me[1], target[0] - me[0])
         if self.params.straight_when_visible and self._corridor_clear(heading, max(self.step_m, dist - end_margin_m)):
             return Action(direction_rad=float(wrap_angle(heading - self._pose[2]))), progressing
+        if (self.params.straight_when_visible and self.params.slide_when_blocked
+                and (trust or self._sees(*target, 2.0 * self.radius_m))):
+            slide = self._slide_heading(heading, min(dist - end_margin_m, self.params.slide_lookahead_m))
+            if slide is not None:
+                self.slide_steps += 1
+                return Action(direction_rad=float(wrap_angle(slide - self._pose[2]))), progressing
         action, _ = self._navigate(target)
         return action, progressing
+
+    def _slide_heading(self, heading_rad: float, length_m: float) -> float | None:
+        """The free heading nearest to ``heading_rad`` (own frame) whose corridor of
+        ``length_m`` is clear for the body, within ±90° in 5° steps; None if there is none.
+
+        Gap filled: the paper's robots are points, so a point in line of sight can be reached
+        in a straight line; ours have a radius, and a line of sight through a door at a
+        slant grazes its jamb. Sliding along the nearest free direction (the side tried first
+        at each angle is the side of the last slide, so the robot does not dither) keeps the
+        robot on its way to the point it sees instead of handing it to the navigator, whose
+        own memory (Avoid-Past) or boundary state (VisBug) is about its task goal, not about
+        this point (measured: handing over sent R1 back into the room it was leaving)."""
+        length_m = max(self.step_m, length_m)
+        side = getattr(self, "_slide_side", 1.0)
+        for k in range(1, 19):
+            for sgn in (side, -side):
+                h = heading_rad + sgn * math.radians(5.0 * k)
+                if self._corridor_clear(h, length_m):
+                    self._slide_side = sgn
+                    return h
+        return None
 
     def _drive(self, target: XY) -> tuple[Action, bool]:
         """Drive towards an unseen target with the navigator (algorithm A)."""
@@ -455,6 +523,9 @@ class _LosBrain(abc.ABC):
             "known_goals": len(self.sharing.known),
             "ghosts": sum(1 for p in self.sharing.points() if p.kind != "direct"),
             "own_d_m": float(own.distance_m(self._me_xy())) if own is not None else -1.0,
+            **{f"steps_{m}": int(n) for m, n in sorted(self.mode_steps.items())},
+            "slide_steps": int(self.slide_steps),
+            "temp_switches": int(self.temp_switches),
         }
 
 
@@ -490,6 +561,11 @@ class LosExplorer(_LosBrain):
         self.target_index = 0
         self.targets_reached = 0
         self.finished = not self.targets
+        self.gave_up = False
+        self._target_since = 0
+        self._promised: int | None = None
+        self.promised_steps = 0
+        self.goal_seen_steps = 0
         self._trouble_target: tuple[int, XY] | None = None
         self._set_goal()
 
@@ -501,11 +577,18 @@ class LosExplorer(_LosBrain):
             self.sharing.set_own_goal(self.target_index + 1, self.targets[self.target_index])
 
     def _advance_task(self) -> None:
-        """§2: the current goal is reached when dist < ε; then the next one becomes current."""
+        """§2: the current goal is reached when dist < ε; then the next one becomes current.
+        A target not reached within ``max_steps_per_target`` steps ends the task (gave up)."""
         while not self.finished:
             gx, gy = self.targets[self.target_index]
             if math.hypot(gx - self._pose[0], gy - self._pose[1]) >= self.params.goal_tolerance_m:
+                budget = self.params.max_steps_per_target
+                if budget is not None and self._step - self._target_since >= budget:
+                    self.gave_up = True
+                    self.finished = True
+                    self.sharing.set_own_goal(None)
                 return
+            self._target_since = self._step
             self.target_index += 1
             self.targets_reached += 1
             self.finished = self.target_index >= len(self.targets)
@@ -516,8 +599,20 @@ class LosExplorer(_LosBrain):
 
     def _decide(self, obs: Observation) -> Action:
         if self.finished:
-            self.mode = "done"
+            self.mode = "gave_up" if self.gave_up else "done"
             return Action()
+        action = self._decide_task(obs)
+        if self.mode in ("follow_teammate", "ghost", "trouble_follow"):
+            key = self._last_target[0] if self._last_target is not None else None
+            key = key[:2] if isinstance(key, tuple) else key  # the point's source, not its step
+            if key != self._temp_key:
+                self.temp_switches += 1
+            self._temp_key = key
+        else:
+            self._temp_key = None
+        return action
+
+    def _decide_task(self, obs: Observation) -> Action:
         p = self.params
         goal = self.targets[self.target_index]
         path = self.sharing.path(self.me) if p.goal_sharing else None
@@ -525,6 +620,7 @@ class LosExplorer(_LosBrain):
         progressing = True
         if path is not None and path.kind == "direct":
             self.mode = "own_goal"  # §2 point 4: it sees its goal, A is suppressed
+            self.goal_seen_steps += 1
             action, progressing = self._head_to(goal, ("goal", self.target_index),
                                                 end_margin_m=0.5 * p.goal_tolerance_m)
         elif path is not None and path.kind in ("ghost", "self") and not path.reached:
@@ -532,12 +628,19 @@ class LosExplorer(_LosBrain):
             # the mirror itself still stands where it promised (§3), or only its ghost does (§4.2)
             seen = self._seen_now.get(path.source)
             live = seen is not None and math.hypot(seen[0] - point[0], seen[1] - point[1]) <= 2.0 * self.radius_m + self.step_m
-            reach = max(p.goal_tolerance_m, 2.0 * self.radius_m + self.step_m) if live else p.goal_tolerance_m
+            # a ghost is reached closer than a target: the goal may be seen only from a narrow
+            # stretch of corridor through a door (measured: stopping ε = 0.5 m short of it,
+            # R1 often did not see the goal the helper had seen from there)
+            reach = max(p.goal_tolerance_m, 2.0 * self.radius_m + self.step_m) if live else p.ghost_tolerance_m
             me = self._me_xy()
             if math.hypot(point[0] - me[0], point[1] - me[1]) < reach:
                 # §4.2: at the ghost without seeing the goal: explore again with A, keeping the
                 # promise only to arbitrate later reports
                 self.sharing.mark_reached(self.me)
+                if p.trust_direct_promise and path.d_point_m <= math.hypot(goal[0] - point[0], goal[1] - point[1]) + self.step_m:
+                    # the teammate saw the goal itself from here (its D is the straight
+                    # distance): head straight for it (see ``trust_direct_promise``)
+                    self._promised = self.target_index
             else:
                 self.mode = "follow_teammate" if live else "ghost"
                 action, progressing = self._head_to(point, ("path", path.source, path.step),
@@ -564,6 +667,11 @@ class LosExplorer(_LosBrain):
                 # distance jumps by up to err_max·d, so a step that was not blocked counts
                 # (§5 leaves the measure to the designer)
                 progressing = not obs.stalled
+        if action is None and self._promised == self.target_index and not self.trouble.tr:
+            self.mode = "own_goal"
+            self.promised_steps += 1
+            action, progressing = self._head_to(goal, ("promised", self.target_index),
+                                                end_margin_m=0.5 * p.goal_tolerance_m, trust=True)
         if action is None:
             self.mode = "own_goal"
             action, progressing = self._drive(goal)
@@ -575,16 +683,22 @@ class LosExplorer(_LosBrain):
 
         ``target_index`` (0-based current target), ``targets_reached``, ``moves`` (motion
         steps commanded so far), ``mode`` (``"own_goal"`` | ``"follow_teammate"`` |
-        ``"ghost"`` | ``"trouble_follow"`` | ``"done"``), ``tr``, ``pr``, ``nt`` (§5),
+        ``"ghost"`` | ``"trouble_follow"`` | ``"done"`` | ``"gave_up"``), ``tr``, ``pr``, ``nt`` (§5),
         ``msgs_sent``, ``bytes_sent``, ``msgs_received`` (§4.4 traffic, cumulative),
         ``nav_restarts`` (times A gave up and was started afresh),
         ``known_goals`` and ``ghosts`` (memory, §4.4), ``own_d_m`` (D to its own goal, -1
-        when none), ``finished``; and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
+        when none), ``finished``, ``gave_up`` (the step budget of a target ran out, see
+        ``max_steps_per_target``); where the steps go, cumulative: ``steps_<mode>`` for each
+        mode met so far, ``goal_seen_steps`` (own goal in sight), ``promised_steps`` (heading for it on a
+        teammate's direct promise, ``trust_direct_promise``), ``slide_steps`` (heading to
+        a seen point along a side direction), ``temp_switches`` (changes of the teammate, ghost
+        or trouble helper headed for); and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
         the odometry frame (when ``log_layers``).
         """
         out = self._common_log()
         out.update(target_index=int(self.target_index), targets_reached=int(self.targets_reached),
-                   finished=bool(self.finished))
+                   finished=bool(self.finished), gave_up=bool(self.gave_up),
+                   goal_seen_steps=int(self.goal_seen_steps), promised_steps=int(self.promised_steps))
         layers = self._layers()
         if layers:
             out["layers"] = layers

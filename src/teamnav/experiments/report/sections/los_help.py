@@ -21,14 +21,21 @@ map's steps stay below R1 alone; on the complex map help fades (at 0.4 it keeps 
 half of its err_max = 0 gain).
 
 As in §6 the potential field runs with state + goal sharing and Avoid-Past and VisBug with
-goal sharing only: a sweep grid cannot tie two keys, so each table and noise sweep has a
-``-pf`` twin for the potential field; the ablation shows what state sharing does to the others.
+goal sharing only: the sweeps give the algorithms as ``cases`` (:data:`~teamnav.experiments.
+los_tasks.CASES`), which tie a navigator to its sharing flag; the ablation shows what state
+sharing does to the others.
+
+Budget: R1 abandons its task when a target is not reached within
+:data:`~teamnav.experiments.los_tasks.BUDGET_STEPS_PER_TARGET` steps (1500 simple, 2500
+complex); the run then ends and counts as failed (not in the means). A trapped run so ends
+at its first trap instead of burning a whole task's budget.
 
 Running it: ``teamnav report los-help --out DIR`` (full) runs 2 x 4 x 15 table trials, 2 x 75
-noise trials and 60 ablation trials; ``teamnav sweep los-table1 --out DIR`` plus
-``los-table1-pf`` alone grid every subset of R2, R3, R4 (8 teams, 80 + 40 trials). Set ``NUMBA_NUM_THREADS=1`` for sweeps on a small
-box: the line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread
-launch costs more than the work for four robots.
+noise trials and 60 ablation trials; ``teamnav sweep los-table1 --out DIR`` alone grids every
+subset of R2, R3, R4 (3 cases x 8 teams x 5 tasks = 120 trials); :data:`FULL_CPU_NOTE` says
+what it costs here. Set ``NUMBA_NUM_THREADS=1`` for sweeps on a small box: the
+line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread launch
+costs more than the work for four robots.
 
 Quick mode (CI): the simple map only, the first target of task 1 with a 400-step budget,
 teams {R1, R1..R4}, err_max 0.4 (err_max 0 is the tables' R1..R4 run), no ablation: 9 short
@@ -51,6 +58,7 @@ TARGETS_KEY = "robots.0.params.targets_xy"
 ERR_KEY = "robots.0.detector.err_max"
 DELAYED_KEY = "robots.0.params.delayed_visibility"
 STATE_KEY = "robots.0.params.state_sharing"
+BUDGET_KEY = "robots.0.params.max_steps_per_target"
 NAV_LABEL = {"potential_field": "Pot. Fields", "avoid_past": "Av. Past", "visbug21": "VisBug"}
 TEAM_LABEL = {0: "R1", 1: "R1,2", 2: "R1,2,3", 3: "R1,2,3,4"}
 TABLE_SWEEP = {"simple": "los-table1", "complex": "los-table2"}
@@ -136,6 +144,10 @@ def strictly_falling(means: Sequence[float]) -> bool:
 
 
 # ---------------------------------------------------------------------------- sweeps
+#: What the full reproduction costs on this machine (measured, see the note's numbers).
+FULL_CPU_NOTE = ("Cost of the full reproduction here (one core, measured on 10-target prefixes of the tasks and "
+                 "scaled to 200 targets): about 5 ms of CPU per simulated step with four robots, so "
+                 "`teamnav sweep los-table1` (120 runs) and `los-table2` (120 runs) take roughly TBD CPU-hours each.")
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
 QUICK_BUDGET_STEPS_PER_TARGET = 400
@@ -165,13 +177,15 @@ def _team_set(h: int) -> dict[str, int]:
     return {f"robots.{k + 1}.count": int(k < h) for k in range(3)}
 
 
-def _both(ctx, sweep: str, suffix: str, **kw: Any) -> list[dict]:
-    """Rows of ``sweep`` (Avoid-Past, VisBug: goal sharing) and ``sweep-pf`` (the potential
-    field: state + goal sharing, §6), each called with ``kw`` and named ``<sweep>[-pf]<suffix>``.
-    The potential field's rows get the navigator key (its sweep sets it)."""
-    rows = ok_rows(ctx.sweep(sweep, name=sweep + suffix, **kw))
-    pf = ok_rows(ctx.sweep(sweep + "-pf", name=sweep + "-pf" + suffix, **kw))
-    return rows + [{**r, "params": {**(r.get("params") or {}), NAV_KEY: "potential_field"}} for r in pf]
+def _rows(ctx, sweep: str, suffix: str, **kw: Any) -> list[dict]:
+    """Rows of ``sweep`` called with ``kw`` and named ``<sweep><suffix>``: every algorithm, as
+    the sweep's ``cases`` (the potential field with state + goal sharing, the others with goal
+    sharing, §6); each row's params carry its case's navigator key."""
+    return ok_rows(ctx.sweep(sweep, name=sweep + suffix, **kw))
+
+
+def _quick_set(team: dict[str, int] | None = None) -> dict[str, Any]:
+    return {**(team or {}), BUDGET_KEY: QUICK_BUDGET_STEPS_PER_TARGET}
 
 
 def run_tables(ctx, map_key: str) -> dict[int, list[dict]]:
@@ -181,9 +195,10 @@ def run_tables(ctx, map_key: str) -> dict[int, list[dict]]:
     for h in _teams(map_key, quick):
         kw: dict[str, Any] = {"set": _team_set(h)}
         if quick:
+            kw["set"] = _quick_set(_team_set(h))
             kw["grid"] = {TARGETS_KEY: _tasks(map_key, True)}
             kw["duration_s"] = _budget_s(map_key, True)
-        out[h] = _both(ctx, TABLE_SWEEP[map_key], f"-h{h}" + ("-quick" if quick else ""), **kw)
+        out[h] = _rows(ctx, TABLE_SWEEP[map_key], f"-h{h}" + ("-quick" if quick else ""), **kw)
     return out
 
 
@@ -191,10 +206,11 @@ def run_noise(ctx, map_key: str, all_helpers: list[dict]) -> list[dict]:
     """Rows of the noise sweeps; in quick mode only err_max = 0.4 runs, and the tables' R1..R4
     rows (the same configuration at err_max = 0) stand for err_max = 0."""
     if not ctx.quick:
-        return _both(ctx, NOISE_SWEEP[map_key], "")
-    kw = {"grid": {TARGETS_KEY: _tasks(map_key, True), ERR_KEY: [0.4]}, "duration_s": _budget_s(map_key, True)}
+        return _rows(ctx, NOISE_SWEEP[map_key], "")
+    kw = {"grid": {TARGETS_KEY: _tasks(map_key, True), ERR_KEY: [0.4]}, "duration_s": _budget_s(map_key, True),
+          "set": _quick_set()}
     zero = [{**r, "params": {**r["params"], ERR_KEY: 0.0}} for r in all_helpers]
-    return zero + _both(ctx, NOISE_SWEEP[map_key], "-quick", **kw)
+    return zero + _rows(ctx, NOISE_SWEEP[map_key], "-quick", **kw)
 
 
 # ---------------------------------------------------------------------------- blocks
@@ -255,6 +271,7 @@ def noise_plot(map_key: str, rows: list[dict], alone: dict[str, float]) -> tuple
         ys, lo, hi = [], [], []
         for e in xs:
             st = steps_of(per[e])
+            st = st[finished_of(per[e]) > 0.5]  # failures have no step count to average
             m = float(np.nanmean(st)) if st.size else float("nan")
             sd = float(np.nanstd(st, ddof=1)) if st.size > 1 else 0.0
             ys.append(m)
@@ -265,7 +282,7 @@ def noise_plot(map_key: str, rows: list[dict], alone: dict[str, float]) -> tuple
     hl = [(v, f"{NAV_LABEL[k]} alone") for k, v in alone.items() if np.isfinite(v)]
     fig = 16 if map_key == "simple" else 17
     return Plot(f"Fig. {fig} ({L.MAPS[map_key]}): R1's steps vs err_max, R2..R4 present", "err_max (eqs. 1-2)",
-                "motion steps of R1 per task (budget when not finished)", series, hlines=hl,
+                "motion steps of R1 per task (finished tasks)", series, hlines=hl,
                 caption="Horizontal lines: R1 alone (Tables 1-2, noise has no effect without teammates); "
                         "the potential field alone fails and has no line."), means
 
@@ -386,6 +403,44 @@ def traffic_block(rows_by_map: dict[str, list[dict]]) -> Table:
                  out, "Messages are sent only to teammates in line of sight; O(M) bytes per meeting (§4.4).")
 
 
+FRACTIONS = (("goal_seen", "goal in sight"), ("follow_teammate", "to a teammate"), ("ghost", "to a ghost"),
+             ("promised", "on a promise"), ("trouble_follow", "to a helper (in trouble)"))
+
+
+def _mean(xs: Sequence[float]) -> float:
+    a = np.asarray(xs, dtype=float)
+    a = a[np.isfinite(a)]
+    return float(a.mean()) if a.size else float("nan")
+
+
+def where_steps_go_block(tables: dict[str, dict[int, list[dict]]]) -> Table:
+    """Where R1's steps went with helpers (§3-§5): share of its steps per temporary-goal kind,
+    the rest being the navigator towards its unseen goal; and how often the temporary goal
+    changed per target (oscillation between temporary goals would show there)."""
+    out = []
+    for m, by_team in tables.items():
+        for h in sorted(by_team):
+            if h == 0:
+                continue
+            for nav in L.NAVIGATORS:
+                rs = group(by_team[h], NAV_KEY).get(nav, [])
+                if not rs:
+                    continue
+                fr = [_mean([_metric(r, f"los_frac_{k}") for r in rs]) for k, _ in FRACTIONS]
+                if not np.isfinite(fr).any():
+                    continue  # runs without these logs
+                rest = 1.0 - float(np.nansum(fr))
+                sw = _mean([_metric(r, "los_temp_switches") / max(_metric(r, "los_targets_reached"), 1.0)
+                            for r in rs])
+                out.append([L.MAPS[m], TEAM_LABEL[h], NAV_LABEL[nav], *(f"{100 * f:.0f} %" for f in fr),
+                            f"{100 * rest:.0f} %", f"{sw:.1f}"])
+    return Table("Where R1's steps go with helpers (share of its steps, mean over tasks)",
+                 ["map", "team", "algorithm", *(t for _, t in FRACTIONS), "navigator to goal", "switches / target"],
+                 out, "'to a teammate': heading for a teammate in sight that offers the shortest D (§3); 'to a ghost': "
+                      "for where a teammate promised it (§4); 'on a promise': for its goal from a ghost where the "
+                      "teammate saw the goal itself; 'switches': changes of temporary goal per target reached.")
+
+
 def build(ctx) -> list:
     from teamnav.control import registry
 
@@ -397,9 +452,11 @@ def build(ctx) -> list:
         f"R1 reaches {_n_targets(quick)} room-centre targets in sequence ({1 if quick else L.N_TASKS} task(s) per cell; "
         f"the paper: 5 tasks of 200) with a fixed step of {L.STEP_LENGTH_M} m, so steps measure path length. "
         f"Helpers R2..R4 patrol the corridors; every robot sees and talks only within {L.VISIBILITY_M:g} m in line of "
-        f"sight; frames are each robot's start pose. A task not finished within {L.BUDGET_STEPS_PER_TARGET} steps per "
-        "target (simple, complex) counts as failed. As in §6, state sharing is used with the potential field "
-        "only; the ablation shows what it does to the others.")]
+        f"sight; frames are each robot's start pose. A task counts as failed when a target is not reached within "
+        f"{QUICK_BUDGET_STEPS_PER_TARGET if quick else ' / '.join(map(str, L.BUDGET_STEPS_PER_TARGET.values()))} "
+        f"steps{'' if quick else ' (simple / complex map)'}: R1 then gives up and the run ends. As in §6, state "
+        "sharing is used with the potential field only; the ablation shows what it does to the others. "
+        + FULL_CPU_NOTE)]
     tables: dict[str, dict[int, list[dict]]] = {}
     comps: list[Comparison] = []
     alone: dict[str, dict[str, float]] = {}
@@ -428,6 +485,7 @@ def build(ctx) -> list:
         blocks.append(Missing("the ablation (reflected only / + ghosts / + state sharing)", "full mode only (teamnav report los-help)"))
     else:
         blocks.append(ablation_block(ok_rows(ctx.sweep("los-ablation"))))
+    blocks.append(where_steps_go_block(tables))
     blocks.append(traffic_block({m: tables[m].get(3, []) for m in maps}))
     if quick:
         note = "quick mode: one target per cell, not 5 tasks of 200; the verdict is indicative only"
