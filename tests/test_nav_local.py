@@ -369,3 +369,128 @@ def test_boundary_heading_keeps_the_wall_on_the_chosen_side(side, d, want_rad):
     pts = np.column_stack((np.linspace(-3, 3, 121), np.full(121, -d)))
     h = boundary_heading(np.zeros(2), pts, 0.5, side, 1.5)
     assert abs(math.remainder(h - want_rad, 2 * math.pi)) < 1e-9
+
+
+# ---------------------------------------------------------------------------- seen free, leave rule
+@settings(max_examples=60, deadline=None)
+@given(x=st.floats(-5, 5), y=st.floats(-5, 5), th=st.floats(-math.pi, math.pi), r=st.floats(0.5, 3.5),
+       bearing=st.floats(-math.pi, math.pi), frac=st.floats(0.05, 2.0))
+def test_seen_free_is_in_front_of_the_returns(x, y, th, r, bearing, frac):
+    """Inside a circular wall of radius r every point nearer than r is seen free, none beyond it."""
+    from teamnav.control.nav.local.base import seen_free
+    scan = RangeScan(np.full(N_BEAMS, r), ANGLES, RANGE_M)
+    d = frac * r
+    p = np.array([[x + d * math.cos(bearing), y + d * math.sin(bearing)]])
+    got = bool(seen_free(np.array([x, y, th]), scan, p)[0])
+    if frac < 0.999:
+        assert got
+    elif frac > 1.001:
+        assert not got
+
+
+def test_visbug_does_not_leave_for_a_run_hidden_behind_a_door_jamb():
+    """office_simple, R1 alone (los-help-simple task 4, first target; its robot: 0.2 m radius and
+    step, 72 beams of 8 m): following the corridor's south side, the robot sees the M-line slip
+    into room N2's door; the sensed points leave the run past the door free, but the jamb's far
+    face is hidden from it. It must not leave for that point (it did, hit the jamb at once and
+    walked the whole building again, lap after lap)."""
+    from teamnav.control.nav.local.base import scan_points
+    em = builtin_map("office_simple")
+    nav = make_navigator("visbug21", None, rng=np.random.default_rng(0), step_length_m=0.2, radius_m=0.2)
+    angles = np.linspace(-np.pi, np.pi, 72, endpoint=False)
+    caster = RayCaster(em.grid, max_range_m=8.0)
+    s, g = np.array([1.2, 7.03]), np.array([26.9, 11.1])
+    nav.set_goal(g)
+    nav.mline = (s, g)
+    nav.mode, nav.hit_xy = MODE_FOLLOW, np.array([10.8, 8.45])
+    nav.hit_dist_m = float(np.hypot(*(g - nav.hit_xy)))
+    nav._slack = math.pi / 72
+    r_safe = 0.2 + nav.params.safety_margin_m
+
+    def leave_from(xy):
+        pose = np.array([*xy, 0.0])
+        scan = RangeScan(caster.cast(pose[None], angles, parallel=False)[0], angles, 8.0)
+        return nav._leave_point(pose, scan, scan_points(pose, scan), r_safe + nav.params.leave_hysteresis_m,
+                                8.0 - r_safe)
+
+    assert leave_from((8.37, 6.13)) is None
+    # inside room N3 it sees the M-line cross the room: the same test is not simply always False
+    q = leave_from((13.0, 10.5))
+    assert q is not None and 14.0 < q[0] < 17.8 and 8.4 < q[1] < 10.0
+
+
+# ---------------------------------------------------------------------------- temporary goals
+def test_visbug_temporary_goal_keeps_and_resumes_the_task():
+    nav = nav_of("visbug21")
+    loop = Loop(u_trap(), nav, U_START, U_GOAL)
+    task = loop.to_own(np.array(U_GOAL))
+    while nav.mode != MODE_FOLLOW and loop.steps < 200:
+        loop.step()
+    for _ in range(5):
+        loop.step()
+    assert nav.mode == MODE_FOLLOW
+    hit, mline, d_hit, side = nav.hit_xy, nav.mline, nav.hit_dist_m, nav.side
+    nav.set_goal(loop.to_own(np.array([1.0, 1.0])), temporary=True)  # e.g. a teammate in sight
+    assert nav.temporary and nav.hit_xy is None and nav.mode == MODE_TO_GOAL
+    assert np.allclose(nav.suspended_goal_xy, task)
+    nav.set_goal(loop.to_own(np.array([1.5, 1.0])), temporary=True)  # the teammate moved: still suspended
+    assert np.allclose(nav.suspended_goal_xy, task)
+    for _ in range(25):
+        loop.step()
+    nav.set_goal(task)  # back on the task: M-line, H, d_H, mode and side as before
+    assert not nav.temporary and nav.suspended_goal_xy is None
+    assert nav.hit_xy is hit and nav.mline is mline and nav.hit_dist_m == d_hit
+    assert nav.mode == MODE_FOLLOW and nav.side == side
+    assert loop.run(1500) is not None and loop.stalls == 0
+
+
+def test_visbug_plain_goal_drops_the_suspended_task_and_default_restarts():
+    nav = nav_of("visbug21")
+    loop = Loop(u_trap(), nav, U_START, U_GOAL)
+    task = loop.to_own(np.array(U_GOAL))
+    while nav.mode != MODE_FOLLOW and loop.steps < 200:
+        loop.step()
+    nav.set_goal(loop.to_own(np.array([1.0, 1.0])), temporary=True)
+    nav.set_goal(loop.to_own(np.array([2.0, 1.0])))  # a plain new goal: the task is forgotten
+    assert nav.suspended_goal_xy is None and not nav.temporary
+    nav.set_goal(task)
+    assert nav.hit_xy is None and nav.mline is None and nav.mode == MODE_TO_GOAL
+
+
+def test_visbug_resumes_afresh_when_the_excursion_ended_closer_than_its_hit_point():
+    nav = nav_of("visbug21")
+    loop = Loop(u_trap(), nav, U_START, U_GOAL)
+    task = loop.to_own(np.array(U_GOAL))
+    while nav.mode != MODE_FOLLOW and loop.steps < 200:
+        loop.step()
+    d_hit = nav.hit_dist_m
+    nav.set_goal(loop.to_own(np.array([2.0, 9.0])), temporary=True)
+    nav.set_goal(task)
+    # the robot now stands (say) 1 m from T, closer than d_H - margin: Bug2 starts over here
+    here = task + np.array([0.0, -1.0])
+    assert 1.0 < d_hit - nav.params.leave_margin_m
+    h = nav.direction(np.array([*here, 0.0]), FREE_SCAN)
+    assert np.allclose(nav.mline[0], here) and nav.hit_xy is None and nav.mode == MODE_TO_GOAL
+    assert abs(math.remainder(h - math.pi / 2, 2 * math.pi)) < 1e-9
+
+
+def test_potential_field_trapped_in_the_u_escapes_with_a_temporary_goal():
+    """§5 rule 3 / §3 rule 5 on the potential field: trapped alone under the cup; a temporary
+    goal at a teammate seen out of the cup's mouth takes it out, and from there the field
+    (descended again, Fig. 9) brings it round the cup to its goal."""
+    nav = nav_of("potential_field")
+    loop = Loop(u_trap(), nav, U_START, U_GOAL)
+    assert loop.run(400) is None and not loop.progress[-1]  # trapped (as in the test above)
+    mate = np.array([1.5, 2.0])
+    nav.set_goal(loop.to_own(mate), temporary=True)
+    assert nav.temporary
+    for _ in range(300):
+        if np.hypot(*(loop.pose[:2] - mate)) < 0.5:
+            break
+        loop.step()
+    assert np.hypot(*(loop.pose[:2] - mate)) < 0.5
+    nav.set_goal(loop.to_own(np.array(U_GOAL)))
+    assert not nav.temporary
+    steps = loop.run(loop.steps + 400)
+    assert steps is not None and loop.stalls == 0
+    assert min(p[0] for p in loop.path[-100:]) < 3.5  # it went round the cup's west side

@@ -31,7 +31,7 @@ from teamnav.geometry import wrap_angle
 
 __all__ = [
     "GOAL_SAME_TOL_M", "LocalNavigator", "ProgressMonitor", "check_goal", "check_pose", "check_scan",
-    "safe_heading", "scan_points", "segment_clearance",
+    "safe_heading", "scan_points", "seen_free", "segment_clearance",
 ]
 
 #: Two goals closer than this [m] are "the same goal" for :meth:`LocalNavigator.set_goal`.
@@ -48,16 +48,26 @@ class LocalNavigator(Protocol):
     ----------
     name : str
         Registry key (``"potential_field"``, ``"avoid_past"``, ``"visbug21"``).
+    temporary : bool
+        Whether the current goal was set with ``temporary=True``.
     """
 
     name: str
+    temporary: bool
 
-    def set_goal(self, goal_xy: np.ndarray) -> None:
+    def set_goal(self, goal_xy: np.ndarray, temporary: bool = False) -> None:
         """Set the current goal ``G_icurr`` (x, y) [m] in the robot's own odometry frame.
 
         Setting the same goal again (within ``GOAL_SAME_TOL_M``) changes nothing; a different
         goal restarts goal-specific memory (progress estimate, VisBug's M-line and hit point),
         not Avoid-Past's memory of visited places.
+
+        ``temporary=True`` marks an excursion (Sgorbissa & Arkin §3 rule 5 and §4.2: head to a
+        teammate or a ghost; §5 rule 3: "R_j temporarily becomes R_i goal"): the task goal's
+        memory is suspended, not dropped, and setting the task goal again (non-temporary)
+        resumes it. Only VisBug-21 has such memory (M-line, hit point); the potential fields
+        restart their progress estimate on every change either way. The default (False) is
+        the old behaviour.
         """
 
     def direction(self, pose: np.ndarray, scan: RangeScan) -> float | None:
@@ -161,6 +171,54 @@ def segment_clearance(points: np.ndarray, start_xy: np.ndarray, ends_xy: np.ndar
     if slack_m is not None:
         dist = dist - np.asarray(slack_m, dtype=np.float64)[:, None]
     return dist.min(axis=0)
+
+
+def seen_free(pose: np.ndarray, scan: RangeScan, points_xy: np.ndarray) -> np.ndarray:
+    """Which points (own frame) the scan *saw* to be free: in range and not behind a return.
+
+    A point at distance ``d`` and bearing ``b`` from the robot is seen free when ``d`` is within
+    the scan's maximum range and the beam nearest ``b`` and both its neighbours read more than
+    ``d`` (a wall face the beams hit hides everything behind it; the neighbours guard against a
+    corner between two beams). A range sensor tells nothing about the far side of what it hits:
+    this is the test for "the robot knows this place is free", as opposed to "no sensed point
+    is near it" (:func:`segment_clearance`), which is true of the inside of an unseen wall.
+
+    Parameters
+    ----------
+    pose : ndarray of shape (3,)
+    scan : RangeScan
+    points_xy : ndarray of shape (M, 2)
+
+    Returns
+    -------
+    ndarray of shape (M,), bool
+
+    Examples
+    --------
+    >>> a = np.linspace(-np.pi, np.pi, 8, endpoint=False)
+    >>> s = RangeScan(np.where(np.abs(a) < 1e-9, 1.0, 4.0), a, 4.0)     # a return 1 m ahead
+    >>> seen_free(np.zeros(3), s, np.array([[0.5, 0.0], [2.0, 0.0], [0.0, 2.0], [0.0, 4.5]])).tolist()
+    [True, False, True, False]
+    """
+    pts = np.atleast_2d(np.asarray(points_xy, dtype=np.float64))
+    r = np.asarray(scan.ranges_m, dtype=np.float64)
+    a = np.asarray(scan.angles_rad, dtype=np.float64)
+    if pts.shape[0] == 0 or r.size == 0:
+        return np.zeros(pts.shape[0], dtype=bool)
+    order = np.argsort(np.mod(a, 2.0 * math.pi), kind="stable")
+    r, a = r[order], np.mod(a[order], 2.0 * math.pi)
+    dx, dy = pts[:, 0] - pose[0], pts[:, 1] - pose[1]
+    d = np.hypot(dx, dy)
+    b = np.mod(np.arctan2(dy, dx) - pose[2], 2.0 * math.pi)
+    # nearest beam in angle (circular)
+    k = np.searchsorted(a, b) % r.size
+    km = (k - 1) % r.size
+    dk = np.abs(np.mod(a[k] - b + math.pi, 2.0 * math.pi) - math.pi)
+    dkm = np.abs(np.mod(a[km] - b + math.pi, 2.0 * math.pi) - math.pi)
+    i = np.where(dk <= dkm, k, km)
+    n = r.size
+    least = np.minimum(np.minimum(r[i], r[(i - 1) % n]), r[(i + 1) % n])
+    return (d <= float(scan.max_range_m)) & (least > d)
 
 
 def safe_heading(heading_rad: float, xy: np.ndarray, points: np.ndarray, step_length_m: float,

@@ -161,12 +161,20 @@ class PotentialField:
         self.step_length_m = float(step_length_m)
         self.radius_m = float(radius_m)
         self.goal_xy: np.ndarray | None = None
+        self.temporary = False
         self._monitor = ProgressMonitor(params.progress_window_steps, params.progress_fraction, self.step_length_m)
 
     # ------------------------------------------------------------------ protocol
-    def set_goal(self, goal_xy: np.ndarray) -> None:
-        """Set the goal (own frame); a different goal restarts the progress estimate."""
+    def set_goal(self, goal_xy: np.ndarray, temporary: bool = False) -> None:
+        """Set the goal (own frame); a different goal restarts the progress estimate.
+
+        ``temporary`` is recorded (:attr:`temporary`) and otherwise changes nothing: the field
+        has no memory of a goal to keep across an excursion (Sgorbissa & Arkin Fig. 9: back on
+        its own goal the robot simply descends the field again from where it stands).
+        Avoid-Past's memory of visited places belongs to the robot and is kept either way.
+        """
         g = check_goal(goal_xy)
+        self.temporary = bool(temporary)
         if self.goal_xy is not None and math.hypot(*(g - self.goal_xy)) <= GOAL_SAME_TOL_M:
             return
         self.goal_xy = g

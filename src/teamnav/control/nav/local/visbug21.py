@@ -36,7 +36,13 @@ Step 2 (``MODE_FOLLOW``, "follow the boundary in the local direction")
     - the M-line runs on free from Q (corridor half-width R) for ``leave_run_m`` or up to
       T (Bug2: "the robot can move towards T from Q"; we ask for a finite run: otherwise an
       M-line slipping into a door at an angle the robot cannot pass makes it leave, hit a
-      few centimetres further on, and walk the whole boundary again, lap after lap).
+      few centimetres further on, and walk the whole boundary again, lap after lap);
+    - that run was *seen* free (:func:`~teamnav.control.nav.local.base.seen_free`: points
+      along it and ``RUN_SEEN_FRACTION · R`` to its sides lie in front of their beams'
+      returns). No sensed point near the run is not enough: from the corridor a robot sees
+      the near face of a door jamb, never its far side, and took an M-line point just
+      inside a door as a leave point, hit the jamb's hidden face at once and walked the
+      whole building again, lap after lap (R1 alone on ``office_simple``, task 4).
 
     It takes the such Q nearest to T (VisBug-21's shortcut: with range sensing the robot
     leaves for a visible M-line point instead of walking the boundary to it) and drives to
@@ -57,8 +63,23 @@ strictly closer to T than its hit point, as in Bug2.
 
 A new goal (:meth:`set_goal` with a goal more than 1 µm away from the current one) restarts
 the algorithm: the M-line runs from wherever the robot is at the next :meth:`direction`
-call (Sgorbissa & Arkin §3: a robot heading for a teammate resets its goal often; each time
-VisBug starts over).
+call (Sgorbissa & Arkin §3: a robot heading for a teammate resets its goal often; set as a
+plain goal, each time VisBug starts over: see temporary goals below).
+
+Temporary goals (``set_goal(g, temporary=True)``): Sgorbissa & Arkin send R1 to a teammate
+or a ghost (§3 rule 5, §4.2) or to a helper (§5 rule 3, "R_j temporarily becomes R_i goal")
+and back to its own goal; Fig. 9 says what happens back on it: R1 resumes algorithm A from
+where the excursion left it ("once R1 has reached R2(t3), it is not in a better position for
+finding a path to its goal, and gets trapped again"). The paper does not say whether A's
+memory survives. We keep it: a temporary goal suspends the task's M-line, hit point H,
+``d_H``, mode and lap count, runs a fresh VisBug to the temporary goal, and the task goal
+set again resumes them (Bug2's progress memory is what makes it complete; restarting it at
+every excursion made helpers *lengthen* R1's tasks). Back on the task the robot goes on
+with the M-line and H of before, except when the excursion ended closer to T than
+``d_H − leave_margin_m``: that point is as good as a leave point, and Bug2 starts over from
+there (a new M-line; the distances at which it restarts fall each time, so Bug2's
+progress argument still holds). A plain ``set_goal(g)`` with another goal drops the
+suspended task (the old behaviour).
 
 ``progressing`` (§5): in Step 1, the distance to T beats its best-so-far for this goal
 within ``progress_window_steps`` steps (as for the potential field); in Step 2, the walk
@@ -83,6 +104,7 @@ from teamnav.control.nav.local.base import (
     check_scan,
     safe_heading,
     scan_points,
+    seen_free,
     segment_clearance,
 )
 from teamnav.control.types import RangeScan
@@ -94,6 +116,8 @@ MODE_FOLLOW = 1
 MODE_UNREACHABLE = 2
 #: Two neighbouring beams' points closer than this [m] (or 2.5 beam gaps) lie on one obstacle.
 FOLLOW_GAP_M: float = 0.3
+#: The leave test's run must be seen free this fraction of its half-width to either side.
+RUN_SEEN_FRACTION: float = 0.8
 
 
 class VisBugParams(BaseModel):
@@ -205,6 +229,8 @@ class VisBug21:
         +1: the followed obstacle is kept on the right (turn left at a hit), -1: on the left.
     mline : tuple of ndarray or None
         (S, T) of the current M-line, own frame.
+    temporary : bool
+        The current goal was set with ``temporary=True`` (a task goal is suspended).
     hit_xy : ndarray or None
         The current hit point H.
 
@@ -228,6 +254,8 @@ class VisBug21:
         self.radius_m = float(radius_m)
         self.goal_xy: np.ndarray | None = None
         self.side = 1 if params.turn == "left" else -1
+        self.temporary = False
+        self._suspended: dict | None = None
         self._monitor = ProgressMonitor(params.progress_window_steps, params.progress_fraction, self.step_length_m)
         self._restart()
 
@@ -240,23 +268,68 @@ class VisBug21:
         self._walked_m = 0.0
         self._left_hit = False
         self._returns = 0
-        self._follow_ref = None
         self._last_xy: np.ndarray | None = None
         self._leave_target: np.ndarray | None = None
         self._leave_steps = 0
         self._follow_ref: np.ndarray | None = None
+        self._resumed = False
         self._monitor.reset()
 
+    # the task's Bug2 memory, kept across a temporary goal
+    _TASK_STATE = ("goal_xy", "side", "mode", "mline", "hit_xy", "hit_dist_m", "_t_anchor", "_walked_m",
+                   "_left_hit", "_returns")
+
     # ------------------------------------------------------------------ protocol
-    def set_goal(self, goal_xy: np.ndarray) -> None:
-        """Set the goal (own frame); a different goal restarts VisBug (new M-line, no hit point)."""
+    def set_goal(self, goal_xy: np.ndarray, temporary: bool = False) -> None:
+        """Set the goal (own frame); a different goal restarts VisBug (new M-line, no hit point).
+
+        ``temporary=True`` (a teammate, a ghost, a helper in §5: "R_j temporarily becomes R_i
+        goal") suspends the current task goal with its M-line, hit point H, ``d_H`` and mode,
+        and drives to the temporary goal with a fresh VisBug. Setting the suspended task goal
+        again (``temporary=False``, the same point within ``GOAL_SAME_TOL_M``) resumes it (see
+        the module docstring, "Temporary goals"); any other non-temporary goal drops it.
+        """
         g = check_goal(goal_xy)
-        if self.goal_xy is not None and math.hypot(*(g - self.goal_xy)) <= GOAL_SAME_TOL_M:
+        same = self.goal_xy is not None and math.hypot(*(g - self.goal_xy)) <= GOAL_SAME_TOL_M
+        if temporary:
+            if same and self.temporary:
+                return
+            if self._suspended is None and self.goal_xy is not None and not self.temporary:
+                self._suspended = {k: getattr(self, k) for k in self._TASK_STATE}
+            self.temporary = True
+            self.goal_xy = g
+            self._restart()
+            return
+        if same and not self.temporary:
+            return
+        task = self._suspended
+        self._suspended = None
+        self.temporary = False
+        if task is not None and math.hypot(*(g - task["goal_xy"])) <= GOAL_SAME_TOL_M:
+            self._restart()
+            for k, v in task.items():
+                setattr(self, k, v)
+            self._resumed = True
             return
         self.goal_xy = g
         self._restart()
         if self.params.turn == "random":
             self.side = 1 if self.rng.random() < 0.5 else -1
+
+    @property
+    def suspended_goal_xy(self) -> np.ndarray | None:
+        """The task goal suspended by the current temporary goal (own frame), or None."""
+        return None if self._suspended is None else self._suspended["goal_xy"]
+
+    def _resume(self, xy: np.ndarray) -> None:
+        """First step back on the task goal after a temporary one (module docstring)."""
+        self._resumed = False
+        if self.hit_xy is not None and math.hypot(*(self.goal_xy - xy)) < self.hit_dist_m - self.params.leave_margin_m:
+            # the excursion ended closer to T than every hit point: as good as a leave point,
+            # Bug2 starts over from here (its progress argument holds: d falls at each restart)
+            self._restart()
+        # else: M-line, H, d_H and the mode are those of before the excursion; the followed
+        # obstacle is picked afresh (nearest) and the excursion's path is not boundary walk
 
     def direction(self, pose: np.ndarray, scan: RangeScan) -> float | None:
         """Heading of the next step (Step 1 or Step 2 above); None without a goal or once unreachable."""
@@ -266,6 +339,8 @@ class VisBug21:
             return None
         xy = pose[:2]
         goal = self.goal_xy
+        if self._resumed:
+            self._resume(xy)
         if self.mline is None:
             self.mline = (xy.copy(), goal.copy())
         if self._last_xy is not None and self.mode == MODE_FOLLOW:
@@ -280,7 +355,7 @@ class VisBug21:
 
         heading: float | None = None
         if self.mode == MODE_FOLLOW:
-            ti = self._leave_point(xy, points, r_safe + p.leave_hysteresis_m, reach_m)
+            ti = self._leave_point(pose, scan, points, r_safe + p.leave_hysteresis_m, reach_m)
             if ti is not None:
                 self.mode = MODE_TO_GOAL
                 self._monitor.reset()
@@ -413,8 +488,9 @@ class VisBug21:
             return ti
         return None
 
-    def _leave_point(self, xy, points, r_safe, reach_m) -> np.ndarray | None:
+    def _leave_point(self, pose, scan, points, r_safe, reach_m) -> np.ndarray | None:
         """Step 2's leave test: a visible M-line point closer to the goal than H by the margin."""
+        xy = pose[:2]
         cand, t = self._mline_samples(0.0)
         closer = np.hypot(cand[:, 0] - self.goal_xy[0], cand[:, 1] - self.goal_xy[1]) < self.hit_dist_m - self.params.leave_margin_m
         if not closer.any():
@@ -423,13 +499,22 @@ class VisBug21:
         ok = self._visible(xy, points, cand, r_safe, reach_m)
         # Bug2: from Q the robot must be able to move on towards T (or Q is T)
         idx = np.flatnonzero(ok & (t < 1.0 - 1e-12))
-        if idx.size and points.shape[0]:
+        if idx.size:
             s, g = self.mline
             u = (g - s) / max(math.hypot(*(g - s)), 1e-12)
             run = np.minimum(self.params.leave_run_m, np.hypot(g[0] - cand[idx, 0], g[1] - cand[idx, 1]))
             ahead = cand[idx] + run[:, None] * u
-            slack = self._slack * np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1])
-            ok[idx] = segment_clearance(points, cand[idx], ahead, slack) >= r_safe - self.params.leave_hysteresis_m
+            if points.shape[0]:
+                slack = self._slack * np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1])
+                ok[idx] = segment_clearance(points, cand[idx], ahead, slack) >= r_safe - self.params.leave_hysteresis_m
+            # ... and the robot must have *seen* that run free, not merely sensed nothing near
+            # it: from afar it sees the near face of a wall, never its far side (a door jamb's
+            # thickness), and a run grazing an unseen face made it leave, hit at once, and walk
+            # the whole boundary again, lap after lap (office_simple, R1 alone, task 4)
+            keep = ok[idx]
+            if keep.any():
+                ok[idx[keep]] = self._run_seen(pose, scan, cand[idx[keep]], run[keep], u,
+                                               r_safe - self.params.leave_hysteresis_m)
         if not ok.any():
             return None
         j = int(np.flatnonzero(ok)[-1])
@@ -438,3 +523,19 @@ class VisBug21:
             return None
         self._t_anchor = float(t[j])
         return cand[j]
+
+    def _run_seen(self, pose, scan, starts: np.ndarray, runs_m: np.ndarray, u: np.ndarray,
+                  half_width_m: float) -> np.ndarray:
+        """Whether each run ``starts[k] -> starts[k] + runs_m[k]·u`` was seen free by the scan.
+
+        Seen free (:func:`~teamnav.control.nav.local.base.seen_free`): points along the run
+        every ``mline_sample_m``, each with two points ``RUN_SEEN_FRACTION · half_width_m`` to
+        its sides, all in front of the returns of their beams.
+        """
+        n = max(1, int(math.ceil(self.params.leave_run_m / self.params.mline_sample_m)))
+        f = np.linspace(0.0, 1.0, n + 1)
+        normal = np.array([-u[1], u[0]]) * (RUN_SEEN_FRACTION * half_width_m)
+        centres = starts[:, None, :] + (runs_m[:, None] * f[None, :])[:, :, None] * u  # (K, n+1, 2)
+        probe = np.concatenate((centres, centres + normal, centres - normal), axis=1)  # (K, 3(n+1), 2)
+        seen = seen_free(pose, scan, probe.reshape(-1, 2)).reshape(probe.shape[:2])
+        return seen.all(axis=1)
