@@ -17,7 +17,7 @@ from teamnav.control import registry as controllers
 from teamnav.control.nav.route_follow import pursuit_point
 from teamnav.experiments.metric_sets import trails as M
 from teamnav.experiments.metrics import RunData
-from teamnav.experiments.report.model import Comparison, Missing, Plot, Table
+from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, Table
 from teamnav.experiments.runner import run
 from teamnav.experiments.spec import load_scenario
 from teamnav.world.grid import OccupancyGrid
@@ -101,6 +101,84 @@ def test_distance_per_robot_is_the_true_path():
     assert m["distance_m.robot0"] == pytest.approx(5.0) and m["distance_m.robot1"] == pytest.approx(1.0)
 
 
+def test_efficiency_and_table1_on_the_papers_own_numbers():
+    # Try §3.6 / Table 1: trips 36, 59, 78, 86 over lifetimes 81.3, 138.1, 176.6, 188.4 min;
+    # "average time between Places was (9h43m40s / 262) = 2m13s ... 0.23 m/s" (31 m; ours 31.5 m)
+    table = [(36, 81.3), (59, 138.1), (78, 176.6), (86, 188.4)]
+    log = []
+    for r, (n, life_min) in enumerate(table):
+        for k in range(1, n + 1):
+            log.append(_ev(life_min * 60.0 * k / n, r, "source" if k % 2 else "home"))
+    m = M.trail_metrics(_data(log, n_robots=4, duration_s=11400.0))
+    # (Table 1's own columns sum to 259 trips and 584.4 min; its Total row says 262 and 583.6)
+    assert [m[f"trips.robot{r}"] for r in range(4)] == [36, 59, 78, 86] and m["trips_total"] == 259
+    assert [m[f"lifetime_min.robot{r}"] for r in range(4)] == pytest.approx([81.3, 138.1, 176.6, 188.4])
+    assert m["lifetime_min_total"] == pytest.approx(584.4)
+    assert m["place_interval_s"] == pytest.approx(584.4 * 60 / 259)  # 2 m 15 s (the paper's totals: 2 m 13 s)
+    assert m["place_speed_mps"] == pytest.approx(31.5 / (584.4 * 60 / 259))
+    assert m["place_speed_mps"] / 0.25 == pytest.approx(0.93, abs=0.01)  # the paper: 0.23 m/s of 0.25, 92 %
+    # a unit is a source-then-home round trip: 18 + 29 + 39 + 43
+    assert m["units_total"] == 18 + 29 + 39 + 43
+
+
+def test_three_times_one_optimal_robot_is_a_units_ratio_in_the_same_time():
+    # Blazing §5.1: 28 units in 30 min; one robot on a ~3 min round trip delivers 10
+    solo = [e for k in range(10) for e in (_ev(180 * k + 90, 0, "source"), _ev(180 * k + 180, 0, "home"))]
+    team = [e for r in range(4) for k in range(7)
+            for e in (_ev(250 * k + 100 + r, r, "source"), _ev(250 * k + 200 + r, r, "home"))]
+    m1 = M.trail_metrics(_data(solo, n_robots=1, duration_s=1800.0))
+    m4 = M.trail_metrics(_data(team, n_robots=4, duration_s=1800.0))
+    assert (m1["units_total"], m4["units_total"]) == (10, 28)
+    assert m4["units_total"] / m1["units_total"] == pytest.approx(2.8)
+    assert m1["trip_time_s_after_median"] == pytest.approx(90.0)
+
+
+def test_units_over_time_and_breakdown_like_blazing_fig5():
+    # units every 60 s until 27 min, nothing after: Fig. 5's curve levels out at ~27 min
+    log = [e for k in range(27) for e in (_ev(60 * k + 30, k % 4, "source"), _ev(60 * k + 60, k % 4, "home"))]
+    m = M.trail_metrics(_data(log, n_robots=4, duration_s=1800.0))
+    s = M.trail_series(_data(log, n_robots=4, duration_s=1800.0))
+    assert m["breakdown_s"] == pytest.approx(27 * 60) and m["breakdown_censored"] == 0
+    assert json.loads(s["units_per_10min_series"]) == [9, 10, 8]
+    assert json.loads(s["units_series"])[-1] == [1620.0, 27]
+    assert m["units_per_10min_peak"] == 10 and m["units_per_10min_last"] == 8
+
+
+def _crumb_run(theta, shift, n=400, t_source=100.0):
+    """One robot shuttling home (0, 0) -> source (20, 0) and back along y = 0, 1 s samples; its odometry
+    frame is the world rotated by ``theta`` and shifted by ``shift`` (a drifted frame)."""
+    t = np.arange(n, dtype=float)
+    x = 20.0 * (1.0 - np.abs(((t - t_source) / t_source) % 2.0 - 1.0))  # 0 at 0, 20 at t_source, 0 at 2 t_source
+    true = np.zeros((n, 1, 3))
+    true[:, 0, 0] = x
+    c, s_ = math.cos(theta), math.sin(theta)
+    odom = np.zeros_like(true)
+    odom[:, 0, 0] = c * x + shift[0]
+    odom[:, 0, 1] = s_ * x + shift[1]
+    log = [_ev(float(k * t_source), 0, "source" if k % 2 else "home") for k in range(1, int(n // t_source))]
+    grid = OccupancyGrid(np.zeros((4, 4), dtype=np.uint8), 1.0)
+    return RunData(t_s=t, true_pose=true, odom_pose=odom, stalled=np.zeros((n, 1), bool), radius_m=np.full(1, 0.25),
+                   grid=grid, n_steps=n * 10, dt_s=0.1, event_log=log), x
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.floats(-math.pi, math.pi), st.floats(-5, 5), st.floats(-5, 5))
+def test_crumbs_in_the_fixed_frame_of_the_places_undo_any_drifted_frame(theta, dx, dy):
+    data, x = _crumb_run(theta, (dx, dy))
+    out = M.trail_crumbs(data)
+    own = np.asarray(json.loads(out["crumbs_own_series"])["0"])
+    glob = np.asarray(json.loads(out["crumbs_global_series"])["0"])
+    k = np.arange(0, x.size, int(M.CRUMB_EVERY_S))
+    assert own == pytest.approx(np.round(data.odom_pose[k, 0, :2], 2), abs=1e-9)
+    # before the first source event (t < 100 s) the robot has one Place: crumbs as they are
+    early = data.t_s[k] < 100.0
+    assert glob[early] == pytest.approx(own[early], abs=1e-9)
+    # home at (0, 0) is the start pose in the own frame only when the shift is 0; after the source
+    # event at 100 s and the home event at 200 s, both Places are known: crumbs back on the corridor
+    late = data.t_s[k] >= 200.0
+    assert glob[late] == pytest.approx(np.stack([x[k][late], np.zeros(late.sum())], axis=1), abs=0.02)
+
+
 # ---------------------------------------------------------------------------- route-follow-v1
 @settings(max_examples=50, deadline=None)
 @given(st.floats(0.0, 20.0), st.floats(-1.0, 1.0), st.floats(0.1, 3.0))
@@ -144,6 +222,29 @@ def test_trail_scenario_validates_and_runs_5_s(name):
     assert "units_total" in res.metrics  # the trails metric set recognised the run
 
 
+# ---------------------------------------------------------------------------- drift sweeps
+def test_drift_sweeps_give_each_robot_its_own_drift_the_same_for_both_algorithms():
+    from teamnav.experiments.report.sections import _trails as T
+    from teamnav.experiments.sweep import expand, load_sweep
+
+    scenes = {}
+    for name, brain in (("blazing-drift", "blazing-trail-v1"), ("try-drift", "trail-share-v1")):
+        spec = T.drift_spec(name, [1.0, 2.0])
+        assert [c["case"] for c in spec.cases] == ["x1", "x2"]
+        trial = next(t for t in expand(spec.model_copy(update={"seeds": 1})) if t.params["case"] == "x2")
+        overrides = {k: v for k, v in trial.params.items() if k not in ("case", "duration_s")}
+        scn = load_scenario(spec.scenario, overrides=overrides, seed=0, duration_s=1.0)
+        scenes[name] = scn
+        assert [g.controller for g in scn.robots] == [brain] * 4
+        # Try §3.6 x 2: Bug clockwise, the others anticlockwise, Tanis slowest, Fly fastest
+        assert [g.odometry.heading_drift_deg_per_min for g in scn.robots] == pytest.approx(
+            [2 * v for v in T.DRIFT_PATTERN.values()])
+        assert load_sweep(name).n_trials == 4 * 10  # k = 0, 0.5, 1, 2 x 10 seeds
+    with pytest.raises(ValueError, match="no drift case for scale"):
+        T.drift_spec("try-drift", [3.0])
+    assert T.drift_scale({"params": {"case": "x0.5"}}) == 0.5 and T.drift_scale({"params": {}}) is None
+
+
 # ---------------------------------------------------------------------------- report sections
 class _FakeResult:
     def __init__(self, rows):
@@ -160,9 +261,11 @@ def _row(units, after, drift=None, extra=None, series=None):
          "distance_m_total": 63.0 * units, "place_speed_mps": 0.37, "crumbs_max_first_half": 100.0,
          "crumbs_max_second_half": 105.0,
          "units_series": json.dumps([[0, 0]] + [[60.0 * (k + 1), k + 1] for k in range(units)]),
-         "units_per_10min_series": json.dumps([units / 3] * 3)}
-    if drift is not None:
-        r["params"] = {"robots.0.odometry.heading_drift_deg_per_min": drift}
+         "units_per_10min_series": json.dumps([units / 3] * 3),
+         "crumbs_own_series": json.dumps({"0": [[2.0, 4.9], [10.0, 5.0]], "1": [[3.0, 4.8]]}),
+         "crumbs_global_series": json.dumps({"0": [[2.0, 4.9], [10.0, 4.9]], "1": [[3.0, 4.9]]})}
+    if drift is not None:  # a drift sweep's case: k x the 2002 paper's per-robot drift
+        r["params"] = {"case": f"x{drift:g}", "robots.2.odometry.heading_drift_deg_per_min": 2.0 * drift}
     r.update(extra or {})
     return r
 
@@ -179,6 +282,7 @@ class _FakeCtx:
 
     def sweep(self, name, **kw):
         key = name if isinstance(name, str) else name.name
+        _FakeCtx.last = self
         self.calls.append((key, kw))
         return _FakeResult(self.table(key, kw))
 
@@ -192,8 +296,8 @@ def test_blazing_section_verdicts_follow_the_data():
             return [_row(3, 80.0)]
         if key == "blazing-drift":
             return [_row(9, 90.0, 0.0), _row(8, 95.0, 0.0),
-                    _row(2, 200.0, 4.0, {"breakdown_s": 500.0, "breakdown_censored": 0, "units_per_10min_last": 0}),
-                    _row(1, 220.0, 4.0, {"breakdown_s": 400.0, "breakdown_censored": 0, "units_per_10min_last": 0})]
+                    _row(2, 200.0, 2.0, {"breakdown_s": 500.0, "breakdown_censored": 0, "units_per_10min_last": 0}),
+                    _row(1, 220.0, 2.0, {"breakdown_s": 400.0, "breakdown_censored": 0, "units_per_10min_last": 0})]
         if key == "trail-communication":
             return [_row(2, 150.0, extra={"params": {"robots.0.params.communicate": False}})]
         return [_row(9, 100.0), _row(10, 90.0)]
@@ -206,6 +310,11 @@ def test_blazing_section_verdicts_follow_the_data():
     assert verdicts == [True, True, True]
     assert any(isinstance(b, Table) for b in blocks) and any(isinstance(b, Plot) for b in blocks)
     assert not any(isinstance(b, Missing) for b in blocks)
+    views = [b for b in blocks if isinstance(b, MapView)]  # Fig. 6 (own frames) and the fixed frame
+    assert len(views) == 2 and [len(v.points) for v in views] == [2, 2]
+    # the drift sweep asked for: every case of blazing-drift (per-robot drift), 10 seeds, 1 h
+    (drift_call,) = [kw for key, kw in _FakeCtx.last.calls if key == "blazing-drift"]
+    assert drift_call == {"seeds": 10, "duration_s": 3600.0}
 
 
 @pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
@@ -216,8 +325,8 @@ def test_try_section_says_it_does_not_hold_when_the_2002_team_breaks_down():
 
     def table(key, kw):
         if key in ("try-paper", "try-drift"):
-            return [_row(2, 100.0, d, broke) for d in (0.0, 4.0)]
-        return [_row(9, 100.0, d) for d in (0.0, 4.0)]
+            return [_row(2, 100.0, d, broke) for d in (0.0, 2.0)]
+        return [_row(9, 100.0, d) for d in (0.0, 2.0)]
 
     blocks = SECTION.build(_FakeCtx(table))
     comps = [b for b in blocks if isinstance(b, Comparison)]

@@ -37,6 +37,16 @@ Definitions (each with the paper passage it stands for):
   the efficiency (the report does; the metric does not know the brain's speed).
 - **memory**: ``n_crumbs`` from the brains' logs: max and last value over robots, and the max
   in the first and the second half of the run (flat memory: the second is not above the first).
+- **crumbs for the figures** (``trails_crumbs``, opt-in: sweeps list it in ``metrics``): every
+  :data:`CRUMB_EVERY_S` seconds each robot's odometry position, i.e. the crumb it drops there, in
+  its own frame (Try Fig. 3, Blazing Fig. 6: "the trails announced by each robot"), and the same
+  crumbs in a fixed global frame where Places A and B are held at fixed points (Try Fig. 4): each
+  crumb is mapped by the similarity that takes the robot's Place estimates *at that time* (its
+  odometry position at its last home / source event; home starts at its start pose, §3.5 "on
+  start-up each robot is told it is at Home") onto the mean true positions of all robots' events
+  at home and at the source (our stand-in for the paper's fixed points, within the 1 m event
+  discs). Before a robot's first source event it has one Place only and its crumbs are used as
+  they are (the optimistic policy, §3.5).
 """
 
 from __future__ import annotations
@@ -51,11 +61,13 @@ from teamnav.experiments.metrics import RunData, register
 
 __all__ = [
     "BREAKDOWN_GAP_S",
+    "CRUMB_EVERY_S",
     "HOME_EVENT",
     "ROUTE_LENGTH_M",
     "SOURCE_EVENT",
     "WINDOW_S",
     "deliveries",
+    "trail_crumbs",
     "trail_metrics",
     "trail_series",
     "trips",
@@ -65,6 +77,9 @@ HOME_EVENT = "given_resource"
 SOURCE_EVENT = "took_resource"
 #: no delivery for this long before the run ends = broken down [s] (≈ one optimal round trip)
 BREAKDOWN_GAP_S = 180.0
+#: one crumb per robot this often in the figure series [s] (the 2002 robots broadcast every 2 s;
+#: one in five keeps a 3-hour run's series small)
+CRUMB_EVERY_S = 10.0
 #: throughput window [s] (10 minutes)
 WINDOW_S = 600.0
 #: driven route length between pairs of places [m] (trail_office; see module docstring)
@@ -240,8 +255,66 @@ def trail_series(data: RunData) -> dict[str, str]:
     }
 
 
+def _place_track(data: RunData, robot: int, event: str, t_s: np.ndarray) -> np.ndarray:
+    """(len(t_s), 2) the robot's own-frame estimate of the place of ``event`` at each time (NaN before
+    its first such event): its odometry position at the latest such event (nearest sample)."""
+    out = np.full((t_s.size, 2), np.nan)
+    evs = sorted(float(e["t_s"]) for e in data.event_log if e.get("event") == event and int(e["robot"]) == robot)
+    if not evs:
+        return out
+    k = np.clip(np.searchsorted(data.t_s, evs), 0, data.t_s.size - 1)
+    at = data.odom_pose[k, robot, :2]
+    idx = np.searchsorted(np.asarray(evs), t_s, side="right") - 1
+    ok = idx >= 0
+    out[ok] = at[idx[ok]]
+    return out
+
+
+def trail_crumbs(data: RunData) -> dict[str, str]:
+    """Crumbs for the papers' trail figures (module docstring), as JSON strings.
+
+    ``crumbs_own_series``: ``{robot: [[x_m, y_m], ...]}`` in each robot's own odometry frame;
+    ``crumbs_global_series``: the same crumbs in the fixed global frame of the places.
+    """
+    if not _is_trail_run(data) or data.t_s.size == 0:
+        return {}
+    step = max(1, int(round(CRUMB_EVERY_S / max(float(np.median(np.diff(data.t_s))) if data.t_s.size > 1 else 1.0, 1e-9))))
+    k = np.arange(0, data.t_s.size, step)
+    t = data.t_s[k]
+
+    def fixed(event: str) -> np.ndarray | None:
+        at = [data.true_pose[min(int(np.searchsorted(data.t_s, e["t_s"])), data.t_s.size - 1), int(e["robot"]), :2]
+              for e in data.event_log if e.get("event") == event]
+        return np.mean(at, axis=0) if at else None
+
+    qa, qb = fixed(HOME_EVENT), fixed(SOURCE_EVENT)
+    own, glob = {}, {}
+    for r in range(data.n_robots):
+        p = data.odom_pose[k, r, :2]
+        own[str(r)] = np.round(p, 2).tolist()
+        g = p.copy()
+        if qa is not None and qb is not None:
+            a = _place_track(data, r, HOME_EVENT, t)
+            a[np.isnan(a[:, 0])] = data.odom_pose[0, r, :2]  # told it is at Home at start-up
+            b = _place_track(data, r, SOURCE_EVENT, t)
+            za = a[:, 0] + 1j * a[:, 1]
+            zb = b[:, 0] + 1j * b[:, 1]
+            zq_a, zq_b = complex(*qa), complex(*qb)
+            use = np.isfinite(zb) & (np.abs(zb - za) > 1e-6)
+            zp = p[:, 0] + 1j * p[:, 1]
+            m = (zq_b - zq_a) / np.where(use, zb - za, 1.0)  # scale * e^{i rotation}
+            zg = np.where(use, zq_a + m * (zp - za), zp)
+            g = np.stack([zg.real, zg.imag], axis=1)
+        glob[str(r)] = np.round(g, 2).tolist()
+    return {"crumbs_own_series": json.dumps(own, separators=(",", ":")),
+            "crumbs_global_series": json.dumps(glob, separators=(",", ":"))}
+
+
 register("trails", trail_metrics,
          "trail papers: units delivered, trips, trip times before/after the first trail, 10-min throughput, "
          "breakdown time, Table 1 per robot, place interval, crumb memory")
 register("trails_series", trail_series,
          "trail papers: cumulative units over time, per robot, per 10-min window, arrivals (JSON strings)")
+register("trails_crumbs", trail_crumbs,
+         "trail papers' figures: each robot's crumbs (odometry positions every 10 s) in its own frame and in the "
+         "fixed global frame of the places (JSON strings; opt-in, large)")

@@ -14,14 +14,55 @@ import numpy as np
 
 from teamnav.experiments.report.model import Missing, Series
 
-#: cruise speed of every trail scenario [m/s] (robots' ``params.cruise_speed_mps``)
-CRUISE_MPS = 0.4
-#: the drift grid of the blazing-drift / try-drift sweeps [deg/min]
-DRIFT_KEY = "robots.0.odometry.heading_drift_deg_per_min"
+#: the 2002 paper's per-robot heading drift [deg/min] (Try §3.6: "Bug's coordinate system rotated
+#: clockwise; the other robots' systems drifted anti-clockwise. Tanis' system rotated only by
+#: around 0.35° per minute, while Fly's rotated at 2° per minute"; Bug's and Ant's rates are not
+#: given: 1 deg/min). The drift sweeps (blazing-drift, try-drift) scale it by k, case ``x<k>``.
+DRIFT_PATTERN = {"Bug": -1.0, "Ant": 1.0, "Fly": 2.0, "Tanis": 0.35}
+#: how the drift sweeps' axis reads in the figures
+DRIFT_AXIS = "drift scale k (x Bug -1, Ant +1, Fly +2, Tanis +0.35 deg/min)"
 TRAIL_BRAINS = ("blazing-trail-v1", "trail-share-v1")
 #: a team "works" when it delivers at least this many units per 10 minutes (the paper's 4 robots
 #: delivered ~9 per 10 min before the breakdown; one optimal robot delivers ~4)
 WORKING_UNITS_PER_10MIN = 1.0
+#: the map every trail scenario runs on
+TRAIL_MAP = "trail_office_corridors"
+
+
+def cruise_mps(scenario: str = "try-to-see-it-my-way") -> float:
+    """The cruise speed of the scenario's first robot group [m/s] (the efficiency's denominator)."""
+    from teamnav.experiments.spec import load_scenario
+
+    return float(load_scenario(scenario).robots[0].params["cruise_speed_mps"])
+
+
+def drift_scale(row_or_case: dict) -> float | None:
+    """k of a drift-sweep case (``"x0.5"`` -> 0.5), from a case dict or a row's params; None if none."""
+    label = row_or_case.get("case", (row_or_case.get("params") or {}).get("case"))
+    if not isinstance(label, str) or not label.startswith("x"):
+        return None
+    try:
+        return float(label[1:])
+    except ValueError:
+        return None
+
+
+def drift_spec(name: str, scales: Sequence[float]):
+    """Sweep ``name`` (blazing-drift / try-drift) with only the cases of drift scales ``scales``.
+
+    Raises
+    ------
+    ValueError
+        A scale that the sweep has no case for.
+    """
+    from teamnav.experiments.sweep import load_sweep
+
+    spec = load_sweep(name)
+    have = {drift_scale(c): c for c in spec.cases}
+    lacking = [k for k in scales if k not in have]
+    if lacking:
+        raise ValueError(f"sweep {name!r}: no drift case for scale(s) {lacking}; it has {sorted(k for k in have if k is not None)}")
+    return spec.model_copy(update={"cases": [have[k] for k in scales]})
 
 
 def brains_missing(names: Iterable[str]) -> Missing | None:
@@ -95,19 +136,58 @@ def band_series(label: str, rows: Sequence[dict], t_s: np.ndarray, *, scale_x: f
                   lo.tolist(), hi.tolist())
 
 
+def by_scale(rows: Sequence[dict]) -> dict[float, list[dict]]:
+    """Drift-sweep rows grouped by drift scale k, in increasing k."""
+    out: dict[float, list[dict]] = {}
+    for r in rows:
+        k = drift_scale(r)
+        if k is not None:
+            out.setdefault(k, []).append(r)
+    return dict(sorted(out.items()))
+
+
 def per_drift(rows: Sequence[dict], key: str, stat: Callable[[np.ndarray], float] = np.median) -> tuple[list, list, list, list]:
-    """(drift, stat, 25 %, 75 %) of metric ``key`` per drift value of the drift sweeps."""
+    """(drift scale k, stat, 25 %, 75 %) of metric ``key`` per case of the drift sweeps."""
     xs, ys, lo, hi = [], [], [], []
-    groups = by_param(rows, DRIFT_KEY)
-    for d in sorted(groups, key=lambda v: float(v)):
-        v = values(groups[d], key)
+    for k, group in by_scale(rows).items():
+        v = values(group, key)
         if v.size == 0:
             continue
-        xs.append(float(d))
+        xs.append(k)
         ys.append(float(stat(v)))
         lo.append(float(np.percentile(v, 25)))
         hi.append(float(np.percentile(v, 75)))
     return xs, ys, lo, hi
+
+
+def crumb_views(row: dict, names: Sequence[str], what: str) -> list:
+    """The papers' crumb figures from one run's ``trails_crumbs`` series (MapView blocks).
+
+    Own frame per robot (Try Fig. 3 top, Blazing Fig. 6) and every robot's crumbs in the fixed
+    global frame of the places (Try Fig. 4). A Missing block when the row has no crumbs.
+    """
+    from teamnav.experiments.report.model import MapView
+    from teamnav.world import builtin_map
+
+    own, glob = row.get("crumbs_own_series"), row.get("crumbs_global_series")
+    if not isinstance(own, str) or not isinstance(glob, str):
+        return [Missing(f"crumb plots ({what})", "the run has no trails_crumbs metric (add it to the sweep's metrics)")]
+    grid = builtin_map(TRAIL_MAP).grid
+    own_d, glob_d = json.loads(own), json.loads(glob)
+
+    def clouds(d: dict) -> list:
+        return [(names[int(r)] if int(r) < len(names) else f"robot {r}", np.asarray(v, float).reshape(-1, 2))
+                for r, v in sorted(d.items(), key=lambda kv: int(kv[0]))]
+
+    seed = row.get("seed", "?")
+    return [
+        MapView(f"Crumbs each robot dropped, in its own odometry frame ({what}, seed {seed})", grid, clouds(own_d),
+                caption="one crumb per 10 s; frames start aligned with the map, so drift shows as each robot's "
+                        "trail rotating away from the corridors (Try Fig. 3, Blazing Fig. 6)"),
+        MapView(f"All crumbs in a fixed global frame of the Places ({what}, seed {seed})", grid, clouds(glob_d),
+                caption="each crumb mapped by the similarity that takes its robot's Place estimates at that time "
+                        "onto fixed home and source points: what a receiver makes of them (Try Fig. 4)"),
+    ]
 
 
 def time_grid(duration_s: float, n: int = 61) -> np.ndarray:

@@ -8,15 +8,17 @@ EXPERIMENTS.md rows, each a :class:`Comparison`:
 2. "4 robots ≈ 3x a single optimal robot" (§5.1: 28 units in 30 min vs a ~3 min round trip) →
    units of the 4-robot team / units of one optimal robot in the same time (holds at >= 2.5x).
 3. "odometry drift makes the system break down (~27 min)" → breakdown time falls and the last
-   10-minute window's throughput drops as the drift rate grows (blazing-drift sweep).
+   10-minute window's throughput drops as the drift grows (blazing-drift sweep: each robot its
+   own drift, k x the 2002 paper's Bug -1, Ant +1, Fly +2, Tanis +0.35 deg/min, k = 0..2).
 
 Baselines beside them: one optimal robot (route-follow-v1), one exploring robot
 (blazing-trail-v1 alone), the team without communication. Figures: units over time (Fig. 5
-left), units per 10 min (Fig. 5 right), breakdown time vs drift.
+left), units per 10 min (Fig. 5 right), breakdown time vs drift, the trails each robot
+announced in its own frame (Fig. 6) and all of them in a fixed frame of the places.
 
-Quick mode: 450 s runs (drift sweep 300 s), 2 seeds, drift 0 and 4 deg/min only, no explorer or
-no-communication baselines; full: the paper's 30 min, 10
-seeds, drift 0..4 deg/min for 1 h.
+Quick mode: 450 s runs (drift sweep 300 s), 2 seeds, drift k = 0 and 2 only, no explorer or
+no-communication baselines; full: the paper's 30 min, 10 seeds, k = 0, 0.5, 1, 2 for 1 h (the
+drift sweep is shared with the try-to-see-it-my-way section).
 """
 
 from __future__ import annotations
@@ -41,25 +43,27 @@ def build(ctx) -> list:
     seeds = 2 if quick else 10
     dur = 450.0 if quick else 1800.0
     drift_dur = 300.0 if quick else 3600.0
-    drifts = [0.0, 4.0] if quick else [0.0, 0.5, 1.0, 2.0, 4.0]
+    scales = [0.0, 2.0] if quick else [0.0, 0.5, 1.0, 2.0]
+    cruise = T.cruise_mps("blazing-a-trail")
 
     paper = T.ok(ctx.sweep("blazing-paper", seeds=seeds, duration_s=dur))
     opt = T.ok(ctx.sweep("trail-solo-optimal", seeds=1 if quick else 3, duration_s=dur))
     # quick mode (CI) skips the two baselines: each sweep call costs a worker pool's start-up
     explore = [] if quick else T.ok(ctx.sweep("trail-solo-explore", seeds=seeds, duration_s=dur))
-    comm = [] if quick else T.ok(ctx.sweep("trail-communication", seeds=seeds, duration_s=dur,
-                                           set={"robots.0.controller": "blazing-trail-v1"},
-                                           grid={"robots.0.params.communicate": [True, False]}))
-    drift = T.ok(ctx.sweep("blazing-drift", seeds=seeds, duration_s=drift_dur, grid={T.DRIFT_KEY: drifts}))
-    nocomm = [r for r in comm if (r.get("params") or {}).get("robots.0.params.communicate") is False]
-    drift0 = T.by_param(drift, T.DRIFT_KEY).get(0.0, [])
+    # (the team with communication and no drift is the drift sweep's k = 0)
+    nocomm = [] if quick else T.ok(ctx.sweep("trail-communication", seeds=seeds, duration_s=dur,
+                                             set={"robots.0.controller": "blazing-trail-v1"},
+                                             grid={"robots.0.params.communicate": [False]}))
+    drift = T.ok(ctx.sweep(T.drift_spec("blazing-drift", scales), seeds=seeds, duration_s=drift_dur))
+    drift0 = T.by_scale(drift).get(0.0, [])
 
     blocks: list = [Text(
         f"Scenario blazing-a-trail: 4 robots on trail_office_corridors (home and source ~31.5 m apart through two "
         f"corners), {dur / 60:g} min per run, per-robot heading drift (Ant 1.5, Bee 1.0, Punky 0.3, "
-        f"Tanis -0.3 deg/min), cruise {T.CRUISE_MPS} m/s, {seeds} seeds. A unit is delivered when a robot "
+        f"Tanis -0.3 deg/min), cruise {cruise:g} m/s, {seeds} seeds. A unit is delivered when a robot "
         "that reached the source reaches home; breakdown = the last delivery when none followed in the "
-        f"last {180:g} s of the run (otherwise censored at the run's end).")]
+        f"last {180:g} s of the run (otherwise censored at the run's end). The drift sweep gives each robot its "
+        f"own drift, k x {T.DRIFT_PATTERN} deg/min (the 2002 paper's robots), {drift_dur / 60:g} min per run.")]
     if not paper or not opt:
         return blocks + [Missing("blazing-a-trail runs", "every trial of the blazing-paper or trail-solo-optimal sweep failed")]
 
@@ -109,11 +113,11 @@ def build(ctx) -> list:
         "no unit after ~27 min of 30 (rate falls from the start, Fig. 5 right)",
         f"paper conditions: breakdown at {T.msd(paper_bd / 60, '{:.1f}', 'min')} "
         f"({int(cens.sum()) if cens.size else 0} of {cens.size} runs did not break down within {dur / 60:g} min); "
-        + "; ".join(f"{d:g} deg/min: median breakdown {b / 60:.1f} min, last-10-min units {u:.1f}"
+        + "; ".join(f"k = {d:g}: median breakdown {b / 60:.1f} min, last-10-min units {u:.1f}"
                     for d, b, u in zip(xs, bd, last)),
         holds3,
-        "drift is the same for all 4 robots in the sweep (one knob), where the paper's robots drifted by "
-        "different amounts and directions; censored runs count at the run's length"))
+        "the sweep scales the 2002 paper's per-robot drift (the 2000 paper gives no rates); pure heading drift, "
+        "no wheel-slip noise; censored runs count at the run's length"))
 
     # per-robot units (paper's table)
     rows = []
@@ -127,7 +131,7 @@ def build(ctx) -> list:
     # baselines side by side
     base = [
         ["4 robots, paper drift", T.msd(team_units), T.msd(T.values(paper, "trip_time_s_after_median"), "{:.0f}")],
-        ["4 robots, no drift", T.msd(T.values(drift0, "units_total")) + ("" if drift_dur == dur else f" ({drift_dur / 60:g} min)"),
+        ["4 robots, no drift", T.msd(T.values(drift0, "units_total")) + ("" if drift_dur == dur else f" (in {drift_dur / 60:g} min)"),
          T.msd(after0, "{:.0f}")],
         ["4 robots, no communication", T.msd(T.values(nocomm, "units_total")),
          T.msd(T.values(nocomm, "trip_time_s_after_median"), "{:.0f}")],
@@ -160,11 +164,15 @@ def build(ctx) -> list:
                                    W.min(0).tolist(), W.max(0).tolist(), style="bar")],
                            caption="mean over seeds, band min..max"))
     if xs:
-        blocks.append(Plot("Breakdown time vs heading drift (blazing-trail-v1)", "heading drift [deg/min]",
+        blocks.append(Plot("Breakdown time vs per-robot heading drift (blazing-trail-v1)", T.DRIFT_AXIS,
                            "breakdown [min]",
                            [Series("median (25–75 %)", xs, [b / 60 for b in bd], [b / 60 for b in bd_lo],
                                    [b / 60 for b in bd_hi], style="line+points")],
                            hlines=[(27.0, "paper: ~27 min"), (drift_dur / 60, "run length (no breakdown)")]))
+        blocks.append(Plot("Units per 10 minutes at the end of the run vs per-robot drift", T.DRIFT_AXIS, "units",
+                           [Series("mean (25–75 %)", xs, last, last_lo, last_hi, style="line+points")],
+                           caption=f"the last 10 minutes of {drift_dur / 60:g}-minute runs"))
+    blocks += T.crumb_views(paper[0], [n.capitalize() for n in OUR_ROBOTS], "blazing-a-trail")
     return blocks
 
 

@@ -3,18 +3,21 @@
 EXPERIMENTS.md rows, each a :class:`Comparison`:
 
 1. "4 robots, 3 h 8 min, 262 trips, 8.2 km, ≈ 92 % of cruise speed" → the try-paper runs go on
-   for hours under drift that breaks the 2000 system, with no breakdown; efficiency
-   (route length / mean time between places / cruise speed, §3.6) near the paper's.
-2. "trails shared despite diverged frames" → the same drift with and without Place transforms.
+   for hours under the paper's per-robot drift with no breakdown; efficiency (§3.6: route length
+   / (total lifetime / trips) / cruise speed) near the paper's.
+2. "trails shared despite diverged frames" → the same drift for 1 h with and without Place
+   transforms, and the 2000 algorithm (the drift sweeps' k = 1 case: the paper's drift).
+3. The drift sweep of both algorithms (each robot its own drift, k x Bug -1, Ant +1, Fly +2,
+   Tanis +0.35 deg/min): breakdown time and last-10-minute throughput vs k.
+4. Memory stays flat (crumbs held, first vs second half of the long runs: 4-minute expiry).
 
-Beside them: the 2000 algorithm under the 2002 drift (same scenario), the drift sweep of both
-algorithms (breakdown time and last-10-minute throughput vs drift), Table 1 (trips, distance,
-lifetime per robot), memory (crumbs held over time stays flat: 4-minute expiry), and the
-N-place mail round (§2.1).
+Beside them: Table 1 (trips, distance, lifetime per robot), units over time, the times each
+robot reached the places (Fig. 2 top), the crumbs each robot dropped in its own frame (Fig. 3)
+and all crumbs in the fixed frame of the Places (Fig. 4), and the N-place mail round (§2.1).
 
-Quick mode: 300 s runs, 2 seeds, drift 4 deg/min (the 2000 algorithm also at 0), no run without
-Place transforms; full: 3 h 10 min, 10 seeds, drift
-0..4 deg/min for 1 h.
+Quick mode: 300 s runs, 2 seeds, drift k = 0 and 2 (the blazing section's quick drift trials,
+reused), no run without Place transforms, no mail round. Full: 3 h 10 min x 10 seeds; the drift
+sweeps and the no-transform control 1 h x 10 seeds per point.
 """
 
 from __future__ import annotations
@@ -35,7 +38,7 @@ PAPER_TABLE1 = {"Tanis": (36, 1102, 81.3), "Bug": (59, 2102, 138.1), "Fly": (78,
 OUR_ROBOTS = ("Bug", "Ant", "Fly", "Tanis")
 
 
-def _last_hour_units(rows, dur_s: float) -> np.ndarray:
+def _last_quarter_units(rows, dur_s: float) -> np.ndarray:
     """Units delivered in the last quarter of each run (steady state, after any breakdown)."""
     t0 = 0.75 * dur_s
     c = T.cumulative(rows, np.array([t0, dur_s]))
@@ -50,24 +53,27 @@ def build(ctx) -> list:
     seeds = 2 if quick else 10
     dur = 300.0 if quick else 11400.0
     drift_dur = 300.0 if quick else 3600.0
-    drifts = [4.0] if quick else [0.0, 0.5, 1.0, 2.0, 4.0]
-    # quick: blazing-drift's trials are the blazing-a-trail section's (same arguments: reused)
-    b_drifts = [0.0, 4.0] if quick else drifts
+    # quick: the blazing section's quick drift trials (same arguments: reused)
+    scales = [0.0, 2.0] if quick else [0.0, 0.5, 1.0, 2.0]
+    cruise = T.cruise_mps("try-to-see-it-my-way")
 
     share = T.ok(ctx.sweep("try-paper", seeds=seeds, duration_s=dur))
-    blazing = T.ok(ctx.sweep("blazing-under-try-drift", seeds=seeds, duration_s=dur))
-    plain = [] if quick else T.ok(ctx.sweep("try-no-transforms", seeds=seeds, duration_s=dur))
-    d_share = T.ok(ctx.sweep("try-drift", seeds=seeds, duration_s=drift_dur, grid={T.DRIFT_KEY: drifts}))
-    d_blaze = T.ok(ctx.sweep("blazing-drift", seeds=seeds, duration_s=drift_dur, grid={T.DRIFT_KEY: b_drifts}))
+    d_share = T.ok(ctx.sweep(T.drift_spec("try-drift", scales), seeds=seeds, duration_s=drift_dur))
+    d_blaze = T.ok(ctx.sweep(T.drift_spec("blazing-drift", scales), seeds=seeds, duration_s=drift_dur))
+    plain = [] if quick else T.ok(ctx.sweep("try-no-transforms", seeds=seeds, duration_s=drift_dur))
     mail = [] if quick else T.ok(ctx.sweep(
         SweepSpec(scenario="trail-mail-round", seeds=3, name="trail-mail-round",
                   set={"metrics": ["path_length", "events", "trails", "trails_series"]}), duration_s=1800.0))
+    # the paper's drift (k = 1) for drift_dur: the 2002 team, the 2000 team
+    same_share = T.by_scale(d_share).get(1.0, [])
+    same_blaze = T.by_scale(d_blaze).get(1.0, [])
 
     blocks: list = [Text(
         f"Scenario try-to-see-it-my-way: 4 robots on trail_office_corridors, {dur / 60:g} min per run, heading drift "
         "Bug -1, Ant +1, Fly +2, Tanis +0.35 deg/min (§3.6), frames initially aligned, optimistic policy, "
-        f"1-crumb trails every 2 s, crumbs expire after 4 min, cruise {T.CRUISE_MPS} m/s, {seeds} seeds. "
-        "The same scenario runs the 2000 algorithm (blazing-trail-v1) and trail-share-v1 without Place transforms.")]
+        f"1-crumb trails every 2 s, crumbs expire after 4 min, cruise {cruise:g} m/s, {seeds} seeds. "
+        f"The drift sweeps run both algorithms {drift_dur / 60:g} min with each robot drifting k x that pattern; "
+        "k = 1 is the paper's drift.")]
     if not share:
         return blocks + [Missing("try-to-see-it-my-way runs", "every trial of the try-paper sweep failed")]
 
@@ -75,34 +81,39 @@ def build(ctx) -> list:
     trips = T.values(share, "trips_total")
     dist_km = T.values(share, "distance_m_total") / 1000.0
     cens = T.values(share, "breakdown_censored")
+    interval = T.values(share, "place_interval_s")
     speed = T.values(share, "place_speed_mps")
-    eff = speed / T.CRUISE_MPS
-    b_cens = T.values(blazing, "breakdown_censored")
+    eff = speed / cruise
+    b_cens = T.values(same_blaze, "breakdown_censored")
+    b_bd = T.values(same_blaze, "breakdown_s")
     holds1 = bool(cens.size and cens.mean() >= 0.8 and eff.size and np.median(eff) >= 0.75)
     blocks.append(Comparison(
         "Runs for hours under drift, with no breakdown; efficiency near the paper's",
-        "4 robots, 3 h 8 min: 262 trips, 8.2 km, 2 m 13 s between places = 0.23 m/s of 0.25 m/s cruise (92 %)",
-        f"{dur / 60:g} min: {T.msd(trips, '{:.0f}')} trips, {T.msd(dist_km, '{:.2f}', 'km')}; no breakdown in "
-        f"{int(cens.sum())} of {cens.size} runs (2000 algorithm, same drift: {int(b_cens.sum()) if b_cens.size else 0} "
-        f"of {b_cens.size}); efficiency {T.msd(eff * 100, '{:.0f}', '%')}",
+        "4 robots, 3 h 8 min: 262 trips, 8.2 km; 9 h 43 m 40 s of lifetime / 262 trips = 2 m 13 s between places "
+        "= 0.23 m/s over 31 m, of 0.25 m/s cruise (92 %)",
+        f"{dur / 60:g} min: {T.msd(trips, '{:.0f}')} trips, {T.msd(dist_km, '{:.2f}', 'km')}; "
+        f"{T.msd(interval, '{:.0f}', 's')} between places = {T.msd(speed, '{:.2f}', 'm/s')}: efficiency "
+        f"{T.msd(eff * 100, '{:.0f}', '%')}; no breakdown in {int(cens.sum())} of {cens.size} runs (2000 algorithm, "
+        f"same drift, {drift_dur / 60:g} min: {int(b_cens.sum()) if b_cens.size else 0} of {b_cens.size}, breakdown at "
+        f"{T.msd(b_bd / 60, '{:.0f}', 'min')})",
         holds1,
-        "our robots never fail, so every robot's lifetime is the whole run (the paper's lost power or odometry); "
-        "route length 31.5 m, cruise 0.4 m/s (paper 31 m, 0.25 m/s)"))
+        f"our robots never fail, so every lifetime is about the whole run (the paper's ran out of power or lost "
+        f"odometry); route 31.5 m, cruise {cruise:g} m/s (paper 31 m, 0.25 m/s)"))
 
-    # 2. with vs without Place transforms, and the 2000 algorithm, same drift
-    late_share = _last_hour_units(share, dur)
-    late_plain = _last_hour_units(plain, dur)
-    late_blaze = _last_hour_units(blazing, dur)
+    # 2. with vs without Place transforms, and the 2000 algorithm, same drift, same length
+    late_share = _last_quarter_units(same_share, drift_dur)
+    late_plain = _last_quarter_units(plain, drift_dur)
+    late_blaze = _last_quarter_units(same_blaze, drift_dur)
     holds2 = None
     if late_share.size and late_plain.size and late_blaze.size:
-        per_10min = late_share.mean() / (0.25 * dur / 600.0)  # the 2002 team must still be working
+        per_10min = late_share.mean() / (0.25 * drift_dur / 600.0)  # the 2002 team must still be working
         holds2 = bool(per_10min >= T.WORKING_UNITS_PER_10MIN and late_share.mean() >= late_plain.mean()
                       and late_share.mean() > late_blaze.mean())
     blocks.append(Comparison(
         "Trails are shared despite diverged frames (Place transforms)",
         "frames rotated 0.35–2 deg/min in both directions; trails shared throughout the 188 min",
-        f"units in the last quarter of the run: with transforms {T.msd(late_share)}, without {T.msd(late_plain)}, "
-        f"2000 algorithm {T.msd(late_blaze)}",
+        f"units in the last quarter of {drift_dur / 60:g}-min runs at the paper's drift: with transforms "
+        f"{T.msd(late_share)}, without {T.msd(late_plain)}, 2000 algorithm {T.msd(late_blaze)}",
         holds2,
         "the paper had no no-transform or 2000-algorithm control under the same drift; ours are simulated with "
         "pure heading drift (no wheel noise)"))
@@ -110,19 +121,21 @@ def build(ctx) -> list:
     # 3. drift sweep, both algorithms
     xs_s, bd_s, lo_s, hi_s = T.per_drift(d_share, "breakdown_s")
     xs_b, bd_b, lo_b, hi_b = T.per_drift(d_blaze, "breakdown_s")
-    _, last_s, _, _ = T.per_drift(d_share, "units_per_10min_last", np.mean)
-    _, last_b, _, _ = T.per_drift(d_blaze, "units_per_10min_last", np.mean)
+    _, last_s, llo_s, lhi_s = T.per_drift(d_share, "units_per_10min_last", np.mean)
+    _, last_b, llo_b, lhi_b = T.per_drift(d_blaze, "units_per_10min_last", np.mean)
     holds3 = None
     if xs_s and xs_b and xs_s[-1] == xs_b[-1]:  # at the highest drift both ran
         holds3 = bool(last_s[-1] >= T.WORKING_UNITS_PER_10MIN and last_s[-1] > last_b[-1]
                       and (len(xs_s) < 2 or last_s[-1] >= 0.5 * last_s[0]))
+    bmap = dict(zip(xs_b, zip(last_b, bd_b)))
     blocks.append(Comparison(
         "The 2000 algorithm's throughput collapses as drift grows; the 2002 one keeps working",
         "2000: breaks down at ~27 min; 2002: works for 3 h with 0.35–2 deg/min",
-        "last-10-min units, 2002 / 2000: " + "; ".join(
-            f"{d:g} deg/min: {a:.1f} / {dict(zip(xs_b, last_b)).get(d, float('nan')):.1f}" for d, a in zip(xs_s, last_s)),
+        "last-10-min units (median breakdown), 2002 / 2000: " + "; ".join(
+            f"k = {d:g}: {a:.1f} ({b / 60:.0f} min) / {bmap.get(d, (float('nan'),) * 2)[0]:.1f} "
+            f"({bmap.get(d, (float('nan'),) * 2)[1] / 60:.0f} min)" for d, a, b in zip(xs_s, last_s, bd_s)),
         holds3,
-        f"{drift_dur / 60:g}-min runs, the same drift for all 4 robots"))
+        f"{drift_dur / 60:g}-min runs, {seeds} seeds per point; k scales the 2002 paper's per-robot drift"))
 
     # Table 1
     rows = []
@@ -162,19 +175,27 @@ def build(ctx) -> list:
 
     # baselines
     base = [
-        ["trail-share-v1 (2002)", T.msd(T.values(share, "units_total")), T.msd(late_share)],
+        ["trail-share-v1 (2002)", T.msd(T.values(same_share, "units_total")), T.msd(late_share)],
         ["trail-share-v1 without Place transforms", T.msd(T.values(plain, "units_total")), T.msd(late_plain)],
-        ["blazing-trail-v1 (2000), same drift", T.msd(T.values(blazing, "units_total")), T.msd(late_blaze)],
+        ["blazing-trail-v1 (2000)", T.msd(T.values(same_blaze, "units_total")), T.msd(late_blaze)],
     ]
-    blocks.append(Table("Same drift, three algorithms", ["algorithm", f"units in {dur / 60:g} min",
-                                                         "units in the last quarter"], base))
+    if quick:
+        blocks.append(Missing("trail-share-v1 without Place transforms", "full mode only"))
+    blocks.append(Table("The paper's drift, three algorithms", ["algorithm", f"units in {drift_dur / 60:g} min",
+                                                                "units in the last quarter"], base))
 
     # figures: units over time, Fig. 2 top (arrivals), breakdown vs drift
     t = T.time_grid(dur)
-    series = [s for s in (T.band_series("trail-share-v1", share, t), T.band_series("no Place transforms", plain, t),
-                          T.band_series("blazing-trail-v1", blazing, t)) if s is not None]
-    blocks.append(Plot("Units transported over time, 2002 drift (Fig. 2 bottom)", "time [min]", "units (cumulative)",
-                       series, caption="mean over seeds with a 10–90 % band"))
+    blocks.append(Plot("Units transported over time, the paper's drift (Fig. 2 bottom)", "time [min]",
+                       "units (cumulative)", [T.band_series("trail-share-v1", share, t)],
+                       caption="mean over seeds with a 10–90 % band"))
+    t1 = T.time_grid(drift_dur)
+    series = [s for s in (T.band_series("trail-share-v1", same_share, t1),
+                          T.band_series("no Place transforms", plain, t1),
+                          T.band_series("blazing-trail-v1 (2000)", same_blaze, t1)) if s is not None]
+    if series:
+        blocks.append(Plot(f"Units over time, the paper's drift, three algorithms ({drift_dur / 60:g} min)",
+                           "time [min]", "units (cumulative)", series, caption="mean over seeds with a 10–90 % band"))
     arr = share[0].get("arrivals_series")
     if isinstance(arr, str):
         pts = json.loads(arr)
@@ -193,15 +214,14 @@ def build(ctx) -> list:
         if xs_b:
             sers.append(Series("blazing-trail-v1 (2000)", xs_b, [b / 60 for b in bd_b], [b / 60 for b in lo_b],
                                [b / 60 for b in hi_b], style="line+points"))
-        blocks.append(Plot("Breakdown time vs heading drift, both algorithms", "heading drift [deg/min]",
+        blocks.append(Plot("Breakdown time vs per-robot heading drift, both algorithms", T.DRIFT_AXIS,
                            "breakdown [min] (median, 25–75 %)", sers,
                            hlines=[(drift_dur / 60, "run length (no breakdown)")]))
-        blocks.append(Plot("Units in the last 10 minutes vs heading drift", "heading drift [deg/min]", "units",
-                           [Series("trail-share-v1 (2002)", xs_s, last_s, style="line+points"),
-                            Series("blazing-trail-v1 (2000)", xs_b, last_b, style="line+points")]))
-    blocks.append(Missing("crumb plots (Figs. 3, 4 and Blazing Fig. 6)",
-                          "the sweeps keep metrics only; crumbs in each robot's frame need the brains' crumb layers "
-                          "from a recorded run (teamnav run try-to-see-it-my-way --out DIR, then the replay)"))
+        blocks.append(Plot("Units in the last 10 minutes vs per-robot heading drift", T.DRIFT_AXIS, "units",
+                           [Series("trail-share-v1 (2002)", xs_s, last_s, llo_s, lhi_s, style="line+points"),
+                            Series("blazing-trail-v1 (2000)", xs_b, last_b, llo_b, lhi_b, style="line+points")],
+                           caption=f"mean, band 25–75 % over seeds; {drift_dur / 60:g}-min runs"))
+    blocks += T.crumb_views(share[0], OUR_ROBOTS, "try-to-see-it-my-way")
     return blocks
 
 
