@@ -168,3 +168,85 @@ def test_log_is_small_and_scores_the_belief():
     assert np.all(np.hypot(pts[:, 0] - 20.0, pts[:, 1] - 9.6) < 1.5)
     second = a.log()
     assert "layers" not in second and "sensor_kind" not in second
+
+
+# ---------------------------------------------------------------- received trees (sensor resetting)
+def _tree_msg(center_xy, observer: int = 0, target: int = 1, std_m: float = 0.3, seed: int = 9) -> Message:
+    """A detection message whose tree puts the receiver around ``center_xy`` (the sender's claim)."""
+    from teamnav.localization.density_tree import DensityTree
+
+    pts = np.random.default_rng(seed).normal(center_xy, std_m, size=(2000, 2))
+    tree = DensityTree.fit(pts, np.full(2000, 1 / 2000), min_samples=20, max_depth=20)
+    body = SyncMessage("detection", observer, target, 1.5, 0.0, 0.035, tree)
+    return Message(observer, 0.0, body, to=target, kind=SYNC_KIND)
+
+
+def _mass_near(b: MCLWander, xy, r_m: float = 1.5) -> float:
+    p = b.mcl.particles
+    return float(b.mcl.weights[np.hypot(p[:, 0] - xy[0], p[:, 1] - xy[1]) < r_m].sum())
+
+
+HERE, THERE = (20.0, 9.6), (35.0, 9.6)
+
+
+@pytest.mark.parametrize("weighting", ["tree", "bayes"])
+def test_a_localized_robot_does_not_follow_a_wrong_sender(weighting):
+    """A receiver sure to be at x = 20 m gets a tree that puts it at x = 35 m (the sender is wrong).
+    The first version's draws took all the weight (eq. 14 on draws from the tree counts the tree
+    twice, and the kept samples get only the p_fp floor): the receiver jumped to the sender's
+    claim. With the lost-prior weighting the draws get the posterior probability of "lost",
+    eps / (eps + (1 - eps) p_fp), and the own belief keeps the rest."""
+    b = _brain(1, 5, inject_fraction=0.2, inject_weighting=weighting, inject_lost_prior=0.02)
+    b.step(_obs(1, 0))
+    b.step(_obs(1, 1, inbox=[_tree_msg(THERE)]))
+    assert b.sync.applied["detection"] == 1
+    if weighting == "tree":
+        assert _mass_near(b, THERE) > 0.95
+    else:
+        share = 0.02 / (0.02 + 0.98 * 0.035)
+        assert abs(_mass_near(b, THERE) - share) < 0.03
+        assert _mass_near(b, HERE) > 0.6
+
+
+def test_a_tree_the_belief_confirms_leaves_the_draws_almost_nothing():
+    b = _brain(1, 5, inject_fraction=0.2, inject_lost_prior=0.3)
+    b.step(_obs(1, 0))
+    before = b.mcl.estimate().cluster_pose[:2].copy()
+    b.step(_obs(1, 1, inbox=[_tree_msg(HERE)]))
+    assert np.hypot(*(b.mcl.estimate().cluster_pose[:2] - before)) < 0.2
+    assert _mass_near(b, HERE, 1.0) > 0.99
+
+
+@pytest.mark.parametrize("before_reply", [True, False])
+def test_the_reply_carries_only_the_receivers_own_belief(before_reply):
+    """§2.3 symmetry: the detected robot answers with its position tree. The first version drew
+    the tree's samples first, so the reply held the sender's own claim (x = 35 m) and the sender
+    multiplied its own belief into itself again (double counting)."""
+    b = _brain(1, 5, inject_fraction=0.2, inject_before_reply=before_reply)
+    b.step(_obs(1, 0))
+    _, out = b.step(_obs(1, 1, inbox=[_tree_msg(THERE)]))
+    reply = next(m for m in out if m.kind == SYNC_KIND and m.body.kind == "inverse")
+    claim = float(reply.body.tree(np.array([THERE]))[0])
+    if before_reply:
+        assert claim > 0.01
+    else:
+        assert claim == 0.0
+        assert float(reply.body.tree(np.array([HERE]))[0]) > 0.1
+
+
+@pytest.mark.parametrize("share", [0.0, 1.0])
+def test_draws_take_their_heading_from_the_belief(share):
+    """A detection sees no heading. Uniform headings (share 0) put draws on the mirror pose of a
+    corridor (other side of the axis, heading reversed) that the scan cannot tell apart; headings
+    from the own belief (facing +x here) do not."""
+    b = _brain(1, 5, inject_fraction=0.5, inject_lost_prior=0.5, inject_heading_belief_share=share)
+    b.step(_obs(1, 0))
+    b.step(_obs(1, 1, inbox=[_tree_msg(THERE)]))
+    p = b.mcl.particles
+    th = p[np.hypot(p[:, 0] - THERE[0], p[:, 1] - THERE[1]) < 1.5, 2]
+    assert th.size > 100
+    facing = float(np.mean(np.abs(np.angle(np.exp(1j * th))) < math.radians(30)))
+    if share == 1.0:
+        assert facing > 0.9
+    else:
+        assert 0.08 < facing < 0.3

@@ -90,7 +90,7 @@ from teamnav.localization import (
 )
 from teamnav.localization.density_tree import DensityTree
 from teamnav.localization.resample import low_variance_kernel
-from teamnav.localization.sync import SYNC_KIND, detection_tree
+from teamnav.localization.sync import SYNC_KIND, detection_factors, detection_tree
 from teamnav.world.grid import FREE
 
 __all__ = ["MCLWander", "MCLWanderParams", "load_detection_model", "MODEL_DIR"]
@@ -188,6 +188,29 @@ class MCLWanderParams(BaseModel):
         (:meth:`MCL.replace_samples`: sensor resetting). 0 (default): pure eq. 14. Needed
         with our sample sets (thousands, not the paper's "very large" ones) when the belief
         has no sample near the detected position.
+    inject_weighting : {"bayes", "tree"}
+        How much weight the draws get (:meth:`MCLWander._inject_and_apply`). ``"tree"``: the
+        set's mean weight, then eq. 14 (measured: a receiver whose belief the tree contradicts
+        adopts the sender's belief, right or wrong; in the hexagon a confidently wrong robot
+        dragged localized teammates to its mode). ``"bayes"`` (default): the share of the
+        posterior that the receiver is lost, under the prior ``inject_lost_prior``.
+    inject_lost_prior : float
+        Prior probability that the receiver's belief is wrong (``"bayes"`` weighting).
+    inject_heading_belief_share : float
+        Share of the draws whose heading comes from the own belief (a sample drawn by weight,
+        plus ``inject_heading_std_deg`` of noise); the rest get a uniform heading (0: all
+        uniform, the first version). A detection sees the position only; with uniform
+        headings the draws in a featureless corridor include the mirror pose (other side of
+        the axis, heading reversed) that the scan cannot tell apart, and it won in one of 10
+        §5.1 runs (Robin then drove "west" while it went east: error 23 m).
+    inject_heading_std_deg : float
+        Heading noise of those draws [deg].
+    inject_before_reply : bool
+        The first version drew the samples *before* building the reply tree of §2.3, so the
+        reply carried ``inject_fraction`` of the sender's own tree back to it and the sender
+        multiplied its own belief in again (double counting: a confidently wrong sender was
+        confirmed by the teammate it had just dragged along). False (default): the reply is
+        built from the belief as it was before the message.
     detection_model : str
         Shipped model name or a path to a model file (:func:`load_detection_model`).
     detection_period_s : float
@@ -240,6 +263,11 @@ class MCLWanderParams(BaseModel):
     collaborate: bool = False
     send_min_cluster_weight: float = Field(0.0, ge=0.0, le=1.0)
     inject_fraction: float = Field(0.0, ge=0.0, le=0.5)
+    inject_weighting: Literal["bayes", "tree"] = "bayes"
+    inject_lost_prior: float = Field(0.02, gt=0.0, lt=1.0)
+    inject_heading_belief_share: float = Field(0.5, ge=0.0, le=1.0)
+    inject_heading_std_deg: float = Field(10.0, ge=0.0, le=180.0)
+    inject_before_reply: bool = False
     detection_model: str = Field("default", min_length=1)
     detection_period_s: float = Field(1.0, ge=0.0, le=60.0)
     min_travel_m: float = Field(2.5, ge=0.0, le=1000.0)
@@ -506,11 +534,69 @@ class MCLWander:
                 return []
         if (p.inject_fraction > 0 and body.kind == "detection" and body.target == self.robot_id
                 and self.sync.receive_gate.allowed(body.observer)):
-            k = int(round(p.inject_fraction * self.mcl.n_particles))
-            xy = body.tree.sample(k, self.rng)
-            th = self.rng.uniform(-math.pi, math.pi, size=k)
-            self.mcl.replace_samples(np.column_stack([xy, th]))
+            return self._inject_and_apply(msg, obs)
         return self.sync.on_message(self.mcl, msg, obs.time_s)
+
+    def _inject_and_apply(self, msg: Message, obs: Observation) -> list[Message]:
+        """Apply a detection tree with sensor resetting; the reply (§2.3 symmetry) carries the
+        belief from before the draws unless ``inject_before_reply`` (the first version)."""
+        if self.params.inject_before_reply:
+            factors = self._inject(self.mcl, msg.body)
+            return self.sync.on_message(self.mcl, msg, obs.time_s, evidence=lambda mcl, body: factors)
+        return self.sync.on_message(self.mcl, msg, obs.time_s, evidence=self._inject)
+
+    def _inject(self, mcl: MCL, body: SyncMessage) -> np.ndarray:
+        """Sensor resetting on a received detection tree, then eq. 14 (see ``inject_*`` params).
+
+        ``inject_weighting="tree"`` (the first version): ``k`` random samples are replaced by
+        draws from the tree with the set's mean weight and eq. 14 multiplies the tree into all
+        of them, so when the tree contradicts the belief the ``k`` draws take nearly all the
+        weight: the receiver adopts the sender's belief whether the sender is right or not.
+
+        ``inject_weighting="bayes"``: two hypotheses, "my belief holds" (prior ``1 - eps``) and
+        "I am lost" (prior ``eps`` = ``inject_lost_prior``, pose uniform over the free space).
+        Their evidences for the tree ``f = (1 - p_fp) tree + p_fp / A`` are ``E_own = sum_i w_i
+        f(x_i)`` and ``E_lost = 1 / A``; the draws (the posterior under "lost", ``U f ∝ f``)
+        get the share ``s = eps E_lost / (eps E_lost + (1 - eps) E_own)`` of the weight, the
+        kept samples ``1 - s`` in proportion to ``w_i f(x_i)`` (eq. 14). A confident belief the
+        tree contradicts keeps ``1 - s`` (about 0.6 with ``eps`` = 0.02 and ``p_fp`` = 3.5 %)
+        and the robot's own sensors decide between it and the draws; a belief the tree
+        confirms gives the draws almost nothing; a second, consistent tree makes the draws win.
+        """
+        p = self.params
+        n = mcl.n_particles
+        area = mcl.free_area_m2
+        k = int(round(p.inject_fraction * n))
+        if k == 0:
+            return detection_factors(body.tree, mcl.particles, body.p_false_positive, area)
+        xy = body.tree.sample(k, self.rng)
+        th = self.rng.uniform(-math.pi, math.pi, size=k)
+        m = int(round(p.inject_heading_belief_share * k))
+        if m > 0:  # heading of a sample drawn by weight from the own belief (a detection sees no heading)
+            idx = low_variance_kernel(mcl.weights, m, float(self.rng.random()), np.empty(m, dtype=np.int64))
+            th[:m] = mcl.particles[idx, 2] + self.rng.normal(0.0, math.radians(p.inject_heading_std_deg), size=m)
+        q = np.column_stack([xy, th])
+        if p.inject_weighting == "tree":
+            mcl.replace_samples(q)
+            return detection_factors(body.tree, mcl.particles, body.p_false_positive, area)
+        f_own = detection_factors(body.tree, mcl.particles, body.p_false_positive, area)
+        e_own = float(np.dot(mcl.weights, f_own))
+        eps = p.inject_lost_prior
+        share = eps / area / (eps / area + (1.0 - eps) * e_own)
+        before = mcl.particles.copy()
+        mcl.replace_samples(q)
+        after = mcl.particles
+        new = np.any(after != before, axis=1)
+        if int(new.sum()) != k:  # a draw equal to the sample it replaced (never in practice): locate by value
+            new = np.zeros(n, dtype=bool)
+            new[np.argsort(np.any(after != before, axis=1))[-k:]] = True
+        w = mcl.weights  # kept samples: w_i / Z, draws: 1 / (n Z)
+        f = detection_factors(body.tree, after, body.p_false_positive, area)
+        own_mass = float(np.dot(w[~new], f[~new]))
+        factors = np.empty(n)
+        factors[~new] = f[~new] * (1.0 - share) / own_mass if own_mass > 0 else 0.0
+        factors[new] = share / k / w[new]
+        return factors
 
     # ------------------------------------------------------------------ logs
     def _subsample(self, k: int) -> np.ndarray:

@@ -231,10 +231,17 @@ class BeliefSync:
             self.detect_gate.use(rid)
         return out
 
-    def on_message(self, mcl: MCL, msg: Message, stamp_s: float) -> list[Message]:
+    def on_message(self, mcl: MCL, msg: Message, stamp_s: float, evidence=None) -> list[Message]:
         """Apply a synchronisation message addressed to this robot; return a reply, if any.
 
         Messages of other kinds, or not for this robot, are ignored (``[]``).
+
+        ``evidence``: for a ``"detection"`` message, a callable ``evidence(mcl, body) -> factors``
+        that replaces eq. 14's ``detection_factors`` (it may change the sample set first, e.g.
+        sensor resetting). It is called *after* the reply tree was built, so the reply carries
+        only this robot's own belief: a reply built from a belief that already holds the
+        sender's tree would hand the sender its own information back (double counting; the
+        first version of the brain's sensor resetting did so, see ``test_sync.py``).
         """
         body = msg.body
         if msg.kind != SYNC_KIND or not isinstance(body, SyncMessage):
@@ -249,7 +256,10 @@ class BeliefSync:
                 reply = SyncMessage("inverse", other, self.robot_id, body.range_m, body.bearing_rad,
                                     body.p_false_positive, tree)
                 replies.append(Message(self.robot_id, float(stamp_s), reply, to=other, kind=SYNC_KIND))
-            f = detection_factors(body.tree, mcl.particles, body.p_false_positive, mcl.free_area_m2)
+            if evidence is None:
+                f = detection_factors(body.tree, mcl.particles, body.p_false_positive, mcl.free_area_m2)
+            else:
+                f = evidence(mcl, body)
             if mcl.multiply_weights(f):
                 self.applied["detection"] += 1
             self.receive_gate.use(other)
