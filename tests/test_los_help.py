@@ -53,9 +53,13 @@ class StraightNav:
         self.goal = None
         self.stuck = stuck
         self.progressing = True
+        self.temporary = False
+        self.calls: list[tuple[tuple[float, float], bool]] = []
 
-    def set_goal(self, goal_xy) -> None:
+    def set_goal(self, goal_xy, temporary: bool = False) -> None:
         self.goal = np.asarray(goal_xy, dtype=float)
+        self.temporary = temporary
+        self.calls.append((tuple(self.goal.tolist()), temporary))
 
     def direction(self, pose, scan):
         self.progressing = not self.stuck
@@ -562,13 +566,17 @@ def test_at_a_ghost_that_saw_the_goal_itself_r1_heads_for_the_goal(straight_nav,
     # R2 at (0, 3) reports D for R1's goal: 6.71 m is the straight distance (it sees the goal), 9 m is not
     r1.step(obs(1, walls=wall, seen=[(1, *polar((0, 0), r2))], inbox=[
         msg(1, 0, sightings=[Sighting(0, -math.pi / 2, 3.0)], reports=[VisReport(0, 2, d_m)])]))
-    r1.step(obs(2, pose=(0.0, 1.5, 0.0), walls=wall))
+    # on the way to the ghost something hides it: A takes R1 there, as a temporary goal
+    r1.step(obs(2, pose=(0.0, 1.5, 0.0), walls=[*wall, (math.pi / 2, 0.05, 0.8)]))
+    (gx, gy), temporary = straight_nav[-1].calls[-1]
+    assert r1.mode == "ghost" and temporary and (gx, gy) == (pytest.approx(0.0, abs=1e-9), pytest.approx(3.0))
     # at the ghost, R1's own scan does not show the goal (a return 1 m along its bearing)
     bearing = math.atan2(-2.95, 6.0)
     a, _ = r1.step(obs(3, pose=(0.0, 2.95, 0.0), walls=[(bearing, 0.01, 1.0)]))
     assert r1.mode == "own_goal" and r1.sharing.path(0).reached
     assert (r1.promised_steps == 1) is promised
-    if not promised:  # explore again with A (§4.2)
+    if not promised:  # explore again with A (§4.2), towards the task goal: A resumes it
         assert a.direction_rad == pytest.approx(bearing, abs=1e-9)
+        assert straight_nav[-1].calls[-1] == ((6.0, 0.0), False)
     else:  # straight for the goal, sliding past what blocks the line
         assert a.direction_rad != pytest.approx(bearing, abs=1e-3) and abs(wrap_angle(a.direction_rad - bearing)) < math.pi / 2

@@ -405,15 +405,25 @@ class _LosBrain(abc.ABC):
                                        step_length_m=self.step_m, radius_m=self.radius_m)
         return self._nav
 
-    def _navigate(self, target: XY) -> tuple[Action, bool]:
-        """A heading from the navigator towards ``target`` (own frame); (action, progressing)."""
+    def _navigate(self, target: XY, temporary: bool = False) -> tuple[Action, bool]:
+        """A heading from the navigator towards ``target`` (own frame); (action, progressing).
+
+        ``temporary``: an excursion to a teammate, a ghost or a trouble helper (§3 rule 5, §4.2,
+        §5 rule 3: "R_j temporarily becomes R_i goal"); A suspends its task goal's memory
+        (VisBug's M-line and hit point) and resumes it when the task goal is set again
+        (``LocalNavigator.set_goal(..., temporary=True)``)."""
         nav = self._navigator()
-        if self._nav_goal is None or self._nav_goal != target:
-            nav.set_goal(np.array(target, dtype=np.float64))
-            self._nav_goal = target
+        key = (target, bool(temporary))
+        if self._nav_goal is None or self._nav_goal != key:
+            nav.set_goal(np.array(target, dtype=np.float64), temporary=bool(temporary))
+            self._nav_goal = key
         heading = nav.direction(self._pose.copy(), self._scan)
         progressing = bool(nav.progressing)
         if heading is None:
+            if temporary:
+                # A found the temporary point unreachable: drop the excursion for this step,
+                # keeping A (and the task's suspended memory)
+                return Action(), progressing
             if self.params.restart_navigator_on_give_up:
                 # gap filled: A gave up on this target (VisBug's "unreachable", which on a grid
                 # with a robot radius can be wrong): start A afresh from here next step
@@ -464,7 +474,8 @@ class _LosBrain(abc.ABC):
             if slide is not None:
                 self.slide_steps += 1
                 return Action(direction_rad=float(wrap_angle(slide - self._pose[2]))), progressing
-        action, _ = self._navigate(target)
+        temporary = not (isinstance(key, tuple) and key and key[0] in ("goal", "waypoint", "promised"))
+        action, _ = self._navigate(target, temporary=temporary)
         return action, progressing
 
     def _slide_heading(self, heading_rad: float, length_m: float) -> float | None:

@@ -37,7 +37,7 @@ what it costs here. Set ``NUMBA_NUM_THREADS=1`` for sweeps on a small box: the
 line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread launch
 costs more than the work for four robots.
 
-Quick mode (CI): the simple map only, the first target of task 1 with a 400-step budget,
+Quick mode (CI): the simple map only, the first target of task 1 with an 800-step budget,
 teams {R1, R1..R4}, err_max 0.4 (err_max 0 is the tables' R1..R4 run), no ablation: 9 short
 runs.
 """
@@ -150,7 +150,7 @@ FULL_CPU_NOTE = ("Cost of the full reproduction here (one core, measured on 10-t
                  "`teamnav sweep los-table1` (120 runs) and `los-table2` (120 runs) take roughly TBD CPU-hours each.")
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
-QUICK_BUDGET_STEPS_PER_TARGET = 400
+QUICK_BUDGET_STEPS_PER_TARGET = 800
 #: Maps run in quick mode (the complex map's runs are the longest).
 QUICK_MAPS = ("simple",)
 
