@@ -1,13 +1,32 @@
 """One MCL update (motion + perception weighting + resampling), particle-beams per second.
 
-Contenders, on the same map, particles and scan in one run:
+Contenders, on the same map, scan and particle distribution in one run:
 
 - teamnav ``MCL``, beam model with exact ray casting (Fox et al. §2.2 Fig. 1; ``teamnav.world.raycast``);
+- the same, doing what nav2 AMCL's update also does: augmented recovery (w_slow / w_fast), the
+  KLD bound over a histogram (``min = max = n``, as the peer is run) and the pose estimate;
 - teamnav ``MCL``, likelihood field (Probabilistic Robotics §6.4);
 - a straightforward NumPy MCL (written here): Table 5.6 motion, ray marching at half a cell,
   the exact beam mixture, ``searchsorted`` low-variance resampling;
 - nav2's AMCL core through the ``amcl`` package from PyPI (GPL-3.0: only in the benchmark's
-  own venv, never a teamnav dependency), ``min_particles = max_particles = n``, 60 beams.
+  own venv, never a teamnav dependency), ``min_particles = max_particles = n``, 60 beams. Its
+  binding hard-wires nav2's ``BeamModel`` (``amcl-0.1.2/src/amcl.cpp`` builds
+  ``std::make_unique<BeamModel>`` in the constructor and in ``setMap``; the likelihood-field
+  sources are compiled but never constructed): Bresenham ray casting per beam
+  (``map_calc_range``), ``exp`` of the mixture per beam, then ``pf_update_resample`` (KLD
+  histogram, random-pose injection, cluster statistics; its draw is a linear search per
+  sample, hence quadratic).
+
+Every round re-initialises every contender from the same Gaussian ``N(pose, diag(1 m, 1 m,
+0.5 rad)^2)`` around the pose the scan was taken from (untimed; amcl through
+``set_initial_pose``, which draws the same Gaussian, in walls and unknown space too) and then
+times one update: all contenders weigh the same kind of sample set, and the best of the
+rounds is kept. (Uniform sampling over free space is not reachable through the binding, and
+amcl's own global start, a Gaussian around the map centre, puts most samples in unknown
+space where its rays end at once.) Contenders take turns within a round, so they share the
+machine's load. The map is handed to amcl with its origin shifted by half a cell: amcl
+indexes a cell by ``round`` of the world coordinate (its cells are centred on grid
+corners), teamnav by ``floor``.
 
 Plus density-tree build + query for 10 000 samples. Usage::
 
@@ -21,15 +40,19 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import time
 from pathlib import Path
 
+import numba
 import numpy as np
 
 from teamnav.control.protocol import SensorInfo
-from teamnav.localization import MCL, DensityTree, MCLParams, MotionParams
+from teamnav.localization import MCL, DensityTree, KLDParams, MCLParams, MotionParams
 from teamnav.localization.beam_model import BeamModelParams, beam_probability
 from teamnav.world import load_map
+from teamnav.world.distance import distance_field
+from teamnav.world.grid import FREE, UNKNOWN
 from teamnav.world.raycast import RayCaster
 
 MAP = Path(__file__).resolve().parents[1] / "src/teamnav/world/maps/mit/basement_hallways_5cm.yaml"
@@ -93,105 +116,169 @@ class NumpyMCL:
 
 
 # ---------------------------------------------------------------------------- amcl peer
-def make_amcl(grid, n, angles):
-    try:
-        import amcl
-    except ImportError:
-        return None
-    occ = np.where(grid.cells == 0, 0, 100).astype(int)
-    occ[grid.cells == 2] = -1
-    mp = amcl.MotionParameters(alpha1=0.05, alpha2=0.05, alpha3=0.05, alpha4=0.05, alpha5=0.05)
-    lp = amcl.LaserParameters(z_hit=0.8, z_short=0.1, z_max=0.05, z_rand=0.05, sigma_hit=0.1, lambda_short=0.5,
-                              chi_outlier=0.0, max_beams=N_BEAMS)
-    loc = amcl.AMCL(n, n, 0.001, 0.1, mp, lp, "differential")
-    loc.set_map(amcl.create_occupancy_grid_from_list(occ.tolist(), grid.resolution_m, *grid.origin_xy_m))
-    loc.set_laser_pose(amcl.Vector3D(0.0, 0.0, 0.0))
-    xmin, xmax, ymin, ymax = grid.bounds_m
-    loc.set_initial_pose(amcl.Vector3D(0.5 * (xmin + xmax), 0.5 * (ymin + ymax), 0.0),
-                         amcl.create_diagonal_covariance(25.0, 25.0, 3.0))
-    return loc, amcl
+AMCL_NAME = "nav2 AMCL beam model (amcl 0.1.2, C++)"
+NUMPY_NAME = "NumPy (ray marching)"
 
 
-def time_amcl(peer, scan_m, angles, rounds):
-    loc, amcl = peer
-    scan = amcl.create_laser_scan_from_list([[float(r), float(a)] for r, a in zip(scan_m, angles)], MAX_RANGE)
-    x = 0.0
-    loc.update(scan, amcl.Vector3D(x, 0.0, 0.0))
-    best = math.inf
-    for _ in range(rounds):
-        x += 0.3  # beyond AMCL's update thresholds, so every call runs the filter
-        t = time.perf_counter()
-        loc.update(scan, amcl.Vector3D(x, 0.0, 0.0))
-        best = min(best, time.perf_counter() - t)
-    return best
+class AmclPeer:
+    """nav2 AMCL through the ``amcl`` binding, fed the same map, scan and odometry steps."""
+
+    def __init__(self, amcl, grid, n, scan_m, angles):
+        self.amcl = amcl
+        occ = np.where(grid.cells == FREE, 0, 100).astype(int)
+        occ[grid.cells == UNKNOWN] = -1  # amcl: unknown stops its rays, as "unknown" in SEES does here
+        mp = amcl.MotionParameters(alpha1=0.05, alpha2=0.05, alpha3=0.05, alpha4=0.05, alpha5=0.05)
+        lp = amcl.LaserParameters(z_hit=0.8, z_short=0.1, z_max=0.05, z_rand=0.05, sigma_hit=0.1, lambda_short=0.5,
+                                  chi_outlier=0.0, max_beams=N_BEAMS)
+        self.loc = amcl.AMCL(n, n, 0.001, 0.1, mp, lp, "differential")
+        half = 0.5 * grid.resolution_m  # amcl's cell i spans (i - 1/2, i + 1/2) cells from its origin
+        ox, oy = grid.origin_xy_m
+        self.loc.set_map(amcl.create_occupancy_grid_from_list(occ.tolist(), grid.resolution_m, ox + half, oy + half))
+        self.loc.set_laser_pose(amcl.Vector3D(0.0, 0.0, 0.0))
+        self.scan = amcl.create_laser_scan_from_list([[float(r), float(a)] for r, a in zip(scan_m, angles)], MAX_RANGE)
+        self.odom = np.zeros(3)
+
+    def reset(self, mean, std):
+        a = self.amcl
+        self.loc.set_initial_pose(a.Vector3D(*map(float, mean)), a.create_diagonal_covariance(*(float(v) ** 2 for v in std)))
+
+    def step(self, delta):
+        # the first update after set_initial_pose takes its odometry as the reference (a zero
+        # step: amcl still draws the motion noise), then weighs the scan and resamples
+        c, s = math.cos(self.odom[2]), math.sin(self.odom[2])
+        self.odom = self.odom + [c * delta[0] - s * delta[1], s * delta[0] + c * delta[1], delta[2]]
+        self.loc.update(self.scan, self.amcl.Vector3D(*self.odom))
+
+    def pose(self):
+        m = self.loc.get_pose_mean()
+        return np.array([m.x, m.y, m.theta])
+
+
+# ---------------------------------------------------------------------------- teamnav contenders
+class TeamnavPeer:
+    def __init__(self, grid, sensor, n, model, scan, as_amcl=False):
+        extra = {}
+        if as_amcl:
+            extra = dict(recovery="augmented", adaptive=True, kld=KLDParams(min_particles=n, max_particles=n))
+        else:
+            extra = dict(recovery="none")
+        self.f = MCL(MCLParams(n_particles=n, sensor_model=model, motion=MotionParams(), **extra), grid, sensor,
+                     np.random.default_rng(0))
+        self.scan = scan
+        self.as_amcl = as_amcl
+
+    def reset(self, mean, std):
+        self.f.init_pose(mean, np.diag(np.asarray(std) ** 2))
+
+    def step(self, delta):
+        f = self.f
+        f.predict(delta)
+        f.update(self.scan)
+        f.resample()
+        if self.as_amcl:
+            f.estimate()
+
+
+class NumpyPeer:
+    def __init__(self, grid, angles, n, scan):
+        self.grid, self.angles, self.n, self.scan = grid, angles, n, scan
+        self.rng = np.random.default_rng(3)
+        self.m = None
+
+    def reset(self, mean, std):
+        p = np.asarray(mean) + self.rng.standard_normal((self.n, 3)) * np.asarray(std)
+        p[:, 2] = np.angle(np.exp(1j * p[:, 2]))
+        self.m = NumpyMCL(self.grid, p, self.angles, self.rng)
+
+    def step(self, delta):
+        self.m.update(delta, self.scan, (0.05,) * 4)
 
 
 # ---------------------------------------------------------------------------- runs
-def time_teamnav(grid, sensor, n, model, scan, rounds):
-    params = MCLParams(n_particles=n, sensor_model=model, recovery="none", motion=MotionParams())
-    f = MCL(params, grid, sensor, np.random.default_rng(0))
-    f.init_global()
-    d = np.array([0.1, 0.0, 0.02])
-    f.predict(d), f.update(scan), f.resample()  # compile / warm caches
-    best = math.inf
-    for _ in range(rounds):
-        t = time.perf_counter()
-        f.predict(d)
-        f.update(scan)
-        f.resample()
-        best = min(best, time.perf_counter() - t)
-    return best
+DELTA = np.array([0.1, 0.0, 0.02])  # odometry step of every update (previous body frame) [m, m, rad]
+INIT_STD = (1.0, 1.0, 0.5)  # spread of the sample set every round starts from [m, m, rad]
+
+
+def best_of_rounds(peers, mean, rounds, once=()):
+    """Best wall and best CPU time of one update per contender (contenders take turns within
+    a round, so they share the machine's load); those named in ``once`` run one round only."""
+    wall = {k: math.inf for k in peers}
+    cpu = {k: math.inf for k in peers}
+    for r in range(rounds):
+        for name, peer in peers.items():
+            if r and name in once:
+                continue
+            peer.reset(mean, INIT_STD)
+            c = time.process_time()
+            t = time.perf_counter()
+            peer.step(DELTA)
+            wall[name] = min(wall[name], time.perf_counter() - t)
+            cpu[name] = min(cpu[name], time.process_time() - c)
+    return wall, cpu
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="1k and 10k particles only, fewer rounds")
+    ap.add_argument("--sizes", type=int, nargs="+", help="particle counts (default 1000 10000 100000)")
+    ap.add_argument("--rounds", type=int, help="timed rounds per size (default 7, 5 with --quick)")
     ap.add_argument("--no-numpy-at", type=int, default=100_000, help="skip the NumPy peer from this many particles")
     args = ap.parse_args()
-    sizes = [1000, 10_000] if args.quick else [1000, 10_000, 100_000]
-    rounds = 3 if args.quick else 5
+    sizes = args.sizes or ([1000, 10_000] if args.quick else [1000, 10_000, 100_000])
+    rounds = args.rounds or (5 if args.quick else 7)
     grid = load_map(MAP)
     angles = np.linspace(-np.pi / 2, np.pi / 2, N_BEAMS)
     sensor = SensorInfo("laser", "laser", angles, MAX_RANGE, 0.02)
     caster = RayCaster(grid, SEES, MAX_RANGE)
     rng = np.random.default_rng(1)
-    free = np.argwhere(grid.cells == 0)
+    free = np.argwhere(distance_field(grid) >= 0.5)
     rc = free[rng.integers(len(free))]
-    here = np.array([[(rc[1] + 0.5) * grid.resolution_m, (rc[0] + 0.5) * grid.resolution_m, 0.3]])
-    scan = caster.cast(here, angles)[0]
-    print(f"map {grid.name} {grid.shape[1]}x{grid.shape[0]} cells, {N_BEAMS} beams over 180 deg, "
-          f"{MAX_RANGE:g} m; particles uniform over free space; best of {rounds}")
+    here = np.array([(rc[1] + 0.5) * grid.resolution_m, (rc[0] + 0.5) * grid.resolution_m, 0.3])
+    scan = caster.cast(here[None], angles)[0]
+    try:
+        import amcl
+    except ImportError:
+        amcl = None
+    # the ray lengths the contenders meet: the samples of one round's start
+    probe = MCL(MCLParams(n_particles=10_000), grid, sensor, np.random.default_rng(5))
+    probe.init_pose(here, np.diag(np.asarray(INIT_STD) ** 2))
+    pr = caster.cast(np.array(probe.particles), angles)
+    print(f"map {grid.name} {grid.shape[1]}x{grid.shape[0]} cells, {N_BEAMS} beams over 180 deg, {MAX_RANGE:g} m; "
+          f"every round starts from N(pose of the scan, diag{INIT_STD}^2) [m, m, rad]: "
+          f"{(pr[:, 0] == 0).mean():.0%} of the samples in walls or unknown space, mean expected range "
+          f"{pr.mean():.2f} m; one update = predict + weigh + resample; best of {rounds} rounds; "
+          f"numba threads {numba.get_num_threads()}, load average {os.getloadavg()[0]:.1f}; NumPy: one round "
+          f"from 10 000 samples", flush=True)
     print()
-    print(f"| particles | method | ms / update | M particle-beams/s | vs amcl | vs NumPy |")
-    print(f"| ---: | --- | ---: | ---: | ---: | ---: |")
-    amcl_missing = False
+    print("| particles | method | ms / update | M particle-beams/s | vs amcl | CPU ms / update | vs amcl (CPU) "
+          "| vs NumPy |")
+    print("| ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: |")
     for n in sizes:
         pb = n * N_BEAMS
-        res = {}
-        res["teamnav beam (exact ray casting)"] = time_teamnav(grid, sensor, n, "beam", scan, rounds)
-        res["teamnav likelihood field"] = time_teamnav(grid, sensor, n, "likelihood_field", scan, rounds)
+        peers = {
+            "teamnav beam (exact ray casting)": TeamnavPeer(grid, sensor, n, "beam", scan),
+            "teamnav beam + KLD + augmented + estimate": TeamnavPeer(grid, sensor, n, "beam", scan, as_amcl=True),
+            "teamnav likelihood field": TeamnavPeer(grid, sensor, n, "likelihood_field", scan),
+        }
         if n < args.no_numpy_at:
-            init = MCL(MCLParams(n_particles=n), grid, sensor, np.random.default_rng(2))
-            init.init_global()
-            peer = NumpyMCL(grid, np.array(init.particles), angles, np.random.default_rng(3))
-            best = math.inf
-            for _ in range(max(1, rounds // 2)):
-                t = time.perf_counter()
-                peer.update([0.1, 0.0, 0.02], scan, (0.05,) * 4)
-                best = min(best, time.perf_counter() - t)
-            res["NumPy (ray marching)"] = best
-        peer = make_amcl(grid, n, angles)
-        if peer is None:
-            amcl_missing = True
-        else:
-            res["nav2 AMCL (amcl 0.1.2, C++)"] = time_amcl(peer, scan, angles, rounds)
-        ref_a = res.get("nav2 AMCL (amcl 0.1.2, C++)")
-        ref_n = res.get("NumPy (ray marching)")
-        for name, t in res.items():
-            va = f"{ref_a / t:.2f}x" if ref_a else "-"
+            peers[NUMPY_NAME] = NumpyPeer(grid, angles, n, scan)
+        if amcl is not None:
+            peers[AMCL_NAME] = AmclPeer(amcl, grid, n, scan, angles)
+        for name, peer in peers.items():  # compile, warm caches (the slow peers need no warming)
+            if name not in (NUMPY_NAME, AMCL_NAME) or n <= 1000:
+                peer.reset(here, INIT_STD)
+                peer.step(DELTA)
+        slow = (NUMPY_NAME,) if n >= 10_000 else ()
+        wall, cpu = best_of_rounds(peers, here, rounds if n < 100_000 else max(3, rounds // 2), once=slow)
+        ref_a, ref_ac = wall.get(AMCL_NAME), cpu.get(AMCL_NAME)
+        ref_n = wall.get(NUMPY_NAME)
+        for name, t in wall.items():
+            va = f"**{ref_a / t:.2f}x**" if ref_a and name.startswith("teamnav beam") else (f"{ref_a / t:.2f}x" if ref_a else "-")
+            vc = f"{ref_ac / cpu[name]:.2f}x" if ref_ac else "-"
             vn = f"{ref_n / t:.1f}x" if ref_n else "-"
-            print(f"| {n:,} | {name} | {t * 1e3:.2f} | {pb / t / 1e6:.2f} | {va} | {vn} |")
-    if amcl_missing:
+            print(f"| {n:,} | {name} | {t * 1e3:.2f} | {pb / t / 1e6:.2f} | {va} | {cpu[name] * 1e3:.2f} | {vc} | {vn} |",
+                  flush=True)
+    if amcl is None:
         print("\namcl is not installed in this interpreter; for the AMCL column run:\n"
               "  python -m venv /tmp/amcl-venv && /tmp/amcl-venv/bin/pip install amcl numpy numba scipy pillow "
               "pyyaml pydantic\n  /tmp/amcl-venv/bin/pip install -e . --no-deps\n"

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy import integrate
 
@@ -22,6 +24,7 @@ from teamnav.localization.likelihood_field import lf_log_likelihood_reference
 from teamnav.localization.motion import motion_kernel, sample_motion, sample_motion_reference
 from teamnav.localization.resample import low_variance_indices, low_variance_kernel, low_variance_reference
 from teamnav.world import MapBuilder, load_map
+from teamnav.world.grid import OccupancyGrid
 from teamnav.world.distance import distance_field
 from teamnav.world.raycast import RayCaster
 
@@ -300,3 +303,50 @@ def test_serial_twins_agree_and_have_their_own_cache():
     table, step = beam_log_table(rng.uniform(0.1, 10.0, 20), BeamModelParams(), 10.0)
     assert_allclose(beam_model.beam_loglik_kernel_serial(rays, 2, table, 1 / step, 0.5, np.empty(300)),
                     beam_loglik_kernel(rays, 2, table, 1 / step, 0.5, np.empty(300)), atol=0)
+
+
+# ---------------------------------------------------------------------------- estimate
+def _reference_estimate(p, w, cell):
+    """The NumPy + ``scipy.ndimage.label`` estimate the compiled one replaced."""
+    from scipy import ndimage
+
+    def wpose(q, v):
+        s = v.sum()
+        m = np.array([np.dot(v, q[:, 0]) / s, np.dot(v, q[:, 1]) / s,
+                      math.atan2(np.dot(v, np.sin(q[:, 2])), np.dot(v, np.cos(q[:, 2])))])
+        d = np.stack([q[:, 0] - m[0], q[:, 1] - m[1], wrap_angle(q[:, 2] - m[2])], axis=1)
+        return m, (d * (v / s)[:, None]).T @ d
+
+    mean, cov = wpose(p, w)
+    ix = ((p[:, 0] - p[:, 0].min()) / cell).astype(np.int64)
+    iy = ((p[:, 1] - p[:, 1].min()) / cell).astype(np.int64)
+    occ = np.zeros((iy.max() + 1, ix.max() + 1), dtype=bool)
+    occ[iy, ix] = True
+    labels, k = ndimage.label(occ, structure=np.ones((3, 3), dtype=bool))
+    lab = labels[iy, ix]
+    cw = np.bincount(lab, weights=w, minlength=k + 1)
+    best = int(np.argmax(cw))
+    cmean, _ = wpose(p[lab == best], w[lab == best])
+    return mean, cov, cmean, cw[best], k
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31), k=st.integers(1, 6), n=st.integers(1, 1500),
+       cell=st.sampled_from([0.2, 0.5, 1.0]), equal=st.booleans())
+def test_estimate_matches_ndimage_clusters(seed, k, n, cell, equal):
+    rng = np.random.default_rng(seed)
+    g = OccupancyGrid.empty(40.0, 30.0, 0.1)
+    f = MCL(MCLParams(n_particles=n, cluster_cell_m=cell), g, SensorInfo("laser", "laser", np.zeros(1), 5.0),
+            np.random.default_rng(0))
+    centres = rng.uniform(2, 38, (k, 2))
+    xy = centres[rng.integers(0, k, n)] + rng.normal(0, rng.uniform(0.05, 2.0), (n, 2))
+    f._particles = np.ascontiguousarray(np.c_[xy, wrap_angle(rng.normal(3.0, rng.uniform(0.1, 3.0), n))])
+    w = np.full(n, 1.0 / n) if equal else rng.random(n) ** 3 + 1e-9  # equal weights: ties break as ndimage's
+    f._weights = w / w.sum()
+    est = f.estimate()
+    mean, cov, cmean, cw, nc = _reference_estimate(f._particles, f._weights, cell)
+    assert est.n_clusters == nc
+    assert est.cluster_weight == pytest.approx(cw, abs=1e-12)
+    assert_allclose(est.pose, mean, atol=1e-9)
+    assert_allclose(est.cov, cov, atol=1e-9)
+    assert_allclose(est.cluster_pose, cmean, atol=1e-9)

@@ -32,7 +32,7 @@ from typing import Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
-from scipy import ndimage
+from numba import njit
 
 from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
@@ -42,7 +42,7 @@ from teamnav.localization.kld import KLDParams, kld_count_kernel
 from teamnav.localization.likelihood_field import (
     LikelihoodFieldParams, build_log_field, lf_loglik_kernel, lf_loglik_kernel_serial,
 )
-from teamnav.localization.motion import MotionParams, motion_kernel, motion_kernel_serial
+from teamnav.localization.motion import MotionParams, _wrap, motion_kernel, motion_kernel_serial
 from teamnav.localization.resample import effective_sample_size, low_variance_kernel, normalize_log_weights
 from teamnav.world.distance import distance_field
 from teamnav.world.grid import DEFAULT_SEES, FREE, OccupancyGrid
@@ -158,15 +158,126 @@ class Estimate:
     n_particles: int
 
 
-def _weighted_pose(p: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    s = w.sum()
-    x = float(np.dot(w, p[:, 0]) / s)
-    y = float(np.dot(w, p[:, 1]) / s)
-    th = math.atan2(float(np.dot(w, np.sin(p[:, 2]))), float(np.dot(w, np.cos(p[:, 2]))))
-    mean = np.array([x, y, th])
-    d = np.stack([p[:, 0] - x, p[:, 1] - y, wrap_angle(p[:, 2] - th)], axis=1)
-    cov = (d * (w / s)[:, None]).T @ d
-    return mean, cov
+@njit(cache=True)
+def _weighted_pose_kernel(p, w, sel, out_mean, out_cov):
+    """Weighted mean (circular in heading) and covariance of the samples with ``sel[i]``."""
+    s = 0.0
+    sx = 0.0
+    sy = 0.0
+    ss = 0.0
+    sc = 0.0
+    for i in range(p.shape[0]):
+        if sel[i]:
+            wi = w[i]
+            s += wi
+            sx += wi * p[i, 0]
+            sy += wi * p[i, 1]
+            ss += wi * math.sin(p[i, 2])
+            sc += wi * math.cos(p[i, 2])
+    x = sx / s
+    y = sy / s
+    th = math.atan2(ss, sc)
+    out_mean[0] = x
+    out_mean[1] = y
+    out_mean[2] = th
+    out_cov[:, :] = 0.0
+    d = np.empty(3)
+    for i in range(p.shape[0]):
+        if sel[i]:
+            wi = w[i] / s
+            d[0] = p[i, 0] - x
+            d[1] = p[i, 1] - y
+            d[2] = _wrap(p[i, 2] - th)
+            for a in range(3):
+                for b in range(a, 3):
+                    out_cov[a, b] += wi * d[a] * d[b]
+    for a in range(3):
+        for b in range(a):
+            out_cov[a, b] = out_cov[b, a]
+
+
+@njit(cache=True)
+def _find(parent, a):
+    while parent[a] != a:
+        parent[a] = parent[parent[a]]
+        a = parent[a]
+    return a
+
+
+@njit(cache=True)
+def _clusters_kernel(p, w, cell, sel):
+    """Clusters of the samples: 8-connected components of the cells of side ``cell`` that hold
+    samples (``scipy.ndimage.label`` with a 3 x 3 structure), numbered in raster order of the
+    cells. Marks in ``sel`` the samples of the heaviest cluster (the first on a tie); returns
+    ``(n_clusters, its weight)``."""
+    n = p.shape[0]
+    xmin = p[0, 0]
+    ymin = p[0, 1]
+    for i in range(n):
+        xmin = min(xmin, p[i, 0])
+        ymin = min(ymin, p[i, 1])
+    ix = np.empty(n, np.int64)
+    iy = np.empty(n, np.int64)
+    nx = 0
+    ny = 0
+    for i in range(n):
+        ix[i] = int((p[i, 0] - xmin) / cell)
+        iy[i] = int((p[i, 1] - ymin) / cell)
+        nx = max(nx, ix[i] + 1)
+        ny = max(ny, iy[i] + 1)
+    # occupied cells, sorted in raster order, and the cell of every sample
+    key = iy * nx + ix
+    order = np.argsort(key, kind="mergesort")
+    cell_of = np.empty(n, np.int64)
+    keys = np.empty(n, np.int64)
+    m = 0
+    for k in range(n):
+        i = order[k]
+        if m == 0 or keys[m - 1] != key[i]:
+            keys[m] = key[i]
+            m += 1
+        cell_of[i] = m - 1
+    keys = keys[:m]
+    parent = np.arange(m)
+    # union with the already-seen neighbours (left, and the three below) found by binary search
+    for a in range(m):
+        r = keys[a] // nx
+        c = keys[a] - r * nx
+        for dr, dc in ((0, -1), (-1, -1), (-1, 0), (-1, 1)):
+            rr = r + dr
+            cc = c + dc
+            if rr < 0 or cc < 0 or cc >= nx:
+                continue
+            kb = rr * nx + cc
+            b = np.searchsorted(keys, kb)
+            if b < m and keys[b] == kb:
+                ra = _find(parent, a)
+                rb = _find(parent, b)
+                if ra != rb:
+                    if ra < rb:
+                        parent[rb] = ra
+                    else:
+                        parent[ra] = rb
+    # roots are the lowest cell (raster order) of each component: number them in that order
+    label = np.empty(m, np.int64)
+    n_clusters = 0
+    for a in range(m):
+        ra = _find(parent, a)
+        if ra == a:
+            label[a] = n_clusters
+            n_clusters += 1
+        else:
+            label[a] = label[ra]
+    cw = np.zeros(n_clusters)
+    for i in range(n):
+        cw[label[cell_of[i]]] += w[i]
+    best = 0
+    for k in range(1, n_clusters):
+        if cw[k] > cw[best]:
+            best = k
+    for i in range(n):
+        sel[i] = label[cell_of[i]] == best
+    return n_clusters, cw[best]
 
 
 class MCL:
@@ -552,21 +663,14 @@ class MCL:
         """Weighted mean and covariance, and the heaviest cluster's mean (see :class:`Estimate`)."""
         self._require_particles("estimate")
         p, w = self._particles, self._weights
-        mean, cov = _weighted_pose(p, w)
-        cell = self.params.cluster_cell_m
-        xmin, ymin = p[:, 0].min(), p[:, 1].min()
-        ix = ((p[:, 0] - xmin) / cell).astype(np.int64)
-        iy = ((p[:, 1] - ymin) / cell).astype(np.int64)
-        shape = (int(iy.max()) + 1, int(ix.max()) + 1)
-        occ = np.zeros(shape, dtype=bool)
-        occ[iy, ix] = True
-        labels, n_clusters = ndimage.label(occ, structure=np.ones((3, 3), dtype=bool))
-        lab = labels[iy, ix]
-        cw = np.bincount(lab, weights=w, minlength=n_clusters + 1)
-        best = int(np.argmax(cw))
-        sel = lab == best
-        cmean, _ = _weighted_pose(p[sel], w[sel])
-        return Estimate(mean, cov, cmean, float(cw[best]), int(n_clusters), effective_sample_size(w), int(p.shape[0]))
+        n = p.shape[0]
+        mean, cov = np.empty(3), np.empty((3, 3))
+        _weighted_pose_kernel(p, w, np.ones(n, dtype=np.bool_), mean, cov)
+        sel = np.empty(n, dtype=np.bool_)
+        n_clusters, cluster_weight = _clusters_kernel(p, w, float(self.params.cluster_cell_m), sel)
+        cmean, ccov = np.empty(3), np.empty((3, 3))
+        _weighted_pose_kernel(p, w, sel, cmean, ccov)
+        return Estimate(mean, cov, cmean, float(cluster_weight), int(n_clusters), effective_sample_size(w), int(n))
 
 
 # ---------------------------------------------------------------------------- scoring helpers
