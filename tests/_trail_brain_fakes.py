@@ -9,15 +9,22 @@ from teamnav.control.types import Observation, RangeScan
 
 
 class RecordingNav:
-    """Stands in for Navigate: records the preferred headings it is handed."""
+    """Stands in for Navigate: records the preferred headings, reversal vetoes and turn-arounds
+    it is handed."""
 
     def __init__(self, params, rng, info, laser="laser"):
         self.headings = []
+        self.allow_reverse = []
+        self.turn_arounds = []  # leave_m of each turn_around call
         self.mode = "fake"
 
-    def step(self, obs, preferred_heading_rad=None):
+    def step(self, obs, preferred_heading_rad=None, *, allow_reverse=True):
         self.headings.append(preferred_heading_rad)
+        self.allow_reverse.append(allow_reverse)
         return 0.3, 0.0
+
+    def turn_around(self, leave_m=0.0):
+        self.turn_arounds.append((len(self.headings), leave_m))
 
 
 def make_obs(robot_id, step, pose, events=(), inbox=()):

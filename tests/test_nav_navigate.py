@@ -292,11 +292,48 @@ def test_heading_against_the_trail_makes_a_sharp_right_turn_then_progress():
     assert poses[-1, 0] > 5.0 and clearance(corridor, poses) > RADIUS
 
 
-@pytest.mark.parametrize(("off_deg", "reverses"), [(125.0, False), (145.0, True)])
-def test_reverse_threshold_is_135_degrees(off_deg, reverses):
+@pytest.mark.parametrize(("off_deg", "reverses"), [(135.0, False), (145.0, False), (155.0, True)])
+def test_reverse_threshold_is_150_degrees(off_deg, reverses):
+    # 150, not 135: at a corner the averaged trail points 45 deg between its two legs, and a
+    # robot coming back out of the dead end beyond it is 135 deg off; it must not reverse there.
     n = nav()
     n.step(observe(np.full(181, MAX_R), (0.0, 0.0, math.radians(off_deg))), 0.0)
     assert (n.mode == "turn") == reverses
+
+
+def test_a_vetoed_reversal_is_not_made_and_the_next_waits_for_distance_driven():
+    n = nav()
+    n.step(observe(np.full(181, MAX_R), (0.0, 0.0, math.pi)), 0.0, allow_reverse=False)
+    assert n.mode == "navigate"
+    n = nav(reverse_cooldown_s=0.0, reverse_cooldown_m=3.0)
+    x = 0.0
+    n.step(observe(np.full(181, MAX_R), (x, 0.0, math.pi), 0), 0.0)
+    assert n.mode == "turn"
+    n.mode = "navigate"  # as if the turn had ended with the robot still facing away
+    reversals = []
+    for k in range(1, 100):  # drives 0.04 m per step, still facing against the hint
+        x -= 0.04
+        n.step(observe(np.full(181, MAX_R), (x, 0.0, math.pi), k), 0.0)
+        if n.mode == "turn":
+            reversals.append(-x)
+            n.mode = "navigate"
+    assert reversals and reversals[0] == pytest.approx(3.0, abs=0.05)
+
+
+def test_turn_around_at_a_place_turns_right_180_then_leaves_without_trail_rules():
+    corridor = [(-10.0, 0.9, 10.0, 0.9), (-10.0, -0.9, 10.0, -0.9)]
+    n = nav(reverse_cooldown_m=0.0, reverse_cooldown_s=0.0)
+    n.turn_around(2.0)
+    assert n.mode == "turn" and n.leaving
+    # the hint says "go on east" (against the turn) all along: no reversal until 2 m are driven
+    poses, cmds, modes = drive(n, corridor, (0.0, 0.0, 0.0), 120, preferred=0.0)
+    assert cmds[0][0] == 0.0 and cmds[0][1] < 0  # a right turn on the spot
+    end = modes.index("navigate")
+    assert abs(abs(poses[end, 2]) - math.pi) < math.radians(10)
+    first_reverse = next(k for k in range(end, len(modes)) if modes[k] == "turn")
+    assert poses[first_reverse, 0] == pytest.approx(-2.0, abs=0.1)
+    with pytest.raises(ValueError, match="leave_m"):
+        n.turn_around(-1.0)
 
 
 def test_reset_forgets_a_manoeuvre():

@@ -100,6 +100,17 @@ class BlazingTrailParams(BaseModel):
         Cut loops out of the private list (module docstring; False: the paper as written).
     prune_radius_m, prune_min_loop_m : float
         Back within this distance [m] of an own crumb at least this much path behind [m] = a loop.
+    crumb_min_move_m : float
+        No crumb unless the robot moved at least this far [m] since its last one (0: the paper).
+    turn_at_place : bool
+        Turn 180 deg on reaching the sought place (False: the paper's rules alone).
+    lookahead_m : float
+        Average the crumbs around the point this far ahead of the position estimate [m]
+        (0: around the position estimate, the paper).
+    reverse_min_crumbs : int
+        No 180 deg reversal on a hint from fewer crumbs than this (1: the paper).
+    leave_place_m : float
+        After that turn, wall follow this far [m] before the trail rules apply again.
     sensor : str
         The laser Navigate reads.
     layer_every_steps : int
@@ -119,6 +130,11 @@ class BlazingTrailParams(BaseModel):
     cruise_speed_mps: float = Field(0.25, gt=0.0, le=10.0)
     max_global_crumbs: int | None = Field(None, ge=1, le=10_000_000)
     prune_loops: bool = True
+    crumb_min_move_m: float = Field(0.1, ge=0.0, le=100.0)
+    turn_at_place: bool = True
+    lookahead_m: float = Field(1.0, ge=0.0, le=100.0)
+    reverse_min_crumbs: int = Field(3, ge=1, le=1_000_000)
+    leave_place_m: float = Field(2.0, ge=0.0, le=100.0)
     prune_radius_m: float = Field(1.0, gt=0.0, le=100.0)
     prune_min_loop_m: float = Field(4.0, gt=0.0, le=1000.0)
     sensor: str = Field("laser", min_length=1)
@@ -161,6 +177,7 @@ class BlazingTrail:
         self._next_crumb_s = 0.0
         self._path_m = 0.0
         self._last_xy: tuple[float, float] | None = None
+        self._crumb_xy: tuple[float, float] | None = None
         self.loops_cut = 0
         self._following = False
         self._step = 0
@@ -191,7 +208,9 @@ class BlazingTrail:
         if self._last_xy is not None:
             self._path_m += math.hypot(x - self._last_xy[0], y - self._last_xy[1])
         self._last_xy = (x, y)
-        if t >= self._next_crumb_s:  # before the events: a crumb dropped on arrival goes out with the list
+        moved = self._crumb_xy is None or math.hypot(x - self._crumb_xy[0], y - self._crumb_xy[1]) >= p.crumb_min_move_m
+        if t >= self._next_crumb_s and moved:  # before the events: a crumb on arrival goes out with the list
+            self._crumb_xy = (x, y)
             if p.prune_loops:
                 self.loops_cut += self.private.drop_pruning_loops(
                     x, y, th, outbound=not self.carrying, path_m=self._path_m, radius_m=p.prune_radius_m,
@@ -203,14 +222,19 @@ class BlazingTrail:
             if reached == p.home_event:
                 self.deliveries += 1
             outbox += self._waggle_dance(obs)
+            if p.turn_at_place:
+                self.nav.turn_around(p.leave_place_m)
         if p.communicate:
             for msg in obs.inbox:
                 if msg.kind == "crumbs" and isinstance(msg.body, CrumbBatch) and msg.sender != self.info.robot_id:
                     self.global_crumbs.extend(msg.body)
-        mean = self.global_crumbs.average_heading(x, y, p.radius_m)
+        qx, qy = x + p.lookahead_m * math.cos(th), y + p.lookahead_m * math.sin(th)
+        mean = self.global_crumbs.average_heading(qx, qy, p.radius_m)
         pref = preferred_heading(mean, self.carrying)
         self._following = pref is not None
-        v, w = self.nav.step(obs, preferred_heading_rad=pref)
+        allow = pref is not None and (p.reverse_min_crumbs <= 1
+                                      or self.global_crumbs.count_near(qx, qy, p.radius_m) >= p.reverse_min_crumbs)
+        v, w = self.nav.step(obs, preferred_heading_rad=pref, allow_reverse=allow)
         return Action(float(v), float(w)), outbox
 
     def log(self) -> dict[str, Any]:

@@ -195,6 +195,14 @@ class CrumbList:
         """:func:`average_heading` over this list."""
         return average_heading(self.xy_m, self.heading_rad, x_odom_m, y_odom_m, radius_m)
 
+    def count_near(self, x_odom_m: float, y_odom_m: float, radius_m: float) -> int:
+        """How many crumbs lie within ``radius_m`` (inclusive) of (x, y)."""
+        if self._n == 0:
+            return 0
+        dx = self._buf[: self._n, 0] - x_odom_m
+        dy = self._buf[: self._n, 1] - y_odom_m
+        return int(np.count_nonzero(dx * dx + dy * dy <= radius_m * radius_m))
+
 
 def average_heading(xy_m: np.ndarray, heading_rad: np.ndarray, x_odom_m: float, y_odom_m: float,
                     radius_m: float) -> float | None:

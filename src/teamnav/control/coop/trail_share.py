@@ -93,6 +93,14 @@ class TrailShareParams(BaseModel):
         Head only for crumbs below the robot's own time-to-goal bound (module docstring).
     reach_m : float
         A goal crumb this close [m] has been reached (it sets the bound).
+    turn_at_place : bool
+        Turn 180 deg on reaching the sought place (False: the paper's rules alone).
+    lookahead_m : float
+        Pick the best crumb among those around the point this far ahead of the position
+        estimate [m] (0: around the position estimate, the paper); the hint still points
+        from the robot to that crumb.
+    leave_place_m : float
+        After that turn, wall follow this far [m] before the trail rules apply again.
     sensor : str
         The laser Navigate reads.
     layer_every_steps : int
@@ -117,6 +125,9 @@ class TrailShareParams(BaseModel):
     crumbs_for: Literal["last_place", "every_place"] = "last_place"
     min_move_m: float = Field(0.05, ge=0.0, le=100.0)
     descend_only: bool = True
+    turn_at_place: bool = True
+    lookahead_m: float = Field(1.0, ge=0.0, le=100.0)
+    leave_place_m: float = Field(2.0, ge=0.0, le=100.0)
     reach_m: float = Field(0.6, gt=0.0, le=100.0)
     sensor: str = Field("laser", min_length=1)
     layer_every_steps: int = Field(50, ge=1, le=1_000_000)
@@ -180,7 +191,7 @@ class TrailShare:
         p = self.params
         self._step = int(obs.step)
         t = float(obs.time_s)
-        x, y = obs.odom_pose.tolist()[:2]
+        x, y, th = obs.odom_pose.tolist()[:3]
         outbox: list[Message] = []
         if not self._started:
             self._started = True
@@ -193,6 +204,8 @@ class TrailShare:
             self.visits_s[e] = t
         if self.round.observe(obs.events, t):
             self._bound_s = math.inf  # a new goal
+            if p.turn_at_place:
+                self.nav.turn_around(p.leave_place_m)
         if p.communicate:  # §2.2 step 3
             for msg in obs.inbox:
                 if msg.kind == "trail" and isinstance(msg.body, TrailMessage) and msg.sender != self.info.robot_id:
@@ -219,7 +232,8 @@ class TrailShare:
             if near is not None and near[1] < bound:
                 self._bound_s, self._bound_t, bound = near[1], t, near[1]
             below = bound
-        heading = self.trail.heading_to_best(goal, x, y, p.radius_m, below_s=below)  # §2.3 step 1
+        qx, qy = x + p.lookahead_m * math.cos(th), y + p.lookahead_m * math.sin(th)
+        heading = self.trail.heading_to_best(goal, qx, qy, p.radius_m, below_s=below, from_xy=(x, y))  # §2.3 step 1
         self._following = heading is not None
         v, w = self.nav.step(obs, preferred_heading_rad=heading)
         return Action(float(v), float(w)), outbox

@@ -350,13 +350,18 @@ class Trail:
         return i, float(s[i])
 
     def heading_to_best(self, goal: str, x_odom_m: float, y_odom_m: float, radius_m: float, *,
-                        below_s: float = math.inf) -> float | None:
-        """Direction [rad] from (x, y) towards :meth:`best_crumb`, or None (no crumb, or on it)."""
+                        below_s: float = math.inf, from_xy: tuple[float, float] | None = None) -> float | None:
+        """Direction [rad] towards :meth:`best_crumb` around (x, y), or None (no crumb, or on it).
+
+        The direction is taken from ``from_xy`` (the robot's position, when the crumbs were
+        searched around a point ahead of it), by default from (x, y).
+        """
         best = self.best_crumb(goal, x_odom_m, y_odom_m, radius_m, below_s=below_s)
         if best is None:
             return None
+        fx, fy = (x_odom_m, y_odom_m) if from_xy is None else from_xy
         cx, cy = self._xys[best[0], :2]
-        dx, dy = cx - x_odom_m, cy - y_odom_m
+        dx, dy = cx - fx, cy - fy
         if dx * dx + dy * dy < 1e-12:
             return None
         return math.atan2(dy, dx)

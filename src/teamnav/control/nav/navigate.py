@@ -19,7 +19,11 @@ One step, in priority order:
 3. **Against the trail**: "If the robot is heading in approximately the opposite direction to
    the trail it makes a sharp 180° right turn" (§4.2). "Approximately opposite" is taken as
    more than ``reverse_threshold_deg`` (default 135 deg) between the odometry heading and the
-   preferred heading; afterwards no second reversal for ``reverse_cooldown_s``.
+   preferred heading; afterwards no second reversal for ``reverse_cooldown_s`` nor before the
+   robot has driven ``reverse_cooldown_m`` (gap filled: with a time cooldown alone, a robot whose
+   hint flips at the end of a trail, or near a place, turned back and forth on the spot every
+   few seconds; 0 m gives the time rule alone). A caller may veto a reversal for one step
+   (``allow_reverse=False``, e.g. a hint from too few crumbs).
 4. **Openings** (:mod:`teamnav.control.nav.openings`): "If the robot detects a corridor and it
    is not already turning, there is a 50% chance that the robot will decide to take the new
    corridor and make a sharp 90° turn into the corridor" (exploring; ``p_take_opening``). The
@@ -110,8 +114,9 @@ class NavigateParams(BaseModel):
     straight_half_angle_deg: float = Field(20.0, gt=0.0, le=90.0)
     trail_rule: Literal["closest", "side"] = "closest"
     side_rule_min_deg: float = Field(20.0, ge=0.0, le=90.0)
-    reverse_threshold_deg: float = Field(135.0, ge=90.0, le=180.0)
+    reverse_threshold_deg: float = Field(150.0, ge=90.0, le=180.0)
     reverse_cooldown_s: float = Field(5.0, ge=0.0, le=600.0)
+    reverse_cooldown_m: float = Field(3.0, ge=0.0, le=1000.0)
     turn_tolerance_deg: float = Field(3.0, gt=0.0, le=45.0)
     turn_timeout_s: float = Field(8.0, gt=0.0, le=600.0)
     panic_clearance_m: float = Field(0.12, gt=0.0, le=5.0)
@@ -220,6 +225,7 @@ class Navigate:
         self._last_pose: tuple[float, float, float] | None = None
         self._cool_until_m = [0.0, 0.0]  # per side (left, right): no decision before this odometry length
         self._reverse_after_s = -math.inf
+        self._reverse_after_m = -math.inf
         self._turn_dir = 0.0
         self._turn_goal_rad = 0.0
         self._turned_rad = 0.0
@@ -229,6 +235,31 @@ class Navigate:
         self._advance_max_steps = 0
         self._pending_dir = 0.0
         self._pending_heading_rad = 0.0
+        self._leave_until_m = 0.0  # no reversal and no openings before this odometry length
+
+    def turn_around(self, leave_m: float = 0.0) -> None:
+        """Start a sharp 180 deg right turn now (any manoeuvre or Panic is dropped), then wall
+        follow for ``leave_m`` of odometry with no reversal and no opening decisions.
+
+        For a robot that has reached a place and must go back the way it came (*Blazing* §5.1:
+        "Ant turned around at the resource position and followed its trail back"). Gap filled:
+        the paper's 180 deg rule does this only when the trail near the place points clearly
+        the other way; near a place the trail holds both legs and the robots' turning on the
+        spot, and robots were seen spinning there for minutes (180 deg turns every few seconds).
+        """
+        if not (leave_m >= 0.0 and math.isfinite(leave_m)):
+            raise ValueError(f"leave_m must be a finite number of metres >= 0, got {leave_m!r}")
+        self.panic.reset()
+        self.box.reset()
+        self._start_turn(-self.side_sign, math.pi)
+        self._leave_until_m = self._odo_m + leave_m
+        self._reverse_after_s = -math.inf
+        self._reverse_after_m = -math.inf
+
+    @property
+    def leaving(self) -> bool:
+        """True while a :meth:`turn_around` has the robot turning or driving off (no trail rules)."""
+        return self._odo_m < self._leave_until_m
 
     def _cool(self, extra_m: float) -> None:
         self._cool_until_m = [self._odo_m + extra_m, self._odo_m + extra_m]
@@ -287,7 +318,8 @@ class Navigate:
                 float(min(max(w, -self.max_omega_radps), self.max_omega_radps)))
 
     # ------------------------------------------------------------------ step
-    def step(self, obs: Observation, preferred_heading_rad: float | None = None) -> tuple[float, float]:
+    def step(self, obs: Observation, preferred_heading_rad: float | None = None, *,
+             allow_reverse: bool = True) -> tuple[float, float]:
         """The command ``(v_mps, omega_radps)`` for this step.
 
         Parameters
@@ -297,6 +329,9 @@ class Navigate:
         preferred_heading_rad : float or None
             Heading suggested by a trail, in the robot's own odometry frame [rad]; None to
             explore (random turns at openings).
+        allow_reverse : bool, default True
+            False: no 180 deg reversal this step whatever the hint (the hint still steers at
+            openings).
 
         Returns
         -------
@@ -354,10 +389,15 @@ class Navigate:
                 self.box_state, self.box_offset_m = box.state, box.offset_m
                 return self._clip(box.v_mps, box.omega_radps)
 
+        leaving = self._odo_m < self._leave_until_m
+        if leaving:
+            preferred_heading_rad = None
         # 3. Heading against the trail: a sharp 180 deg right turn.
-        if (preferred_heading_rad is not None and obs.time_s >= self._reverse_after_s
+        if (preferred_heading_rad is not None and allow_reverse and obs.time_s >= self._reverse_after_s
+                and self._odo_m >= self._reverse_after_m
                 and abs(_wrap(preferred_heading_rad - th)) > self._reverse_rad):
             self._reverse_after_s = obs.time_s + self.params.reverse_cooldown_s
+            self._reverse_after_m = self._odo_m + self.params.reverse_cooldown_m
             self._start_turn(-self.side_sign, math.pi)
             cmd = self._turn_command()
             if cmd is not None:
@@ -367,7 +407,7 @@ class Navigate:
         box: BoxCommand = self.box.command(r)
         self.box_state, self.box_offset_m = box.state, box.offset_m
         # 4. Openings: decided once each, not while the box has the robot turning on the spot.
-        if box.state != "blocked":
+        if box.state != "blocked" and not leaving:
             left, right = self.openings.detect(r)
             found = [o for k, o in enumerate((left, right))
                      if o is not None and self._odo_m >= self._cool_until_m[k]]
