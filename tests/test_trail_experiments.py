@@ -239,7 +239,7 @@ def test_drift_sweeps_give_each_robot_its_own_drift_the_same_for_both_algorithms
         # Try §3.6 x 2: Bug clockwise, the others anticlockwise, Tanis slowest, Fly fastest
         assert [g.odometry.heading_drift_deg_per_min for g in scn.robots] == pytest.approx(
             [2 * v for v in T.DRIFT_PATTERN.values()])
-        assert load_sweep(name).n_trials == 4 * 10  # k = 0, 0.5, 1, 2 x 10 seeds
+        assert load_sweep(name).n_trials == 5 * 10  # k = 0, 0.5, 1, 2, 4 x 10 seeds
     with pytest.raises(ValueError, match="no drift case for scale"):
         T.drift_spec("try-drift", [3.0])
     assert T.drift_scale({"params": {"case": "x0.5"}}) == 0.5 and T.drift_scale({"params": {}}) is None
