@@ -17,7 +17,7 @@ from teamnav.control import registry as controllers
 from teamnav.control.nav.route_follow import pursuit_point
 from teamnav.experiments.metric_sets import trails as M
 from teamnav.experiments.metrics import RunData
-from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, Table
+from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, Table, Text
 from teamnav.experiments.runner import run
 from teamnav.experiments.spec import load_scenario
 from teamnav.world.grid import OccupancyGrid
@@ -332,6 +332,30 @@ def test_try_section_says_it_does_not_hold_when_the_2002_team_breaks_down():
     comps = [b for b in blocks if isinstance(b, Comparison)]
     assert comps[0].holds is False  # no breakdown claimed, but every run broke down
     assert comps[2].holds is False  # the 2002 algorithm did worse than the 2000 one at high drift
+
+
+@pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
+def test_try_section_draws_fig2_trips_and_the_crumb_figures():
+    from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
+
+    # robot 0: home -> source -> home -> home again (not a trip); robot 2: source, source (one trip)
+    arrivals = [[60.0, 0, "source"], [120.0, 0, "home"], [130.0, 0, "home"], [200.0, 2, "source"], [260.0, 2, "source"]]
+
+    def table(key, kw):
+        rows = [_row(9, 100.0, d) for d in (0.0, 4.0)] if "drift" in key else [_row(9, 100.0)]
+        for r in rows:
+            r["arrivals_series"] = json.dumps(arrivals)
+            r["wall_time_s"] = 12.0
+        return rows
+
+    blocks = SECTION.build(_FakeCtx(table))
+    (fig2,) = [b for b in blocks if isinstance(b, Plot) and b.title.startswith("Trips over time")]
+    assert [(s.label, s.y[-1]) for s in fig2.series] == [("total (3)", 3), ("Bug (2)", 2), ("Ant (0)", 0),
+                                                         ("Fly (1)", 1), ("Tanis (0)", 0)]
+    assert fig2.series[0].x == pytest.approx([0.0, 1.0, 2.0, 200 / 60])
+    assert len([b for b in blocks if isinstance(b, MapView)]) == 2
+    # quick mode: 300 s runs, 12 s each = 144 s per simulated hour
+    assert any(isinstance(b, Text) and "144 ± 0 s" in b.text for b in blocks)
 
 
 # ---------------------------------------------------------------------------- long runs (slow)

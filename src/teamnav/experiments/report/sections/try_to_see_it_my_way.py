@@ -32,6 +32,7 @@ import json
 
 import numpy as np
 
+from teamnav.experiments.metric_sets import trails as M
 from teamnav.experiments.report.model import Comparison, Missing, Plot, SectionSpec, Series, Table, Text
 from teamnav.experiments.report.sections import _trails as T
 from teamnav.experiments.sweep import SweepSpec
@@ -82,6 +83,11 @@ def build(ctx) -> list:
         "k = 1 is the paper's drift.")]
     if not share:
         return blocks + [Missing("try-to-see-it-my-way runs", "every trial of the try-paper sweep failed")]
+    per_h = T.values(share, "wall_time_s") / (dur / 3600.0)
+    if per_h.size:
+        blocks.append(Text(f"Speed: 4 robots x 1 simulated hour took {T.msd(per_h, '{:.0f}', 's')} of wall time per run "
+                           "(the runs' wall_time metric; one core per trial when the report runs with --workers 1 "
+                           "on an idle machine, more on a shared one)."))
 
     # 1. hours without breakdown, efficiency
     trips = T.values(share, "trips_total")
@@ -192,7 +198,7 @@ def build(ctx) -> list:
 
     # figures: units over time, Fig. 2 top (arrivals), breakdown vs drift
     t = T.time_grid(dur)
-    blocks.append(Plot("Units transported over time, the paper's drift (Fig. 2 bottom)", "time [min]",
+    blocks.append(Plot("Units transported over time, the paper's drift", "time [min]",
                        "units (cumulative)", [T.band_series("trail-share-v1", share, t)],
                        caption="mean over seeds with a 10–90 % band"))
     t1 = T.time_grid(drift_dur)
@@ -212,6 +218,18 @@ def build(ctx) -> list:
                               style="points"))
         blocks.append(Plot("Reaching places (Fig. 2 top), first seed", "time [min]", "robot (home low, source high)",
                            ser))
+        # Fig. 2 bottom: trips (A-B or B-A, §3.5) accumulated over time, per robot and in total
+        events = [{"t_s": p[0], "robot": p[1], "place": p[2], "event": p[2]} for p in pts]
+        tr = M.trips(events, len(OUR_ROBOTS))
+        ends = sorted(t1 for _, _, t1, _, _ in tr)
+        ser = [Series(f"total ({len(ends)})", [0.0] + [t / 60 for t in ends], list(range(len(ends) + 1)), style="step")]
+        for i, name in enumerate(OUR_ROBOTS):
+            mine = sorted(t1 for r, _, t1, _, _ in tr if r == i)
+            ser.append(Series(f"{name} ({len(mine)})", [0.0] + [t / 60 for t in mine], list(range(len(mine) + 1)),
+                              style="step"))
+        blocks.append(Plot("Trips over time (Fig. 2 bottom), first seed", "time [min]", "trips (cumulative)", ser,
+                           caption="a trip is a robot's move from one place to the other (§3.5); the paper's "
+                                   "4 robots: 262 in 188 min, about 1.4 per minute while all four ran"))
     if xs_s or xs_b:
         sers = []
         if xs_s:
