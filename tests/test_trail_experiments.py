@@ -328,10 +328,13 @@ def test_try_section_says_it_does_not_hold_when_the_2002_team_breaks_down():
             return [_row(2, 100.0, d, broke) for d in (0.0, 2.0)]
         return [_row(9, 100.0, d) for d in (0.0, 2.0)]
 
-    blocks = SECTION.build(_FakeCtx(table))
+    blocks = SECTION.build(_FakeCtx(table, quick=False))
     comps = [b for b in blocks if isinstance(b, Comparison)]
     assert comps[0].holds is False  # no breakdown claimed, but every run broke down
     assert comps[2].holds is False  # the 2002 algorithm did worse than the 2000 one at high drift
+    # quick mode (5-minute runs) gives no verdict on hours of work or on a breakdown
+    quick = [b for b in SECTION.build(_FakeCtx(table)) if isinstance(b, Comparison)]
+    assert quick[0].holds is None and quick[2].holds is None
 
 
 @pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")

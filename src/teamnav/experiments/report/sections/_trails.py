@@ -19,6 +19,11 @@ from teamnav.experiments.report.model import Missing, Series
 #: around 0.35° per minute, while Fly's rotated at 2° per minute"; Bug's and Ant's rates are not
 #: given: 1 deg/min). The drift sweeps (blazing-drift, try-drift) scale it by k, case ``x<k>``.
 DRIFT_PATTERN = {"Bug": -1.0, "Ant": 1.0, "Fly": 2.0, "Tanis": 0.35}
+#: the pattern as text ("Bug -1, Ant +1, Fly +2, Tanis +0.35 deg/min")
+DRIFT_TEXT = ", ".join(f"{n} {v:+g}" for n, v in DRIFT_PATTERN.items()) + " deg/min"
+#: drift-sweep runs shorter than this [s] get no breakdown verdict (quick mode: a 5-minute run
+#: cannot show a 27-minute breakdown)
+MIN_VERDICT_S = 1800.0
 #: how the drift sweeps' axis reads in the figures
 DRIFT_AXIS = "drift scale k (x Bug -1, Ant +1, Fly +2, Tanis +0.35 deg/min)"
 TRAIL_BRAINS = ("blazing-trail-v1", "trail-share-v1")
