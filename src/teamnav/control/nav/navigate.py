@@ -23,7 +23,11 @@ One step, in priority order:
    robot has driven ``reverse_cooldown_m`` (gap filled: with a time cooldown alone, a robot whose
    hint flips at the end of a trail, or near a place, turned back and forth on the spot every
    few seconds; 0 m gives the time rule alone). A caller may veto a reversal for one step
-   (``allow_reverse=False``, e.g. a hint from too few crumbs).
+   (``allow_reverse=False``, e.g. a hint from too few crumbs). Nor does a robot reverse within
+   ``reverse_memory_m`` of a spot (odometry) where it reversed since its last
+   :meth:`Navigate.turn_around` (gap filled: a drifted trail that points into a dead end made
+   robots reverse at the same spot, follow the dead end round and come back to it, for tens of
+   minutes; 0 m: no memory).
 4. **Openings** (:mod:`teamnav.control.nav.openings`): "If the robot detects a corridor and it
    is not already turning, there is a 50% chance that the robot will decide to take the new
    corridor and make a sharp 90° turn into the corridor" (exploring; ``p_take_opening``). The
@@ -117,6 +121,7 @@ class NavigateParams(BaseModel):
     reverse_threshold_deg: float = Field(150.0, ge=90.0, le=180.0)
     reverse_cooldown_s: float = Field(5.0, ge=0.0, le=600.0)
     reverse_cooldown_m: float = Field(3.0, ge=0.0, le=1000.0)
+    reverse_memory_m: float = Field(3.0, ge=0.0, le=1000.0)
     turn_tolerance_deg: float = Field(3.0, gt=0.0, le=45.0)
     turn_timeout_s: float = Field(8.0, gt=0.0, le=600.0)
     panic_clearance_m: float = Field(0.12, gt=0.0, le=5.0)
@@ -226,6 +231,7 @@ class Navigate:
         self._cool_until_m = [0.0, 0.0]  # per side (left, right): no decision before this odometry length
         self._reverse_after_s = -math.inf
         self._reverse_after_m = -math.inf
+        self._reversed_at: list[tuple[float, float]] = []  # odometry spots of this leg's reversals
         self._turn_dir = 0.0
         self._turn_goal_rad = 0.0
         self._turned_rad = 0.0
@@ -255,11 +261,16 @@ class Navigate:
         self._leave_until_m = self._odo_m + leave_m
         self._reverse_after_s = -math.inf
         self._reverse_after_m = -math.inf
+        self._reversed_at = []
 
     @property
     def leaving(self) -> bool:
         """True while a :meth:`turn_around` has the robot turning or driving off (no trail rules)."""
         return self._odo_m < self._leave_until_m
+
+    def _reversed_near(self, x: float, y: float) -> bool:
+        r2 = self.params.reverse_memory_m ** 2
+        return any((x - a) ** 2 + (y - b) ** 2 < r2 for a, b in self._reversed_at)
 
     def _cool(self, extra_m: float) -> None:
         self._cool_until_m = [self._odo_m + extra_m, self._odo_m + extra_m]
@@ -395,7 +406,9 @@ class Navigate:
         # 3. Heading against the trail: a sharp 180 deg right turn.
         if (preferred_heading_rad is not None and allow_reverse and obs.time_s >= self._reverse_after_s
                 and self._odo_m >= self._reverse_after_m
-                and abs(_wrap(preferred_heading_rad - th)) > self._reverse_rad):
+                and abs(_wrap(preferred_heading_rad - th)) > self._reverse_rad
+                and not self._reversed_near(x, y)):
+            self._reversed_at.append((x, y))
             self._reverse_after_s = obs.time_s + self.params.reverse_cooldown_s
             self._reverse_after_m = self._odo_m + self.params.reverse_cooldown_m
             self._start_turn(-self.side_sign, math.pi)

@@ -15,8 +15,9 @@ Read here, per side, walking the beams from the outermost one (+90 deg on the le
    ``jump_m`` further: the near edge of an opening, ``P1``;
 2. *an opening wide enough*: the first beam past the jump whose return lies back on the wall
    line (its lateral distance at most ``wall_tolerance_m`` beyond ``P1``'s) is the far edge
-   ``P2``; the wall's direction is that from ``P1`` to the furthest return back on the wall
-   line; the opening's width is ``P1 -> P2`` measured along the wall (infinite when the wall
+   ``P2``; the wall's direction is that of the returns beside the robot up to ``P1`` (the wall
+   the opening is cut into; when they span less than ``NEAR_WALL_MIN_M``, from ``P1`` to the
+   furthest return back on the wall line); the opening's width is ``P1 -> P2`` measured along the wall (infinite when the wall
    does not come back within the side sector, e.g. a hall), and it counts when at least
    ``min_width_m`` (the robot's diameter plus a margin).
 
@@ -39,7 +40,11 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-__all__ = ["Opening", "OpeningDetector", "any_near_edge"]
+__all__ = ["NEAR_WALL_MIN_M", "Opening", "OpeningDetector", "any_near_edge"]
+
+#: The returns beside the robot up to the near edge give the wall's direction when they span at
+#: least this much [m] (see :meth:`OpeningDetector.detect_side`).
+NEAR_WALL_MIN_M = 0.2
 
 
 @njit(cache=True)
@@ -157,9 +162,15 @@ class OpeningDetector:
         on_wall = (y[j + 1:] <= y1 + self.wall_tolerance_m) & (x[j + 1:] > x1)
         back = np.flatnonzero(on_wall)
         if back.size:
-            # The wall runs from P1 to the furthest return back on its line: measure along it.
             k, last = j + 1 + int(back[0]), j + 1 + int(back[-1])
-            dx, dy = float(x[last]) - x1, float(y[last]) - y1
+            # The wall's direction: along the returns beside the robot up to P1 (the wall the
+            # opening is cut into), when they span at least NEAR_WALL_MIN_M; else from P1 to the
+            # furthest return back on the wall line. (At a T-junction the far "wall" is the
+            # crossing corridor's far wall, and P1 -> it runs diagonally: the robot then turned
+            # 45 deg instead of 90 and wall-followed into the wrong branch.)
+            dx, dy = x1 - float(x[0]), y1 - float(y[0])
+            if j == 0 or math.hypot(dx, dy) < NEAR_WALL_MIN_M:
+                dx, dy = float(x[last]) - x1, float(y[last]) - y1
             norm = math.hypot(dx, dy)
             ux, uy = (dx / norm, dy / norm) if norm > 1e-9 else (1.0, 0.0)
             wall_rad = side * math.atan2(uy, ux)
