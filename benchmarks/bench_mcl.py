@@ -21,7 +21,7 @@ Every round re-initialises every contender from the same Gaussian ``N(pose, diag
 0.5 rad)^2)`` around the pose the scan was taken from (untimed; amcl through
 ``set_initial_pose``, which draws the same Gaussian, in walls and unknown space too) and then
 times one update: all contenders weigh the same kind of sample set, and the best of the
-rounds is kept. (Uniform sampling over free space is not reachable through the binding, and
+rounds is kept (after an init neither teamnav nor amcl injects random samples: w_slow = w_fast). (Uniform sampling over free space is not reachable through the binding, and
 amcl's own global start, a Gaussian around the map centre, puts most samples in unknown
 space where its rays end at once.) Contenders take turns within a round, so they share the
 machine's load. The map is handed to amcl with its origin shifted by half a cell: amcl
