@@ -116,3 +116,37 @@ def test_gate_and_sync_validate_input():
         BeliefSync(0, None, SyncParams(), np.random.default_rng(0))
     with pytest.raises(ValueError, match="extra"):
         SyncParams(min_travel=2.0)
+
+
+@pytest.mark.parametrize("provenance", [False, True])
+def test_own_information_coming_back_through_a_third_robot(provenance):
+    """Rule 2 made transitive: A's belief reaches C through B (A sees B, B sees C); when C then
+    sees A, its tree holds A's own information. The paper's rules let A multiply it in (rule 2
+    only blocks A <-> C pairs): A's belief counted twice. With provenance A drops it until it
+    has travelled min_travel_m, then takes it."""
+    poses = {0: np.array([5.0, 3.0, 0.0]), 1: np.array([8.0, 3.0, 0.0]), 2: np.array([11.0, 3.0, math.pi])}
+    f = {i: filter_with_modes([p], seed=20 + i) for i, p in poses.items()}
+    s = {i: BeliefSync(i, MODEL, SyncParams(provenance=provenance, symmetric=False), np.random.default_rng(30 + i))
+         for i in poses}
+    (ab,) = s[0].on_detections(f[0], (Detection(3.0, 0.0, 1),), 0.0)  # A sees B 3 m ahead
+    s[1].on_message(f[1], ab, 0.1)
+    (bc,) = s[1].on_detections(f[1], (Detection(3.0, 0.0, 2),), 1.0)  # B sees C
+    s[2].on_message(f[2], bc, 1.1)
+    (ca,) = s[2].on_detections(f[2], (Detection(6.0, 0.0, 0),), 2.0)  # C sees A 6 m ahead
+    assert s[1].applied["detection"] == 1 and s[2].applied["detection"] == 1
+    if not provenance:
+        assert ab.body.sources == () and ca.body.sources == ()
+        s[0].on_message(f[0], ca, 2.1)
+        assert s[0].applied["detection"] == 1
+        return
+    assert dict(ab.body.sources) == {0: 0.0}
+    assert set(dict(ca.body.sources)) == {0, 1, 2}  # A's information, passed on by B, then C
+    assert ca.size_bytes() > ab.size_bytes() - ab.body.tree.nbytes + ca.body.tree.nbytes  # sources are counted
+    s[0].on_message(f[0], ca, 2.1)
+    assert s[0].applied["detection"] == 0 and s[0].looped == 1
+    for _ in range(26):  # 2.6 m later A's information in C's belief is old news: C's next tree is used
+        s[0].travel([0.1, 0.0, 0.0])
+        s[2].travel([0.1, 0.0, 0.0])
+    (ca2,) = s[2].on_detections(f[2], (Detection(6.0, 0.0, 0),), 9.0)
+    s[0].on_message(f[0], ca2, 9.1)
+    assert s[0].applied["detection"] == 1 and s[0].looped == 1

@@ -211,6 +211,10 @@ class MCLWanderParams(BaseModel):
         multiplied its own belief in again (double counting: a confidently wrong sender was
         confirmed by the teammate it had just dragged along). False (default): the reply is
         built from the belief as it was before the message.
+    provenance : bool
+        Rule 2 of §2.3 made transitive (:class:`~teamnav.localization.SyncParams`): a tree that
+        holds this robot's own information from less than ``min_travel_m`` ago, passed on by a
+        third robot, is dropped (beyond the paper; False: the paper's rules only).
     detection_model : str
         Shipped model name or a path to a model file (:func:`load_detection_model`).
     detection_period_s : float
@@ -264,10 +268,11 @@ class MCLWanderParams(BaseModel):
     send_min_cluster_weight: float = Field(0.0, ge=0.0, le=1.0)
     inject_fraction: float = Field(0.0, ge=0.0, le=0.5)
     inject_weighting: Literal["bayes", "tree"] = "bayes"
-    inject_lost_prior: float = Field(0.02, gt=0.0, lt=1.0)
+    inject_lost_prior: float = Field(0.3, gt=0.0, lt=1.0)
     inject_heading_belief_share: float = Field(0.5, ge=0.0, le=1.0)
     inject_heading_std_deg: float = Field(10.0, ge=0.0, le=180.0)
     inject_before_reply: bool = False
+    provenance: bool = True
     detection_model: str = Field("default", min_length=1)
     detection_period_s: float = Field(1.0, ge=0.0, le=60.0)
     min_travel_m: float = Field(2.5, ge=0.0, le=1000.0)
@@ -342,7 +347,8 @@ class MCLWander:
         self.model = load_detection_model(params.detection_model) if params.collaborate else None
         self.sync = (BeliefSync(self.robot_id, self.model, SyncParams(min_travel_m=params.min_travel_m,
                                                                       tree_min_samples=params.tree_min_samples,
-                                                                      tree_max_depth=params.tree_max_depth), rng)
+                                                                      tree_max_depth=params.tree_max_depth,
+                                                                      provenance=params.provenance), rng)
                      if params.collaborate else None)
         self._free = (info.known_map.cells == FREE)
         self._next_frame_s = 0.0
@@ -499,7 +505,7 @@ class MCLWander:
                 continue
             det = pend["det"]
             body = SyncMessage("detection", self.robot_id, rid, float(det.range_m), float(det.bearing_rad),
-                               float(self.model.p_false_positive), pend["tree"])
+                               float(self.model.p_false_positive), pend["tree"], self.sync.outgoing_sources())
             out.append(Message(self.robot_id, float(obs.time_s), body, to=rid, kind=SYNC_KIND))
             self.sync.detect_gate.use(rid)
             self.sync.detect_gate.use(-1)
@@ -623,6 +629,7 @@ class MCLWander:
             "n_particles": int(est.n_particles),
             "spread_m": round(float(math.sqrt(max(0.0, est.cov[0, 0] + est.cov[1, 1]))), 3),
             "syncs": int(sum(self.sync.applied.values())) if self.sync is not None else 0,
+            "looped": int(self.sync.looped) if self.sync is not None else 0,
             "pts": [round(float(v), 2) for v in sub[:, :2].ravel()],
         }
         if self._n_log == 0:

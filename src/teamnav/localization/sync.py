@@ -63,6 +63,16 @@ class SyncParams(BaseModel):
     ``min_travel_m``: rule 2 of §2.3 [m]; ``tree_min_samples`` / ``tree_max_depth``: stopping
     rule of the density trees; ``symmetric``: answer a received tree with one's own position
     tree so that the detecting robot is constrained too (§2.3).
+
+    ``provenance`` (beyond the paper; False: the paper's two rules only): rule 2 made
+    transitive. Rule 2 stops robot n from using robot m twice within ``min_travel_m``, but
+    not from getting m's information back through a third robot (m -> n -> k -> m): in a
+    team that detects each other often, such loops multiply one robot's belief into itself
+    again and again, the double counting §2.3 warns about (measured: the hexagon team
+    converged on one wrong configuration in 1 of 8 runs). Every tree carries its sources, the
+    robots whose information the sender's belief holds, each with that robot's odometer when
+    the information left it; a robot drops a tree that holds its own information from less
+    than ``min_travel_m`` of its own travel ago (:meth:`BeliefSync.on_message`).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True)
@@ -71,6 +81,7 @@ class SyncParams(BaseModel):
     tree_min_samples: int = Field(20, ge=1, le=100_000)
     tree_max_depth: int = Field(20, ge=1, le=64)
     symmetric: bool = True
+    provenance: bool = False
 
 
 @dataclass(frozen=True)
@@ -93,6 +104,9 @@ class SyncMessage:
         The observer's detection model's false-positive rate.
     tree : DensityTree
         2-D density over (x, y) [1/m²].
+    sources : tuple of (int, float)
+        ``(robot id, that robot's odometer [m])`` for every robot whose information the
+        sender's belief holds, the sender included (``SyncParams.provenance``; empty without).
     """
 
     kind: str
@@ -102,6 +116,7 @@ class SyncMessage:
     bearing_rad: float
     p_false_positive: float
     tree: DensityTree
+    sources: tuple = ()
 
 
 class SightingGate:
@@ -208,6 +223,32 @@ class BeliefSync:
         self.receive_gate = SightingGate(params.min_travel_m)
         #: Count of applied updates, by kind ("detection", "inverse"), for logs.
         self.applied = {"detection": 0, "inverse": 0}
+        #: Trees dropped because they held this robot's own recent information (provenance).
+        self.looped = 0
+        #: Robots whose information this belief holds -> their odometer when it left them [m].
+        self.sources: dict[int, float] = {}
+
+    def outgoing_sources(self) -> tuple:
+        """Sources a tree built from this robot's belief carries now (empty without provenance)."""
+        if not self.params.provenance:
+            return ()
+        out = dict(self.sources)
+        out[self.robot_id] = self.detect_gate.odometer_m
+        return tuple(sorted((int(k), float(v)) for k, v in out.items()))
+
+    def _looped(self, body: SyncMessage) -> bool:
+        """The tree holds this robot's own information from less than ``min_travel_m`` ago."""
+        if not self.params.provenance:
+            return False
+        for rid, odo in body.sources:
+            if int(rid) == self.robot_id and self.detect_gate.odometer_m - float(odo) < self.params.min_travel_m:
+                return True
+        return False
+
+    def _merge(self, body: SyncMessage) -> None:
+        for rid, odo in body.sources:
+            if int(rid) != self.robot_id:
+                self.sources[int(rid)] = max(self.sources.get(int(rid), -math.inf), float(odo))
 
     def travel(self, odom_delta) -> None:
         """Advance both gates' odometers by this step's travel."""
@@ -226,7 +267,7 @@ class BeliefSync:
             tree = detection_tree(mcl.particles, mcl.weights, det.range_m, det.bearing_rad, self.model, self.rng,
                                   self.params)
             body = SyncMessage("detection", self.robot_id, int(rid), float(det.range_m), float(det.bearing_rad),
-                               float(self.model.p_false_positive), tree)
+                               float(self.model.p_false_positive), tree, self.outgoing_sources())
             out.append(Message(self.robot_id, float(stamp_s), body, to=int(rid), kind=SYNC_KIND))
             self.detect_gate.use(rid)
         return out
@@ -254,22 +295,30 @@ class BeliefSync:
             if self.params.symmetric:
                 tree = position_tree(mcl.particles, mcl.weights, self.params)
                 reply = SyncMessage("inverse", other, self.robot_id, body.range_m, body.bearing_rad,
-                                    body.p_false_positive, tree)
+                                    body.p_false_positive, tree, self.outgoing_sources())
                 replies.append(Message(self.robot_id, float(stamp_s), reply, to=other, kind=SYNC_KIND))
+            if self._looped(body):
+                self.looped += 1
+                return replies
             if evidence is None:
                 f = detection_factors(body.tree, mcl.particles, body.p_false_positive, mcl.free_area_m2)
             else:
                 f = evidence(mcl, body)
             if mcl.multiply_weights(f):
                 self.applied["detection"] += 1
+                self._merge(body)
             self.receive_gate.use(other)
         elif body.kind == "inverse" and body.observer == self.robot_id:
             other = body.target
             if not self.receive_gate.allowed(other):
                 return []
+            if self._looped(body):
+                self.looped += 1
+                return []
             f = inverse_detection_factors(body.tree, mcl.particles, body.range_m, body.bearing_rad, self.model,
                                           self.rng, mcl.free_area_m2)
             if mcl.multiply_weights(f):
                 self.applied["inverse"] += 1
+                self._merge(body)
             self.receive_gate.use(other)
         return replies
