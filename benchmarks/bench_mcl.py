@@ -140,7 +140,8 @@ class AmclPeer:
 
     def reset(self, mean, std):
         a = self.amcl
-        self.loc.set_initial_pose(a.Vector3D(*map(float, mean)), a.create_diagonal_covariance(*(float(v) ** 2 for v in std)))
+        cov = a.create_diagonal_covariance(*(float(v) ** 2 for v in std))
+        self.loc.set_initial_pose(a.Vector3D(*map(float, mean)), cov)
 
     def step(self, delta):
         # the first update after set_initial_pose takes its odometry as the reference (a zero
@@ -273,11 +274,12 @@ def main() -> None:
         ref_a, ref_ac = wall.get(AMCL_NAME), cpu.get(AMCL_NAME)
         ref_n = wall.get(NUMPY_NAME)
         for name, t in wall.items():
-            va = f"**{ref_a / t:.2f}x**" if ref_a and name.startswith("teamnav beam") else (f"{ref_a / t:.2f}x" if ref_a else "-")
+            va = f"{ref_a / t:.2f}x" if ref_a else "-"
+            va = f"**{va}**" if ref_a and name.startswith("teamnav beam") else va
             vc = f"{ref_ac / cpu[name]:.2f}x" if ref_ac else "-"
             vn = f"{ref_n / t:.1f}x" if ref_n else "-"
-            print(f"| {n:,} | {name} | {t * 1e3:.2f} | {pb / t / 1e6:.2f} | {va} | {cpu[name] * 1e3:.2f} | {vc} | {vn} |",
-                  flush=True)
+            print(f"| {n:,} | {name} | {t * 1e3:.2f} | {pb / t / 1e6:.2f} | {va} | {cpu[name] * 1e3:.2f} | {vc} "
+                  f"| {vn} |", flush=True)
     if amcl is None:
         print("\namcl is not installed in this interpreter; for the AMCL column run:\n"
               "  python -m venv /tmp/amcl-venv && /tmp/amcl-venv/bin/pip install amcl numpy numba scipy pillow "

@@ -377,6 +377,7 @@ class MCL:
         self._weights = np.zeros(0)
         self._weighted = False
         self._rays = np.empty((0, 0))
+        self._table = None
         self._ll = np.empty(0)
         self._log_w_slow = None
         self._log_w_fast = None
@@ -502,8 +503,9 @@ class MCL:
             p = self._particles
             threads = self._threads(n * r)
             self._caster.cast_xyt(p[:, 0], p[:, 1], p[:, 2], self._ray_angles, out=self._rays, parallel=threads)
-            table = self._beam_table(z)
-            (beam_loglik_kernel if threads else beam_loglik_kernel_serial)(self._rays, self._k, table, 1.0 / self._beam_table.step_m, exponent, self._ll)
+            self._table = table = self._beam_table(z, out=self._table)  # reuses the last scan's buffer
+            kernel = beam_loglik_kernel if threads else beam_loglik_kernel_serial
+            kernel(self._rays, self._k, table, 1.0 / self._beam_table.step_m, exponent, self._ll)
         else:
             keep = z < self.max_range_m - 1e-6
             a = self._used_angles[keep]
