@@ -494,3 +494,55 @@ def test_potential_field_trapped_in_the_u_escapes_with_a_temporary_goal():
     steps = loop.run(loop.steps + 400)
     assert steps is not None and loop.stalls == 0
     assert min(p[0] for p in loop.path[-100:]) < 3.5  # it went round the cup's west side
+
+
+# ---------------------------------------------------------------------------- local direction, hit distance
+@settings(max_examples=25, deadline=None)
+@given(th=st.floats(-math.pi, math.pi), dx=st.floats(-0.1, 0.1), dy=st.floats(-0.3, 0.3))
+def test_visbug_nearer_end_turns_towards_the_door_on_the_goals_side(th, dx, dy):
+    """In room N3 of office_simple, against its east wall: the sensed ends of the room's wall
+    are its door's jambs (x 16.0 and 17.2, y 8.4) whatever the beams' sampling; the robot turns
+    towards the jamb nearer the goal's way: clockwise (side -1) for room N5 to the east,
+    counter-clockwise (+1) for room N1 to the west (|xO| + |OT|, TangentBug's heuristic)."""
+    from teamnav.control.nav.local.base import scan_points
+    em = builtin_map("office_simple")
+    angles = np.linspace(-np.pi, np.pi, 72, endpoint=False)
+    pose = np.array([17.34 + dx, 9.58 + dy, th])
+    scan = RangeScan(RayCaster(em.grid, max_range_m=8.0).cast(pose[None], angles, parallel=False)[0], angles, 8.0)
+    for room, side in (("room_N5", -1), ("room_N1", 1)):
+        nav = make_navigator("visbug21", None, rng=np.random.default_rng(0), step_length_m=0.2, radius_m=0.2)
+        assert nav.params.turn == "nearer_end"
+        nav.set_goal(np.array(em.places[room]))
+        nav._followed(pose, scan)
+        ends = np.array(nav._ends)
+        assert np.allclose(np.sort(ends[:, 0]), [16.0, 17.2], atol=0.15) and np.allclose(ends[:, 1], 8.4, atol=0.2)
+        nav._choose_side(pose[:2])
+        assert nav.side == side
+    assert scan_points(pose, scan).shape[0] > 0
+
+
+def test_visbug_nearer_end_leaves_a_room_by_its_door_towards_the_goal():
+    """From room N3 to room N5: "nearer_end" goes out of the door and east; a fixed "left"
+    (the obstacle on the right) goes out west and round the whole building."""
+    em = builtin_map("office_simple")
+    near = Loop(em.grid, nav_of("visbug21"), (14.0, 11.0), em.places["room_N5"])
+    assert near.run(600) is not None and near.stalls == 0
+    left = Loop(em.grid, nav_of("visbug21", {"turn": "left"}), (14.0, 11.0), em.places["room_N5"])
+    steps = left.run(3000)
+    assert steps is not None and steps > 3 * near.steps
+
+
+def test_visbug_hit_distance_is_where_the_obstacle_cuts_the_m_line():
+    """Bug2's H lies on the M-line at the obstacle; the robot stops up to a step short of it.
+    d_H is measured there, so an M-line point between the robot and the wall is no leave point."""
+    b = MapBuilder(12.0, 10.0, 0.1).border(0.2).rect(5.0, 2.0, 5.3, 8.0)
+    nav = nav_of("visbug21")
+    loop = Loop(b.build("wall"), nav, (2.0, 5.0), (9.0, 5.0), frame=(0.0, 0.0, 0.0))
+    while nav.mode != MODE_FOLLOW and loop.steps < 200:
+        loop.step()
+    d_robot = float(np.hypot(*(nav.goal_xy - nav.hit_xy)))
+    # the wall's face is at x = 5.0; the blocked M-line point lies within R (+ a sample) of it
+    r_safe = RADIUS_M + nav.params.safety_margin_m
+    assert 9.0 - 5.0 + r_safe - 0.1 - 1e-9 <= nav.hit_dist_m <= 9.0 - 5.0 + r_safe + 1e-9
+    assert nav.hit_dist_m < d_robot
+    assert loop.run(600) is not None

@@ -53,6 +53,16 @@ Step 2 (``MODE_FOLLOW``, "follow the boundary in the local direction")
     path by up to a step: one pass near H while turning into a door next to it is not yet a
     closed lap); :meth:`direction` then returns None until a new goal is set.
 
+The local direction (``turn``): Lumelsky & Skewis fix it a priori. With a fixed direction
+R1 alone finished 0 of 5 ``los-help-simple`` tasks (10 targets, 1500 steps per target): in
+an office every wrong guess is a lap of the whole building (~270 m, 1350 steps), as the
+rooms' doors all sit on one side. Our default ``turn="nearer_end"`` chooses it afresh at
+every hit point: towards the sensed end O of the hit obstacle (a door jamb, a corner's edge,
+the range limit) with the shorter ``|xO| + |OT|`` (TangentBug's heuristic distance, Kamon,
+Rimon & Rivlin 1998), and keeps it until the next leave. Completeness does not rest on the
+direction: every hit is closer to T than the previous one by ``leave_margin_m`` and each
+boundary walk ends at a leave point or back at H, whichever direction it takes.
+
 Where we deviate: Lumelsky & Skewis also let ``Ti`` be the farthest visible point of the
 obstacle boundary in the local direction (so a robot cuts across concave stretches of the
 boundary); we follow the boundary reactively at a constant offset instead, since the
@@ -116,6 +126,12 @@ MODE_FOLLOW = 1
 MODE_UNREACHABLE = 2
 #: Two neighbouring beams' points closer than this [m] (or 2.5 beam gaps) lie on one obstacle.
 FOLLOW_GAP_M: float = 0.3
+#: Two ends' costs closer than this [m] are a tie for ``turn="nearer_end"``.
+NEARER_END_TIE_M: float = 0.05
+#: ``turn="nearer_end"``: a beam reading up to this much beyond the surface's line continues it [m] ...
+END_TOL_M: float = 0.1
+#: ... plus this fraction of the range.
+END_TOL_FRACTION: float = 0.1
 #: The leave test's run must be seen free this fraction of its half-width to either side.
 RUN_SEEN_FRACTION: float = 0.8
 
@@ -125,11 +141,13 @@ class VisBugParams(BaseModel):
 
     Attributes
     ----------
-    turn : {"left", "right", "random"}, default "left"
+    turn : {"nearer_end", "left", "right", "random"}, default "nearer_end"
         Local direction at a hit point ("left": the obstacle stays on the robot's right).
         "random": drawn (fair coin from the robot's ``rng``) at every new goal and kept for
         that goal, so a map whose doors all sit on one side of the rooms does not favour
-        or punish the algorithm systematically.
+        or punish the algorithm systematically. "nearer_end" (our default; a deviation, see
+        the module docstring): chosen at every hit point, towards the sensed end of the hit
+        obstacle that promises the shorter way to T; "left" until the first choice.
     safety_margin_m : float, default 0.05
         Free corridors keep ``R = radius + this`` from sensed points [m].
     follow_margin_m : float, default 0.08
@@ -161,7 +179,7 @@ class VisBugParams(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
-    turn: Literal["left", "right", "random"] = "left"
+    turn: Literal["left", "right", "random", "nearer_end"] = "nearer_end"
     safety_margin_m: float = Field(0.05, ge=0.0, le=2.0)
     follow_margin_m: float = Field(0.08, ge=0.0, le=2.0)
     leave_hysteresis_m: float = Field(0.03, ge=0.0, le=2.0)
@@ -272,6 +290,8 @@ class VisBug21:
         self._leave_target: np.ndarray | None = None
         self._leave_steps = 0
         self._follow_ref: np.ndarray | None = None
+        self._ends: tuple[np.ndarray, np.ndarray] | None = None
+        self._blocked_xy: np.ndarray | None = None
         self._resumed = False
         self._monitor.reset()
 
@@ -386,8 +406,10 @@ class VisBug21:
             ti = self._intermediate_target(xy, points, r_safe, reach_m)
             if ti is None:
                 self._hit(xy)
-                heading = boundary_heading(xy, self._followed(pose, scan), r_safe + p.follow_margin_m, self.side,
-                                           p.follow_gain)
+                followed = self._followed(pose, scan)
+                if p.turn == "nearer_end":
+                    self._choose_side(xy)
+                heading = boundary_heading(xy, followed, r_safe + p.follow_margin_m, self.side, p.follow_gain)
                 if heading is None:
                     heading = math.atan2(goal[1] - xy[1], goal[0] - xy[0])
             else:
@@ -406,10 +428,18 @@ class VisBug21:
 
     # ------------------------------------------------------------------ steps
     def _hit(self, xy: np.ndarray) -> None:
-        """Step 1 -> Step 2 at hit point ``xy``."""
+        """Step 1 -> Step 2 at hit point ``xy``.
+
+        ``d_H`` is measured from the first M-line point Step 1 found blocked when there is one
+        (Bug2's hit point lies on the M-line, where the obstacle cuts it; the robot stops up to
+        a step short of it), else from ``xy``. Measured from ``xy``, M-line points between the
+        robot and the obstacle counted as leave points: the robot left for them and hit the
+        same obstacle again, a lap of the building for every ``leave_margin_m`` gained.
+        """
         self.mode = MODE_FOLLOW
         self.hit_xy = xy.copy()
-        self.hit_dist_m = min(self.hit_dist_m, math.hypot(*(self.goal_xy - xy)))
+        at = self._blocked_xy if self._blocked_xy is not None else xy
+        self.hit_dist_m = min(self.hit_dist_m, math.hypot(*(self.goal_xy - at)))
         self._walked_m = 0.0
         self._left_hit = False
         self._returns = 0
@@ -454,7 +484,62 @@ class VisBug21:
         members = idx[labels[idx] == labels[choice]]
         near = members[int(np.argmin(np.hypot(pts[members, 0] - pose[0], pts[members, 1] - pose[1])))]
         self._follow_ref = pts[near].copy()
+        if self.params.turn == "nearer_end":
+            self._ends = self._sensed_ends(pose[:2], r, ang, hit, joined, near)
         return pts[members]
+
+    @staticmethod
+    def _sensed_ends(xy: np.ndarray, r: np.ndarray, ang: np.ndarray, hit: np.ndarray, joined: np.ndarray,
+                     start: int):
+        """The two sensed ends (counter-clockwise first: the one side +1 walks to) of the
+        surface holding beam ``start`` (beams sorted by angle), or None when it is seen all round.
+
+        TangentBug's endpoints (Kamon, Rimon & Rivlin 1998): the surface ends where the range
+        jumps *beyond* it. Walking from beam to beam, the surface is the line through the last
+        two points; the next beam continues it when it reads no farther than where it would
+        meet that line (plus ``END_TOL_M + END_TOL_FRACTION × range``): a wall seen at a grazing
+        angle (on the line) and a concave corner (nearer than the line) continue it; a door, a
+        jamb's edge or a beam without return (farther) end it.
+        """
+        n = r.size
+        pts = np.column_stack((xy[0] + r * np.cos(ang), xy[1] + r * np.sin(ang)))
+        d = np.column_stack((np.cos(ang), np.sin(ang)))
+
+        def continues(i: int, j: int, k: int) -> bool:
+            """Does beam k continue the surface through points j (older) and i (newest)?"""
+            if not hit[k]:
+                return False
+            v = pts[i] - pts[j]
+            den = d[k, 0] * v[1] - d[k, 1] * v[0]
+            w = pts[i] - xy
+            r_line = (w[0] * v[1] - w[1] * v[0]) / den if abs(den) > 1e-12 else math.inf
+            if not r_line > 0.0:
+                r_line = math.inf
+            return bool(r[k] <= r_line + END_TOL_M + END_TOL_FRACTION * min(r[k], r_line))
+
+        ends = []
+        for step in (1, -1):  # counter-clockwise, then clockwise
+            i, j, walked = start, start, 0
+            while walked < n:
+                k = (i + step) % n
+                close = joined[i] if step == 1 else joined[k]
+                if not (close and hit[k]) and not (j != i and continues(i, j, k)):
+                    break
+                j, i, walked = i, k, walked + 1
+            if walked >= n:
+                return None
+            ends.append(pts[i].copy())
+        return ends[0], ends[1]
+
+    def _choose_side(self, xy: np.ndarray) -> None:
+        """``turn="nearer_end"``: at a hit, the side whose sensed end O of the hit obstacle
+        gives the shorter ``|xO| + |OT|`` (TangentBug's heuristic, Kamon, Rimon & Rivlin 1998);
+        ties, or an obstacle seen all round, keep the current side."""
+        if self._ends is None:
+            return
+        cost = [math.hypot(*(e - xy)) + math.hypot(*(self.goal_xy - e)) for e in self._ends]
+        if abs(cost[0] - cost[1]) > NEARER_END_TIE_M:
+            self.side = 1 if cost[0] < cost[1] else -1
 
     def _mline_samples(self, t_from: float) -> tuple[np.ndarray, np.ndarray]:
         """M-line points with parameter t in [t_from, 1] (goal last), and their t."""
@@ -480,12 +565,15 @@ class VisBug21:
         """Step 1's Ti: the visible M-line point nearest the goal, at least one step away (else None)."""
         cand, t = self._mline_samples(self._t_anchor)
         ok = self._visible(xy, points, cand, r_safe, reach_m)
+        self._blocked_xy = None
         if not ok.any():
             return None
         j = int(np.flatnonzero(ok)[-1])
         ti = cand[j]
         if t[j] >= 1.0 - 1e-12 or math.hypot(*(ti - xy)) >= self.step_length_m:
             return ti
+        if j + 1 < cand.shape[0]:
+            self._blocked_xy = cand[j + 1]  # where the obstacle cuts the M-line: Bug2's H
         return None
 
     def _leave_point(self, pose, scan, points, r_safe, reach_m) -> np.ndarray | None:
