@@ -14,8 +14,12 @@ One step, in priority order:
    close to the front, or the stall flag, stops the robot and starts Panic; Navigate resumes
    when Panic times out.
 2. A **sharp turn** under way (on the spot, by odometry heading) runs to its end; an
-   **advance** to the centre of a chosen opening runs (wall following) until the odometry has
-   covered the distance, then the 90 deg turn starts.
+   **advance** to the centre of a chosen opening runs until the odometry has covered the
+   distance, then the 90 deg turn starts, to the heading chosen when the opening was seen. The
+   advance follows the wall (``advance_hold_heading=True`` holds the heading along the wall
+   instead); a left-wall follower at a T-junction can swing into the left branch before it gets
+   to turn right: swung more than 90 deg past the chosen heading, it turns the long way round
+   (gap filled; it used to skip the turn and carry on down the wrong branch).
 3. **Against the trail**: "If the robot is heading in approximately the opposite direction to
    the trail it makes a sharp 180° right turn" (§4.2). "Approximately opposite" is taken as
    more than ``reverse_threshold_deg`` (default 135 deg) between the odometry heading and the
@@ -107,6 +111,7 @@ class NavigateParams(BaseModel):
     box_reach_m: float = Field(1.2, gt=0.0, le=20.0)
     slide_step_m: float = Field(0.05, gt=0.0, le=1.0)
     p_take_opening: float = Field(0.5, ge=0.0, le=1.0)
+    advance_hold_heading: bool = False
     opening_near_m: float = Field(2.0, gt=0.0, le=50.0)
     opening_jump_m: float = Field(1.5, gt=0.0, le=50.0)
     opening_margin_m: float = Field(0.2, ge=0.0, le=5.0)
@@ -241,6 +246,7 @@ class Navigate:
         self._advance_max_steps = 0
         self._pending_dir = 0.0
         self._pending_heading_rad = 0.0
+        self._advance_heading_rad = 0.0
         self._leave_until_m = 0.0  # no reversal and no openings before this odometry length
 
     def turn_around(self, leave_m: float = 0.0) -> None:
@@ -390,7 +396,10 @@ class Navigate:
             self._advance_steps += 1
             if self._odo_m >= self._advance_to_m or self._advance_steps > self._advance_max_steps:
                 # Square to the wall: the heading chosen when the opening was seen (odometry frame).
-                self._start_turn(self._pending_dir, max(0.0, self._pending_dir * _wrap(self._pending_heading_rad - th)))
+                # A robot swung more than 90 deg the wrong way (its wall follower took an opening
+                # on the other side) turns the long way round to the chosen heading.
+                amount = self._pending_dir * _wrap(self._pending_heading_rad - th)
+                self._start_turn(self._pending_dir, amount + _TWO_PI if amount < -0.5 * math.pi else max(0.0, amount))
                 cmd = self._turn_command()
                 if cmd is not None:
                     return self._clip(*cmd)
@@ -398,6 +407,10 @@ class Navigate:
             else:
                 box = self.box.command(r)
                 self.box_state, self.box_offset_m = box.state, box.offset_m
+                if self.params.advance_hold_heading and box.state != "blocked":
+                    err = _wrap(self._advance_heading_rad - th)
+                    return self._clip(self.cruise_mps * max(self.params.min_speed_fraction, math.cos(err)),
+                                      self.params.steer_gain_per_s * err)
                 return self._clip(box.v_mps, box.omega_radps)
 
         leaving = self._odo_m < self._leave_until_m
@@ -438,6 +451,7 @@ class Navigate:
                     self.mode = "advance"
                     self._pending_dir = float(choice.side)
                     self._pending_heading_rad = th + choice.direction_rad
+                    self._advance_heading_rad = th + choice.wall_rad
                     self._advance_to_m = self._odo_m + choice.advance_m
                     self._advance_steps = 0
                     self._advance_max_steps = int(round((choice.advance_m / self.cruise_mps + 3.0) / self.dt_s))
