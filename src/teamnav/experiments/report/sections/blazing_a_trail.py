@@ -104,7 +104,8 @@ def build(ctx) -> list:
         bool(np.isfinite(ratio) and ratio >= 2.5) if np.isfinite(ratio) else None,
         "the paper's single robot is an estimate (a ~3 min round trip, no run), ours a measured robot that drives "
         "the optimal route at the team's cruise speed (round trip ≈ 2.6 min); the paper's ~3 min over the 2002 "
-        "paper's 2 x 31 m implies ≥ 0.34 m/s, faster than its own 0.25 m/s cruise, so its 3x is generous; "
+        "paper's 2 x 31 m needs ≥ 0.34 m/s (the 2002 robots cruised at 0.25): a fast single robot, which makes its "
+        "3x if anything conservative; "
         "in quick mode the runs are short and the initial search weighs more"))
 
     # 3. breakdown vs drift
