@@ -45,7 +45,9 @@ One step, in priority order:
    paper's results paragraph (§5.1) says the robot turns "if the average heading of the crumbs
    points to the side where the opening is detected", i.e. within 90 deg of the opening
    direction; ``trail_rule="side"`` gives that rule instead (any preferred heading more than
-   ``side_rule_min_deg`` to that side). Exploring, each opening is decided once: a side is not
+   ``side_rule_min_deg`` to that side, or any at all when straight on is blocked, as at a
+   T-junction: there the wall follower would otherwise take its own side whatever the hint).
+   Exploring, each opening is decided once: a side is not
    looked at again until the robot has driven ``opening_cooldown_m`` (or the opening's width)
    further; with a trail, an opening passed by is looked at again while it stays in sight (a
    trail's hint changes as the robot nears a corner), and the cooldown follows a turn.
@@ -318,8 +320,10 @@ class Navigate:
         along = found[0].wall_rad  # straight on = along the corridor's wall
         if self.params.trail_rule == "side":
             rel = _wrap(preferred_rad - heading_rad - along)
+            # Straight on blocked (a T-junction): any hint to an opening's side takes it.
+            margin = self._side_rule_rad if self._straight_ok(ranges_m, along) else 0.0
             for o in found:
-                if o.side * rel > self._side_rule_rad:
+                if o.side * rel > margin:
                     return o
             return None
         best: Opening | None = None
