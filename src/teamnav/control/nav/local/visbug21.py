@@ -496,10 +496,11 @@ class VisBug21:
 
         TangentBug's endpoints (Kamon, Rimon & Rivlin 1998): the surface ends where the range
         jumps *beyond* it. Walking from beam to beam, the surface is the line through the last
-        two points; the next beam continues it when it reads no farther than where it would
-        meet that line (plus ``END_TOL_M + END_TOL_FRACTION × range``): a wall seen at a grazing
-        angle (on the line) and a concave corner (nearer than the line) continue it; a door, a
-        jamb's edge or a beam without return (farther) end it.
+        two points; the next beam continues it when it meets that line ahead and reads no
+        farther than the line (plus ``END_TOL_M + END_TOL_FRACTION × range``): a wall seen at a
+        grazing angle (on the line) and a concave corner (nearer than the line) continue it; a
+        door, a jamb's edge (the line turns away from the beam) or a beam without return end
+        it. Neighbouring points closer than the following's joining gap always continue it.
         """
         n = r.size
         pts = np.column_stack((xy[0] + r * np.cos(ang), xy[1] + r * np.sin(ang)))
@@ -512,9 +513,11 @@ class VisBug21:
             v = pts[i] - pts[j]
             den = d[k, 0] * v[1] - d[k, 1] * v[0]
             w = pts[i] - xy
-            r_line = (w[0] * v[1] - w[1] * v[0]) / den if abs(den) > 1e-12 else math.inf
+            if abs(den) <= 1e-12:
+                return False
+            r_line = (w[0] * v[1] - w[1] * v[0]) / den
             if not r_line > 0.0:
-                r_line = math.inf
+                return False  # the surface turns away from the beam: a convex edge (a jamb)
             return bool(r[k] <= r_line + END_TOL_M + END_TOL_FRACTION * min(r[k], r_line))
 
         ends = []
