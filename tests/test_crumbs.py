@@ -165,6 +165,56 @@ def test_brain_without_communication_follows_only_its_own_crumbs(monkeypatch):
     assert len(b.global_crumbs) == 0 and b.nav.headings[-1] is None
 
 
+def test_brain_turns_around_at_each_place_reached_unless_told_not_to(monkeypatch):
+    (a,) = _brains(monkeypatch, n=1, leave_place_m=2.5)
+    a.step(_obs(0, 0, [0.0, 0.0, 0.0]))
+    a.step(_obs(0, 1, [0.1, 0.0, 0.0], events=["given_resource"]))  # home, not sought: no turn
+    a.step(_obs(0, 2, [0.2, 0.0, 0.0], events=["took_resource"]))
+    a.step(_obs(0, 3, [0.3, 0.0, 0.0], events=["given_resource"]))
+    assert a.nav.turn_arounds == [(2, 2.5), (3, 2.5)]  # called before Navigate's step of that tick
+    (b,) = _brains(monkeypatch, n=1, turn_at_place=False)
+    b.step(_obs(0, 0, [0.0, 0.0, 0.0], events=["took_resource"]))
+    assert b.nav.turn_arounds == []
+
+
+def test_brain_drops_no_crumbs_while_turning_on_the_spot(monkeypatch):
+    """A robot turning on the spot (at a place, in Panic) would drop crumbs pointing every way."""
+    for min_move, expected in ((0.1, 1), (0.0, 5)):
+        (a,) = _brains(monkeypatch, n=1, crumb_interval_s=1.0, crumb_min_move_m=min_move)
+        for k in range(41):  # 4 s on the spot, turning at 0.5 rad/s
+            a.step(_obs(0, k, [3.0, 1.0, 0.05 * k]))
+        assert len(a.private) == expected
+
+
+def _corner_crumbs(b):
+    """A trail east along y = 0 to (5, 0), then north along x = 5 (crumbs 0.5 m apart)."""
+    xs = np.arange(0.0, 5.0, 0.5)
+    ys = np.arange(0.5, 5.0, 0.5)
+    xy = np.concatenate([np.stack([xs, 0 * xs], 1), np.stack([5.0 + 0 * ys, ys], 1)])
+    h = np.concatenate([np.zeros(xs.size), np.full(ys.size, math.pi / 2)])
+    b.global_crumbs.extend(CrumbBatch(xy, h))
+
+
+def test_brain_reads_the_trail_a_little_ahead_so_it_turns_at_the_corner(monkeypatch):
+    prefs = {}
+    for look in (0.0, 1.5):
+        (b,) = _brains(monkeypatch, n=1, radius_m=2.0, lookahead_m=look)
+        _corner_crumbs(b)
+        b.step(_obs(0, 0, [3.0, 0.0, 0.0]))
+        prefs[look] = b.nav.headings[-1]
+    # at (3, 0) the crumbs around the robot are mostly east-heading; 1.5 m ahead the corner's
+    # northbound crumbs count: the hint turns to the corridor the trail takes
+    assert prefs[0.0] < math.radians(15.0) < math.radians(30.0) < prefs[1.5] < math.pi / 2
+
+
+def test_brain_vetoes_a_reversal_on_a_hint_from_too_few_crumbs(monkeypatch):
+    for n_crumbs, allowed in ((2, False), (3, True)):
+        (b,) = _brains(monkeypatch, n=1, radius_m=2.0, lookahead_m=0.0, reverse_min_crumbs=3)
+        b.global_crumbs.extend(CrumbBatch(np.tile([[1.0, 0.0]], (n_crumbs, 1)), np.zeros(n_crumbs)))
+        b.step(_obs(0, 0, [1.5, 0.0, math.pi]))  # heading west against an eastbound trail
+        assert b.nav.headings[-1] == pytest.approx(0.0) and b.nav.allow_reverse[-1] is allowed
+
+
 # ---------------------------------------------------------------------------- closed loop
 def trail_scenario(controller: str, params: dict, duration_s: float = 40.0):
     """trail_office, robot 0 starting 2.4 m west of the source facing it, robot 1 at home."""

@@ -510,3 +510,60 @@ def test_two_robots_meeting_head_on_in_a_corridor_pass_each_other(monkeypatch):
     gap = np.hypot(*(xy[:, 0] - xy[:, 1]).T) - 2 * RADIUS
     assert gap.min() > 0.2
     assert result.metrics["collisions_robot"] == 0 and result.metrics["stall_fraction"] == 0.0
+
+
+# ------------------------------------------------------------------------ gaps filled for efficiency
+def t_junction(x_cross_m=1.0, width_m=1.8, left_m=0.45, right_m=1.35):
+    """Robot's corridor along +x ends in a crossing corridor (along y) open both ways: a T-junction."""
+    far = x_cross_m + width_m
+    return [(-5.0, left_m, x_cross_m, left_m), (-5.0, -right_m, x_cross_m, -right_m),
+            (x_cross_m, left_m, x_cross_m, 8.0), (x_cross_m, -right_m, x_cross_m, -8.0), (far, -8.0, far, 8.0)]
+
+
+def test_opening_at_a_t_junction_is_square_to_the_wall_beside_the_robot():
+    # The far wall of the crossing corridor must not tilt the wall's direction (it used to give a
+    # 45 deg turn, and the wall follower then drifted into the other branch).
+    r = cast(t_junction(), (0.6, 0.0, 0.0))
+    _, right = detector().detect(r)
+    assert right is not None and right.side == -1
+    assert math.degrees(right.direction_rad) == pytest.approx(-90.0, abs=5.0)
+    assert right.advance_m == pytest.approx(1.9 - 0.6, abs=0.2)  # the crossing corridor's centre line
+
+
+def test_side_rule_takes_an_opening_on_any_hint_to_its_side_only_when_straight_on_is_blocked():
+    from teamnav.control.nav.openings import Opening
+
+    n = nav(trail_rule="side", side_rule_min_deg=20.0)
+    right = Opening(-1, -math.pi / 2, 0.0, 1.8, 1.0, 1.3)
+    blocked = np.full(181, 1.5)  # a wall 1.5 m ahead: no way straight on
+    clear = np.full(181, MAX_R)
+    hint = math.radians(-10.0)  # slightly to the right of straight on
+    assert n._choose_opening([right], blocked, 0.0, hint) is right
+    assert n._choose_opening([right], clear, 0.0, hint) is None
+    assert n._choose_opening([right], blocked, 0.0, math.radians(10.0)) is None  # the hint is to the left
+    assert n._choose_opening([right], clear, 0.0, math.radians(-30.0)) is right
+
+
+def test_advance_swung_past_the_opening_turns_the_long_way_round():
+    n = nav()
+    n.mode, n._pending_dir, n._pending_heading_rad = "advance", -1.0, -math.pi  # chose: right, to face west
+    n._advance_to_m, n._advance_max_steps = 0.0, 10
+    v, w = n.step(observe(np.full(181, MAX_R), (0.0, 0.0, 0.1)), None)  # but it faces east (+0.1 rad)
+    assert n.mode == "turn" and v == 0.0 and w < 0.0  # a right turn on the spot...
+    assert n._turn_goal_rad == pytest.approx(math.pi + 0.1)  # ...all the way round to west
+
+
+def test_no_second_reversal_near_a_spot_of_this_legs_reversals():
+    n = nav(reverse_cooldown_s=0.0, reverse_cooldown_m=0.0, reverse_memory_m=3.0)
+    scan = np.full(181, MAX_R)
+
+    def reverses(x, k):
+        n.mode = "navigate"
+        n.step(observe(scan, (x, 0.0, math.pi), k), 0.0)
+        return n.mode == "turn"
+
+    assert reverses(0.0, 0)
+    assert not reverses(1.0, 1)  # back near the spot: it would loop in a dead end
+    assert reverses(5.0, 2)
+    n.turn_around(0.0)  # a new leg forgets the spots
+    assert reverses(0.0, 3)

@@ -299,3 +299,28 @@ def test_brain_descends_the_trail_and_explores_at_its_end(monkeypatch):
         assert r.nav.headings[-1] == pytest.approx(0.0)  # on towards x = 4 (s = 2)
         r.step(_obs(0, 2, [4.3, 0.0, 0.0]))  # just past the trail's end (s = 2 at x = 4)
         assert r.nav.headings[-1] == at_end  # the paper's rule turns back to it
+
+
+def test_brain_turns_around_at_the_place_it_seeks(monkeypatch):
+    (a,) = _brains(monkeypatch, n=1, round=["home", "source"], leave_place_m=2.0)
+    a.step(_obs(0, 0, [0.0, 0.0, 0.0]))
+    a.step(_obs(0, 1, [5.0, 0.0, 0.0], events=["home"]))  # passing home while seeking the source
+    a.step(_obs(0, 2, [20.0, 0.0, 0.0], events=["source"]))
+    assert a.nav.turn_arounds == [(2, 2.0)]
+    (b,) = _brains(monkeypatch, n=1, round=["home", "source"], turn_at_place=False)
+    b.step(_obs(0, 0, [0.0, 0.0, 0.0]))
+    b.step(_obs(0, 1, [20.0, 0.0, 0.0], events=["source"]))
+    assert b.nav.turn_arounds == []
+
+
+def test_brain_picks_the_best_crumb_around_a_point_ahead_and_heads_to_it_from_where_it_is(monkeypatch):
+    heads = {}
+    for look in (0.0, 1.0):
+        (a,) = _brains(monkeypatch, n=1, round=["home", "source"], radius_m=1.5, lookahead_m=look)
+        a.step(_obs(0, 0, [0.0, 0.0, 0.0]))
+        # one crumb beside the robot (10 s from the source), one ahead (5 s from it)
+        a.trail.add_crumbs(["source", "source"], [[0.0, 1.2], [2.5, 0.0]], [10.0, 5.0], [0.0, 0.0])
+        a.step(_obs(0, 1, [0.0, 0.0, 0.0]))
+        heads[look] = a.nav.headings[-1]
+    assert heads[0.0] == pytest.approx(math.pi / 2)  # only the crumb beside it is within 1.5 m
+    assert heads[1.0] == pytest.approx(0.0)  # around (1, 0) the better crumb at (2.5, 0) counts
