@@ -32,6 +32,23 @@ it (sensor resetting) before eq. 14 reweights them, because our sample sets (tho
 robot) lose the true mode of a symmetric belief long before a detection arrives, and eq. 14
 alone cannot move weight onto samples that do not exist.
 
+Against double counting and wrong senders (measured on the failing runs of the first version,
+each fix a parameter with the first behaviour one flag away):
+
+- the draws get the posterior probability that the receiver is lost (``inject_weighting``,
+  ``inject_lost_prior``), not the tree's density a second time: drawing from the tree and then
+  multiplying the tree in counted the detection twice and handed a receiver to any sender
+  whose tree contradicted it, right or wrong (in the hexagon, pairs of robots swapped their
+  right and wrong beliefs at every exchange);
+- the §2.3 reply is built from the belief before the draws (``inject_before_reply``): it
+  carried the sender's own claim back to it, which then confirmed its own belief;
+- the draws take headings from the own belief (``inject_heading_belief_share``): a detection
+  sees no heading, and with uniform headings the mirror pose of a featureless corridor (other
+  side of the axis, heading reversed) won a §5.1 run;
+- ``provenance``: rule 2 made transitive (:class:`~teamnav.localization.SyncParams`): a robot
+  drops a tree holding its own information from less than 2.5 m of travel ago that came back
+  through a third robot.
+
 Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report section):
 
 ``false_positive_filter`` (§7.2: "a rate of 3.5 % ... turns out to cause major problems")
@@ -565,9 +582,12 @@ class MCLWander:
         f(x_i)`` and ``E_lost = 1 / A``; the draws (the posterior under "lost", ``U f ∝ f``)
         get the share ``s = eps E_lost / (eps E_lost + (1 - eps) E_own)`` of the weight, the
         kept samples ``1 - s`` in proportion to ``w_i f(x_i)`` (eq. 14). A confident belief the
-        tree contradicts keeps ``1 - s`` (about 0.6 with ``eps`` = 0.02 and ``p_fp`` = 3.5 %)
-        and the robot's own sensors decide between it and the draws; a belief the tree
-        confirms gives the draws almost nothing; a second, consistent tree makes the draws win.
+        tree contradicts keeps ``1 - s`` (0.08 with the default ``eps`` = 0.3, 0.64 with 0.02;
+        ``p_fp`` = 3.5 %) and the robot's own sensors decide between it and the draws over the
+        next scans; a belief the tree confirms gives the draws almost nothing. ``eps`` = 0.3 is
+        about how often a globally localizing robot alone was wrong at the time of a
+        detection in our runs (Robin in §5.1: 5 of 10 runs still wrong at the end); with 0.02
+        Robin kept a confident wrong belief 2.2 m behind the truth (seed 7).
         """
         p = self.params
         n = mcl.n_particles

@@ -164,16 +164,24 @@ def _hexagon(ctx) -> list:
                          _ms(_metric(rs, f"loc_time_to_localize_s_{kind}"))])
     together_all = min(frac[("together", "sonar")], frac[("together", "laser")])
     alone_best = max(frac[("alone", "sonar")], frac[("alone", "laser")])
+    # runs in which every robot ended localized: "each robot is able to uniquely determine its position"
+    full = {name: sum(1 for r in rs if r["metrics"].get("loc_final_localized_fraction") == 1.0)
+            for name, rs in (("alone", alone), ("together", team))}
     return [
         Comparison("§5.2.2: alone each sensor type stays ambiguous; together every robot localizes",
                    "Fig. 14: single-robot errors stay high (sonar: 3 modes, laser: 2); collaborative errors fall "
                    "for both types",
                    f"localized at the end: alone sonar {frac[('alone', 'sonar')]:.0%}, laser "
                    f"{frac[('alone', 'laser')]:.0%}; together sonar {frac[('together', 'sonar')]:.0%}, laser "
-                   f"{frac[('together', 'laser')]:.0%} (n = {len(alone)} / {len(team)} runs)",
-                   bool(together_all > alone_best and together_all >= 0.75),
+                   f"{frac[('together', 'laser')]:.0%}; every robot localized in {full['alone']} / {len(alone)} "
+                   f"runs alone, {full['together']} / {len(team)} together",
+                   bool(together_all > alone_best and together_all >= 0.75
+                        and (ctx.quick or full["together"] >= 0.9 * len(team))),
                    "Our hexagon's glass discs are 2-fold and foam discs 3-fold symmetric, so sonar robots keep 2 "
-                   "modes and laser robots 3 (the paper has them the other way round)."),
+                   "modes and laser robots 3 (the paper has them the other way round). Double counting guarded "
+                   "beyond §2.3's two rules: received trees are weighted by the chance the receiver is lost, the "
+                   "answer tree carries only the answering robot's own belief, and a tree holding the receiver's "
+                   "own recent information through a third robot is dropped (provenance)."),
         Plot("Fig. 14: error vs time by sensor kind", "time [s]", "mean distance of samples to the true pose [m]",
              series, hlines=[(1.5, "localized (1.5 m)")], caption="Bands: 95 % confidence interval over runs."),
         Table("Hexagon: by sensor kind (mean ± std over runs)",
@@ -220,14 +228,27 @@ def _detection(ctx) -> list:
     et = _metric(team, "loc_final_error_m_g_robin")
     la = _metric(alone, "loc_time_to_localize_s_g_robin")
     lt = _metric(team, "loc_time_to_localize_s_g_robin")
+    fa = float(np.mean(np.asarray(ea) < 1.5)) if ea else float("nan")
+    ft = float(np.mean(np.asarray(et) < 1.5)) if et else float("nan")
+    # Holds only when the detection collapses Robin's belief to the right place in (nearly) every
+    # run — the paper's "this single incident almost completely resolves the uncertainty" — not
+    # just on average: mean error < 1.5 m with detections, >= 90 % of runs localized with them
+    # (all 10 of 10 in the full report: one run on a wrong mode pulls the mean up by ~2 m, so the
+    # mean alone would hide one failure at most), and ignoring them leaves the mean >= 1.5 m.
+    holds = bool(np.mean(et) < 1.5 <= np.mean(ea) and ft >= 0.9) if ea and et else None
     blocks = [
         Comparison("§5.1 / Fig. 11: a single detection collapses the corridor robot's belief",
                    "error falls much faster with detections (10 runs, detection after 60-100 s)",
                    f"Robin's final error {_ms(ea)} m ignoring detections vs {_ms(et)} m using them; "
+                   f"localized at the end in {fa:.0%} vs {ft:.0%} of runs; "
                    f"time to < 1.5 m {_ms(la)} s vs {_ms(lt)} s (n = {len(alone)} / {len(team)} runs)",
-                   bool(np.mean(et) < 1.5 <= np.mean(ea)) if ea and et else None,
+                   holds,
                    "Our corridor robot starts 15-19 m west of the lab opening and passes it after about 60 s; "
-                   "Marian stands still, so the 2.5 m rule lets it use Robin once per run."),
+                   "Marian stands still, so the 2.5 m rule lets it use Robin once per run. Robin's sample set "
+                   "often collapses onto a wrong place before the detection (the paper's stays spread along the "
+                   "corridor), so the brain draws part of its samples from the received tree (sensor resetting, "
+                   "weighted by the posterior probability that Robin was lost) with headings from Robin's own "
+                   "belief (half of them; uniform for the rest)."),
         Plot("Fig. 11: the corridor robot's error vs time", "time [s]", "mean distance of samples to the true pose [m]",
              _series("single-robot MCL (ignores detections)", alone, lambda d: d["by_group"].get("robin"))
              + _series("using Marian's detection", team, lambda d: d["by_group"].get("robin")),
