@@ -546,3 +546,19 @@ def test_visbug_hit_distance_is_where_the_obstacle_cuts_the_m_line():
     assert 9.0 - 5.0 + r_safe - 0.1 - 1e-9 <= nav.hit_dist_m <= 9.0 - 5.0 + r_safe + 1e-9
     assert nav.hit_dist_m < d_robot
     assert loop.run(600) is not None
+
+
+def test_visbug_resumes_with_step1_when_the_excursion_left_the_boundary_far_behind():
+    nav = nav_of("visbug21")
+    loop = Loop(u_trap(), nav, U_START, U_GOAL)
+    task = loop.to_own(np.array(U_GOAL))
+    while nav.mode != MODE_FOLLOW and loop.steps < 200:
+        loop.step()
+    loop.step()
+    hit, mline, d_hit = nav.hit_xy, nav.mline, nav.hit_dist_m
+    nav.set_goal(loop.to_own(np.array([1.0, 1.0])), temporary=True)
+    nav.set_goal(task)
+    # back 3 m from the cup, in the open: not the walk of the cup's boundary, but Step 1 on the kept M-line
+    far = loop.to_own(np.array([9.5, 2.0]))
+    nav.direction(np.array([*far, 0.0]), FREE_SCAN)
+    assert nav.mode == MODE_TO_GOAL and nav.mline is mline and nav.hit_xy is hit and nav.hit_dist_m == d_hit

@@ -88,7 +88,9 @@ every excursion made helpers *lengthen* R1's tasks). Back on the task the robot 
 with the M-line and H of before, except when the excursion ended closer to T than
 ``d_H − leave_margin_m``: that point is as good as a leave point, and Bug2 starts over from
 there (a new M-line; the distances at which it restarts fall each time, so Bug2's
-progress argument still holds). A plain ``set_goal(g)`` with another goal drops the
+progress argument still holds). Resuming a boundary walk more than ``RESUME_FOLLOW_M``
+from where it was suspended, it takes Step 1 on the kept M-line instead (the nearest
+obstacle there is not the one it was walking). A plain ``set_goal(g)`` with another goal drops the
 suspended task (the old behaviour).
 
 ``progressing`` (§5): in Step 1, the distance to T beats its best-so-far for this goal
@@ -126,6 +128,9 @@ MODE_FOLLOW = 1
 MODE_UNREACHABLE = 2
 #: Two neighbouring beams' points closer than this [m] (or 2.5 beam gaps) lie on one obstacle.
 FOLLOW_GAP_M: float = 0.3
+#: Back from a temporary goal farther than this [m] from where it left the boundary walk,
+#: VisBug resumes with Step 1 (on the kept M-line and d_H), not the walk.
+RESUME_FOLLOW_M: float = 1.0
 #: Two ends' costs closer than this [m] are a tie for ``turn="nearer_end"``.
 NEARER_END_TIE_M: float = 0.05
 #: ``turn="nearer_end"``: a beam reading up to this much beyond the surface's line continues it [m] ...
@@ -274,6 +279,7 @@ class VisBug21:
         self.side = 1 if params.turn == "left" else -1
         self.temporary = False
         self._suspended: dict | None = None
+        self._suspended_at: np.ndarray | None = None
         self._monitor = ProgressMonitor(params.progress_window_steps, params.progress_fraction, self.step_length_m)
         self._restart()
 
@@ -316,6 +322,7 @@ class VisBug21:
                 return
             if self._suspended is None and self.goal_xy is not None and not self.temporary:
                 self._suspended = {k: getattr(self, k) for k in self._TASK_STATE}
+                self._suspended_at = None if self._last_xy is None else self._last_xy.copy()
             self.temporary = True
             self.goal_xy = g
             self._restart()
@@ -348,6 +355,11 @@ class VisBug21:
             # the excursion ended closer to T than every hit point: as good as a leave point,
             # Bug2 starts over from here (its progress argument holds: d falls at each restart)
             self._restart()
+        elif (self.mode == MODE_FOLLOW and self._suspended_at is not None
+              and math.hypot(*(xy - self._suspended_at)) > RESUME_FOLLOW_M):
+            # far from the boundary it was walking, "the nearest obstacle" is another one:
+            # Step 1 on the kept M-line instead (a new hit keeps the smaller d_H)
+            self.mode = MODE_TO_GOAL
         # else: M-line, H, d_H and the mode are those of before the excursion; the followed
         # obstacle is picked afresh (nearest) and the excursion's path is not boundary walk
 
