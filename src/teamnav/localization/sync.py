@@ -28,6 +28,10 @@ The two rules of §2.3 against the factorial representation's over-confidence:
    (:class:`SightingGate`): both when it detects that robot and when it applies a tree coming
    from it. Two robots that detect each other therefore update each once, not twice.
 
+Beyond the paper, ``SyncParams.provenance`` makes rule 2 transitive: trees carry the robots
+whose information they hold, and a robot drops its own information coming back through a third
+robot before it has travelled ``min_travel_m`` (:class:`SyncParams`).
+
 Messages carry their tree as flat arrays (:class:`SyncMessage`), so
 :meth:`Message.size_bytes` counts what the radio really carries. Trees describe the robots at
 the time of the detection; the radio's delay (a step or more) is not compensated, as in the
@@ -68,8 +72,9 @@ class SyncParams(BaseModel):
     transitive. Rule 2 stops robot n from using robot m twice within ``min_travel_m``, but
     not from getting m's information back through a third robot (m -> n -> k -> m): in a
     team that detects each other often, such loops multiply one robot's belief into itself
-    again and again, the double counting §2.3 warns about (measured: the hexagon team
-    converged on one wrong configuration in 1 of 8 runs). Every tree carries its sources, the
+    again and again, the double counting §2.3 warns about (measured in the hexagon, same
+    seed and settings: 0 of 8 robots localized at the end without provenance, 8 of 8 with it).
+    Every tree carries its sources, the
     robots whose information the sender's belief holds, each with that robot's odometer when
     the information left it; a robot drops a tree that holds its own information from less
     than ``min_travel_m`` of its own travel ago (:meth:`BeliefSync.on_message`).
@@ -282,7 +287,7 @@ class BeliefSync:
         sensor resetting). It is called *after* the reply tree was built, so the reply carries
         only this robot's own belief: a reply built from a belief that already holds the
         sender's tree would hand the sender its own information back (double counting; the
-        first version of the brain's sensor resetting did so, see ``test_sync.py``).
+        first version of the brain's sensor resetting did so, see ``tests/test_localizing_brain.py``).
         """
         body = msg.body
         if msg.kind != SYNC_KIND or not isinstance(body, SyncMessage):
