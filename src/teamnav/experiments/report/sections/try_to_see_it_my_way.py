@@ -23,7 +23,7 @@ paper's trial lasted 3 h 8 min); the drift sweeps at k = 0, 1, 4 and the no-tran
 Cost of the full mode (measured on one core: 4 robots x 1 simulated hour = 37 CPU s for
 trail-share-v1, 30 CPU s for blazing-trail-v1): 30 team-hours of try-paper (≈ 19 CPU min),
 30 of try-drift (≈ 19), 10 without transforms (≈ 6), the mail round (≈ 1); blazing-drift is
-the blazing-a-trail section's (≈ 15, run once for both): ≈ 44 CPU min here, ≈ 65 for both sections.
+the blazing-a-trail section's (≈ 15, run once for both): ≈ 44 CPU min here, ≈ 68 for both sections.
 """
 
 from __future__ import annotations
