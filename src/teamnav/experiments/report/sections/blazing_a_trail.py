@@ -25,7 +25,7 @@ sweep is shared with the try-to-see-it-my-way section).
 Cost of the full mode (measured on one core: 4 robots x 1 simulated hour = 30 CPU s for
 blazing-trail-v1, 37 CPU s for trail-share-v1): this section 5 (paper) + 5 (paper rules) + ≈ 1 (one
 robot, optimal and exploring) + 5 (no communication) + 30 (drift sweep) team-hours ≈ 24 CPU
-min; with the try-to-see-it-my-way section (≈ 44 CPU min more) ≈ 68 CPU min for both.
+min; with the try-to-see-it-my-way section (≈ 52 CPU min more) ≈ 76 CPU min for both.
 """
 
 from __future__ import annotations
