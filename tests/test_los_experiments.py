@@ -66,7 +66,34 @@ def test_patrol_routes_and_starts_lie_in_the_corridors_with_clearance(m):
     for x, y in pts:
         r, c = env.grid.world_to_cell((x, y))
         assert clear[r, c] >= L.RADIUS_M + 0.3, (x, y)
-        assert any(x0 <= x <= x1 and y0 <= y <= y1 for x0, y0, x1, y1 in corridors), (x, y)
+        # in a corridor, or in a doorway just off it (the simple map's helpers step into the doors)
+        assert any(x0 <= x <= x1 and y0 - 0.4 <= y <= y1 + 0.4 for x0, y0, x1, y1 in corridors), (x, y)
+
+
+def _sees(occ, res, a, b):
+    """Line of sight between two world points on an occupancy grid (2 cm samples)."""
+    n = int(math.hypot(b[0] - a[0], b[1] - a[1]) / 0.02) + 2
+    xs, ys = np.linspace(a[0], b[0], n), np.linspace(a[1], b[1], n)
+    return not occ[(ys / res).astype(int), (xs / res).astype(int)].any()
+
+
+@pytest.mark.parametrize("m, rooms", [("simple", None), ("complex", {"room_3", "room_5", "room_7"})])
+def test_every_helper_route_passes_where_it_sees_into_the_rooms(m, rooms):
+    # §6: helpers patrol the corridors; a room centre is seen from there only through the room's
+    # door, from a short stretch beside it: each route must pass those stretches (simple map: all
+    # ten rooms, the doors of S1 and N5 lie at the corridor's ends)
+    env = builtin_map(L.MAPS[m])
+    occ, res = np.asarray(env.grid.occupied()), env.grid.resolution_m
+    centres = L.room_centres(m)
+    want = set(centres) if rooms is None else rooms
+    for k, (start, route) in enumerate(L.LAYOUTS[m].helpers):
+        pts = [start[:2], *route]
+        seen = {r for a, b in zip(pts, pts[1:]) for t in np.linspace(0.0, 1.0, 150)
+                for r, c in centres.items()
+                if (p := (a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t))
+                and math.hypot(c[0] - p[0], c[1] - p[1]) <= L.VISIBILITY_M and _sees(occ, res, p, c)}
+        if m == "simple" or k != 1:  # on the complex map R3 (north-south corridor) sees room 7 only
+            assert seen >= want, (k, sorted(want - seen))
 
 
 # ---------------------------------------------------------------------------- frames
@@ -194,7 +221,8 @@ def test_metrics_are_empty_without_an_explorer_log():
 # ---------------------------------------------------------------------------- section verdicts
 def _row(nav, steps, finished=1, **params):
     return {"status": "ok", "params": {S.NAV_KEY: nav, **params},
-            "metrics": {"los_steps": steps, "los_finished": finished, "los_msgs_per_robot": 10.0,
+            "metrics": {"los_steps": 10 * steps, "los_steps_per_target": steps, "los_finished": finished,
+                        "los_msgs_per_robot": 10.0,
                         "los_bytes_per_robot": 1000.0}}
 
 

@@ -338,7 +338,8 @@ def test_brain_state_sharing_follows_teammate_not_in_trouble(monkeypatch):
     stuck = StraightNav(stuck=True)
     monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
     cr = 3
-    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False),
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False,
+                                        trouble_progress="moved"),  # any unblocked step is progress
                      np.random.default_rng(0), info(0, 2))
     wall = [(0.0, 0.1, 0.5)]
     for k in range(cr):
@@ -580,3 +581,30 @@ def test_at_a_ghost_that_saw_the_goal_itself_r1_heads_for_the_goal(straight_nav,
         assert straight_nav[-1].calls[-1] == ((6.0, 0.0), False)
     else:  # straight for the goal, sliding past what blocks the line
         assert a.direction_rad != pytest.approx(bearing, abs=1e-3) and abs(wrap_angle(a.direction_rad - bearing)) < math.pi / 2
+
+
+def test_in_trouble_progress_is_towards_the_own_goal_so_following_away_keeps_following(monkeypatch):
+    # §5 rule 1 ("progressing well towards the goal"): R1 follows R2 while that takes it away from
+    # its goal, and is out of trouble only once following brings it nearer
+    stuck = StraightNav(stuck=True)
+    monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
+    cr = 3
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False),
+                     np.random.default_rng(0), info(0, 2))
+    wall = [(0.0, 0.1, 0.5)]
+    for k in range(cr):
+        r1.step(obs(k, walls=wall))
+    assert r1.trouble.tr
+    x, k = 0.0, cr
+    for _ in range(20):  # R2 walks away from the goal (-x), R1 after it: still in trouble
+        r1.step(obs(k, pose=(x, 0.0, 0.0), walls=wall, seen=[(1, 2.0, math.pi)], inbox=[msg(1, k - 1, trouble=False)]))
+        assert r1.mode == "trouble_follow" and r1.trouble.tr
+        x -= 0.2
+        k += 1
+    for _ in range(3 * cr):  # R2 turns back towards R1's goal: R1 gets nearer and recovers
+        r1.step(obs(k, pose=(x, 0.0, 0.0), walls=wall, seen=[(1, 2.0, 0.0)], inbox=[msg(1, k - 1, trouble=False)]))
+        x += 0.2
+        k += 1
+        if not r1.trouble.tr:
+            break
+    assert not r1.trouble.tr and r1.trouble.nt == 2

@@ -88,6 +88,7 @@ STEP_LENGTH_M = 0.2  # §6: fixed distance per motion step, so steps measure pat
 RADIUS_M = 0.2
 VISIBILITY_M = 8.0  # bounded omnidirectional visibility radius (§2) = laser range = radio range
 GOAL_TOLERANCE_M = 0.5  # ε of §2
+HELPER_TOLERANCE_M = 0.2  # a helper's waypoints: close enough to stand in a doorway
 DT_S = 0.1
 RECORD_EVERY = 10
 #: Step budget per target (R1's ``max_steps_per_target``): a target not reached within this
@@ -111,15 +112,38 @@ class Layout:
     helpers: tuple[tuple[tuple[float, float, float], tuple[tuple[float, float], ...]], ...]
 
 
+#: Door centres (x [m]) of office_simple's south rooms (wall y 5.6-5.8) and north rooms (y 8.2-8.4).
+SIMPLE_DOORS_S: tuple[float, ...] = (1.4, 7.2, 13.2, 19.2, 25.2)
+SIMPLE_DOORS_N: tuple[float, ...] = (4.6, 10.6, 16.6, 22.6, 28.6)
+
+
+def _door_route(y_m: float, doors_x: Sequence[float], door_y_m: float, x0_m: float = 1.0,
+                x1_m: float = 29.0) -> tuple[tuple[float, float], ...]:
+    """A corridor route along ``y_m`` from ``x0_m`` to ``x1_m`` stepping into every door on the way
+    (to ``door_y_m``, just past the door's wall) and back out."""
+    pts: list[tuple[float, float]] = [(x0_m, y_m)]
+    for xd in sorted(doors_x):
+        pts += [(xd, y_m), (xd, door_y_m), (xd, y_m)]
+    pts.append((x1_m, y_m))
+    out = [pts[0]]
+    for p in pts[1:]:
+        if p != out[-1]:
+            out.append(p)
+    return tuple(out)
+
+
 LAYOUTS: dict[str, Layout] = {
     # corridor y in [5.8, 8.2], x in [0.2, 29.8]; base (1, 7)
     "simple": Layout(
         r1_start=(1.0, 7.0, 90.0),
         helpers=(
             # end to end: a room centre is seen from the corridor only through the room's door,
-            # from a 1.5 m stretch beside it (the doors of S1 and N5 are at the corridor's ends)
-            ((3.0, 6.5, 0.0), ((29.0, 6.5), (1.0, 6.5))),  # R2: whole corridor, west -> east first
-            ((28.5, 7.5, 180.0), ((1.0, 7.5), (29.0, 7.5))),  # R3: whole corridor, east -> west first
+            # from a 1.5 m stretch beside it (the doors of S1 and N5 are at the corridor's ends).
+            # R2 steps into each south door on its way, R3 into each north door: from the doorway
+            # a helper sees the whole room, and a robot trapped inside sees it (§5 needs a
+            # teammate in sight; a potential field against a room's wall sees no corridor)
+            ((3.0, 6.5, 0.0), _door_route(6.5, SIMPLE_DOORS_S, 5.5)),  # R2: to the west end first
+            ((28.5, 7.5, 180.0), _door_route(7.5, SIMPLE_DOORS_N, 8.5)[::-1]),  # R3: to the east end first
             ((15.0, 7.0, 0.0), ((29.0, 7.0), (1.0, 7.0))),  # R4: whole corridor, from the middle
         ),
     ),
@@ -127,10 +151,13 @@ LAYOUTS: dict[str, Layout] = {
     "complex": Layout(
         r1_start=(1.0, 12.0, 90.0),
         helpers=(
-            ((3.0, 11.6, 0.0), ((34.5, 11.6), (3.0, 11.6))),  # R2: east-west corridor
+            # from the corridors a helper sees the centres of rooms 3, 5 and 7 only (through their
+            # doors; room 5's from the corridor's east end, x > 34.6); the others lie behind
+            # U-shaped obstacles or other rooms
+            ((3.0, 11.6, 0.0), ((35.2, 11.6), (3.0, 11.6))),  # R2: east-west corridor
             ((18.4, 22.5, 270.0), ((18.4, 1.5), (18.4, 22.5))),  # R3: north-south corridor
             # R4: both corridors, through the junction (ping-pong over this list)
-            ((20.0, 12.4, 0.0), ((34.5, 12.4), (17.6, 12.4), (17.6, 22.5), (17.6, 12.4), (3.0, 12.4),
+            ((20.0, 12.4, 0.0), ((35.2, 12.4), (17.6, 12.4), (17.6, 22.5), (17.6, 12.4), (3.0, 12.4),
                                  (17.6, 12.4), (17.6, 1.5))),
         ),
     ),
@@ -296,7 +323,8 @@ def scenario_data(map_key: str, *, name: str | None = None, task: int = 1, n_tar
         x, y, th = start
         groups.append({
             "name": f"R{k + 2}", "count": 1 if k < helpers else 0, **_body(), "controller": "los-helper-v1",
-            "params": {"navigator": "potential_field", "patrol_xy": patrol_xy(map_key, k), "goal_sharing": True,
+            "params": {"navigator": "potential_field", "patrol_xy": patrol_xy(map_key, k),
+                       "goal_tolerance_m": HELPER_TOLERANCE_M, "goal_sharing": True,
                        "delayed_visibility": True, "state_sharing": True, "laser": "laser",
                        "log_layers": False},
             "detector": det,

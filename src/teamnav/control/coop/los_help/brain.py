@@ -35,7 +35,7 @@ Heading to a visible point (goal, teammate, ghost) goes straight unless the next
 touch something the laser sees; then the navigator is asked for a heading towards that point
 (gap filled: the paper's robots are points, ours have a radius). Progress (§5) is the
 navigator's own estimate while it drives, and "the distance to the point being headed for fell
-by at least ``progress_min_fraction`` of a step since the last step" otherwise.
+by at least ``progress_min_fraction`` of a step below its best so far" otherwise.
 
 ``Action(direction_rad=...)`` is a body-frame direction for ``holonomic_step`` kinematics
 (Sgorbissa & Arkin count motion steps); ``Action()`` stays and does not count as a move.
@@ -194,6 +194,12 @@ class LosExplorerParams(_CommonParams):
         In trouble, keep heading to the chosen helper's last seen position when it goes out of
         sight, until no longer in trouble or the goal is seen (§5 names only these two ends);
         False follows it only while in sight.
+    trouble_progress : {"goal", "moved"}
+        While following a teammate in trouble (§5 rule 3), what counts as progress for Pr:
+        ``"goal"``, its straight distance to its own goal fell by ``progress_min_fraction`` of
+        a step (§5 rule 1: "progressing well towards the goal"; measured: with ``"moved"`` R1
+        left trouble wherever the teammate had led it, 40 m away, and was trapped again);
+        ``"moved"``, any step that was not blocked.
     max_steps_per_target : int or None
         Step budget per target: when the current target is not reached within this many steps
         (from the step it became current), R1 abandons the task (``gave_up``, and ``finished``
@@ -206,6 +212,7 @@ class LosExplorerParams(_CommonParams):
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
     keep_trouble_helper: bool = True
     max_steps_per_target: int | None = Field(None, ge=1, le=100_000_000)
+    trouble_progress: Literal["goal", "moved"] = "goal"
 
 
 class LosHelperParams(_CommonParams):
@@ -460,9 +467,13 @@ class _LosBrain(abc.ABC):
         dist = math.hypot(target[0] - me[0], target[1] - me[1])
         last = self._last_target
         progressing = True
+        best = dist
         if last is not None and last[0] == key:
+            # progress against the best distance so far, not the last step's: a robot rocking
+            # between two cells got halfway progress (measured: 700 steps in place before a ghost)
             progressing = dist < last[2] - self.params.progress_min_fraction * self.step_m
-        self._last_target = (key, target, dist)
+            best = dist if progressing else last[2]
+        self._last_target = (key, target, best)
         if dist <= stop_within_m:
             return Action(), True
         heading = math.atan2(target[1] - me[1], target[0] - me[0])
@@ -575,6 +586,9 @@ class LosExplorer(_LosBrain):
         self.gave_up = False
         self._target_since = 0
         self._promised: int | None = None
+        self._temp_stall = 0
+        self.temp_dropped = 0
+        self._prev_goal_d = math.inf
         self.promised_steps = 0
         self.goal_seen_steps = 0
         self._trouble_target: tuple[int, XY] | None = None
@@ -656,8 +670,19 @@ class LosExplorer(_LosBrain):
                 self.mode = "follow_teammate" if live else "ghost"
                 action, progressing = self._head_to(point, ("path", path.source, path.step),
                                                     end_margin_m=reach)
+                # a point R1 makes no progress towards for Cr steps (A trapped on the way; a
+                # teammate standing still in a doorway) is given up like a reached one, so
+                # that A, or §5 when in trouble, takes over (gap filled: §4.2 assumes the
+                # straight path to a ghost is free)
+                self._temp_stall = 0 if progressing else self._temp_stall + 1
+                if self._temp_stall >= p.trouble_cr:
+                    self._temp_stall = 0
+                    self.temp_dropped += 1
+                    self.sharing.mark_reached(self.me)
         if not self.trouble.tr:
             self._trouble_target = None
+        me_xy = self._me_xy()
+        goal_d = math.hypot(goal[0] - me_xy[0], goal[1] - me_xy[1])
         if action is None and p.state_sharing and self.trouble.tr:
             # §5 rule 3: in trouble, a teammate in sight that is not becomes the temporary goal
             # "until it realizes it is no longer in trouble or ... perceives its own goal": kept
@@ -674,10 +699,15 @@ class LosExplorer(_LosBrain):
             if tt is not None and (tt[0] in self._seen_now or p.keep_trouble_helper):
                 self.mode = "trouble_follow"
                 action, _ = self._head_to(tt[1], ("helper", tt[0]), stop_within_m=near, end_margin_m=near)
-                # progress towards a moving teammate seen with noise (eqs. 1-2): its perceived
-                # distance jumps by up to err_max·d, so a step that was not blocked counts
-                # (§5 leaves the measure to the designer)
-                progressing = not obs.stalled
+                if p.trouble_progress == "moved":
+                    # a step that was not blocked counts (the distance to a teammate seen with
+                    # noise, eqs. 1-2, jumps by up to err_max·d)
+                    progressing = not obs.stalled
+                else:
+                    # §5 rule 1: progress "towards the goal", R1's own: following a teammate away
+                    # from it keeps R1 in trouble (and following), so it is led along the
+                    # patrol until it sees its goal or the teammate takes it nearer
+                    progressing = goal_d < self._prev_goal_d - p.progress_min_fraction * self.step_m
         if action is None and self._promised == self.target_index and not self.trouble.tr:
             self.mode = "own_goal"
             self.promised_steps += 1
@@ -687,6 +717,7 @@ class LosExplorer(_LosBrain):
             self.mode = "own_goal"
             action, progressing = self._drive(goal)
         self.trouble.update(progressing)
+        self._prev_goal_d = goal_d
         return action
 
     def log(self) -> dict[str, Any]:
@@ -703,13 +734,15 @@ class LosExplorer(_LosBrain):
         mode met so far, ``goal_seen_steps`` (own goal in sight), ``promised_steps`` (heading for it on a
         teammate's direct promise, ``trust_direct_promise``), ``slide_steps`` (heading to
         a seen point along a side direction), ``temp_switches`` (changes of the teammate, ghost
-        or trouble helper headed for); and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
+        or trouble helper headed for), ``temp_dropped`` (teammate or ghost points given up after
+        ``trouble_cr`` steps without progress towards them); and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
         the odometry frame (when ``log_layers``).
         """
         out = self._common_log()
         out.update(target_index=int(self.target_index), targets_reached=int(self.targets_reached),
                    finished=bool(self.finished), gave_up=bool(self.gave_up),
-                   goal_seen_steps=int(self.goal_seen_steps), promised_steps=int(self.promised_steps))
+                   goal_seen_steps=int(self.goal_seen_steps), promised_steps=int(self.promised_steps),
+                   temp_dropped=int(self.temp_dropped))
         layers = self._layers()
         if layers:
             out["layers"] = layers

@@ -92,8 +92,10 @@ def _metric(row: dict, key: str) -> float:
 
 
 def steps_of(rows: Iterable[dict]) -> np.ndarray:
-    """``los_steps`` of each row (NaN where missing)."""
-    return np.array([_metric(r, "los_steps") for r in rows], dtype=float)
+    """R1's motion steps per target (``los_steps_per_target``) of each row (NaN where missing).
+
+    Per target, as the paper's numbers must be: its 200-target tasks could not take 554 steps."""
+    return np.array([_metric(r, "los_steps_per_target") for r in rows], dtype=float)
 
 
 def finished_of(rows: Iterable[dict]) -> np.ndarray:
@@ -232,10 +234,11 @@ def table_block(map_key: str, by_team: dict[int, list[dict]]) -> tuple[Table, di
         rows.append(["", "paper", *(_paper_cell(v) for v in PAPER_TABLES[map_key][nav])])
     n = max((len(v) for v in by_team.values()), default=0)
     title = f"Table {1 if map_key == 'simple' else 2} ({L.MAPS[map_key]}): R1's motion steps, mean (std as % of the mean)"
-    note = (f"Ours: motion steps of R1 for a whole task (step {L.STEP_LENGTH_M} m), over the tasks run "
-            f"({n // max(len(L.NAVIGATORS), 1)} per cell), counting finished runs; teams run: "
-            f"{', '.join(TEAM_LABEL[h] for h in teams)}. The paper's unit is not ours (its 200-target tasks took "
-            "hundreds of steps): compare ratios along a row, not values.")
+    note = (f"Ours: R1's motion steps per target (a task's steps over its targets; step {L.STEP_LENGTH_M} m), "
+            f"mean and std over the tasks run ({n // max(len(L.NAVIGATORS), 1)} per cell), counting finished "
+            f"tasks only; teams run: {', '.join(TEAM_LABEL[h] for h in teams)}. The paper's numbers must be per "
+            "target too (a 200-target task cannot take 554 steps), but its step length and maps are not ours: "
+            "compare ratios along a row, not values.")
     return Table(title, ["algorithm", "", *TEAM_LABEL.values()], rows, note), means
 
 
@@ -258,7 +261,7 @@ def robots_plot(map_key: str, by_team: dict[int, list[dict]]) -> Plot:
         series.append(Series(NAV_LABEL[nav], xs, ys, lo, hi, style="line+points"))
     fig = 12 if map_key == "simple" else 14
     return Plot(f"Fig. {fig} ({L.MAPS[map_key]}): R1's steps vs number of robots", "number of robots",
-                "motion steps of R1 per task", series,
+                "R1's motion steps per target", series,
                 caption="Mean over tasks, band ± 1 std; the potential field alone does not finish and is not drawn.")
 
 
@@ -282,7 +285,7 @@ def noise_plot(map_key: str, rows: list[dict], alone: dict[str, float]) -> tuple
     hl = [(v, f"{NAV_LABEL[k]} alone") for k, v in alone.items() if np.isfinite(v)]
     fig = 16 if map_key == "simple" else 17
     return Plot(f"Fig. {fig} ({L.MAPS[map_key]}): R1's steps vs err_max, R2..R4 present", "err_max (eqs. 1-2)",
-                "motion steps of R1 per task (finished tasks)", series, hlines=hl,
+                "R1's motion steps per target (finished tasks)", series, hlines=hl,
                 caption="Horizontal lines: R1 alone (Tables 1-2, noise has no effect without teammates); "
                         "the potential field alone fails and has no line."), means
 
@@ -396,7 +399,7 @@ def traffic_block(rows_by_map: dict[str, list[dict]]) -> Table:
                 continue
             msgs = np.array([_metric(r, "los_msgs_per_robot") for r in rs])
             nbytes = np.array([_metric(r, "los_bytes_per_robot") for r in rs])
-            steps = steps_of(rs)
+            steps = np.array([_metric(r, "los_steps") for r in rs], dtype=float)
             out.append([L.MAPS[m], NAV_LABEL[nav], f"{np.nanmean(msgs):.0f}", f"{np.nanmean(nbytes) / 1024:.1f}",
                         f"{np.nanmean(nbytes / np.maximum(steps, 1)):.1f}"])
     return Table("§4.4 traffic with R1..R4 (per robot and task)", ["map", "algorithm", "messages", "KiB", "bytes per R1 step"],
