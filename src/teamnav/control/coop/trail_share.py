@@ -37,6 +37,13 @@ heads for crumbs with s below that bound, so it never turns back up a trail, and
 minimum it explores instead of dithering. The bound is reset when the goal changes.
 ``descend_only=False`` is the paper's rule as written.
 
+Efficiency gap-fills (one flag away from the paper's rules): ``turn_at_place`` (a sharp 180 deg
+turn on reaching the sought place, then ``leave_place_m`` of wall following, as in
+:mod:`~teamnav.control.coop.blazing_trail`) and ``lookahead_m`` (the best crumb is searched
+around the point 1 m ahead of the position estimate, the hint still points from the robot to
+it: junction decisions no longer lag the corner). Measured on ``try-to-see-it-my-way``
+(4 seeds x 30 min): 61 % of cruise speed between places after the first trail.
+
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
 ``min_move_m`` since the previous temporary trail; radius 2 m (about a corridor's width);
 ``crumbs_for="every_place"`` is the §2.2 alternative the paper names for future work (one Crumb
