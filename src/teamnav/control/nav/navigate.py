@@ -425,7 +425,7 @@ class Navigate:
                 and self._odo_m >= self._reverse_after_m
                 and abs(_wrap(preferred_heading_rad - th)) > self._reverse_rad
                 and not self._reversed_near(x, y)):
-            self._reversed_at.append((x, y))
+            self._reversed_at = self._reversed_at[-15:] + [(x, y)]  # bounded: a leg may never end
             self._reverse_after_s = obs.time_s + self.params.reverse_cooldown_s
             self._reverse_after_m = self._odo_m + self.params.reverse_cooldown_m
             self._start_turn(-self.side_sign, math.pi)
