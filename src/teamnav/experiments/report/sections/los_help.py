@@ -147,9 +147,13 @@ def strictly_falling(means: Sequence[float]) -> bool:
 
 # ---------------------------------------------------------------------------- sweeps
 #: What the full reproduction costs on this machine (measured, see the note's numbers).
-FULL_CPU_NOTE = ("Cost of the full reproduction here (one core, measured on 10-target prefixes of the tasks and "
-                 "scaled to 200 targets): about 5 ms of CPU per simulated step with four robots, so "
-                 "`teamnav sweep los-table1` (120 runs) and `los-table2` (120 runs) take roughly TBD CPU-hours each.")
+FULL_CPU_NOTE = ("Cost of the full reproduction here (measured on prefixes of the tasks, 10 targets on "
+                 "office_simple and 5 on office_complex, and scaled to 200; a trial's CPU time grows with its steps, "
+                 "and a failing trial ends at its first target over budget): about 8 CPU-s per 10 targets on "
+                 "office_simple, so `teamnav sweep los-table1` (120 trials) takes about 5 CPU-hours; "
+                 "`los-table2` (120 trials) about 20 CPU-hours (its targets take 2-5 times the steps); "
+                 "each noise sweep (75 trials, all helpers) about 4 and 13 CPU-hours. Wall time is that over the "
+                 "number of workers (`-j`).")
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
 QUICK_BUDGET_STEPS_PER_TARGET = 800
@@ -268,13 +272,17 @@ def robots_plot(map_key: str, by_team: dict[int, list[dict]]) -> Plot:
 def noise_plot(map_key: str, rows: list[dict], alone: dict[str, float]) -> tuple[Plot, dict[str, dict[float, float]]]:
     by_nav = group(rows, NAV_KEY)
     series, means = [], {}
+    unfinished: list[str] = []
     for nav in L.NAVIGATORS:
         per = group(by_nav.get(nav, []), ERR_KEY)
         xs = sorted(float(e) for e in per)
         ys, lo, hi = [], [], []
         for e in xs:
             st = steps_of(per[e])
-            st = st[finished_of(per[e]) > 0.5]  # failures have no step count to average
+            fin = finished_of(per[e]) > 0.5
+            if not fin.all():
+                unfinished.append(f"{NAV_LABEL[nav]} at {e:g}: {int(fin.sum())}/{fin.size}")
+            st = st[fin]  # failures have no step count to average
             m = float(np.nanmean(st)) if st.size else float("nan")
             sd = float(np.nanstd(st, ddof=1)) if st.size > 1 else 0.0
             ys.append(m)
@@ -287,7 +295,8 @@ def noise_plot(map_key: str, rows: list[dict], alone: dict[str, float]) -> tuple
     return Plot(f"Fig. {fig} ({L.MAPS[map_key]}): R1's steps vs err_max, R2..R4 present", "err_max (eqs. 1-2)",
                 "R1's motion steps per target (finished tasks)", series, hlines=hl,
                 caption="Horizontal lines: R1 alone (Tables 1-2, noise has no effect without teammates); "
-                        "the potential field alone fails and has no line."), means
+                        "the potential field alone fails and has no line. Means over finished tasks only"
+                        + (" (finished: " + "; ".join(unfinished) + ")." if unfinished else "; every task finished.")), means
 
 
 def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict[int, list[dict]]) -> list[Comparison]:
@@ -454,7 +463,9 @@ def build(ctx) -> list:
     blocks: list = [Text(
         f"R1 reaches {_n_targets(quick)} room-centre targets in sequence ({1 if quick else L.N_TASKS} task(s) per cell; "
         f"the paper: 5 tasks of 200) with a fixed step of {L.STEP_LENGTH_M} m, so steps measure path length. "
-        f"Helpers R2..R4 patrol the corridors; every robot sees and talks only within {L.VISIBILITY_M:g} m in line of "
+        "Helpers R2..R4 patrol the corridors end to end (on office_simple R2 steps into every south door and R3 "
+        "into every north door on its way, so that a robot trapped in a room sees a teammate, §5); "
+        f"every robot sees and talks only within {L.VISIBILITY_M:g} m in line of "
         f"sight; frames are each robot's start pose. A task counts as failed when a target is not reached within "
         f"{QUICK_BUDGET_STEPS_PER_TARGET if quick else ' / '.join(map(str, L.BUDGET_STEPS_PER_TARGET.values()))} "
         f"steps{'' if quick else ' (simple / complex map)'}: R1 then gives up and the run ends. As in §6, state "
