@@ -398,3 +398,21 @@ def test_trail_share_memory_flat_over_ten_hours():
     assert m["crumbs_max_second_half"] <= 1.25 * m["crumbs_max_first_half"] + 20
     assert m["breakdown_censored"] == 1
     assert not math.isnan(m["place_speed_mps"])
+
+
+@pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
+@pytest.mark.parametrize("blazing_last_at_k4, holds", [(5.0, False), (3.0, True)])
+def test_try_section_needs_the_2000_team_to_collapse_not_just_slow_down(blazing_last_at_k4, holds):
+    from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
+
+    def table(key, kw):
+        if key == "try-drift":  # the 2002 team keeps 7 of 9 units per 10 min at k = 4
+            return [_row(9, 100.0, 0.0, {"units_per_10min_last": 9.0}), _row(9, 100.0, 4.0, {"units_per_10min_last": 7.0})]
+        if key == "blazing-drift":  # the 2000 team: 9 -> 5 (slower, 56 %) or 9 -> 3 (collapsed, 33 %)
+            return [_row(9, 100.0, 0.0, {"units_per_10min_last": 9.0}),
+                    _row(9, 100.0, 4.0, {"units_per_10min_last": blazing_last_at_k4})]
+        return [_row(9, 100.0)]
+
+    comps = [b for b in SECTION.build(_FakeCtx(table, quick=False)) if isinstance(b, Comparison)]
+    assert comps[2].holds is holds
+    assert f"the 2000 team {100 * blazing_last_at_k4 / 9:.0f} %" in comps[2].ours

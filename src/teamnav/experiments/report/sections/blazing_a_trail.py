@@ -117,7 +117,8 @@ def build(ctx) -> list:
     holds3 = None
     if len(xs) >= 2 and drift_dur >= T.MIN_VERDICT_S:
         # the drift-free team must work at all before a collapse can be read from the curve
-        holds3 = bool(last[0] >= T.WORKING_UNITS_PER_10MIN and last[-1] < last[0] and bd[-1] <= bd[0])
+        # a breakdown, not just a slower team: the highest drift's median breakdown must come before the run's end
+        holds3 = bool(last[0] >= T.WORKING_UNITS_PER_10MIN and last[-1] < last[0] and bd[-1] < bd[0])
     paper_bd = T.values(paper, "breakdown_s")
     cens = T.values(paper, "breakdown_censored")
     blocks.append(Comparison(

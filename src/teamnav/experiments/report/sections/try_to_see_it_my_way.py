@@ -150,14 +150,19 @@ def build(ctx) -> list:
     holds3 = None
     if xs_s and xs_b and xs_s[-1] == xs_b[-1] and drift_dur >= T.MIN_VERDICT_S:  # at the highest drift both ran
         holds3 = bool(last_s[-1] >= T.WORKING_UNITS_PER_10MIN and last_s[-1] > last_b[-1]
-                      and (len(xs_s) < 2 or last_s[-1] >= 0.5 * last_s[0]))
+                      and (len(xs_s) < 2 or last_s[-1] >= 0.5 * last_s[0])
+                      and (len(xs_b) < 2 or last_b[-1] < 0.5 * last_b[0]))  # the 2000 one must collapse
+    kept = ""
+    if len(xs_s) >= 2 and len(xs_b) >= 2 and last_s[0] > 0 and last_b[0] > 0:
+        kept = (f"; at k = {xs_s[-1]:g} the 2002 team keeps {100 * last_s[-1] / last_s[0]:.0f} % of its k = 0 "
+                f"throughput, the 2000 team {100 * last_b[-1] / last_b[0]:.0f} %")
     bmap = dict(zip(xs_b, zip(last_b, bd_b)))
     blocks.append(Comparison(
         "The 2000 algorithm's throughput collapses as drift grows; the 2002 one keeps working",
         "2000: breaks down at ~27 min; 2002: works for 3 h with 0.35–2 deg/min",
         "last-10-min units (median breakdown), 2002 / 2000: " + "; ".join(
             f"k = {d:g}: {a:.1f} ({b / 60:.0f} min) / {bmap.get(d, (float('nan'),) * 2)[0]:.1f} "
-            f"({bmap.get(d, (float('nan'),) * 2)[1] / 60:.0f} min)" for d, a, b in zip(xs_s, last_s, bd_s)),
+            f"({bmap.get(d, (float('nan'),) * 2)[1] / 60:.0f} min)" for d, a, b in zip(xs_s, last_s, bd_s)) + kept,
         holds3,
         f"{drift_dur / 60:g}-min runs, {seeds} seeds per point; k scales the 2002 paper's per-robot drift"))
 
