@@ -332,3 +332,18 @@ def test_a_one_target_run_finishes_with_steps_proportional_to_the_path():
     assert m["los_finished"] == 1
     # 6 m in 0.2 m steps, stopping within eps = 0.5 m: 28..31 steps
     assert 6.0 - L.GOAL_TOLERANCE_M <= m["los_steps"] * L.STEP_LENGTH_M <= 6.0 + 2 * L.STEP_LENGTH_M
+
+
+def test_steps_fall_verdict_pairs_tasks_so_a_failed_hard_task_cannot_fake_a_fall():
+    # task A is hard (600 steps per target alone, 500 with a helper), task B easy (100, 110);
+    # with two helpers R1 fails task A: its mean over finished tasks alone (110) would "fall"
+    def row(h, task, steps, fin=1):
+        return {"status": "ok", "params": {S.NAV_KEY: "avoid_past", S.TARGETS_KEY: [[float(task), 0.0]]},
+                "metrics": {"los_steps_per_target": steps, "los_finished": fin}}
+    by_team = {0: [row(0, 1, 600), row(0, 2, 100)], 1: [row(1, 1, 500), row(1, 2, 110)],
+               2: [row(2, 1, 9999, fin=0), row(2, 2, 120)]}
+    means, kept, run = S.paired_means(by_team, "avoid_past", [0, 1, 2])
+    assert (kept, run) == (1, 2) and means == [100.0, 110.0, 120.0]  # the easy task only: rising
+    tab, m = S.table_block("simple", by_team)
+    comp = [c for c in S.table_comparisons("simple", m, by_team) if "Av. Past" in c.claim][0]
+    assert comp.holds is False and "paired: the 1 of 2 tasks" in comp.ours

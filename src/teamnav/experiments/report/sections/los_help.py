@@ -147,13 +147,13 @@ def strictly_falling(means: Sequence[float]) -> bool:
 
 # ---------------------------------------------------------------------------- sweeps
 #: What the full reproduction costs on this machine (measured, see the note's numbers).
-FULL_CPU_NOTE = ("Cost of the full reproduction here (measured on prefixes of the tasks, 10 targets on "
-                 "office_simple and 5 on office_complex, and scaled to 200; a trial's CPU time grows with its steps, "
-                 "and a failing trial ends at its first target over budget): about 8 CPU-s per 10 targets on "
-                 "office_simple, so `teamnav sweep los-table1` (120 trials) takes about 5 CPU-hours; "
-                 "`los-table2` (120 trials) about 20 CPU-hours (its targets take 2-5 times the steps); "
-                 "each noise sweep (75 trials, all helpers) about 4 and 13 CPU-hours. Wall time is that over the "
-                 "number of workers (`-j`).")
+FULL_CPU_NOTE = ("Cost of the full reproduction here (measured with /usr/bin/time on prefixes of the tasks, 10 "
+                 "targets on office_simple and 5 on office_complex, and scaled to 200; a trial's CPU time grows with "
+                 "its steps and team, and a failing trial ends at its first target over budget): 5 CPU-s per 10 "
+                 "targets for R1 alone, 17 with R1..R4 on office_simple, so `teamnav sweep los-table1` (120 trials) "
+                 "takes about 8 CPU-hours and `los-noise-simple` (75 trials) about 7; office_complex's targets take "
+                 "about 3 times the steps: `los-table2` about 25 CPU-hours, `los-noise-complex` about 20. Wall time "
+                 "is that over the number of workers (`-j`).")
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
 QUICK_BUDGET_STEPS_PER_TARGET = 800
@@ -299,6 +299,29 @@ def noise_plot(map_key: str, rows: list[dict], alone: dict[str, float]) -> tuple
                         + (" (finished: " + "; ".join(unfinished) + ")." if unfinished else "; every task finished.")), means
 
 
+def paired_means(by_team: dict[int, list[dict]], nav: str, hs: Sequence[int]) -> tuple[list[float], int, int] | None:
+    """Mean steps per target per team size over the tasks finished with *every* team size in
+    ``hs`` (a task failed by one team would otherwise leave only the easy tasks in its mean);
+    (means, tasks kept, tasks run), or None when the rows do not name their tasks."""
+    per: dict[int, dict[str, float]] = {}
+    tasks: set[str] = set()
+    for h in hs:
+        per[h] = {}
+        for r in group(by_team.get(h, []), NAV_KEY).get(nav, []):
+            t = (r.get("params") or {}).get(TARGETS_KEY)
+            if t is None:
+                return None
+            key = json.dumps(t)
+            tasks.add(key)
+            if _metric(r, "los_finished") > 0.5:
+                per[h][key] = _metric(r, "los_steps_per_target")
+    common = set.intersection(*(set(v) for v in per.values())) if per else set()
+    if not tasks:
+        return None
+    ms = [float(np.mean([per[h][t] for t in common])) if common else float("nan") for h in hs]
+    return ms, len(common), len(tasks)
+
+
 def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict[int, list[dict]]) -> list[Comparison]:
     tab = 1 if map_key == "simple" else 2
     paper = PAPER_TABLES[map_key]
@@ -307,6 +330,11 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
     for nav in L.NAVIGATORS:
         hs = [h for h in teams if not (nav == "potential_field" and h == 0)]
         ms = [means[nav][h] for h in hs]
+        paired = paired_means(by_team, nav, hs)
+        note = ""
+        if paired is not None:
+            ms, k, n = paired
+            note = f" (paired: the {k} of {n} tasks finished with every team)"
         p = [paper[nav][h][0] for h in hs if paper[nav][h] is not None]
         if len(ms) < 2:
             holds = None  # one team size: no trend to judge (quick mode, potential field)
@@ -317,7 +345,7 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
                  if len(ms) >= 2 and np.isfinite(ms[0]) and np.isfinite(ms[-1]) and ms[0] > 0 else "")
         out.append(Comparison(
             f"Table {tab}: {NAV_LABEL[nav]} steps fall as helpers are added ({', '.join(TEAM_LABEL[h] for h in hs)})",
-            " → ".join(f"{v:.1f}" for v in p), ours + ratio, holds,
+            " → ".join(f"{v:.1f}" for v in p), ours + ratio + note, holds,
             "" if holds or holds is None else "not strictly falling at every added helper in our runs (see the table)"))
     pf = group(by_team.get(0, []), NAV_KEY).get("potential_field", [])
     pf_help = [r for h in teams if h > 0 for r in group(by_team[h], NAV_KEY).get("potential_field", [])]
