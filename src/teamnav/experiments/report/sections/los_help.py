@@ -151,9 +151,11 @@ FULL_CPU_NOTE = ("Cost of the full reproduction here (measured with /usr/bin/tim
                  "targets on office_simple and 5 on office_complex, and scaled to 200; a trial's CPU time grows with "
                  "its steps and team, and a failing trial ends at its first target over budget): 5 CPU-s per 10 "
                  "targets for R1 alone, 17 with R1..R4 on office_simple, so `teamnav sweep los-table1` (120 trials) "
-                 "takes about 8 CPU-hours and `los-noise-simple` (75 trials) about 7; office_complex's targets take "
-                 "about 3 times the steps: `los-table2` about 25 CPU-hours, `los-noise-complex` about 20. Wall time "
-                 "is that over the number of workers (`-j`).")
+                 "takes about 7 CPU-hours "
+                 "(measured: 595 CPU-s for its 60 nested-team trials of 10 targets) and `los-noise-simple` "
+                 "(75 trials) about 7; on office_complex (619 CPU-s for 60 trials of 5 targets; most Avoid-Past and "
+                 "potential-field trials end early, failed) `los-table2` takes about 14 CPU-hours and "
+                 "`los-noise-complex` about 9. Wall time is that over the number of workers (`-j`).")
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
 QUICK_BUDGET_STEPS_PER_TARGET = 800
