@@ -73,3 +73,26 @@ def test_serialised_size_and_bad_input():
         DensityTree.fit(x, circular=[True])
     with pytest.raises(ValueError, match=r"points must have shape \(n, 2\)"):
         t(np.ones((4, 3)))
+
+
+def test_serial_and_threaded_queries_agree_and_have_their_own_cache():
+    """The serial twin (small queries skip the thread launch) gives the threaded kernel's
+    densities bit for bit, including outside the root box and across the circular seam, and has
+    its own cache file (numba's cache does not key by ``parallel``; see tests/test_mcl.py)."""
+    from teamnav.localization import density_tree as dt
+
+    rng = np.random.default_rng(5)
+    x = np.c_[rng.normal(size=(3000, 2)), rng.uniform(-np.pi, np.pi, 3000)]
+    t = dt.DensityTree.fit(x, rng.random(3000), circular=[False, False, True], min_samples=15)
+    q = np.c_[rng.normal(scale=2.0, size=(4000, 2)), rng.uniform(-3 * np.pi, 3 * np.pi, 4000)]
+    q[:5] = [[0.0, 0.0, np.pi], [0.0, 0.0, -np.pi], [50.0, 0.0, 0.0], [t.lo[0], 0.0, 0.0], [t.hi[0], 0.0, 0.0]]
+    args = (t.lo, t.hi, t.circular, t.split_dim, t.split_val, t.child, t.density)
+    ser = dt.query_kernel_serial(q, *args, np.empty(len(q)))
+    par = dt.query_kernel(q, *args, np.empty(len(q)))
+    np.testing.assert_array_equal(ser, par)
+    assert ser[2] == 0.0 and ser[4] == 0.0 and ser[0] > 0.0  # outside the box; hi is open
+    assert (ser > 0).sum() > 1000 and (ser == 0).sum() > 100  # both branches exercised
+    np.testing.assert_array_equal(t(q), ser)  # below the threshold __call__ runs the serial twin
+    big = np.tile(q, (dt._PARALLEL_MIN_POINTS // len(q) + 1, 1))
+    np.testing.assert_array_equal(t(big), np.tile(ser, dt._PARALLEL_MIN_POINTS // len(q) + 1))
+    assert dt.query_kernel_serial._cache._cache_file._index_name != dt.query_kernel._cache._cache_file._index_name
