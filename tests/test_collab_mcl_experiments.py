@@ -171,3 +171,29 @@ def test_report_section_quick_build(tmp_path):
     assert time.perf_counter() - t0 < 120
     assert sum(isinstance(b, Comparison) for b in blocks) >= 3
     assert all(len(s.x) > 2 for b in blocks if isinstance(b, Plot) for s in b.series)
+
+
+def _hallway_rows(alone_s, team_s):
+    rows = []
+    for collaborate, times in ((False, alone_s), (True, team_s)):
+        for seed, t in enumerate(times):
+            rows.append({"status": "ok", "seed": seed, "params": {"robots.0.params.collaborate": collaborate},
+                         "metrics": {"loc_time_to_localize_s": t, "loc_censored": 0,
+                                     "loc_final_localized_fraction": 1.0}})
+    return rows
+
+
+@pytest.mark.parametrize("team_shift_s, holds", [(-60.0, True), (-5.0, False)])
+def test_hallway_verdict_needs_a_paired_reduction_beyond_two_standard_errors(team_shift_s, holds):
+    from types import SimpleNamespace
+
+    from teamnav.experiments.report.sections.collab_mcl import _hallway
+
+    alone = [100.0, 300.0, 200.0, 400.0, 150.0, 250.0, 350.0, 180.0]       # a large run-to-run spread
+    jitter = [10.0, -10.0, 5.0, -5.0, 8.0, -8.0, 3.0, -3.0]
+    team = [a + team_shift_s + j for a, j in zip(alone, jitter)]           # lower mean either way
+    rows = _hallway_rows(alone, team)
+    res = SimpleNamespace(rows=lambda: rows, total=len(rows))
+    comparison = _hallway(SimpleNamespace(quick=False, sweep=lambda *a, **k: res))[0]
+    assert comparison.holds is holds
+    assert "faster together in" in comparison.ours

@@ -112,16 +112,31 @@ def _hallway(ctx) -> list:
     red = 100.0 * (mt - ma) / ma if ma > 0 else float("nan")
     fa = float(np.mean(_metric(alone, "loc_final_localized_fraction")))
     ft = float(np.mean(_metric(team, "loc_final_localized_fraction")))
-    holds = bool(mt < ma and ft >= fa)
+    # "Clearly faster" (the issue) is judged per seed: the same seed starts both conditions from the
+    # same poses, so the paired difference removes the run-to-run spread that the two means share.
+    # The full report needs the mean paired reduction beyond two standard errors.
+    by_seed = {r["seed"]: r["metrics"]["loc_time_to_localize_s"] for r in alone
+               if isinstance(r["metrics"].get("loc_time_to_localize_s"), (int, float))}
+    diffs = [r["metrics"]["loc_time_to_localize_s"] - by_seed[r["seed"]] for r in team
+             if r["seed"] in by_seed and isinstance(r["metrics"].get("loc_time_to_localize_s"), (int, float))]
+    if len(diffs) >= 2:
+        d_mean, d_se = float(np.mean(diffs)), float(np.std(diffs, ddof=1) / math.sqrt(len(diffs)))
+        paired = (f"; per seed {d_mean:+.0f} ± {d_se:.0f} s (s.e.), faster together in "
+                  f"{sum(d < 0 for d in diffs)} / {len(diffs)} seeds")
+        clear = d_mean < -2.0 * d_se
+    else:
+        paired, clear = "", False
+    holds = bool(mt < ma and ft >= fa and (ctx.quick or clear))
     blocks = [
         Comparison(
             "§5.2.1: collaborative localization is faster than single-robot MCL (8 sonar robots, hallway)",
             "379 ± 37 s → 153 ± 17 s (−60 %)",
-            f"{_ms(ta)} s → {_ms(tt)} s ({red:+.0f} %), n = {len(alone)} / {len(team)} runs; "
+            f"{_ms(ta)} s → {_ms(tt)} s ({red:+.0f} %), n = {len(alone)} / {len(team)} runs{paired}; "
             f"robots never below 1.5 m (censored at the duration): {ca} alone, {ct} together",
             holds,
             "Our times are mean ± std over runs of the per-run mean over robots, censored robots counted at the "
-            "run's duration (a lower bound); our hallway, sonar model and sample counts are not the paper's. "
+            "run's duration (a lower bound). The full report's verdict needs the paired per-seed reduction beyond "
+            "two standard errors, not only a lower mean. Our hallway, sonar model and sample counts are not the paper's. "
             "Collaboration needs sensor resetting on received trees (inject_fraction) with our sample sets.",
         ),
         Plot("Fig. 12(b): localization error vs time, 8 sonar robots", "time [s]",
