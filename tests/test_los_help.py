@@ -13,7 +13,7 @@ from pydantic import ValidationError
 
 from teamnav.control import Detection, Message, Observation, RangeScan, RobotInfo, SensorInfo
 from teamnav.control.coop.los_help import brain as brain_mod
-from teamnav.control.coop.los_help.brain import LosExplorer, LosHelper
+from teamnav.control.coop.los_help import LosExplorer, LosHelper
 from teamnav.control.coop.los_help.goal_sharing import (
     GoalSharing,
     accept_goal_id,

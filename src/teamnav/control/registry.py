@@ -61,8 +61,8 @@ register("mcl-wander-v1", "teamnav.control.localizing:MCLWander")
 register("explore-v1", "teamnav.control.nav.explore:Explore")
 
 # Sgorbissa & Arkin: line-of-sight help, R1 explorer and patrolling helpers (helper H2)
-register("los-explorer-v1", "teamnav.control.coop.los_help.brain:LosExplorer")
-register("los-helper-v1", "teamnav.control.coop.los_help.brain:LosHelper")
+register("los-explorer-v1", "teamnav.control.coop.los_help.explorer:LosExplorer")
+register("los-helper-v1", "teamnav.control.coop.los_help.helper:LosHelper")
 
 # Vaughan et al. trail papers: Blazing a trail (2000) and Try to see it my way (2002) (helper H4)
 register("blazing-trail-v1", "teamnav.control.coop.blazing_trail:BlazingTrail")

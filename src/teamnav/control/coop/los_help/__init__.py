@@ -2,9 +2,11 @@
 
 Modules: :mod:`.messages` (message bodies), :mod:`.goal_sharing` (§3–§4 rules: Id, frames
 from mutual bearings, reflected/delayed visibility, §4.3 bookkeeping), :mod:`.state_sharing`
-(§5 Tr/Pr/Cr/Nt), :mod:`.brain` (the ``los-explorer-v1`` and ``los-helper-v1`` brains).
+(§5 Tr/Pr/Cr/Nt), :mod:`.brain` (the step both brains share), :mod:`.explorer` (``los-explorer-v1``, R1) and
+:mod:`.helper` (``los-helper-v1``, R2..R4).
 """
 
-from teamnav.control.coop.los_help.brain import LosExplorer, LosExplorerParams, LosHelper, LosHelperParams
+from teamnav.control.coop.los_help.explorer import LosExplorer, LosExplorerParams
+from teamnav.control.coop.los_help.helper import LosHelper, LosHelperParams
 
 __all__ = ["LosExplorer", "LosExplorerParams", "LosHelper", "LosHelperParams"]

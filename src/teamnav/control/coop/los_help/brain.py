@@ -1,12 +1,14 @@
-"""The brains of the line-of-sight help system (Sgorbissa & Arkin §2–§6).
+"""The step both brains of the line-of-sight help system share (Sgorbissa & Arkin §2–§6).
+
+The brains themselves live in :mod:`.explorer` and :mod:`.helper`.
 
 Paper: A. Sgorbissa and R. C. Arkin, "Local navigation strategies for a team of robots".
 
-- :class:`LosExplorer` (``los-explorer-v1``) is R1: it is given targets in its own frame,
+- :class:`~.explorer.LosExplorer` (``los-explorer-v1``) is R1: it is given targets in its own frame,
   reached in sequence within ε (§2), drives with a local navigation algorithm A
   (``navigator``), and is helped by teammates through goal sharing (§3–§4) and state sharing
   (§5).
-- :class:`LosHelper` (``los-helper-v1``) is R2..R4: it patrols waypoints (§6: helpers "patrol
+- :class:`~.helper.LosHelper` (``los-helper-v1``) is R2..R4: it patrols waypoints (§6: helpers "patrol
   the corridors") with the same navigator family, runs the same sharing rules (shares its
   own patrol goal, relays the goals it knows, reports D for every goal it sees, keeps ghosts)
   and never leaves its patrol to help.
@@ -47,8 +49,8 @@ the default; detections without an id are ignored) and ``radio: {mode: line_of_s
 world point ``w`` is ``R(-θ0)(w - p0)`` for a robot starting at ``(p0, θ0)``. With
 ``stop_when_finished`` a run ends once R1 is ``finished`` (helpers have no such attribute).
 
-Parameters, log keys and layers are documented on :class:`LosExplorerParams`,
-:meth:`LosExplorer.log` and :class:`LosHelperParams`; keep them stable (experiments and
+Parameters, log keys and layers are documented on :class:`~.explorer.LosExplorerParams`,
+:meth:`~.explorer.LosExplorer.log` and :class:`~.helper.LosHelperParams`; keep them stable (experiments and
 the report read them).
 """
 
@@ -75,12 +77,12 @@ from teamnav.control.coop.los_help.messages import (
     VisReport,
     message_size_bytes,
 )
-from teamnav.control.coop.los_help.state_sharing import TroubleState, choose_helper
+from teamnav.control.coop.los_help.state_sharing import TroubleState
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, Message, Observation, RangeScan
 from teamnav.geometry.angles import wrap_angle
 
-__all__ = ["LosExplorer", "LosExplorerParams", "LosHelper", "LosHelperParams", "make_navigator"]
+__all__ = ["make_navigator"]
 
 NavigatorName = Literal["potential_field", "avoid_past", "visbug21"]
 XY = tuple[float, float]
@@ -180,54 +182,6 @@ class _CommonParams(BaseModel):
     slide_when_blocked: bool = True
     slide_lookahead_m: float = Field(1.0, gt=0.0, le=100.0)
     trust_direct_promise: bool = True
-
-
-class LosExplorerParams(_CommonParams):
-    """R1's parameters: :class:`_CommonParams` plus its task.
-
-    Attributes
-    ----------
-    targets_xy : list of (x, y)
-        Targets [m] in the robot's own odometry frame, reached in sequence (§2, §6). Empty:
-        finished at once (the robot stays and still relays).
-    keep_trouble_helper : bool
-        In trouble, keep heading to the chosen helper's last seen position when it goes out of
-        sight, until no longer in trouble or the goal is seen (§5 names only these two ends);
-        False follows it only while in sight.
-    trouble_progress : {"goal", "moved"}
-        While following a teammate in trouble (§5 rule 3), what counts as progress for Pr:
-        ``"goal"``, its straight distance to its own goal fell by ``progress_min_fraction`` of
-        a step (§5 rule 1: "progressing well towards the goal"; measured: with ``"moved"`` R1
-        left trouble wherever the teammate had led it, 40 m away, and was trapped again);
-        ``"moved"``, any step that was not blocked.
-    max_steps_per_target : int or None
-        Step budget per target: when the current target is not reached within this many steps
-        (from the step it became current), R1 abandons the task (``gave_up``, and ``finished``
-        so that a run with ``stop_when_finished`` ends). Gap filled: §6 reports the potential
-        field alone as failing without saying after how long; a budget per target, not per
-        task, ends a hopeless run at its first trap instead of burning the whole task's
-        budget. None: never abandon.
-    """
-
-    targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
-    keep_trouble_helper: bool = True
-    max_steps_per_target: int | None = Field(None, ge=1, le=100_000_000)
-    trouble_progress: Literal["goal", "moved"] = "goal"
-
-
-class LosHelperParams(_CommonParams):
-    """A helper's parameters: :class:`_CommonParams` plus its patrol.
-
-    Attributes
-    ----------
-    patrol_xy : list of (x, y)
-        Waypoints [m] in the robot's own odometry frame. Empty: stays where it is.
-    patrol_mode : {"ping_pong", "cycle"}
-        After the last waypoint, go back through them (ping-pong) or start again (cycle).
-    """
-
-    patrol_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=10_000)
-    patrol_mode: Literal["ping_pong", "cycle"] = "ping_pong"
 
 
 class _LosBrain(abc.ABC):
@@ -549,272 +503,3 @@ class _LosBrain(abc.ABC):
             "slide_steps": int(self.slide_steps),
             "temp_switches": int(self.temp_switches),
         }
-
-
-class LosExplorer(_LosBrain):
-    """R1: reaches its targets in sequence, helped by teammates (``los-explorer-v1``).
-
-    Attributes
-    ----------
-    finished : bool
-        True once the last target is reached (immediately with no targets).
-    target_index : int
-        Index (0-based) of the current target; ``len(targets_xy)`` when finished.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from teamnav.control import Observation, RangeScan, RobotInfo, SensorInfo
-    >>> angles = np.linspace(-np.pi, np.pi, 360, endpoint=False)
-    >>> info = RobotInfo(0, 2, 0.2, "holonomic_step", 0.5, 1.5, 0.1, 0.1,
-    ...                  sensors={"laser": SensorInfo("laser", "laser", angles, 8.0)})
-    >>> brain = LosExplorer(LosExplorer.Params(targets_xy=[(2.0, 0.0)]), np.random.default_rng(0), info)
-    >>> scan = RangeScan(np.full(360, 8.0), angles, 8.0)
-    >>> action, outbox = brain.step(Observation(0, 0, 0.0, np.zeros(3), np.zeros(3), scans={"laser": scan}))
-    >>> round(action.direction_rad, 6), brain.mode, outbox
-    (0.0, 'own_goal', [])
-    """
-
-    Params = LosExplorerParams
-
-    def __init__(self, params: LosExplorerParams, rng: np.random.Generator, info: RobotInfo) -> None:
-        super().__init__(params, rng, info)
-        self.targets = [(float(x), float(y)) for x, y in params.targets_xy]
-        self.target_index = 0
-        self.targets_reached = 0
-        self.finished = not self.targets
-        self.gave_up = False
-        self._target_since = 0
-        self._promised: int | None = None
-        self._temp_stall = 0
-        self.temp_dropped = 0
-        self._prev_goal_d = math.inf
-        self.promised_steps = 0
-        self.goal_seen_steps = 0
-        self._trouble_target: tuple[int, XY] | None = None
-        self._set_goal()
-
-    def _set_goal(self) -> None:
-        if self.finished:
-            self.sharing.set_own_goal(None)
-            self.mode = "done"
-        else:
-            self.sharing.set_own_goal(self.target_index + 1, self.targets[self.target_index])
-
-    def _advance_task(self) -> None:
-        """§2: the current goal is reached when dist < ε; then the next one becomes current.
-        A target not reached within ``max_steps_per_target`` steps ends the task (gave up)."""
-        while not self.finished:
-            gx, gy = self.targets[self.target_index]
-            if math.hypot(gx - self._pose[0], gy - self._pose[1]) >= self.params.goal_tolerance_m:
-                budget = self.params.max_steps_per_target
-                if budget is not None and self._step - self._target_since >= budget:
-                    self.gave_up = True
-                    self.finished = True
-                    self.sharing.set_own_goal(None)
-                return
-            self._target_since = self._step
-            self.target_index += 1
-            self.targets_reached += 1
-            self.finished = self.target_index >= len(self.targets)
-            self._set_goal()
-            self._last_target = None
-            if self.params.reset_trouble_on_target:
-                self.trouble.reset()
-
-    def _decide(self, obs: Observation) -> Action:
-        if self.finished:
-            self.mode = "gave_up" if self.gave_up else "done"
-            return Action()
-        action = self._decide_task(obs)
-        if self.mode in ("follow_teammate", "ghost", "trouble_follow"):
-            key = self._last_target[0] if self._last_target is not None else None
-            key = key[:2] if isinstance(key, tuple) else key  # the point's source, not its step
-            if key != self._temp_key:
-                self.temp_switches += 1
-            self._temp_key = key
-        else:
-            self._temp_key = None
-        return action
-
-    def _decide_task(self, obs: Observation) -> Action:
-        p = self.params
-        goal = self.targets[self.target_index]
-        path = self.sharing.path(self.me) if p.goal_sharing else None
-        action: Action | None = None
-        progressing = True
-        if path is not None and path.kind == "direct":
-            self.mode = "own_goal"  # §2 point 4: it sees its goal, A is suppressed
-            self.goal_seen_steps += 1
-            action, progressing = self._head_to(goal, ("goal", self.target_index),
-                                                end_margin_m=0.5 * p.goal_tolerance_m)
-        elif path is not None and path.kind in ("ghost", "self") and not path.reached:
-            point = (path.px_m, path.py_m)
-            # the mirror itself still stands where it promised (§3), or only its ghost does (§4.2)
-            seen = self._seen_now.get(path.source)
-            live = seen is not None and math.hypot(seen[0] - point[0], seen[1] - point[1]) <= 2.0 * self.radius_m + self.step_m
-            # a ghost is reached closer than a target: the goal may be seen only from a narrow
-            # stretch of corridor through a door (measured: stopping ε = 0.5 m short of it,
-            # R1 often did not see the goal the helper had seen from there)
-            reach = max(p.goal_tolerance_m, 2.0 * self.radius_m + self.step_m) if live else p.ghost_tolerance_m
-            me = self._me_xy()
-            if math.hypot(point[0] - me[0], point[1] - me[1]) < reach:
-                # §4.2: at the ghost without seeing the goal: explore again with A, keeping the
-                # promise only to arbitrate later reports
-                self.sharing.mark_reached(self.me)
-                if p.trust_direct_promise and path.d_point_m <= math.hypot(goal[0] - point[0], goal[1] - point[1]) + self.step_m:
-                    # the teammate saw the goal itself from here (its D is the straight
-                    # distance): head straight for it (see ``trust_direct_promise``)
-                    self._promised = self.target_index
-            else:
-                self.mode = "follow_teammate" if live else "ghost"
-                action, progressing = self._head_to(point, ("path", path.source, path.step),
-                                                    end_margin_m=reach)
-                # a point R1 makes no progress towards for Cr steps (A trapped on the way; a
-                # teammate standing still in a doorway) is given up like a reached one, so
-                # that A, or §5 when in trouble, takes over (gap filled: §4.2 assumes the
-                # straight path to a ghost is free)
-                self._temp_stall = 0 if progressing else self._temp_stall + 1
-                if self._temp_stall >= p.trouble_cr:
-                    self._temp_stall = 0
-                    self.temp_dropped += 1
-                    self.sharing.mark_reached(self.me)
-        if not self.trouble.tr:
-            self._trouble_target = None
-        me_xy = self._me_xy()
-        goal_d = math.hypot(goal[0] - me_xy[0], goal[1] - me_xy[1])
-        if action is None and p.state_sharing and self.trouble.tr:
-            # §5 rule 3: in trouble, a teammate in sight that is not becomes the temporary goal
-            # "until it realizes it is no longer in trouble or ... perceives its own goal": kept
-            # (at its last seen position) when it goes out of sight (gap filled; the paper
-            # names only these two ends)
-            near = 2.0 * self.radius_m + self.step_m
-            cands = [(rid, xy[0], xy[1], self._teammate_tr.get(rid)) for rid, xy in self._seen_now.items()]
-            tt = self._trouble_target
-            if tt is not None and tt[0] in self._seen_now:
-                tt = self._trouble_target = (tt[0], self._seen_now[tt[0]])
-            elif tt is None or math.hypot(tt[1][0] - self._pose[0], tt[1][1] - self._pose[1]) <= near:
-                helper = choose_helper(True, self._me_xy(), cands)
-                tt = self._trouble_target = None if helper is None else (helper, self._seen_now[helper])
-            if tt is not None and (tt[0] in self._seen_now or p.keep_trouble_helper):
-                self.mode = "trouble_follow"
-                action, _ = self._head_to(tt[1], ("helper", tt[0]), stop_within_m=near, end_margin_m=near)
-                if p.trouble_progress == "moved":
-                    # a step that was not blocked counts (the distance to a teammate seen with
-                    # noise, eqs. 1-2, jumps by up to err_max·d)
-                    progressing = not obs.stalled
-                else:
-                    # §5 rule 1: progress "towards the goal", R1's own: following a teammate away
-                    # from it keeps R1 in trouble (and following), so it is led along the
-                    # patrol until it sees its goal or the teammate takes it nearer
-                    progressing = goal_d < self._prev_goal_d - p.progress_min_fraction * self.step_m
-        if action is None and self._promised == self.target_index and not self.trouble.tr:
-            self.mode = "own_goal"
-            self.promised_steps += 1
-            action, progressing = self._head_to(goal, ("promised", self.target_index),
-                                                end_margin_m=0.5 * p.goal_tolerance_m, trust=True)
-        if action is None:
-            self.mode = "own_goal"
-            action, progressing = self._drive(goal)
-        self.trouble.update(progressing)
-        self._prev_goal_d = goal_d
-        return action
-
-    def log(self) -> dict[str, Any]:
-        """Per-step values (keep these keys stable; experiments read them).
-
-        ``target_index`` (0-based current target), ``targets_reached``, ``moves`` (motion
-        steps commanded so far), ``mode`` (``"own_goal"`` | ``"follow_teammate"`` |
-        ``"ghost"`` | ``"trouble_follow"`` | ``"done"`` | ``"gave_up"``), ``tr``, ``pr``, ``nt`` (§5),
-        ``msgs_sent``, ``bytes_sent``, ``msgs_received`` (§4.4 traffic, cumulative),
-        ``nav_restarts`` (times A gave up and was started afresh),
-        ``known_goals`` and ``ghosts`` (memory, §4.4), ``own_d_m`` (D to its own goal, -1
-        when none), ``finished``, ``gave_up`` (the step budget of a target ran out, see
-        ``max_steps_per_target``); where the steps go, cumulative: ``steps_<mode>`` for each
-        mode met so far, ``goal_seen_steps`` (own goal in sight), ``promised_steps`` (heading for it on a
-        teammate's direct promise, ``trust_direct_promise``), ``slide_steps`` (heading to
-        a seen point along a side direction), ``temp_switches`` (changes of the teammate, ghost
-        or trouble helper headed for), ``temp_dropped`` (teammate or ghost points given up after
-        ``trouble_cr`` steps without progress towards them); and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
-        the odometry frame (when ``log_layers``).
-        """
-        out = self._common_log()
-        out.update(target_index=int(self.target_index), targets_reached=int(self.targets_reached),
-                   finished=bool(self.finished), gave_up=bool(self.gave_up),
-                   goal_seen_steps=int(self.goal_seen_steps), promised_steps=int(self.promised_steps),
-                   temp_dropped=int(self.temp_dropped))
-        layers = self._layers()
-        if layers:
-            out["layers"] = layers
-        return out
-
-
-class LosHelper(_LosBrain):
-    """R2..R4: patrols its waypoints and helps by sharing only (``los-helper-v1``).
-
-    It has no ``finished`` attribute (a run with ``stop_when_finished`` waits for R1 only).
-    """
-
-    Params = LosHelperParams
-
-    def __init__(self, params: LosHelperParams, rng: np.random.Generator, info: RobotInfo) -> None:
-        super().__init__(params, rng, info)
-        self.patrol = [(float(x), float(y)) for x, y in params.patrol_xy]
-        self.waypoint_index = 0
-        self._dir = 1
-        self.waypoints_reached = 0
-        self._k = 1
-        self.mode = "patrol" if self.patrol else "stay"
-        if self.patrol:
-            self.sharing.set_own_goal(self._k, self.patrol[0])
-
-    def _advance_task(self) -> None:
-        """Next waypoint when within ε; each new waypoint is a new goal k (new Id = k·M)."""
-        if not self.patrol:
-            return
-        wx, wy = self.patrol[self.waypoint_index]
-        if math.hypot(wx - self._pose[0], wy - self._pose[1]) >= self.params.goal_tolerance_m:
-            return
-        if len(self.patrol) == 1:
-            return  # one waypoint: it stays there
-        n = len(self.patrol)
-        if self.params.patrol_mode == "cycle":
-            self.waypoint_index = (self.waypoint_index + 1) % n
-        else:
-            if not 0 <= self.waypoint_index + self._dir < n:
-                self._dir = -self._dir
-            self.waypoint_index += self._dir
-        self.waypoints_reached += 1
-        self._k += 1
-        self._last_target = None
-        self.sharing.set_own_goal(self._k, self.patrol[self.waypoint_index])
-        if self.params.reset_trouble_on_target:
-            self.trouble.reset()
-
-    def _decide(self, obs: Observation) -> Action:
-        if not self.patrol:
-            self.mode = "stay"
-            return Action()
-        wp = self.patrol[self.waypoint_index]
-        me = self._me_xy()
-        if len(self.patrol) == 1 and math.hypot(wp[0] - me[0], wp[1] - me[1]) < self.params.goal_tolerance_m:
-            self.mode = "stay"
-            return Action()
-        self.mode = "patrol"
-        if self._sees(*wp):
-            action, progressing = self._head_to(wp, ("waypoint", self._k), end_margin_m=0.5 * self.params.goal_tolerance_m)
-        else:
-            action, progressing = self._drive(wp)
-        self.trouble.update(progressing)
-        return action
-
-    def log(self) -> dict[str, Any]:
-        """As :meth:`LosExplorer.log` where meaningful: ``mode`` is ``"patrol"`` or ``"stay"``;
-        ``target_index`` is the current waypoint index and ``targets_reached`` counts waypoints
-        reached."""
-        out = self._common_log()
-        out.update(target_index=int(self.waypoint_index), targets_reached=int(self.waypoints_reached))
-        layers = self._layers()
-        if layers:
-            out["layers"] = layers
-        return out
