@@ -117,10 +117,12 @@ def test_kernel_matches_numpy_reference(seed, noisy):
     drift = rng.normal(0, 1e-3, n)
     scale = rng.uniform(0.9, 1.1, n)
     pose = np.column_stack([rng.uniform(-5, 5, (n, 2)), rng.uniform(-math.pi, math.pi, n)])
-    ref_pose, ref_delta = odometry_reference(p0, p1, noise, alpha, drift, scale, pose)
+    slip_noise = rng.standard_normal((n, 2)) if noisy else np.empty((0, 2))
+    slip_m, slip_rad = rng.uniform(0, 0.05, n), rng.uniform(0, 0.02, n)
+    ref_pose, ref_delta = odometry_reference(p0, p1, noise, alpha, drift, scale, pose, slip_noise, slip_m, slip_rad)
     delta = np.zeros((n, 3))
     odometry_step(*(np.ascontiguousarray(c) for c in (p0[:, 0], p0[:, 1], p0[:, 2], p1[:, 0], p1[:, 1], p1[:, 2])),
-                  noise, alpha, drift, scale, pose, delta)
+                  noise, alpha, drift, scale, pose, delta, slip_noise, slip_m, slip_rad)
     np.testing.assert_allclose(pose, ref_pose, atol=1e-12)
     np.testing.assert_allclose(delta, ref_delta, atol=1e-12)
 

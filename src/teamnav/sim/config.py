@@ -140,7 +140,10 @@ class OdometryConfig(Model):
     5.6), ``alpha = (α1, α2, α3, α4)``: rotation noise from rotation, rotation noise from
     translation, translation noise from translation, translation noise from rotation.
     Systematic part: a heading drift of ``heading_drift_deg_per_min`` (Vaughan et al. saw
-    0.35°–2°/min) and a translation ``scale_error`` (reported = true × (1 + scale_error)).
+    0.35°–2°/min) and a translation ``scale_error`` (reported = true × (1 + scale_error): a wheel
+    diameter off by that fraction). Wheel slip (:mod:`teamnav.sim.odometry`): random walks per
+    metre driven, whatever the step: ``slip_std_m_per_sqrt_m`` (distance error, std √L m after
+    L m) and ``heading_slip_deg_per_sqrt_m`` (heading error, std √L deg after L m).
 
     ``frame``: ``"start"`` — the odometry frame is the robot's start pose (odom starts at
     (0, 0, 0)); ``"world"`` — frames start aligned with the world (Vaughan et al.: robots start
@@ -150,6 +153,8 @@ class OdometryConfig(Model):
     alpha: tuple[NonNegFloat, NonNegFloat, NonNegFloat, NonNegFloat] = (0.0, 0.0, 0.0, 0.0)
     heading_drift_deg_per_min: float = Field(0.0, ge=-360.0, le=360.0)
     scale_error: float = Field(0.0, gt=-0.5, lt=0.5)
+    slip_std_m_per_sqrt_m: float = Field(0.0, ge=0.0, le=0.5)
+    heading_slip_deg_per_sqrt_m: float = Field(0.0, ge=0.0, le=30.0)
     frame: Literal["start", "world"] = "start"
 
 

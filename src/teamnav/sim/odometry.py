@@ -9,13 +9,38 @@ motion is drawn from the odometry motion model (Table 5.6, ``alpha = (a1, a2, a3
     m_trans = d_trans - N(0, a3 d_trans^2 + a4 d_rot1^2 + a4 d_rot2^2)
     m_rot2  = d_rot2  - N(0, a1 d_rot2^2 + a2 d_trans^2)
 
-(``N(0, b^2)`` has variance ``b^2``, as in the book's ``sample(b^2)``), then the systematic
-errors that make Vaughan et al.'s odometry drift (*Blazing a trail* §5, 0.35°–2°/min):
+(``N(0, b^2)`` has variance ``b^2``, as in the book's ``sample(b^2)``), then wheel slip, a
+random walk per metre driven (``L = |d_trans|``, the step's true distance)::
 
-- ``m_trans *= 1 + scale_error``;
+    m_trans += N(0, slip_std_m_per_sqrt_m^2 L)              (std sigma_t sqrt(L) m)
+    m_rot1, m_rot2 += 0.5 N(0, heading_slip_deg_per_sqrt_m^2 L)  each (one draw, split)
+
+and the systematic errors that make Vaughan et al.'s odometry drift:
+
+- ``m_trans *= 1 + scale_error`` (a wheel diameter off by that fraction; applied after the slip,
+  since the encoder ticks are converted to metres with the wrong diameter whatever the ground did);
 - ``heading_drift_deg_per_min * dt / 60`` degrees are added to the measured rotation, half
   to ``m_rot1`` and half to ``m_rot2``. The drift is a rate in *time*, so it accumulates
   while a robot stands still too (like a gyro bias); it is exactly ``rate × elapsed time``.
+
+What the papers say about their robots' odometry
+------------------------------------------------
+Both papers report *rotation* only. *Blazing a trail* §5.1 / Fig. 6: "the odometry of Ant and
+Bee is worse than the odometry of Tanis and Punky whose odometry only rotates slightly", and
+the system "breaks down completely at around 27 minutes" from "the unbounded accumulation of
+odometry errors" (§6). *Try to see it my way* §3.6: "Bug's coordinate system rotated clockwise;
+the other robots' systems drifted anti-clockwise. Tanis' system rotated only by around 0.35° per
+minute, while Fly's rotated at 2° per minute", and one robot "suffered catastrophic odometry
+failure". Neither gives a distance error; the 2002 transform between frames (§2.1.5) has a
+*scale* besides the rotation and translation, which is what a wheel-diameter error needs.
+
+Gap-fills (ours): the scale error and the slip are the two textbook translational errors of
+wheel odometry (systematic: unequal or wrong wheel diameters; non-systematic: slip on the floor,
+Borenstein & Feng's UMBmark split). The slip is given *per metre* and not through Table 5.6's
+``a3``: that noise has variance ``a3 d_trans^2`` per step, so its variance over a path of length
+``L`` is ``a3 L v dt`` and shrinks with the step; a random walk per metre is the same at any
+``dt``. The slip draws come from the odometry stream *after* Table 5.6's, and only when a slip
+parameter is non-zero, so runs without slip draw the same numbers as before it existed.
 
 The believed pose integrates the measured motion::
 
@@ -50,7 +75,8 @@ _MIN_TRANS_M = 1e-12
 
 
 @njit(cache=True)
-def odometry_step(x0, y0, th0, x1, y1, th1, noise, alpha, drift_rad, scale, pose, delta):
+def odometry_step(x0, y0, th0, x1, y1, th1, noise, alpha, drift_rad, scale, pose, delta,
+                  slip_noise, slip_m, slip_rad):
     """Advance every robot's odometry by one step (see the module docstring).
 
     Parameters
@@ -69,8 +95,15 @@ def odometry_step(x0, y0, th0, x1, y1, th1, noise, alpha, drift_rad, scale, pose
         Odometry poses, updated in place.
     delta : (N, 3) float64
         Written: measured motion in the previous odometry body frame.
+    slip_noise : (N, 2) float64 or (0, 2)
+        Standard normal draws (translation, heading) of the slip; empty means no slip.
+    slip_m : (N,) float64
+        Distance slip [m per sqrt(m) driven].
+    slip_rad : (N,) float64
+        Heading slip [rad per sqrt(m) driven].
     """
     noisy = noise.shape[0] > 0
+    slipping = slip_noise.shape[0] > 0
     for i in range(x0.shape[0]):
         dx = x1[i] - x0[i]
         dy = y1[i] - y0[i]
@@ -99,6 +132,12 @@ def odometry_step(x0, y0, th0, x1, y1, th1, noise, alpha, drift_rad, scale, pose
             m_rot1 = rot1
             m_trans = trans
             m_rot2 = rot2
+        if slipping:
+            root = math.sqrt(abs(trans))
+            m_trans += slip_noise[i, 0] * slip_m[i] * root
+            half = 0.5 * slip_noise[i, 1] * slip_rad[i] * root
+            m_rot1 += half
+            m_rot2 += half
         m_trans *= scale[i]
         m_rot1 += 0.5 * drift_rad[i]
         m_rot2 += 0.5 * drift_rad[i]
@@ -111,7 +150,7 @@ def odometry_step(x0, y0, th0, x1, y1, th1, noise, alpha, drift_rad, scale, pose
         delta[i, 2] = wrap(m_rot1 + m_rot2)
 
 
-def odometry_reference(p0, p1, noise, alpha, drift_rad, scale, pose):
+def odometry_reference(p0, p1, noise, alpha, drift_rad, scale, pose, slip_noise=None, slip_m=None, slip_rad=None):
     """Pure-NumPy reference of :func:`odometry_step`; returns ``(new_pose, delta)`` (N, 3) each."""
     from teamnav.geometry.angles import wrap_angle
 
@@ -133,6 +172,13 @@ def odometry_reference(p0, p1, noise, alpha, drift_rad, scale, pose):
         m2 = rot2 - n[:, 2] * np.sqrt(a[:, 0] * rot2**2 + a[:, 1] * trans**2)
     else:
         m1, mt, m2 = rot1, trans, rot2
+    if slip_noise is not None and len(slip_noise):
+        sn = np.asarray(slip_noise, dtype=np.float64)
+        root = np.sqrt(np.abs(trans))
+        mt = mt + sn[:, 0] * np.asarray(slip_m, dtype=np.float64) * root
+        half = 0.5 * sn[:, 1] * np.asarray(slip_rad, dtype=np.float64) * root
+        m1 = m1 + half
+        m2 = m2 + half
     mt = mt * scale
     m1 = m1 + 0.5 * drift_rad
     m2 = m2 + 0.5 * drift_rad
@@ -177,15 +223,22 @@ class Odometry:
         self.alpha = np.array([c.alpha for c in configs], dtype=np.float64).reshape(n, 4)
         self.drift_rad = np.array([math.radians(c.heading_drift_deg_per_min) * dt_s / 60.0 for c in configs])
         self.scale = np.array([1.0 + c.scale_error for c in configs])
+        self.slip_m = np.array([c.slip_std_m_per_sqrt_m for c in configs], dtype=np.float64)
+        self.slip_rad = np.array([math.radians(c.heading_slip_deg_per_sqrt_m) for c in configs], dtype=np.float64)
         world = np.array([c.frame == "world" for c in configs], dtype=bool)
         self.pose = np.where(world[:, None], start_poses, 0.0)
         self.delta = np.zeros((n, 3))
         self.rng = rng
         self._noisy = bool(np.any(self.alpha > 0))
         self._noise = np.empty((n, 3)) if self._noisy else np.empty((0, 3))
+        self._slipping = bool(np.any(self.slip_m > 0) or np.any(self.slip_rad > 0))
+        self._slip_noise = np.empty((n, 2)) if self._slipping else np.empty((0, 2))
 
     def step(self, x0, y0, th0, x1, y1, th1) -> None:
         """Integrate one step of true motion (before → after) into the believed poses."""
         if self._noisy:
             self.rng.standard_normal(out=self._noise)
-        odometry_step(x0, y0, th0, x1, y1, th1, self._noise, self.alpha, self.drift_rad, self.scale, self.pose, self.delta)
+        if self._slipping:  # after Table 5.6's draws: runs without slip keep their numbers
+            self.rng.standard_normal(out=self._slip_noise)
+        odometry_step(x0, y0, th0, x1, y1, th1, self._noise, self.alpha, self.drift_rad, self.scale, self.pose,
+                      self.delta, self._slip_noise, self.slip_m, self.slip_rad)
