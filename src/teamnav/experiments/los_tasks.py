@@ -132,6 +132,32 @@ def _door_route(y_m: float, doors_x: Sequence[float], door_y_m: float, x0_m: flo
     return tuple(out)
 
 
+#: office_complex's corridor doorways (places ``door_*``: 0.3 m past the corridor's edge), as
+#: (position along the corridor [m], doorway's other coordinate [m]): on H (x, y), on V (y, x).
+COMPLEX_DOORS_H: tuple[tuple[float, float], ...] = (
+    (1.4, 10.5), (9.6, 10.5), (12.8, 13.5), (20.6, 13.5), (23.6, 10.5), (26.0, 10.5), (34.8, 10.5), (34.8, 13.5))
+COMPLEX_DOORS_V: tuple[tuple[float, float], ...] = ((22.6, 17.2), (14.8, 18.8), (9.4, 18.8), (1.6, 17.2))
+
+
+def _doors_route(lane_m: float, doors: Sequence[tuple[float, float]], a_m: float, b_m: float, *,
+                 vertical: bool = False) -> tuple[tuple[float, float], ...]:
+    """A corridor route along the lane ``lane_m`` from ``a_m`` to ``b_m`` stepping into each door
+    (position along the corridor, doorway's cross coordinate) passed on the way, and back out;
+    (x, y) points, the lane being a y (east-west corridor) or, ``vertical``, an x."""
+    step = 1.0 if b_m >= a_m else -1.0
+    along: list[tuple[float, float]] = [(a_m, lane_m)]
+    for s, cross in sorted(doors, key=lambda d: step * d[0]):
+        if (s - a_m) * step >= 0 and (b_m - s) * step >= 0:
+            along += [(s, lane_m), (s, cross), (s, lane_m)]
+    along.append((b_m, lane_m))
+    out: list[tuple[float, float]] = []
+    for s, c in along:
+        p = (c, s) if vertical else (s, c)
+        if not out or p != out[-1]:
+            out.append(p)
+    return tuple(out)
+
+
 LAYOUTS: dict[str, Layout] = {
     # corridor y in [5.8, 8.2], x in [0.2, 29.8]; base (1, 7)
     "simple": Layout(
@@ -151,14 +177,14 @@ LAYOUTS: dict[str, Layout] = {
     "complex": Layout(
         r1_start=(1.0, 12.0, 90.0),
         helpers=(
-            # from the corridors a helper sees the centres of rooms 3, 5 and 7 only (through their
-            # doors; room 5's from the corridor's east end, x > 34.6); the others lie behind
-            # U-shaped obstacles or other rooms
-            ((3.0, 11.6, 0.0), ((35.2, 11.6), (3.0, 11.6))),  # R2: east-west corridor
-            ((18.4, 22.5, 270.0), ((18.4, 1.5), (18.4, 22.5))),  # R3: north-south corridor
-            # R4: both corridors, through the junction (ping-pong over this list)
-            ((20.0, 12.4, 0.0), ((35.2, 12.4), (17.6, 12.4), (17.6, 22.5), (17.6, 12.4), (3.0, 12.4),
-                                 (17.6, 12.4), (17.6, 1.5))),
+            # every room of office_complex has a door on H at one end of its corridor wall, and its
+            # centre is in sight from the doorway (place door_<k>) only: R2 and R4 walk H end to
+            # end stepping into every H door (south and north), in opposite phases and lanes; R3
+            # walks V stepping into its four doors. Together they see every target and every
+            # room's inside, as the paper's helpers "patrolling the corridors" must for Table 2
+            ((3.0, 11.6, 0.0), _doors_route(11.6, COMPLEX_DOORS_H, 1.0, 35.2)),  # R2: west end first, eastwards
+            ((18.0, 23.0, 270.0), _doors_route(18.0, COMPLEX_DOORS_V, 23.0, 1.2, vertical=True)),  # R3: V, southwards
+            ((33.0, 12.4, 180.0), _doors_route(12.4, COMPLEX_DOORS_H, 1.0, 35.2)[::-1]),  # R4: east end first, westwards
         ),
     ),
 }

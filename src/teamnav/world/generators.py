@@ -386,70 +386,109 @@ def office_simple(resolution_m: float = 0.1) -> EnvironmentMap:
     return EnvironmentMap(b.build("builtin:office_simple"), places, notes, regions)
 
 
+def _u_obstacle(b: "MapBuilder", xmin: float, ymin: float, xmax: float, ymax: float, opens: str,
+                thickness_m: float = 0.3) -> None:
+    """A U-shaped wall ``thickness_m`` thick on the box, open on side ``opens`` (N, S, E or W).
+
+    Used by :func:`office_complex` only: the classic concave trap of a potential field
+    (Koren & Borenstein, Sgorbissa & Arkin [6]) when it opens towards the robot."""
+    t = thickness_m
+    b.rect(xmin, ymin, xmax, ymax, filled=False, thickness_m=t)
+    gap = {"N": (xmin + t, ymax - t, xmax - t, ymax), "S": (xmin + t, ymin, xmax - t, ymin + t),
+           "E": (xmax - t, ymin + t, xmax, ymax - t), "W": (xmin, ymin + t, xmin + t, ymax - t)}[opens]
+    b.clear_rect(*gap)
+
+
 def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
     """Sgorbissa & Arkin §6, Fig. 13: the complex office, built to trap local methods.
 
     A 36 m x 24 m building with a cross of 2.4 m corridors (east-west ``H`` at
-    y in [10.8, 13.2] m, north-south ``V`` at x in [16.8, 19.2] m) and rooms in the four
-    quarters. What makes it complex (§6: even with three helpers the local algorithm still
-    matters, and PF alone never finishes):
+    y in [10.8, 13.2] m, north-south ``V`` at x in [16.8, 19.2] m) and eight rooms in the
+    four quarters, every one with a 1.2 m door onto ``H`` (rooms 2, 3, 6, 7 also onto ``V``).
 
-    - ``room_1`` (south-west): 0.9 m door at its north-west corner and a U-shaped obstacle
-      opening towards the door between the door and the target: a robot driving at the
-      target enters the U and sticks in its bottom (classic PF local minimum).
-    - ``room_2``: entered from the V corridor through a narrow door behind a baffle wall.
-    - ``room_3``..``room_5`` (south-east): ``room_4`` has no corridor door; it is reached
-      through ``room_3`` (a target behind a wall in front of the robot).
-    - ``room_6`` (north-west, large): a U-shaped obstacle and two pillars.
-    - ``room_7``, ``room_8`` (north-east): ``room_8``'s only door is 0.9 m wide at its far
-      end, opening from ``room_7``.
+    What §6 asks of it, and how:
 
-    Places: ``room_1``..``room_8`` targets (room centres, moved off obstacles where one sits
-    there), ``base`` at the west end of H, ``patrol_*`` waypoints on both corridors.
+    - "target positions which are located in the middle of the rooms": places ``room_1`` ..
+      ``room_8`` are the rooms' exact centres, with at least 1.5 m of free space around.
+    - "other robots ... patrolling the corridors and supporting R1": every room has a door on a
+      corridor, at one end of the room's corridor wall, and the room's centre is in sight
+      (line of sight within 8 m) from a point of that doorway 0.3 m past the corridor's edge.
+      A helper that steps into the doorways on its patrol sees every target and every robot
+      in the room (the first version opened rooms 1, 2, 4, 6 and 8 to no corridor and hid
+      their centres behind obstacles, so helpers could see only rooms 3, 5 and 7 and made no
+      measurable difference, unlike Table 2).
+    - "more complex" than Fig. 11, with local minima a potential field cannot leave
+      ("1) does not guarantee the robot to reach its target without the help of other robots
+      because of the presence of local minima"): doors sit off the room's centre line, so a
+      robot heading at a centre from the corridor (or at a target across the corridor from
+      inside a room) meets a wall; four rooms hold U-shaped walls opening towards the room's
+      centre, set where a robot leaving the centre for a target in another room drives into
+      them (room 1: east, room 6: south, room 8: west, room 4: west); room 2 has a partition
+      hanging from its corridor wall and room 7 two pillars. Rooms 3 and 4, and 7 and 8, are
+      also joined by inner doors (suites), giving a boundary follower shorter ways and longer
+      ones.
+
+    Where we fill a gap: the paper gives Fig. 13 as a picture only (no sizes). The U walls
+    leave the line from the room's doorway to its centre clear, so helpers' visibility is the
+    paper's ("helpers clearly help on this map", Table 2) while the traps stay on the way
+    out of the rooms.
+
+    Places: ``room_1``..``room_8`` (targets), ``base`` at the west end of H (R1's start),
+    ``door_<k>`` at each corridor doorway 0.3 m past the corridor's edge (``door_<k>``: H door,
+    ``door_<k>v``: V door), ``patrol_*`` waypoints on both corridors and the ``junction``.
     """
     res = _res(resolution_m)
     b = MapBuilder(36.0, 24.0, res).fill("wall")
     b.clear_rect(0.2, 10.8, 35.8, 13.2)  # corridor H
     b.clear_rect(16.8, 0.2, 19.2, 23.8)  # corridor V
-    # room 1 (SW) with a U trap open towards its north-west door
-    b.clear_rect(0.2, 0.2, 8.2, 10.6).clear_rect(0.8, 10.6, 1.7, 10.8)
-    b.rect(2.4, 5.6, 6.4, 8.8, filled=False, thickness_m=0.3)
-    b.clear_rect(2.7, 8.5, 6.1, 8.8)  # open the U's top: it now opens towards the door
-    # room 2 with a baffle in front of its narrow east door
-    b.clear_rect(8.4, 0.2, 16.6, 10.6).clear_rect(16.6, 2.0, 16.8, 2.9)
-    b.rect(14.6, 0.2, 14.9, 7.0)  # baffle wall from the south wall, gap to the north
-    # rooms 3, 4, 5 (SE); room 4 only through room 3
-    b.clear_rect(19.4, 0.2, 24.6, 10.6).clear_rect(23.0, 10.6, 24.2, 10.8)
-    b.clear_rect(24.8, 0.2, 30.2, 10.6).clear_rect(24.6, 1.0, 24.8, 2.2)
-    b.clear_rect(30.4, 0.2, 35.8, 10.6).clear_rect(34.4, 10.6, 35.4, 10.8)
-    # room 6 (NW): big room, U obstacle and pillars
-    b.clear_rect(0.2, 13.4, 16.6, 23.8).clear_rect(13.8, 13.2, 15.0, 13.4)
-    b.rect(5.0, 16.0, 9.0, 20.0, filled=False, thickness_m=0.3)
-    b.clear_rect(5.3, 16.0, 8.7, 16.3)  # U open to the south, towards the door side
-    b.disc(11.5, 17.0, 0.5).disc(11.5, 21.0, 0.5)
-    # rooms 7, 8 (NE)
-    b.clear_rect(19.4, 13.4, 27.4, 23.8).clear_rect(19.2, 20.0, 19.4, 21.2).clear_rect(20.0, 13.2, 21.2, 13.4)
-    b.clear_rect(27.6, 13.4, 35.8, 23.8).clear_rect(27.4, 22.4, 27.6, 23.3)
-    places = {
-        "room_1": (4.4, 3.0),
-        "room_2": (11.5, 5.4),
-        "room_3": (22.0, 5.4),
-        "room_4": (27.5, 5.4),
-        "room_5": (33.1, 5.4),
-        "room_6": (7.0, 18.0),
-        "room_7": (23.4, 18.6),
-        "room_8": (31.7, 18.6),
+    # rooms: (xmin, ymin, xmax, ymax); south row's corridor wall is y 10.6-10.8, north row's 13.2-13.4
+    rooms = {
+        1: (0.2, 0.2, 8.2, 10.6), 2: (8.4, 0.2, 16.6, 10.6), 3: (19.4, 0.2, 24.6, 10.6),
+        4: (24.8, 0.2, 30.2, 10.6), 5: (30.4, 0.2, 35.8, 10.6),
+        6: (0.2, 13.4, 16.6, 23.8), 7: (19.4, 13.4, 27.4, 23.8), 8: (27.6, 13.4, 35.8, 23.8),
+    }
+    for box in rooms.values():
+        b.clear_rect(*box)
+    # doors on H (x range), at one end of each room's corridor wall
+    h_doors = {1: (0.8, 2.0), 2: (9.0, 10.2), 3: (23.0, 24.2), 4: (25.4, 26.6), 5: (34.2, 35.4),
+               6: (12.2, 13.4), 7: (20.0, 21.2), 8: (34.2, 35.4)}
+    for k, (x0, x1) in h_doors.items():
+        y0, y1 = (10.6, 10.8) if rooms[k][1] < 10.0 else (13.2, 13.4)
+        b.clear_rect(x0, y0, x1, y1)
+    # doors on V (y range): west side (rooms 2, 6: wall x 16.6-16.8), east side (3, 7: x 19.2-19.4)
+    v_doors = {2: (1.0, 2.2), 3: (8.8, 10.0), 6: (22.0, 23.2), 7: (14.2, 15.4)}
+    for k, (y0, y1) in v_doors.items():
+        x0, x1 = (16.6, 16.8) if k in (2, 6) else (19.2, 19.4)
+        b.clear_rect(x0, y0, x1, y1)
+    b.clear_rect(24.6, 1.0, 24.8, 2.2)  # suite door room 3 <-> room 4 (south end)
+    b.clear_rect(27.4, 22.2, 27.6, 23.4)  # suite door room 7 <-> room 8 (north end)
+    # traps (open towards the room's centre, on the way out to other rooms)
+    _u_obstacle(b, 5.2, 3.4, 6.6, 7.4, "W")  # room 1: east of the centre (4.2, 5.4)
+    _u_obstacle(b, 5.0, 15.0, 8.0, 17.2, "N")  # room 6: south-west of the centre (8.4, 18.6)
+    _u_obstacle(b, 29.2, 16.2, 30.6, 21.0, "E")  # room 8: west of the centre (31.7, 18.6)
+    _u_obstacle(b, 24.8, 3.6, 26.4, 7.2, "E")  # room 4: a bay in its west wall, west of the centre (27.5, 5.4)
+    b.rect(12.4, 7.6, 12.7, 10.6)  # room 2: partition hanging from the corridor wall
+    b.disc(22.4, 21.4, 0.4).disc(25.4, 16.0, 0.4)  # room 7: pillars off the door-centre line
+    places: dict[str, tuple[float, float]] = {}
+    for k, (x0, y0, x1, y1) in rooms.items():
+        places[f"room_{k}"] = (round((x0 + x1) / 2, 3), round((y0 + y1) / 2, 3))
+    for k, (x0, x1) in h_doors.items():
+        places[f"door_{k}"] = (round((x0 + x1) / 2, 3), 10.5 if rooms[k][1] < 10.0 else 13.5)
+    for k, (y0, y1) in v_doors.items():
+        places[f"door_{k}v"] = (16.5 if k in (2, 6) else 19.5, round((y0 + y1) / 2, 3))
+    places.update({
         "base": (1.0, 12.0),
         "patrol_H1": (8.0, 12.0),
         "patrol_H2": (28.0, 12.0),
         "patrol_V1": (18.0, 5.0),
         "patrol_V2": (18.0, 19.0),
         "junction": (18.0, 12.0),
-    }
+    })
     notes = (
         "Sgorbissa & Arkin §6 Fig. 13 (complex office): 36x24 m, cross-shaped 2.4 m corridors, "
-        "8 rooms with U-shaped obstacles open towards the robot's approach, narrow 0.9 m doors, "
-        "a baffle, and rooms reached only through other rooms; targets at room centres."
+        "8 rooms each with a 1.2 m door at one end of its corridor wall (rooms 2, 3, 6, 7 also on the "
+        "north-south corridor), U-shaped walls opening towards four room centres, a partition, pillars, "
+        "and two suites of joined rooms; targets at room centres, each in sight from its doorway."
     )
     regions = {"corridor_H": (0.2, 10.8, 35.8, 13.2), "corridor_V": (16.8, 0.2, 19.2, 23.8)}
     return EnvironmentMap(b.build("builtin:office_complex"), places, notes, regions)
