@@ -239,7 +239,17 @@ def test_drift_sweeps_give_each_robot_its_own_drift_the_same_for_both_algorithms
         # Try §3.6 x 2: Bug clockwise, the others anticlockwise, Tanis slowest, Fly fastest
         assert [g.odometry.heading_drift_deg_per_min for g in scn.robots] == pytest.approx(
             [2 * v for v in T.DRIFT_PATTERN.values()])
-        assert load_sweep(name).n_trials == 5 * 10  # k = 0, 0.5, 1, 2, 4 x 10 seeds
+        # k = 0, 0.5, 1, 2, 4 and the two scale-error cases (alone, with k = 1) x 10 seeds
+        assert load_sweep(name).n_trials == 7 * 10
+        full = load_sweep(name).model_copy(update={"seeds": 1})
+        for case, drift in (("scale5", 0.0), ("x1-scale5", 1.0)):
+            trial = next(t for t in expand(full) if t.params["case"] == case)
+            assert T.drift_scale(trial.params) is None  # not on the drift axis
+            scn = load_scenario(spec.scenario, overrides={k: v for k, v in trial.params.items()
+                                                          if k not in ("case", "duration_s")}, seed=0, duration_s=1.0)
+            assert [g.odometry.scale_error for g in scn.robots] == [0.05, -0.05, 0.03, -0.03]
+            assert [g.odometry.heading_drift_deg_per_min for g in scn.robots] == pytest.approx(
+                [drift * v for v in T.DRIFT_PATTERN.values()])
     with pytest.raises(ValueError, match="no drift case for scale"):
         T.drift_spec("try-drift", [3.0])
     assert T.drift_scale({"params": {"case": "x0.5"}}) == 0.5 and T.drift_scale({"params": {}}) is None
