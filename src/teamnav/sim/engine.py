@@ -269,6 +269,7 @@ class Simulation:
             self._groups.append(grp)
             self.brains.append(brain)
 
+        self._plan_shared_sensing()
         self._any_per_robot = any(not grp.batched for grp in self._groups)
         self.radio = Radio(config.radio, grid, n, np.random.default_rng(radio_ss)) if self._any_per_robot else None
         self.places = Places(config.places, self.state.x_m, self.state.y_m)
@@ -376,6 +377,91 @@ class Simulation:
             h(self)
 
     # ------------------------------------------------------------------ internals
+    def _plan_shared_sensing(self) -> None:
+        """Group the per-robot groups' sensing that can run in one call per step.
+
+        - Detectors with equal configurations: the noise-free part (range, field of view,
+          line of sight) once for all their observers
+          (:meth:`~teamnav.sim.sensors.detector.RobotDetector._detect_groups`); each group
+          still draws its noise from its own stream.
+        - Range sensors that cast the same rays (same materials, ray directions, range and
+          robot bodies): one cast for the robots of all those groups while the call stays
+          below the sensors' parallel threshold; each group's noise from its own stream and
+          its own key, into an array of its own.
+
+        Every stream sees the same draws as with one call per group, so a run is the same bit
+        for bit; a 4-robot team of one-robot groups (Sgorbissa & Arkin's R1..R4) pays one
+        detector call and one cast per step instead of four.
+        """
+        from teamnav.sim.sensors.robot_hits import PARALLEL_MIN_RAYS
+
+        self._det_sets: list[tuple[Any, list[_Group]]] = []
+        self._scan_sets: list[tuple[Any, list[tuple[_Group, int]], np.ndarray, Any]] = []
+        for grp in self._groups:
+            if grp.batched:
+                continue
+            if grp.detector is not None:
+                for det, members in self._det_sets:
+                    if det.cfg == grp.detector.cfg:
+                        members.append(grp)
+                        break
+                else:
+                    self._det_sets.append((grp.detector, [grp]))
+        scan_sets: list[tuple[tuple, list[tuple[_Group, int]]]] = []
+        for grp in self._groups:
+            if grp.batched:
+                continue
+            for k, sensor in enumerate(grp.sensors):
+                key = (sensor.sees, sensor.ray_angles_rad.tobytes(), sensor.rays_per_beam, sensor.angles_rad.shape[0],
+                       sensor.max_range_m, sensor.sees_robots, grp.bodies[k] is not None)
+                n_rays = sensor.ray_angles_rad.shape[0]
+                for skey, members in scan_sets:
+                    rows = sum(g.cfg.count for g, _ in members) + grp.cfg.count
+                    if skey == key and rows * n_rays < PARALLEL_MIN_RAYS:
+                        members.append((grp, k))
+                        break
+                else:
+                    scan_sets.append((key, [(grp, k)]))
+        for _, members in scan_sets:
+            if len(members) < 2:
+                continue
+            idx = np.concatenate([g.ids for g, _ in members])
+            g0, k0 = members[0]
+            bodies = None
+            if g0.bodies[k0] is not None:
+                bodies = (self.state.x_m, self.state.y_m, self.state.radius_m, idx)
+            self._scan_sets.append((g0.sensors[k0], members, idx, bodies))
+        self._shared_scan = {(g.index, k) for _, members, _, _ in self._scan_sets for g, k in members}
+
+    def _shared_readings(self) -> dict:
+        """This step's ranges of the shared casts: ``{(group index, sensor k): (n, B) array}``."""
+        from teamnav.sim.sensors.range_sensors import _keyed_noise, draw_noise_key
+
+        s = self.state
+        out = {}
+        for sensor, members, idx, bodies in self._scan_sets:
+            true = sensor._true_ranges(s.x_m[idx], s.y_m[idx], s.theta_rad[idx], bodies)
+            r0 = 0
+            for grp, k in members:
+                r1 = r0 + grp.cfg.count
+                own = grp.sensors[k]
+                ranges = np.empty((r1 - r0, true.shape[1]))
+                out[(grp.index, k)] = _keyed_noise(true[r0:r1], draw_noise_key(grp.rngs[k]), own.noise_std_m, own.p_max,
+                                                   own.p_short, own.max_range_m, ranges)
+                r0 = r1
+        return out
+
+    def _shared_detections(self) -> dict:
+        """This step's detections, ``{group index: list of tuples of Detection}``."""
+        s = self.state
+        out = {}
+        for det, members in self._det_sets:
+            found = det._detect_groups(s.x_m, s.y_m, s.theta_rad, s.radius_m, [g.ids for g in members],
+                                       [g.detector_rng for g in members], self._ids_all)
+            for grp, d in zip(members, found):
+                out[grp.index] = d
+        return out
+
     def _record(self) -> None:
         logs = None
         if any(g.has_log for g in self._groups):
@@ -394,6 +480,8 @@ class Simulation:
         odom = self.odometry.pose.copy()  # fresh belief arrays for this step's observations
         outgoing: list[tuple[int, Message]] = []
         xs, ys, ths = s.x_m, s.y_m, s.theta_rad
+        shared = self._shared_readings() if self._scan_sets else None
+        dets_of = self._shared_detections() if self._det_sets else None
         for grp in self._groups:
             sl = grp.sl
             gx, gy, gth = xs[sl], ys[sl], ths[sl]
@@ -411,12 +499,13 @@ class Simulation:
                 continue
             delta = self.odometry.delta.copy()
             readings = [
-                (sensor.name, sensor._sense(gx, gy, gth, rng, bodies), angles, float(sensor.max_range_m))
-                for sensor, rng, angles, bodies in zip(grp.sensors, grp.rngs, grp.angles, grp.bodies)
+                (sensor.name,
+                 shared[(grp.index, k)] if shared is not None and (grp.index, k) in self._shared_scan
+                 else sensor._sense(gx, gy, gth, rng, bodies),
+                 angles, float(sensor.max_range_m))
+                for k, (sensor, rng, angles, bodies) in enumerate(zip(grp.sensors, grp.rngs, grp.angles, grp.bodies))
             ]
-            dets = None
-            if grp.detector is not None:
-                dets = grp.detector.detect(xs, ys, ths, s.radius_m, grp.ids, grp.detector_rng, self._ids_all)
+            dets = dets_of[grp.index] if grp.detector is not None else None
             if self._rec_sensing and self.recorder.wants(step):
                 self._record_sensing(grp, [(r[0], r[1]) for r in readings], dets)
             stalled = s.stalled[sl].tolist()

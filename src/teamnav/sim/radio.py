@@ -32,7 +32,8 @@ import numpy as np
 
 from teamnav.control.types import Message
 from teamnav.world.grid import OccupancyGrid
-from teamnav.world.los import line_of_sight
+from teamnav.world.los import _PARALLEL_MIN_SEGMENTS, _los_kernel, _los_kernel_serial
+from teamnav.world.raycast import _check_blocking
 
 __all__ = ["Radio"]
 
@@ -67,6 +68,9 @@ class Radio:
         self.rng = rng
         self._blocking = grid.blocking(cfg.sees) if cfg.mode == "line_of_sight" else None
         self._geo = (grid.origin_xy_m[0], grid.origin_xy_m[1], grid.resolution_m)
+        if self._blocking is not None:
+            self._blocking = _check_blocking(self._blocking)
+        self._geo_inv = (float(self._geo[0]), float(self._geo[1]), 1.0 / float(self._geo[2]))
         self.sent_messages = np.zeros(self.n, np.int64)
         self.sent_bytes = np.zeros(self.n, np.int64)
         self.delivered_messages = np.zeros(self.n, np.int64)
@@ -88,9 +92,13 @@ class Radio:
                 ok[s] = False
                 idx = np.flatnonzero(ok)
                 if idx.size:
-                    ox, oy, res = self._geo
-                    seen = line_of_sight(self._blocking, ox, oy, res, np.full(idx.size, xs[s]), np.full(idx.size, ys[s]),
-                                         xs[idx], ys[idx])
+                    # line_of_sight's kernels, called directly: the map was checked once in __init__
+                    ox, oy, inv = self._geo_inv
+                    seen = np.empty(idx.size, dtype=np.bool_)
+                    kernel = _los_kernel if idx.size >= _PARALLEL_MIN_SEGMENTS else _los_kernel_serial
+                    kernel(self._blocking, ox, oy, inv, np.full(idx.size, float(xs[s])), np.full(idx.size, float(ys[s])),
+                           np.ascontiguousarray(xs[idx], dtype=np.float64), np.ascontiguousarray(ys[idx], dtype=np.float64),
+                           seen)
                     ok[idx[~seen]] = False
         ok[s] = False
         return ok

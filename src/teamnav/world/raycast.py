@@ -425,12 +425,15 @@ def _cached_clearance(blocking: np.ndarray) -> np.ndarray:
 
 
 def _run(clear, ox, oy, res, xs, ys, thetas, beams, max_range_m, out, parallel):
+    return _run_cs(clear, ox, oy, res, xs, ys, thetas, np.cos(beams), np.sin(beams), max_range_m, out, parallel)
+
+
+def _run_cs(clear, ox, oy, res, xs, ys, thetas, cb, sb, max_range_m, out, parallel):
+    """:func:`_run` with the beams' ``cos`` and ``sin`` given (a sensor computes them once)."""
     ct = np.cos(thetas)
     st = np.sin(thetas)
-    cb = np.cos(beams)
-    sb = np.sin(beams)
     tmax = max_range_m / res
-    if xs.shape[0] == 0 or beams.shape[0] == 0:
+    if xs.shape[0] == 0 or cb.shape[0] == 0:
         return out
     if parallel:
         # a few chunks of poses per thread: balances load, amortises the per-chunk buffers
@@ -557,6 +560,14 @@ class RayCaster:
         beams = _check_vec("angles_rad", angles_rad)
         out = _check_out(out, (xs.shape[0], beams.shape[0]))
         return _run(self.clearance, self._ox, self._oy, self._res, xs, ys, thetas, beams, self.max_range_m, out, bool(parallel))
+
+    def _cast_cs(self, xs, ys, thetas, cos_b, sin_b, parallel: bool) -> np.ndarray:
+        """:meth:`cast_xyt` without input checks, the beams given by their ``cos`` and ``sin``
+        (``np.cos(angles_rad)``, ``np.sin(angles_rad)``), into a fresh (P, B) array: the
+        engine's per-step path, for contiguous finite float64 (P,) poses."""
+        out = np.empty((xs.shape[0], cos_b.shape[0]), dtype=np.float64)
+        return _run_cs(self.clearance, self._ox, self._oy, self._res, xs, ys, thetas, cos_b, sin_b, self.max_range_m,
+                       out, parallel)
 
 
 def brute_force_reference(

@@ -48,12 +48,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from teamnav.control.types import Detection
 from teamnav.geometry.angles import wrap_angle
 from teamnav.sim.config import DetectorConfig
 from teamnav.world.grid import OccupancyGrid
-from teamnav.world.los import line_of_sight, pairs_within
+from teamnav.world.los import _segment_visible, line_of_sight, pairs_within
 
 __all__ = ["DetectionArrays", "RobotDetector"]
 
@@ -161,8 +162,18 @@ class RobotDetector:
 
     # ------------------------------------------------------------------ truth
     def _visible(self, xs, ys, thetas, obs):
-        """Noise-free (row, observer, target, range, bearing) of every rule-1–3 pair."""
+        """Noise-free (row, observer, target, range, bearing) of every rule-1–3 pair,
+        ordered by row, then target.
+
+        Up to ``_BRUTE_MAX_ROBOTS`` robots the candidate pairs come from one kernel that
+        tests every observer against every robot (range, then line of sight); larger teams
+        use the spatial hash of :func:`~teamnav.world.los.pairs_within`. Both keep the pairs
+        with ``dx*dx + dy*dy <= max_range_m**2`` and the same line-of-sight kernel (symmetric
+        bit for bit), so they return the same detections.
+        """
         n_all = xs.shape[0]
+        if n_all <= _BRUTE_MAX_ROBOTS:
+            return self._visible_brute(xs, ys, thetas, obs)
         row_of = np.full(n_all, -1, dtype=np.int64)
         row_of[obs] = np.arange(obs.shape[0], dtype=np.int64)
         i, j = pairs_within(xs, ys, self.max_range_m)
@@ -187,6 +198,25 @@ class RobotDetector:
         row = row_of[a]
         order = np.lexsort((b, row))
         return row[order], a[order], b[order], rng_m[order], np.asarray(bearing)[order]
+
+    def _visible_brute(self, xs, ys, thetas, obs):
+        """:meth:`_visible` for a small team: one kernel finds the pairs in range and in line
+        of sight (already ordered by row, then target); NumPy computes range and bearing,
+        as the hashed path does, so both agree to the last bit."""
+        n_all = xs.shape[0]
+        cap = obs.shape[0] * max(n_all - 1, 0)
+        out = np.empty((3, cap), dtype=np.int64)
+        m = _pairs_in_sight(xs, ys, obs, self.max_range_m * self.max_range_m, self.cfg.line_of_sight,
+                            self.blocking, self._ox, self._oy, 1.0 / self._res, out)
+        row, a, b = out[0, :m], out[1, :m], out[2, :m]
+        dx = xs[b] - xs[a]
+        dy = ys[b] - ys[a]
+        rng_m = np.hypot(dx, dy)
+        bearing = wrap_angle(np.arctan2(dy, dx) - thetas[a]) if m else np.empty(0)
+        if not self.full_circle and m:
+            keep = np.abs(bearing) <= self.fov_rad / 2
+            row, a, b, rng_m, bearing = row[keep], a[keep], b[keep], rng_m[keep], bearing[keep]
+        return row, a, b, rng_m, bearing
 
     # ------------------------------------------------------------------ noise
     def _noisy(self, d_r, a_r, size_m, rng):
@@ -245,8 +275,12 @@ class RobotDetector:
             Ordered by observer row, then target index, phantoms last.
         """
         xs, ys, thetas, radii, obs, ids = self._check(xs, ys, thetas, radii, observers, rng, ids)
+        return self._finish(self._visible(xs, ys, thetas, obs), xs.shape[0], radii, obs, rng, ids)
+
+    def _finish(self, truth, n_all, radii, obs, rng, ids) -> DetectionArrays:
+        """Rules 4–7 on the noise-free ``truth`` of :meth:`_visible` (all draws from ``rng``)."""
         cfg = self.cfg
-        row, a, b, d_r, a_r = self._visible(xs, ys, thetas, obs)
+        row, a, b, d_r, a_r = truth
         d_p, a_p = self._noisy(d_r, a_r, 2.0 * radii[b], rng)
         if cfg.p_false_negative > 0.0:
             kept = rng.random(row.shape[0]) >= cfg.p_false_negative
@@ -262,7 +296,6 @@ class RobotDetector:
             else:
                 fp_bearing = self.fov_rad * (u[1] - 0.5)
             fp_obs = obs[fp_rows]
-            n_all = xs.shape[0]
             if cfg.report_identity and n_all >= 2:
                 other = rng.integers(0, n_all - 1, k)
                 other += other >= fp_obs  # any robot but the observer
@@ -293,9 +326,85 @@ class RobotDetector:
             ``result[k]`` holds what ``observers[k]`` perceives, in its body frame.
         """
         arr = self.detect_arrays(xs, ys, thetas, radii, observers, rng, ids)
-        n = np.asarray(observers).shape[0]
-        bounds = np.searchsorted(arr.row, np.arange(n + 1))
-        rids = [None if v < 0 else v for v in arr.robot_id.tolist()]
-        dets = [Detection(r, br, i) for r, br, i in zip(arr.range_m.tolist(), arr.bearing_rad.tolist(), rids)]
-        bl = bounds.tolist()
-        return [tuple(dets[bl[k]:bl[k + 1]]) for k in range(n)]
+        return _as_tuples(arr, np.asarray(observers).shape[0])
+
+    def _detect_groups(self, xs, ys, thetas, radii, observers, rngs, ids) -> list[list[tuple[Detection, ...]]]:
+        """:meth:`detect` for several groups of observers at once, without input checks (the
+        engine's per-step path).
+
+        The noise-free part (range, field of view, line of sight) is computed once for all
+        observers; then each group draws its noise, false negatives and false positives from
+        its own stream, exactly as :meth:`detect` would with that group alone: the result and
+        every stream's state equal those of one :meth:`detect` call per group, in any order.
+
+        Parameters
+        ----------
+        xs, ys, thetas, radii : ndarray of shape (N,)
+            Contiguous float64, finite (true poses and radii of all robots).
+        observers : list of ndarray (n_g,), int64
+            Each group's observers; no robot in two groups.
+        rngs : list of numpy.random.Generator
+            Each group's detector stream.
+        ids : ndarray (N,), int64
+
+        Returns
+        -------
+        list of (list of tuple of Detection)
+            Per group, what :meth:`detect` returns.
+        """
+        obs = observers[0] if len(observers) == 1 else np.concatenate(observers)
+        row, a, b, d_r, a_r = self._visible(xs, ys, thetas, obs)
+        n_all = xs.shape[0]
+        sizes = [o.shape[0] for o in observers]
+        offs = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        cut = np.searchsorted(row, offs).tolist()
+        out = []
+        for g, (o, rng) in enumerate(zip(observers, rngs)):
+            s0, s1 = cut[g], cut[g + 1]
+            truth = (row[s0:s1] - offs[g], a[s0:s1], b[s0:s1], d_r[s0:s1], a_r[s0:s1])
+            out.append(_as_tuples(self._finish(truth, n_all, radii, o, rng, ids), sizes[g]))
+        return out
+
+
+# ---------------------------------------------------------------------------- helpers
+#: Teams up to this size find their visible pairs by testing every pair in one kernel;
+#: larger ones use the spatial hash (:func:`teamnav.world.los.pairs_within`).
+_BRUTE_MAX_ROBOTS = 64
+
+
+@njit(cache=True)
+def _pairs_in_sight(xs, ys, obs, r2, los, blocking, ox, oy, inv, out):
+    """Directed pairs (row, observer, target) with the target within ``sqrt(r2)`` of the
+    observer and, if ``los``, in line of sight; ordered by row, then target. Returns the
+    count written to ``out`` (3, cap)."""
+    n = xs.shape[0]
+    m = 0
+    for k in range(obs.shape[0]):
+        i = obs[k]
+        for j in range(n):
+            if j == i:
+                continue
+            ddx = xs[i] - xs[j]
+            ddy = ys[i] - ys[j]
+            if ddx * ddx + ddy * ddy <= r2:
+                lo = min(i, j)
+                hi = max(i, j)
+                if los and not _segment_visible(blocking, (xs[lo] - ox) * inv, (ys[lo] - oy) * inv,
+                                                (xs[hi] - ox) * inv, (ys[hi] - oy) * inv):
+                    continue
+                out[0, m] = k
+                out[1, m] = i
+                out[2, m] = j
+                m += 1
+    return m
+
+
+def _as_tuples(arr: DetectionArrays, n: int) -> list[tuple[Detection, ...]]:
+    """Per observer row, its detections as :class:`Detection` tuples."""
+    if arr.row.shape[0] == 0:
+        return [()] * n
+    bounds = np.searchsorted(arr.row, np.arange(n + 1))
+    rids = [None if v < 0 else v for v in arr.robot_id.tolist()]
+    dets = [Detection(r, br, i) for r, br, i in zip(arr.range_m.tolist(), arr.bearing_rad.tolist(), rids)]
+    bl = bounds.tolist()
+    return [tuple(dets[bl[k]:bl[k + 1]]) for k in range(n)]

@@ -427,6 +427,8 @@ class RangeSensor:
         self.sees = tuple(sees)
         self.caster = RayCaster(grid, self.sees, self.max_range_m)
         self._plan = beam_plan(rays)
+        self._cos_rays = np.cos(rays)  # what RayCaster.cast_xyt would compute on every call
+        self._sin_rays = np.sin(rays)
 
     def __repr__(self) -> str:
         return (f"RangeSensor(name={self.name!r}, kind={self.kind!r}, beams={self.angles_rad.shape[0]}, "
@@ -475,7 +477,7 @@ class RangeSensor:
         """
         n = xs.shape[0]
         parallel = n * self.ray_angles_rad.shape[0] >= PARALLEL_MIN_RAYS
-        rays = self.caster.cast_xyt(xs, ys, thetas, self.ray_angles_rad, parallel=parallel)
+        rays = self.caster._cast_cs(xs, ys, thetas, self._cos_rays, self._sin_rays, parallel)
         if bodies is not None and self.sees_robots:
             all_x, all_y, all_r, self_idx = bodies
             robot_hits_unchecked(xs, ys, thetas, self._plan, all_x, all_y, all_r, self_idx, rays, self.max_range_m, 0.0,
