@@ -70,6 +70,36 @@ def drift_spec(name: str, scales: Sequence[float]):
     return spec.model_copy(update={"cases": [have[k] for k in scales]})
 
 
+#: the drift sweeps' wheel-scale-error cases (Bug +5 %, Ant -5 %, Fly +3 %, Tanis -3 %): alone and with k = 1
+SCALE_CASES = ("scale5", "x1-scale5")
+
+
+def case_spec(name: str, labels: Sequence[str]):
+    """Sweep ``name`` with only the cases labelled ``labels`` (in that order).
+
+    Raises
+    ------
+    ValueError
+        A label the sweep has no case for.
+    """
+    from teamnav.experiments.sweep import load_sweep
+
+    spec = load_sweep(name)
+    have = {c.get("case"): c for c in spec.cases}
+    lacking = [k for k in labels if k not in have]
+    if lacking:
+        raise ValueError(f"sweep {name!r}: no case {lacking}; it has {sorted(str(k) for k in have)}")
+    return spec.model_copy(update={"cases": [have[k] for k in labels]})
+
+
+def by_case(rows: Sequence[dict]) -> dict[str, list[dict]]:
+    """Rows grouped by their case label."""
+    out: dict[str, list[dict]] = {}
+    for r in rows:
+        out.setdefault(str((r.get("params") or {}).get("case")), []).append(r)
+    return out
+
+
 def brains_missing(names: Iterable[str]) -> Missing | None:
     """A Missing block when a brain the section needs is not registered yet."""
     from teamnav.control import registry

@@ -129,8 +129,9 @@ def build(ctx) -> list:
         + "; ".join(f"k = {d:g}: median breakdown {b / 60:.1f} min, last-10-min units {u:.1f}"
                     for d, b, u in zip(xs, bd, last)),
         holds3,
-        "the sweep scales the 2002 paper's per-robot drift (the 2000 paper gives no rates); pure heading drift, "
-        "no wheel-slip noise; censored runs count at the run's length"))
+        "the sweep scales the 2002 paper's per-robot drift (the 2000 paper gives no rates); heading drift only "
+        "(both papers report rotation only; the wheel-scale cases are in the try-to-see-it-my-way section); "
+        "censored runs count at the run's length"))
 
     # per-robot units (paper's table)
     rows = []
