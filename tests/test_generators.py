@@ -152,6 +152,60 @@ def test_trail_office_corridors_closes_rooms_but_keeps_the_route_and_wrong_turns
             assert labels[tuple(env.grid.world_to_cell(xy))] == home
 
 
+def _office_complex_rooms(env):
+    """office_complex's rooms: free space eroded by 0.65 m (its 1.2 m doors close), one label per room."""
+    yy, xx = np.mgrid[-7:8, -7:8]
+    eroded = ndi.binary_erosion(env.grid.cells == FREE, structure=(xx ** 2 + yy ** 2) <= 6.5 ** 2)
+    return ndi.label(eroded)[0]
+
+
+def test_office_complex_targets_are_in_the_middle_of_eight_separate_rooms():
+    """Sgorbissa & Arkin §6: "target positions which are located in the middle of the rooms"."""
+    env = builtin_map("office_complex")
+    g, res = env.grid, env.grid.resolution_m
+    labels = _office_complex_rooms(env)
+    corridor = labels[tuple(g.world_to_cell(np.array(env.places["junction"])))]
+    seen = set()
+    clear = ndi.distance_transform_edt(g.cells == FREE) * res
+    for k in range(1, 9):
+        xy = env.places[f"room_{k}"]
+        cell = tuple(g.world_to_cell(np.array(xy)))
+        lab = labels[cell]
+        assert lab not in (0, corridor) and lab not in seen, k
+        seen.add(lab)
+        comp = labels == lab
+        rows, cols = comp.sum(1), comp.sum(0)  # extents over the rows / columns that are most of the room
+        ry, cx = np.nonzero(rows >= 0.2 * rows.max())[0], np.nonzero(cols >= 0.2 * cols.max())[0]
+        mid = ((cx.min() + cx.max() + 1) * res / 2, (ry.min() + ry.max() + 1) * res / 2)
+        assert mid == pytest.approx(xy, abs=0.15), (k, mid, xy)
+        assert clear[cell] >= 1.5, (k, clear[cell])  # nothing sits on a target
+
+
+def _sees(occ, res, a, b, max_range_m=8.0) -> bool:
+    n = int(math.dist(a, b) / 0.02) + 2
+    xs, ys = np.linspace(a[0], b[0], n), np.linspace(a[1], b[1], n)
+    return math.dist(a, b) <= max_range_m and not occ[(ys / res).astype(int), (xs / res).astype(int)].any()
+
+
+def test_office_complex_targets_are_seen_from_their_doorways_and_hardly_from_the_corridors():
+    """A helper stepping into a doorway sees the room's target (8 m visibility); a robot on the
+    corridors' centre lines sees any target from less than 8 % of them (the doors sit off the rooms'
+    centre lines: a robot heading at a target from the corridor meets a wall)."""
+    env = builtin_map("office_complex")
+    occ, res = np.asarray(env.grid.occupied()), env.grid.resolution_m
+    line = [(x, 12.0) for x in np.arange(1.0, 35.01, 0.25)] + [(18.0, y) for y in np.arange(1.0, 23.01, 0.25)]
+    for k in range(1, 9):
+        target = env.places[f"room_{k}"]
+        assert _sees(occ, res, env.places[f"door_{k}"], target), k
+        frac = np.mean([_sees(occ, res, p, target) for p in line])
+        assert frac < 0.08, (k, frac)
+        assert not _sees(occ, res, env.places["junction"], target)
+    # and a doorway shows one room only: door k does not see another room's target
+    for k in range(1, 9):
+        others = [j for j in range(1, 9) if j != k and _sees(occ, res, env.places[f"door_{k}"], env.places[f"room_{j}"])]
+        assert others == [], (k, others)
+
+
 def test_symmetric_hallway_regions_and_mirror_symmetry():
     env = builtin_map("symmetric_hallway")
     assert set(env.regions) == {"A", "B", "C", "D"}

@@ -467,7 +467,7 @@ def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
     _u_obstacle(b, 5.0, 15.0, 8.0, 17.2, "N")  # room 6: south-west of the centre (8.4, 18.6)
     _u_obstacle(b, 29.2, 16.2, 30.6, 21.0, "E")  # room 8: west of the centre (31.7, 18.6)
     _u_obstacle(b, 24.8, 3.6, 26.4, 7.2, "E")  # room 4: a bay in its west wall, west of the centre (27.5, 5.4)
-    b.rect(12.4, 7.6, 12.7, 10.6)  # room 2: partition hanging from the corridor wall
+    b.rect(14.2, 7.4, 14.5, 10.6)  # room 2: partition hanging from the corridor wall, east of the door
     b.disc(22.4, 21.4, 0.4).disc(25.4, 16.0, 0.4)  # room 7: pillars off the door-centre line
     places: dict[str, tuple[float, float]] = {}
     for k, (x0, y0, x1, y1) in rooms.items():
