@@ -250,3 +250,44 @@ def test_draws_take_their_heading_from_the_belief(share):
         assert facing > 0.9
     else:
         assert 0.08 < facing < 0.3
+
+
+def _true_scan(pose) -> np.ndarray:
+    from teamnav.world.raycast import cast_rays
+
+    r = cast_rays(GRID.blocking(None), GRID.origin_xy_m[0], GRID.origin_xy_m[1], GRID.resolution_m,
+                  np.array([pose[0]]), np.array([pose[1]]), np.array([pose[2]]), ANGLES, 8.0, parallel=False)
+    return np.asarray(r, dtype=float).reshape(-1)
+
+
+def test_pose_log_likelihood_matches_the_sample_set_and_leaves_it_alone():
+    b = _brain(1, 5)
+    z = _true_scan((20.0, 9.6, 0.0))
+    before_p, before_w = b.mcl.particles.copy(), b.mcl.weights.copy()
+    q = np.array([[20.0, 9.6, 0.0], [20.0, 9.6, math.pi / 2], [35.0, 9.6, 0.0]])
+    ll = b.mcl.pose_log_likelihood(q, z)
+    assert ll.shape == (3,) and ll[0] > ll[1]
+    np.testing.assert_array_equal(b.mcl.particles, before_p)
+    np.testing.assert_array_equal(b.mcl.weights, before_w)
+    np.testing.assert_allclose(b.mcl.log_likelihood(z)[:1], b.mcl.pose_log_likelihood(b.mcl.particles[:1], z))
+
+
+@pytest.mark.parametrize("scan_share", [0.0, 1.0])
+def test_draws_can_take_their_heading_from_the_scan(scan_share):
+    """Hallway case: the receiver's own heading is wrong (it faces +y, the corridor runs along x),
+    so neither its belief's heading nor a uniform one fits. Headings picked by the scan lie along
+    the corridor's axis (either way: a featureless corridor cannot tell the two apart)."""
+    b = _brain(1, 5, pose=(20.0, 9.6, 90.0), inject_fraction=0.5, inject_lost_prior=0.5,
+               inject_heading_belief_share=0.0, inject_heading_scan_share=scan_share)
+    scan = RangeScan(_true_scan((35.0, 9.6, 0.0)), ANGLES, 8.0)
+    obs = _obs(1, 0)
+    b.step(Observation(1, 0, 0.0, obs.odom_pose, obs.odom_delta, scans={"laser": scan}))
+    b.step(Observation(1, 1, 0.1, obs.odom_pose, obs.odom_delta, scans={"laser": scan}, inbox=(_tree_msg(THERE),)))
+    p = b.mcl.particles
+    th = p[np.hypot(p[:, 0] - THERE[0], p[:, 1] - THERE[1]) < 1.5, 2]
+    assert th.size > 50
+    along = float(np.mean(np.abs(np.sin(th)) < math.sin(math.radians(30))))
+    if scan_share == 1.0:
+        assert along > 0.85
+    else:
+        assert 0.2 < along < 0.5

@@ -222,6 +222,20 @@ class MCLWanderParams(BaseModel):
         §5.1 runs (Robin then drove "west" while it went east: error 23 m).
     inject_heading_std_deg : float
         Heading noise of those draws [deg].
+    inject_heading_scan_share : float
+        Share of the remaining draws (those without a belief heading) whose heading is picked
+        by the current scan: ``inject_heading_candidates`` headings on a jittered grid are
+        scored with the sensor model at the drawn position and one is drawn in proportion to
+        the (tempered) likelihood; the rest keep a uniform heading. 0 (default): the first
+        version (uniform). Beyond the paper, measured in the symmetric hallway: a confidently
+        wrong receiver there sits on a *rotated* place (hallways B, C, D look alike), so its own
+        heading is wrong by 90° or 180° and of uniform headings only a few percent fit the
+        corridor; those draws lose to the kept wrong mode within a few scans even when the
+        sender is right (3 of 5 right-sender trees reaching a wrong receiver, seed 2). The scan
+        already weighted the kept samples; using it again for the draws' heading only chooses
+        where among the draws' poses to look (the draws' share stays the Bayes share).
+    inject_heading_candidates : int
+        Headings scored per draw for ``inject_heading_scan_share``.
     inject_before_reply : bool
         The first version drew the samples *before* building the reply tree of §2.3, so the
         reply carried ``inject_fraction`` of the sender's own tree back to it and the sender
@@ -288,6 +302,8 @@ class MCLWanderParams(BaseModel):
     inject_lost_prior: float = Field(0.3, gt=0.0, lt=1.0)
     inject_heading_belief_share: float = Field(0.5, ge=0.0, le=1.0)
     inject_heading_std_deg: float = Field(10.0, ge=0.0, le=180.0)
+    inject_heading_scan_share: float = Field(0.0, ge=0.0, le=1.0)
+    inject_heading_candidates: int = Field(12, ge=2, le=360)
     inject_before_reply: bool = False
     provenance: bool = True
     detection_model: str = Field("default", min_length=1)
@@ -373,6 +389,7 @@ class MCLWander:
         self._pending: dict[int, dict] = {}  # association queries: query id -> {"tree", "det", "scores", "t"}
         self._query_seq = 0
         self._odom = np.zeros(3)
+        self._scan: np.ndarray | None = None  # this step's ranges (scan-picked headings of draws)
         self._acc = np.zeros(3)  # odometry composed since the last filter update
         self._stepped = False
         self._min_rot = math.radians(params.min_update_deg)
@@ -388,6 +405,7 @@ class MCLWander:
         self._odom = np.asarray(obs.odom_pose, dtype=float)
         self._time_s = float(obs.time_s)
         scan = obs.scans[self.wander.sensor]
+        self._scan = np.asarray(scan.ranges_m, dtype=float)
         self._accumulate(np.asarray(obs.odom_delta, dtype=float))
         acc = self._acc
         if not self._stepped or math.hypot(acc[0], acc[1]) >= p.min_update_m or abs(acc[2]) >= self._min_rot:
@@ -601,6 +619,9 @@ class MCLWander:
         if m > 0:  # heading of a sample drawn by weight from the own belief (a detection sees no heading)
             idx = low_variance_kernel(mcl.weights, m, float(self.rng.random()), np.empty(m, dtype=np.int64))
             th[:m] = mcl.particles[idx, 2] + self.rng.normal(0.0, math.radians(p.inject_heading_std_deg), size=m)
+        ms = int(round(p.inject_heading_scan_share * (k - m)))
+        if ms > 0 and self._scan is not None:
+            th[m:m + ms] = self._scan_headings(mcl, xy[m:m + ms])
         q = np.column_stack([xy, th])
         if p.inject_weighting == "tree":
             mcl.replace_samples(q)
@@ -623,6 +644,19 @@ class MCLWander:
         factors[~new] = f[~new] * (1.0 - share) / own_mass if own_mass > 0 else 0.0
         factors[new] = share / k / w[new]
         return factors
+
+    def _scan_headings(self, mcl: MCL, xy: np.ndarray) -> np.ndarray:
+        """One heading per position, drawn in proportion to this step's scan likelihood among
+        ``inject_heading_candidates`` jittered headings (``inject_heading_scan_share``)."""
+        h = self.params.inject_heading_candidates
+        n = xy.shape[0]
+        cand = (np.arange(h)[None, :] + self.rng.random((n, 1))) * (2.0 * math.pi / h) - math.pi
+        poses = np.column_stack([np.repeat(xy, h, axis=0), cand.ravel()])
+        ll = mcl.pose_log_likelihood(poses, self._scan).reshape(n, h)
+        pr = np.exp(ll - ll.max(axis=1, keepdims=True))
+        c = np.cumsum(pr, axis=1)
+        pick = (c < self.rng.random((n, 1)) * c[:, -1:]).sum(axis=1)
+        return cand[np.arange(n), np.minimum(pick, h - 1)]
 
     # ------------------------------------------------------------------ logs
     def _subsample(self, k: int) -> np.ndarray:

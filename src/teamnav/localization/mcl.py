@@ -517,6 +517,30 @@ class MCL:
                              self._lf_outside, self._lf_worst, exponent, self._ll)
         return self._ll
 
+    def pose_log_likelihood(self, poses, scan_ranges) -> np.ndarray:
+        """``log P(o | l)`` (times ``likelihood_exponent``) of a scan at arbitrary ``poses``, (k,).
+
+        The same model as :meth:`log_likelihood`, evaluated at poses that are not samples of the
+        set (the brain's sensor resetting picks the heading of a sample drawn from a received
+        tree with it); the sample set is left as it was.
+
+        Parameters
+        ----------
+        poses : array_like of shape (k, 3)
+            Poses [m, m, rad].
+        scan_ranges : array_like of shape (B,)
+            As in :meth:`update`.
+        """
+        q = np.ascontiguousarray(array("poses", poses, (-1, 3)), dtype=np.float64)
+        keep = (self._particles, self._weights, self._ll, self._rays, self._weighted)
+        try:
+            self._particles = q
+            self._ll = np.empty(q.shape[0])
+            self._rays = np.empty((0, 0))
+            return self.log_likelihood(scan_ranges).copy()
+        finally:
+            self._particles, self._weights, self._ll, self._rays, self._weighted = keep
+
     def update(self, scan_ranges) -> None:
         """Perception update (eq. 12): ``p <- alpha P(o | l) p``.
 
