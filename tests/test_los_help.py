@@ -430,7 +430,10 @@ def test_broadcast_shares_goals_relays_and_counts_bytes(straight_nav):
     assert by_owner[2].goal_id == goal_id(1, m) and by_owner[0].goal_id == goal_id(1, m) - 1
     assert (by_owner[0].gx_m, by_owner[0].gy_m) == pytest.approx((0.0, -1.0))  # in this robot's body frame
     # it sees robot 0's goal directly (1 m away) and reports D
-    assert body.reports == (VisReport(0, goal_id(1, m), pytest.approx(1.0)),)
+    # (share_via: with the point its D leads through, here the goal itself in its body frame)
+    (rep,) = body.reports
+    assert (rep.owner, rep.goal_id, rep.d_m) == (0, goal_id(1, m), pytest.approx(1.0))
+    assert (rep.via_x_m, rep.via_y_m, rep.via_d_m) == pytest.approx((0.0, -1.0, 0.0))
     log = r.log()
     assert log["msgs_sent"] == 2 and log["bytes_sent"] == first[0].size_bytes() + message.size_bytes()
     assert message.size_bytes() > first[0].size_bytes()  # one more goal, one report

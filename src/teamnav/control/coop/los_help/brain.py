@@ -159,6 +159,21 @@ class _CommonParams(BaseModel):
         trouble (gap filled: §3 rule 3 lets R1 head to its goal once it perceives it from
         where R2 stood; our 72-beam scan and 0.2 m tolerance often miss a room centre seen
         through a door at a slant from a point a few centimetres away; False: explore with A).
+    report_margin_steps : float
+        A visibility report replaces a stored path only when it is shorter by more than this
+        many step lengths (``GoalSharing.report_margin_m``; gap filled, 0: §4.2's strict
+        "shorter").
+    lead_on : bool
+        At a reached ghost, accept a teammate's report that leads further along the same light
+        path (``GoalSharing.lead_on``; gap filled, False: §4.2 as written).
+    share_via : bool
+        Send with each visibility report the point the D leads through (the goal, the own last
+        viewpoint of §4.3, or a ghost) and its distance (:class:`~.messages.VisReport`); the
+        explorer, reaching a teammate's point without seeing its goal, goes on to that via
+        point instead of handing over to A. Gap filled (§4.4 sends only (Id, D)): measured,
+        R1 reached a helper's corridor position next to room N5's door, did not see the
+        goal the helper had seen from the doorway, and A took it round the corridor. False:
+        the paper's message.
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
@@ -182,6 +197,9 @@ class _CommonParams(BaseModel):
     slide_when_blocked: bool = True
     slide_lookahead_m: float = Field(1.0, gt=0.0, le=100.0)
     trust_direct_promise: bool = True
+    report_margin_steps: float = Field(1.0, ge=0.0, le=1000.0)
+    lead_on: bool = True
+    share_via: bool = True
 
 
 class _LosBrain(abc.ABC):
@@ -209,7 +227,9 @@ class _LosBrain(abc.ABC):
         self._nav = None
         self._nav_goal: tuple[float, float] | None = None
         self.sharing = GoalSharing(self.me, self.team_size, delayed=params.delayed_visibility,
-                                   point_margin_m=2.5 * self.radius_m)
+                                   point_margin_m=2.5 * self.radius_m,
+                                   report_margin_m=params.report_margin_steps * self.step_m,
+                                   lead_on=params.lead_on)
         self.trouble = TroubleState(int(params.trouble_cr))
         self._history: dict[int, tuple[np.ndarray, dict[int, tuple[float, float]]]] = {}
         self._teammate_tr: dict[int, bool | None] = {}
@@ -339,7 +359,12 @@ class _LosBrain(abc.ABC):
                 self.sharing.receive_goal(g.owner, g.goal_id, gxy)
             me_k = (float(pose_k[0]), float(pose_k[1]))
             for r in body.reports:
-                self.sharing.receive_report(r.owner, r.goal_id, s, sender_xy, r.d_m, me_xy=me_k, step=int(body.step))
+                via = None
+                if r.via_d_m is not None:
+                    via = self._body_to_odom(pose_k, rel[0] + c * r.via_x_m - sn * r.via_y_m,
+                                             rel[1] + sn * r.via_x_m + c * r.via_y_m)
+                self.sharing.receive_report(r.owner, r.goal_id, s, sender_xy, r.d_m, me_xy=me_k, step=int(body.step),
+                                            via_xy=via, via_d_m=r.via_d_m)
 
     # ------------------------------------------------------------------ broadcast (§4.4)
     def _broadcast(self, obs: Observation, sightings: dict[int, tuple[float, float]]) -> list[Message]:
@@ -352,7 +377,11 @@ class _LosBrain(abc.ABC):
         if p.goal_sharing:
             sights = tuple(Sighting(rid, b, r) for rid, (r, b) in sorted(sightings.items()))
             goals = tuple(GoalShare(owner, gid, *self._odom_to_body(x, y)) for owner, gid, x, y in self.sharing.shares())
-            reports = tuple(VisReport(owner, gid, d) for owner, gid, d in self.sharing.reports(self._me_xy()))
+            if p.share_via:
+                reports = tuple(VisReport(owner, gid, d, *self._odom_to_body(vx, vy), vd)
+                                for owner, gid, d, vx, vy, vd in self.sharing.reports_via(self._me_xy()))
+            else:
+                reports = tuple(VisReport(owner, gid, d) for owner, gid, d in self.sharing.reports(self._me_xy()))
         body = LosHelpMsg(int(obs.step), sights, goals, reports, bool(self.trouble.tr) if p.state_sharing else None)
         msg = Message(self.me, float(obs.time_s), body, kind=MESSAGE_KIND)
         self.msgs_sent += 1

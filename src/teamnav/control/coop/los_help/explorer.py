@@ -89,9 +89,14 @@ class LosExplorer(_LosBrain):
         self.finished = not self.targets
         self.gave_up = False
         self._target_since = 0
+        self._moves_since = 0
+        #: motion steps R1 took for each target reached so far (per-target pairing across teams)
+        self.target_steps: list[int] = []
         self._promised: int | None = None
         self._temp_stall = 0
         self.temp_dropped = 0
+        #: times R1 went on from a teammate's reached point to the point its D led through
+        self.vias_taken = 0
         self._prev_goal_d = math.inf
         self.promised_steps = 0
         self.goal_seen_steps = 0
@@ -118,6 +123,8 @@ class LosExplorer(_LosBrain):
                     self.sharing.set_own_goal(None)
                 return
             self._target_since = self._step
+            self.target_steps.append(int(self.moves - self._moves_since))
+            self._moves_since = self.moves
             self.target_index += 1
             self.targets_reached += 1
             self.finished = self.target_index >= len(self.targets)
@@ -162,7 +169,16 @@ class LosExplorer(_LosBrain):
             # R1 often did not see the goal the helper had seen from there)
             reach = max(p.goal_tolerance_m, 2.0 * self.radius_m + self.step_m) if live else p.ghost_tolerance_m
             me = self._me_xy()
-            if math.hypot(point[0] - me[0], point[1] - me[1]) < reach:
+            if (math.hypot(point[0] - me[0], point[1] - me[1]) < reach and p.share_via
+                    and self.sharing.go_via(self.me, self._step)):
+                # at the teammate's point without seeing the goal: on to where its D leads
+                # (``share_via``; a straight line, the teammate saw it from here, §4.3)
+                self.vias_taken += 1
+                self.mode = "ghost"
+                path = self.sharing.path(self.me)
+                action, progressing = self._head_to((path.px_m, path.py_m), ("path", path.source, path.step),
+                                                    end_margin_m=p.ghost_tolerance_m)
+            elif math.hypot(point[0] - me[0], point[1] - me[1]) < reach:
                 # §4.2: at the ghost without seeing the goal: explore again with A, keeping the
                 # promise only to arbitrate later reports
                 self.sharing.mark_reached(self.me)
@@ -239,14 +255,15 @@ class LosExplorer(_LosBrain):
         teammate's direct promise, ``trust_direct_promise``), ``slide_steps`` (heading to
         a seen point along a side direction), ``temp_switches`` (changes of the teammate, ghost
         or trouble helper headed for), ``temp_dropped`` (teammate or ghost points given up after
-        ``trouble_cr`` steps without progress towards them); and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
+        ``trouble_cr`` steps without progress towards them), ``vias_taken`` (times R1 went on from
+        a teammate's reached point to the point its D led through, ``share_via``); and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
         the odometry frame (when ``log_layers``).
         """
         out = self._common_log()
         out.update(target_index=int(self.target_index), targets_reached=int(self.targets_reached),
                    finished=bool(self.finished), gave_up=bool(self.gave_up),
                    goal_seen_steps=int(self.goal_seen_steps), promised_steps=int(self.promised_steps),
-                   temp_dropped=int(self.temp_dropped))
+                   temp_dropped=int(self.temp_dropped), vias_taken=int(self.vias_taken))
         layers = self._layers()
         if layers:
             out["layers"] = layers

@@ -279,6 +279,9 @@ class GoalPath:
     step: int
     reached: bool = False
     d_promised_m: float = math.inf
+    via_x_m: float | None = None
+    via_y_m: float | None = None
+    via_d_m: float | None = None
 
     def distance_m(self, me_xy) -> float:
         """``D = dist(me, point) + d_point`` (§4.2, §4.3)."""
@@ -302,6 +305,23 @@ class GoalSharing:
         Delayed visibility V_D with ghost robots (§4) when True; reflected visibility only (§3).
     point_margin_m : float
         Tolerance [m] of the visibility test of stored points (a teammate may stand on one).
+    report_margin_m : float
+        A report replaces a stored (unreached) path only when its ``D`` is shorter by more than
+        this [m]. Gap filled: §4.2 says "shorter"; a teammate walking along the light path
+        (towards the goal's owner, or away from it) leaves ``dist + D_j`` unchanged, and with
+        the lateral wobble of a real patrol every other step came out a few millimetres
+        shorter: R1 followed a helper walking *away* from its goal (office_simple, Avoid-Past,
+        task 3: 18 steps back along the corridor, then the target was lost). 0: the paper's
+        strict rule.
+    lead_on : bool
+        Owner only: once the stored point is *reached* without seeing the goal, a report whose
+        ``D`` is no longer than the robot's current ``D`` plus ``report_margin_m`` and whose
+        point lies more than ``report_margin_m`` from the reached one is accepted (a teammate
+        further along the same light path "leads on"; one behind the robot cannot, its
+        ``dist + D_j`` counts the way back twice). Each point so accepted promises a
+        strictly smaller distance, so the robot cannot loop. Gap filled: §4.2 only says the
+        robot "will have to start again ... with A"; with the strict rule a chain of ghosts
+        along a corridor was followed only to its first link (a tie). False: the paper's rule.
 
     Examples
     --------
@@ -315,13 +335,16 @@ class GoalSharing:
     ('ghost', 1, 5.0)
     """
 
-    def __init__(self, robot_id: int, team_size: int, *, delayed: bool = True, point_margin_m: float = 0.5) -> None:
+    def __init__(self, robot_id: int, team_size: int, *, delayed: bool = True, point_margin_m: float = 0.5,
+                 report_margin_m: float = 0.0, lead_on: bool = False) -> None:
         if team_size < 1:
             raise ValueError(f"team_size must be >= 1, got {team_size!r}")
         self.me = int(robot_id)
         self.team_size = int(team_size)
         self.delayed = bool(delayed)
         self.point_margin_m = float(point_margin_m)
+        self.report_margin_m = float(report_margin_m)
+        self.lead_on = bool(lead_on)
         self.own_k: int | None = None
         self.own_goal: tuple[float, float] | None = None
         self.known: dict[int, KnownGoal] = {}
@@ -382,7 +405,7 @@ class GoalSharing:
         return True
 
     def receive_report(self, owner: int, gid: int, reporter: int, reporter_xy, d_m: float, *, me_xy,
-                       step: int) -> bool:
+                       step: int, via_xy=None, via_d_m: float | None = None) -> bool:
         """Rules 3–5 on the receiving side: arbitrate a visibility report by shortest D (§4.2).
 
         ``reporter`` at ``reporter_xy`` (own frame, where it was when it reported) sees
@@ -397,6 +420,8 @@ class GoalSharing:
         reached a ghost and wandered off with its navigator is not pulled back by a promise no
         better than the one it already followed (that made robots loop between a ghost and
         the navigator's detour). For a robot relaying another's goal, its current ``D`` (§4.3).
+        ``via_xy`` (own frame) and ``via_d_m``: the point the reporter's D leads through and its
+        own distance to the goal (see :class:`~.messages.VisReport`), kept with the path.
         Returns whether the report was accepted.
         """
         if not (math.isfinite(d_m) and d_m >= 0.0):
@@ -410,10 +435,32 @@ class GoalSharing:
             if path.kind == "direct":
                 return False
             now = path.distance_m(me_xy)
-            if cand >= (min(now, path.d_promised_m) if owner == self.me else now):
+            margin = self.report_margin_m
+            if owner == self.me and path.reached and self.lead_on:
+                # a teammate further along the light path leads on (see ``lead_on``)
+                if (cand > now + margin
+                        or math.hypot(reporter_xy[0] - path.px_m, reporter_xy[1] - path.py_m) <= margin):
+                    return False
+            elif cand >= (min(now, path.d_promised_m) if owner == self.me else now) - margin:
                 return False
+        via = (None, None, None)
+        if via_xy is not None and via_d_m is not None and math.isfinite(via_d_m):
+            via = (float(via_xy[0]), float(via_xy[1]), float(via_d_m))
         self.paths[owner] = GoalPath(stored[0], float(reporter_xy[0]), float(reporter_xy[1]), float(d_m), "ghost",
-                                     int(reporter), int(step), d_promised_m=cand)
+                                     int(reporter), int(step), d_promised_m=cand,
+                                     via_x_m=via[0], via_y_m=via[1], via_d_m=via[2])
+        return True
+
+    def go_via(self, owner: int, step: int) -> bool:
+        """At the reached point of ``owner``'s path, go on to the reporter's via point.
+
+        The path becomes the via point (not reached, no further via) with its own promised
+        distance; returns False (nothing changed) when the path has no via point."""
+        p = self.paths.get(owner)
+        if p is None or p.via_d_m is None:
+            return False
+        self.paths[owner] = replace(p, px_m=p.via_x_m, py_m=p.via_y_m, d_point_m=p.via_d_m, reached=False,
+                                    step=int(step), via_x_m=None, via_y_m=None, via_d_m=None)
         return True
 
     def refresh(self, me_xy, prev_me_xy, sees: Callable[[float, float, float], bool], step: int) -> None:
@@ -474,11 +521,17 @@ class GoalSharing:
 
     def reports(self, me_xy) -> list[tuple[int, int, float]]:
         """(owner, Id, D) for every other robot's goal this robot sees (directly, V_R or V_D)."""
+        return [(o, gid, d) for o, gid, d, _, _, _ in self.reports_via(me_xy)]
+
+    def reports_via(self, me_xy) -> list[tuple[int, int, float, float, float, float]]:
+        """(owner, Id, D, via_x, via_y, via_d) for every other robot's goal this robot sees:
+        :meth:`reports` plus the point its D leads through (own frame) and that point's
+        promised distance (see :class:`~.messages.VisReport`)."""
         out = []
         for owner, p in self.paths.items():
             if owner == self.me:
                 continue
-            out.append((owner, p.goal_id, p.distance_m(me_xy)))
+            out.append((owner, p.goal_id, p.distance_m(me_xy), p.px_m, p.py_m, p.d_point_m))
         return out
 
     def points(self) -> Iterable[GoalPath]:

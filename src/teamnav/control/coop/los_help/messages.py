@@ -14,6 +14,9 @@ Its parts are exactly the terms §4.4 counts, so a message is O(M) for a team of
   F_1", a frame centred on the robot; the body frame is the one the bearings are measured in).
 - ``reports``: "(Id_ik, D_ik)" pairs: for every goal the sender sees directly, by reflection
   (V_R) or with delay (V_D), its estimated path length D to that goal (§3 rule 3, §4.2).
+  With ``share_via`` (gap filled, see :class:`VisReport`) a report also carries the point the
+  sender's D leads through and that point's own distance to the goal: 24 bytes more, still
+  O(M).
 - ``trouble``: the one-bit internal state Tr of §5 (None when state sharing is off).
 
 All fields are plain numbers so :meth:`teamnav.control.types.Message.size_bytes` counts them
@@ -53,11 +56,22 @@ class GoalShare:
 @dataclass(frozen=True, slots=True)
 class VisReport:
     """The sender sees (directly, reflected or delayed) goal ``goal_id`` of ``owner`` with
-    estimated path length ``d_m`` [m] from the sender to the goal (§3 rule 3, §4.2 D_1j)."""
+    estimated path length ``d_m`` [m] from the sender to the goal (§3 rule 3, §4.2 D_1j).
+
+    ``via_x_m``, ``via_y_m`` (sender's body frame) and ``via_d_m``: the point the sender's D
+    leads through (the goal itself when it sees it; its own last viewpoint of §4.3; a ghost)
+    and that point's promised distance to the goal, so ``d_m = dist(sender, via) + via_d_m``.
+    Gap filled: §4.4 sends only (Id, D); with the point, a robot that reaches the sender's
+    position without seeing its goal can go on to where the sender saw it from (a straight
+    line: the sender keeps its viewpoint only while it sees it, §4.3). None: not sent.
+    """
 
     owner: int
     goal_id: int
     d_m: float
+    via_x_m: float | None = None
+    via_y_m: float | None = None
+    via_d_m: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -86,8 +100,9 @@ class LosHelpMsg:
 def message_size_bytes(body: LosHelpMsg) -> int:
     """``Message.size_bytes()`` of a message carrying ``body``, by formula (no recursive walk).
 
-    Header 24 + step 8 + 24 per sighting + 32 per goal + 24 per report + 1 for a Tr bit; equal
-    to :meth:`teamnav.control.types.Message.size_bytes` (the tests check it).
+    Header 24 + step 8 + 24 per sighting + 32 per goal + 24 per report (48 with its via point)
+    + 1 for a Tr bit; equal to :meth:`teamnav.control.types.Message.size_bytes` (the tests check it).
     """
     return (32 + 24 * len(body.sightings) + 32 * len(body.goals) + 24 * len(body.reports)
+            + 24 * sum(1 for r in body.reports if r.via_d_m is not None)
             + (0 if body.trouble is None else 1))
