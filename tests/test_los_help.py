@@ -220,6 +220,55 @@ def test_owner_compares_reports_with_the_stored_promise():
     assert relay.receive_report(0, 3, 2, (4.0, 5.0), 7.0, me_xy=(4.0, 10.0), step=9)
 
 
+def test_report_margin_keeps_ghost_when_helper_walks_back_along_the_light_path():
+    """A helper walking back towards R1 along the light path leaves dist + D unchanged (a tie up
+    to millimetres): with the margin R1 keeps its point; with the strict rule (margin 0) a
+    millimetre shorter report wins and R1 follows the helper away from its goal."""
+    for margin, follows in ((0.2, False), (0.0, True)):
+        gs = GoalSharing(0, 2, report_margin_m=margin)
+        gs.set_own_goal(1, (20.0, 0.0))
+        me = (0.0, 0.0)
+        assert gs.receive_report(0, 2, 1, (10.0, 0.0), 10.0, me_xy=me, step=1)  # D = 20
+        me = (0.2, 0.0)  # R1 one step on; R2 one step back towards it, its D one step longer
+        taken = gs.receive_report(0, 2, 1, (9.8, 0.01), 10.2 - 0.002, me_xy=me, step=2)
+        assert taken is follows
+        # a real shortcut (more than the margin) is still taken
+        assert gs.receive_report(0, 2, 1, (5.0, 5.0), 12.0, me_xy=me, step=3)  # 7.07 + 12 < 19.6
+
+
+def test_lead_on_from_a_reached_ghost_but_never_back():
+    """At a reached ghost, a teammate further along the light path leads on (a tie); one behind
+    R1 does not (its dist + D counts the way back twice); without lead_on neither does."""
+    for lead_on in (True, False):
+        gs = GoalSharing(0, 2, report_margin_m=0.2, lead_on=lead_on)
+        gs.set_own_goal(1, (20.0, 0.0))
+        gs.receive_report(0, 2, 1, (10.0, 0.0), 10.0, me_xy=(0.0, 0.0), step=1)
+        gs.mark_reached(0)
+        me = (10.0, 0.0)
+        assert not gs.receive_report(0, 2, 1, (7.0, 0.0), 13.0, me_xy=me, step=5)  # behind: 16 > 10
+        assert not gs.receive_report(0, 2, 1, (10.1, 0.0), 9.9, me_xy=me, step=6)  # the same spot
+        assert gs.receive_report(0, 2, 1, (14.0, 0.0), 6.0, me_xy=me, step=7) is lead_on  # ahead: 10
+        if lead_on:
+            p = gs.path(0)
+            assert (p.px_m, p.d_point_m, p.reached) == (14.0, 6.0, False)
+
+
+def test_go_via_leads_to_where_the_reporter_saw_the_goal():
+    gs = GoalSharing(0, 2)
+    gs.set_own_goal(1, (5.0, 5.0))
+    # R2 at (5, 0) reports D = 3 + 2: its D leads through (5, 3), 2 m from the goal
+    gs.receive_report(0, 2, 1, (5.0, 0.0), 5.0, me_xy=(0.0, 0.0), step=1, via_xy=(5.0, 3.0), via_d_m=2.0)
+    assert gs.go_via(0, step=9)
+    p = gs.path(0)
+    assert (p.px_m, p.py_m, p.d_point_m, p.reached, p.via_d_m) == (5.0, 3.0, 2.0, False, None)
+    assert not gs.go_via(0, step=10)  # one link only: the next needs a new report
+    # the relayed terms carry the point (own frame) and its promised distance
+    relay = GoalSharing(1, 2)
+    relay.receive_goal(0, goal_id(1, 2), (5.0, 5.0))
+    relay.refresh((5.0, 0.0), None, lambda x, y, m: True, step=0)
+    assert relay.reports_via((5.0, 0.0)) == [(0, 2, 5.0, 5.0, 5.0, 0.0)]
+
+
 def test_distance_bookkeeping_of_section_4_3():
     """Fig. 8: a helper that saw R1's goal and moved on reports D(t1) + dist(me, R_i(t1)); when
     R_i(t1) leaves its view, R_i(t2) and D(t2) replace them."""
