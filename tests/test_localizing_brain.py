@@ -291,3 +291,18 @@ def test_draws_can_take_their_heading_from_the_scan(scan_share):
         assert along > 0.85
     else:
         assert 0.2 < along < 0.5
+
+
+def test_min_draws_are_added_and_get_the_bayes_share():
+    """A confident robot carries few samples; ``inject_min_draws`` adds draws instead of replacing
+    a tenth of them, and the draws together get the posterior share of "lost" (the kept samples
+    all stay, with the rest)."""
+    b = _brain(1, 5, inject_fraction=0.1, inject_lost_prior=0.3, inject_min_draws=300)
+    b.step(_obs(1, 0))
+    n = b.mcl.n_particles
+    b.step(_obs(1, 1, inbox=[_tree_msg(THERE)]))
+    assert b.sync.applied["detection"] == 1
+    assert b.mcl.n_particles == n + 300
+    share = 0.3 / (0.3 + 0.7 * 0.035)
+    assert abs(_mass_near(b, THERE) - share) < 0.03
+    assert abs(_mass_near(b, HERE) - (1 - share)) < 0.03

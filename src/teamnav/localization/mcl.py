@@ -684,6 +684,27 @@ class MCL:
         self._weights = w / w.sum()
         self._weighted = True
 
+    def append_samples(self, poses) -> None:
+        """Add ``poses`` to the set, each with the set's mean weight (sensor resetting that keeps
+        every existing sample; the next resampling brings the count back within the KLD bounds).
+
+        Parameters
+        ----------
+        poses : array_like of shape (k, 3)
+            Poses [m, m, rad].
+        """
+        self._require_particles("append_samples")
+        q = array("poses", poses, (-1, 3))
+        if q.shape[0] == 0:
+            return
+        n = self._particles.shape[0]
+        q = q.copy()
+        q[:, 2] = wrap_angle(q[:, 2])
+        self._particles = np.ascontiguousarray(np.vstack([self._particles, q]), dtype=np.float64)
+        w = np.concatenate([self._weights, np.full(q.shape[0], 1.0 / n)])
+        self._weights = w / w.sum()
+        self._weighted = True
+
     # ------------------------------------------------------------------ estimates
     def estimate(self) -> Estimate:
         """Weighted mean and covariance, and the heaviest cluster's mean (see :class:`Estimate`)."""
