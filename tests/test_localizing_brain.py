@@ -306,3 +306,18 @@ def test_min_draws_are_added_and_get_the_bayes_share():
     share = 0.3 / (0.3 + 0.7 * 0.035)
     assert abs(_mass_near(b, THERE) - share) < 0.03
     assert abs(_mass_near(b, HERE) - (1 - share)) < 0.03
+
+
+@pytest.mark.parametrize("sender_prior", [0.0, 0.3])
+def test_a_disagreement_between_confident_robots_is_split_when_the_sender_may_be_wrong(sender_prior):
+    """The receiver is sure of x = 20 m, the tree says x = 35 m: one of the two robots is wrong.
+    The first version (sender_prior 0) weighs "I am lost" only against a false positive and hands
+    the draws 92 % of the weight; with the sender's own lost prior the split is about 57 / 43."""
+    b = _brain(1, 5, inject_fraction=0.1, inject_lost_prior=0.3, inject_min_draws=300,
+               inject_sender_lost_prior=sender_prior)
+    b.step(_obs(1, 0))
+    b.step(_obs(1, 1, inbox=[_tree_msg(THERE)]))
+    floor = 0.035 + 0.965 * sender_prior
+    share = 0.3 / (0.3 + 0.7 * floor)
+    assert abs(_mass_near(b, THERE) - share) < 0.03
+    assert (share > 0.9) == (sender_prior == 0.0)

@@ -245,6 +245,19 @@ class MCLWanderParams(BaseModel):
         draws got the Bayes share (92 %) but were too few to cover the tree's metre of
         position and the heading, and the kept wrong mode, matching every scan, won back
         within 10-30 s (4 of 10 right-sender trees reaching a confidently wrong robot, seed 0).
+    inject_sender_lost_prior : float
+        Prior probability that the *sender's* belief is wrong (``"bayes"`` weighting). The
+        first version weighs "I am lost" against a false-positive detection only, as if the
+        sender were always right: a tree that contradicts a confident belief gives the draws
+        ``eps / (eps + (1 - eps) p_fp)`` = 92 % of the weight, whoever is wrong. Under "the
+        sender is lost" the tree says nothing about the receiver, so it joins the false
+        positive in the uniform floor: ``f = (1 - p_fp)(1 - eps_s) tree + (p_fp + (1 - p_fp)
+        eps_s) / A``; with ``eps_s = eps`` = 0.3 a disagreement between two confident robots
+        splits the receiver about 57 / 43 and both modes stay until a scan or a third robot
+        decides. 0 (default): the first version. Beyond the paper (eq. 10 treats the sender's
+        belief as exact), measured in the symmetric hallway: 15 applied trees from confidently
+        wrong senders flipped confidently right receivers in one run (seed 0); the places are
+        rotated copies of each other, so the receivers' scans could not undo it.
     inject_before_reply : bool
         The first version drew the samples *before* building the reply tree of §2.3, so the
         reply carried ``inject_fraction`` of the sender's own tree back to it and the sender
@@ -314,6 +327,7 @@ class MCLWanderParams(BaseModel):
     inject_heading_scan_share: float = Field(0.0, ge=0.0, le=1.0)
     inject_heading_candidates: int = Field(12, ge=2, le=360)
     inject_min_draws: int = Field(0, ge=0, le=1_000_000)
+    inject_sender_lost_prior: float = Field(0.0, ge=0.0, lt=1.0)
     inject_before_reply: bool = False
     provenance: bool = True
     detection_model: str = Field("default", min_length=1)
@@ -639,7 +653,7 @@ class MCLWander:
         if p.inject_weighting == "tree":
             mcl.replace_samples(q)
             return detection_factors(body.tree, mcl.particles, body.p_false_positive, area)
-        f_own = detection_factors(body.tree, mcl.particles, body.p_false_positive, area)
+        f_own = detection_factors(body.tree, mcl.particles, self._floor(body), area)
         e_own = float(np.dot(mcl.weights, f_own))
         eps = p.inject_lost_prior
         share = eps / area / (eps / area + (1.0 - eps) * e_own)
@@ -648,7 +662,7 @@ class MCLWander:
             n = mcl.n_particles
             new = np.zeros(n, dtype=bool)
             new[n - k:] = True
-            return self._bayes_factors(mcl, body, new, share, k)
+            return self._bayes_factors(mcl, body, new, share, k, self._floor(body))
         before = mcl.particles.copy()
         mcl.replace_samples(q)
         after = mcl.particles
@@ -656,15 +670,22 @@ class MCLWander:
         if int(new.sum()) != k:  # a draw equal to the sample it replaced (never in practice): locate by value
             new = np.zeros(n, dtype=bool)
             new[np.argsort(np.any(after != before, axis=1))[-k:]] = True
-        return self._bayes_factors(mcl, body, new, share, k)
+        return self._bayes_factors(mcl, body, new, share, k, self._floor(body))
+
+    def _floor(self, body: SyncMessage) -> float:
+        """Probability that the tree says nothing about this robot: a false positive, or a
+        sender whose belief is wrong (``inject_sender_lost_prior``)."""
+        pf = body.p_false_positive
+        return pf + (1.0 - pf) * self.params.inject_sender_lost_prior
 
     @staticmethod
-    def _bayes_factors(mcl: MCL, body: SyncMessage, new: np.ndarray, share: float, k: int) -> np.ndarray:
+    def _bayes_factors(mcl: MCL, body: SyncMessage, new: np.ndarray, share: float, k: int,
+                       floor: float) -> np.ndarray:
         """Factors that give the ``k`` draws (``new``) the share ``share`` of the weight, evenly,
         and the kept samples ``1 - share`` in proportion to ``w_i f(x_i)`` (eq. 14)."""
         n = mcl.n_particles
         w = mcl.weights  # kept samples: w_i / Z, draws: 1 / (n Z)
-        f = detection_factors(body.tree, mcl.particles, body.p_false_positive, mcl.free_area_m2)
+        f = detection_factors(body.tree, mcl.particles, floor, mcl.free_area_m2)
         own_mass = float(np.dot(w[~new], f[~new]))
         factors = np.empty(n)
         factors[~new] = f[~new] * (1.0 - share) / own_mass if own_mass > 0 else 0.0
