@@ -660,3 +660,24 @@ def test_in_trouble_progress_is_towards_the_own_goal_so_following_away_keeps_fol
         if not r1.trouble.tr:
             break
     assert not r1.trouble.tr and r1.trouble.nt == 2
+
+
+@pytest.mark.parametrize("keep", [True, False])
+def test_direct_view_is_kept_while_a_neighbouring_beam_still_reaches_the_goal(straight_nav, keep):
+    """A goal seen through a door at a slant: acquired when the nearest beam reaches past it; one
+    step later that beam hits the jamb but its neighbour still passes. With ``keep_direct_view``
+    R1 keeps heading straight (own_goal with a direct path); without it, it drops to A."""
+    goal = (4.0, 0.0)
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[goal], keep_direct_view=keep), np.random.default_rng(0),
+                     info(0, 2))
+    gap = 2 * math.pi / N_BEAMS
+    r1.step(obs(0))  # nothing in the way: seen (acquired)
+    assert r1.sharing.path(0).kind == "direct"
+    # the beam nearest the goal's bearing now hits a jamb 2 m away; the next one over is free
+    jamb = [(0.0, 0.4 * gap, 2.0), (-gap, 0.4 * gap, 2.0)]
+    r1.step(obs(1, walls=jamb))
+    path = r1.sharing.path(0)
+    assert (path is not None and path.kind == "direct") is keep
+    # with every beam near the bearing blocked the view is lost either way
+    r1.step(obs(2, walls=[(0.0, 2.0 * gap, 2.0)]))
+    assert r1.sharing.path(0) is None

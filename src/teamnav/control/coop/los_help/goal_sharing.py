@@ -463,7 +463,8 @@ class GoalSharing:
                                     step=int(step), via_x_m=None, via_y_m=None, via_d_m=None)
         return True
 
-    def refresh(self, me_xy, prev_me_xy, sees: Callable[[float, float, float], bool], step: int) -> None:
+    def refresh(self, me_xy, prev_me_xy, sees: Callable[[float, float, float], bool], step: int,
+                keeps: Callable[[float, float], bool] | None = None) -> None:
         """Check visibility of every known goal and keep the §4.3 bookkeeping, once per step.
 
         Parameters
@@ -475,6 +476,10 @@ class GoalSharing:
         sees : callable (x, y, margin_m) -> bool
             The robot's own visibility test of a point in its own frame.
         step : int
+        keeps : callable (x, y) -> bool, optional
+            A more lenient test that keeps a goal the robot already sees directly (hysteresis:
+            a goal seen through a door at a slant flickers in and out of the one beam nearest
+            its bearing as the robot moves; see the brain's ``keep_direct_view``). None: ``sees``.
         """
         for owner in [self.me, *self.known]:
             stored = self.goal_of(owner)
@@ -482,7 +487,9 @@ class GoalSharing:
                 continue
             gid, gx, gy = stored
             path = self.paths.get(owner)
-            if sees(gx, gy, 0.0):  # rule 3: direct view (§2 point 4); beats any report (§3.1)
+            kept = (keeps is not None and path is not None and path.kind == "direct"
+                    and (path.px_m, path.py_m) == (gx, gy) and keeps(gx, gy))
+            if kept or sees(gx, gy, 0.0):  # rule 3: direct view (§2 point 4); beats any report (§3.1)
                 self.paths[owner] = GoalPath(gid, gx, gy, 0.0, "direct", self.me, int(step))
                 continue
             if path is None:
