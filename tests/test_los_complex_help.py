@@ -74,8 +74,9 @@ def _leg(navigator: str, a: str, b: str, helpers: int, budget_steps: int):
 
 def test_potential_field_alone_sticks_in_room_1s_trap_where_visbug_gets_out():
     # room 1's U wall opens towards the centre, east of it: heading east to room 2, a potential
-    # field drives into it; VisBug-21 follows the walls out (through room 1's door and room 2's)
+    # field drives into it and stays; VisBug-21 follows the walls out (the long way round: about
+    # 1050 steps, turning right at the U and following the building's walls into room 2's V door)
     pf = _leg("potential_field", "room_1", "room_2", 0, 400)
     assert pf["los_finished"] == 0 and pf["los_gave_up"] == 1
-    vb = _leg("visbug21", "room_1", "room_2", 0, 600)
-    assert vb["los_finished"] == 1 and vb["los_steps"] < 600
+    vb = _leg("visbug21", "room_1", "room_2", 0, 2000)
+    assert vb["los_finished"] == 1 and vb["los_steps"] < 2000

@@ -15,8 +15,13 @@ What is ours (the paper leaves it open)
 - R1 starts at the map's ``base`` place with a heading of 90° (so R1's start frame is
   *not* the world frame, and a brain that confused them would miss every target).
 - Routes: on the simple map R2 and R3 patrol the whole corridor in opposite phases and R4
-  starts in the middle; on the complex map R2 patrols the east-west corridor, R3 the
-  north-south one and R4 loops over both through the junction. Each helper is its own
+  starts in the middle; on the complex map R2 and R4 walk the east-west corridor end to end in
+  opposite phases stepping into every room's doorway (each room of ``office_complex`` has one on
+  it, from which the room's centre is in sight), and R3 walks the north-south corridor stopping
+  in front of its four doors. The paper's Fig. 13 shows where its helpers are but gives no
+  coordinates: these routes are ours, chosen so that the helpers see every target as §6's
+  helpers must for Table 2 (helpers that passed only rooms 3, 5 and 7 made no difference).
+  Each helper is its own
   robot group (``robots.1`` .. ``robots.3``) so each has its own route; its start is a
   1 cm box (``start.region``) so that a sweep can drop it with ``robots.K.count: 0``
   (explicit ``poses`` must list exactly ``count`` poses).
@@ -135,7 +140,8 @@ def _door_route(y_m: float, doors_x: Sequence[float], door_y_m: float, x0_m: flo
 #: office_complex's corridor doorways (places ``door_*``: 0.3 m past the corridor's edge), as
 #: (position along the corridor [m], doorway's other coordinate [m]): on H (x, y), on V (y, x).
 COMPLEX_DOORS_H: tuple[tuple[float, float], ...] = (
-    (1.4, 10.5), (9.6, 10.5), (12.8, 13.5), (20.6, 13.5), (23.6, 10.5), (26.0, 10.5), (34.8, 10.5), (34.8, 13.5))
+    (2.2, 10.5), (4.4, 13.5), (10.4, 10.5), (12.4, 13.5), (21.4, 13.5), (23.6, 10.5), (29.4, 10.5), (33.8, 13.5),
+    (34.8, 10.5))
 COMPLEX_DOORS_V: tuple[tuple[float, float], ...] = ((22.6, 17.2), (14.8, 18.8), (9.4, 18.8), (1.6, 17.2))
 
 

@@ -404,38 +404,37 @@ def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
 
     A 36 m x 24 m building with a cross of 2.4 m corridors (east-west ``H`` at
     y in [10.8, 13.2] m, north-south ``V`` at x in [16.8, 19.2] m) and eight rooms in the
-    four quarters, every one with a 1.2 m door onto ``H`` (rooms 2, 3, 6, 7 also onto ``V``).
+    four quarters, every one with a 1.2 m door onto ``H`` (room 6, 16.4 m wide, two; rooms 2,
+    3, 6, 7 also one onto ``V``).
 
     What §6 asks of it, and how:
 
     - "target positions which are located in the middle of the rooms": places ``room_1`` ..
       ``room_8`` are the rooms' exact centres, with at least 1.5 m of free space around.
-    - "other robots ... patrolling the corridors and supporting R1": every room has a door on a
-      corridor, at one end of the room's corridor wall, and the room's centre is in sight
-      (line of sight within 8 m) from a point of that doorway 0.3 m past the corridor's edge.
-      A helper that steps into the doorways on its patrol sees every target and every robot
-      in the room (the first version opened rooms 1, 2, 4, 6 and 8 to no corridor and hid
-      their centres behind obstacles, so helpers could see only rooms 3, 5 and 7 and made no
-      measurable difference, unlike Table 2).
+    - "other robots ... patrolling the corridors and supporting R1": the room's centre is in
+      sight (line of sight within the 8 m visibility radius of the experiments) from its H
+      doorway (place ``door_<k>``, 0.3 m past the corridor's edge), and so is every spot where a
+      potential field stops in that room (the U pockets' bottoms, the walls' feet facing other
+      rooms' targets): a helper stepping into the doorways on its patrol sees every target and
+      a robot stuck in any room (§5 needs a teammate in sight). The first version opened rooms
+      1, 2, 4, 6 and 8 to no corridor and hid their centres behind obstacles: helpers saw only
+      rooms 3, 5 and 7 and made no measurable difference, unlike Table 2.
     - "more complex" than Fig. 11, with local minima a potential field cannot leave
       ("1) does not guarantee the robot to reach its target without the help of other robots
-      because of the presence of local minima"): doors sit off the room's centre line, so a
-      robot heading at a centre from the corridor (or at a target across the corridor from
-      inside a room) meets a wall; four rooms hold U-shaped walls opening towards the room's
-      centre, set where a robot leaving the centre for a target in another room drives into
-      them (room 1: east, room 6: south, room 8: west, room 4: west); room 2 has a partition
-      hanging from its corridor wall and room 7 two pillars. Rooms 3 and 4, and 7 and 8, are
-      also joined by inner doors (suites), giving a boundary follower shorter ways and longer
-      ones.
+      because of the presence of local minima"): doors sit 1.5-4 m off the rooms' centre
+      lines, so a robot heading at a centre from the corridor (or at a target across the
+      corridor from inside a room) stops at a wall; rooms 1, 2, 4 and 8 hold U-shaped walls
+      opening towards the room's centre where a robot leaving the centre for a target in the
+      next room drives into them; rooms 6 and 7 hold pillars; rooms 3 and 4, and 7 and 8, are
+      joined by inner doors (suites), and a second corridor gives a boundary follower long
+      ways round. Gaps between an obstacle and a wall are >= 1.6 m or closed (VisBug-21
+      circled a U standing 1 m from a wall).
 
-    Where we fill a gap: the paper gives Fig. 13 as a picture only (no sizes). The U walls
-    leave the line from the room's doorway to its centre clear, so helpers' visibility is the
-    paper's ("helpers clearly help on this map", Table 2) while the traps stay on the way
-    out of the rooms.
+    Where we fill a gap: the paper gives Fig. 13 as a picture only (no sizes or coordinates).
 
-    Places: ``room_1``..``room_8`` (targets), ``base`` at the west end of H (R1's start),
-    ``door_<k>`` at each corridor doorway 0.3 m past the corridor's edge (``door_<k>``: H door,
-    ``door_<k>v``: V door), ``patrol_*`` waypoints on both corridors and the ``junction``.
+    Places: ``room_1``..``room_8`` (targets), ``door_<k>`` (H doorways; ``door_6w`` room 6's
+    west one) and ``door_<k>v`` (V doorways, 0.3 m into the room), ``base`` at the west end of H
+    (R1's start), ``patrol_*`` waypoints on both corridors and the ``junction``.
     """
     res = _res(resolution_m)
     b = MapBuilder(36.0, 24.0, res).fill("wall")
@@ -449,11 +448,12 @@ def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
     }
     for box in rooms.values():
         b.clear_rect(*box)
-    # doors on H (x range), at one end of each room's corridor wall
-    h_doors = {1: (0.8, 2.0), 2: (9.0, 10.2), 3: (23.0, 24.2), 4: (25.4, 26.6), 5: (34.2, 35.4),
-               6: (12.2, 13.4), 7: (20.0, 21.2), 8: (34.2, 35.4)}
+    # doors on H (x range), 1.5-4 m off the room's centre line (room 6, 16.4 m wide, has two)
+    h_doors = {1: (1.6, 2.8), 2: (9.8, 11.0), 3: (23.0, 24.2), 4: (28.8, 30.0), 5: (34.2, 35.4),
+               6: (11.8, 13.0), "6w": (3.8, 5.0), 7: (20.8, 22.0), 8: (33.2, 34.4)}
+    south = {1, 2, 3, 4, 5}
     for k, (x0, x1) in h_doors.items():
-        y0, y1 = (10.6, 10.8) if rooms[k][1] < 10.0 else (13.2, 13.4)
+        y0, y1 = (10.6, 10.8) if k in south else (13.2, 13.4)
         b.clear_rect(x0, y0, x1, y1)
     # doors on V (y range): west side (rooms 2, 6: wall x 16.6-16.8), east side (3, 7: x 19.2-19.4)
     v_doors = {2: (1.0, 2.2), 3: (8.8, 10.0), 6: (22.0, 23.2), 7: (14.2, 15.4)}
@@ -462,18 +462,19 @@ def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
         b.clear_rect(x0, y0, x1, y1)
     b.clear_rect(24.6, 1.0, 24.8, 2.2)  # suite door room 3 <-> room 4 (south end)
     b.clear_rect(27.4, 22.2, 27.6, 23.4)  # suite door room 7 <-> room 8 (north end)
-    # traps (open towards the room's centre, on the way out to other rooms)
+    # traps: U walls open towards the room's centre, on the way out to other rooms, their
+    # pockets in sight from the room's doorway (so a helper there sees a robot stuck inside)
     _u_obstacle(b, 5.2, 3.4, 6.6, 7.4, "W")  # room 1: east of the centre (4.2, 5.4)
-    _u_obstacle(b, 5.0, 15.0, 8.0, 17.2, "N")  # room 6: south-west of the centre (8.4, 18.6)
+    _u_obstacle(b, 13.6, 3.4, 15.0, 7.4, "W")  # room 2: east of the centre (12.5, 5.4)
+    _u_obstacle(b, 24.8, 3.6, 26.0, 7.2, "E")  # room 4: a bay in its west wall, west of the centre (27.5, 5.4)
     _u_obstacle(b, 29.2, 16.2, 30.6, 21.0, "E")  # room 8: west of the centre (31.7, 18.6)
-    _u_obstacle(b, 24.8, 3.6, 26.4, 7.2, "E")  # room 4: a bay in its west wall, west of the centre (27.5, 5.4)
-    b.rect(14.2, 7.4, 14.5, 10.6)  # room 2: partition hanging from the corridor wall, east of the door
+    b.disc(5.0, 20.6, 0.4).disc(12.0, 20.6, 0.4)  # room 6: pillars north of its centre
     b.disc(22.4, 21.4, 0.4).disc(25.4, 16.0, 0.4)  # room 7: pillars off the door-centre line
     places: dict[str, tuple[float, float]] = {}
     for k, (x0, y0, x1, y1) in rooms.items():
         places[f"room_{k}"] = (round((x0 + x1) / 2, 3), round((y0 + y1) / 2, 3))
     for k, (x0, x1) in h_doors.items():
-        places[f"door_{k}"] = (round((x0 + x1) / 2, 3), 10.5 if rooms[k][1] < 10.0 else 13.5)
+        places[f"door_{k}"] = (round((x0 + x1) / 2, 3), 10.5 if k in south else 13.5)
     for k, (y0, y1) in v_doors.items():
         places[f"door_{k}v"] = (16.5 if k in (2, 6) else 19.5, round((y0 + y1) / 2, 3))
     places.update({
@@ -486,9 +487,9 @@ def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
     })
     notes = (
         "Sgorbissa & Arkin §6 Fig. 13 (complex office): 36x24 m, cross-shaped 2.4 m corridors, "
-        "8 rooms each with a 1.2 m door at one end of its corridor wall (rooms 2, 3, 6, 7 also on the "
-        "north-south corridor), U-shaped walls opening towards four room centres, a partition, pillars, "
-        "and two suites of joined rooms; targets at room centres, each in sight from its doorway."
+        "8 rooms each with a 1.2 m door off its centre line on the east-west corridor (rooms 2, 3, 6, 7 "
+        "also on the north-south one), U-shaped walls opening towards four room centres, pillars, and two "
+        "suites of joined rooms; targets at room centres, each in sight from its doorway."
     )
     regions = {"corridor_H": (0.2, 10.8, 35.8, 13.2), "corridor_V": (16.8, 0.2, 19.2, 23.8)}
     return EnvironmentMap(b.build("builtin:office_complex"), places, notes, regions)
