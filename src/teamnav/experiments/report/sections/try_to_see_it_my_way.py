@@ -10,23 +10,37 @@ EXPERIMENTS.md rows, each a :class:`Comparison`:
 3. The drift sweep of both algorithms (each robot its own drift, k x Bug -1, Ant +1, Fly +2,
    Tanis +0.35 deg/min): breakdown time and last-10-minute throughput vs k.
 4. Memory stays flat (crumbs held, first vs second half of the long runs: 4-minute expiry).
+5. The issue's "the 2002 one keeps working for hours under the same drift", "memory stays flat
+   over a 10-hour simulated run" and "a simulated hour of 4 robots runs in well under a minute on
+   one core": one 10-hour run of trail-share-v1 at k = 4 (the drift where the 2000 algorithm
+   collapses within the hour), sampled every 30 min in the trial (:func:`_trails.profile_trial`:
+   the largest Trail any robot holds, the process's RSS, CPU seconds per simulated hour), and a
+   2-hour run of blazing-trail-v1 at k = 1 for its CPU cost and its ever-growing crumb list.
+   Measured (commit bec19bc, seed 0, machine shared with ~12 other runs): 341 units in 10 h,
+   5.7 per 10 min on average and 5.7 in the last 3 h (no breakdown); largest Trail 462–476
+   crumbs in every sample (bound 4 x 121); RSS 248.9 MiB at 0.5 h and at 10 h; 40 CPU s per
+   simulated hour (38–49 per interval; 58 in the first, which loads the compiled kernels).
 
 Beside them: Table 1 (trips, distance, lifetime per robot), units over time, the times each
 robot reached the places (Fig. 2 top), the crumbs each robot dropped in its own frame (Fig. 3)
-and all crumbs in the fixed frame of the Places (Fig. 4), and the N-place mail round (§2.1).
+and all crumbs in the fixed frame of the Places (Fig. 4), the N-place mail round (§2.1), the
+drift sweep as a table (mean ± std per k, both algorithms) and the wheel-scale-error cases of
+the drift sweeps (Bug +5 %, Ant −5 %, Fly +3 %, Tanis −3 %, alone and with k = 1; 3 seeds).
 
 Quick mode: 300 s runs, 2 seeds, drift k = 0 and 4 (the blazing section's quick drift trials,
-reused), no run without Place transforms, no long 2000-algorithm runs, no mail round (≈ 45 s
-wall). Full: 3 h x 10 seeds (the paper's trial lasted 3 h 8 min) and the 2000 algorithm under
-the same drift for 3 h x 5 seeds; the drift sweeps at k = 0, 1, 4 and the no-transform control
-1 h x 10 seeds per point; the mail round 30 min x 3 seeds.
+reused), no run without Place transforms, no long 2000-algorithm runs, no mail round, no
+profiled or scale-error runs (≈ 45 s wall on an idle machine; 81 s under a load of 13 on 2 cores,
+38 CPU s for both trail sections). Full: 3 h x 10 seeds (the paper's trial lasted 3 h 8 min)
+and the 2000 algorithm under the same drift for 3 h x 5 seeds; the drift sweeps at k = 0, 1, 4
+and the no-transform control 1 h x 10 seeds per point; the mail round 30 min x 3 seeds; the
+10-hour and 2-hour profiled runs; the scale cases 1 h x 3 seeds.
 
 Cost of the full mode (measured on one core: 4 robots x 1 simulated hour = 37 CPU s for
-trail-share-v1, 30 CPU s for blazing-trail-v1): 30 team-hours of try-paper (≈ 19 CPU min),
-15 of blazing-under-try-drift (≈ 8), 30 of try-drift (≈ 19), 10 without transforms (≈ 6),
-the mail round (≈ 1); blazing-drift is the blazing-a-trail section's (≈ 15, run once for
-both): ≈ 52 CPU min here, ≈ 76 for both sections (≈ 1.3 CPU-hours; 65 without the two
-ablations, blazing-paper-rules and blazing-under-try-drift).
+trail-share-v1, 30 CPU s for blazing-trail-v1; 40 and ≈ 33 under a heavy shared load):
+30 team-hours of try-paper (≈ 19 CPU min), 15 of blazing-under-try-drift (≈ 8), 30 of try-drift
+(≈ 19), 10 without transforms (≈ 6), the mail round (≈ 1), the profiled runs 12 (≈ 8), the scale
+cases 12 (≈ 7); blazing-drift is the blazing-a-trail section's (≈ 15, run once for both):
+≈ 67 CPU min here, ≈ 91 for both sections (≈ 1.5 CPU-hours).
 """
 
 from __future__ import annotations
