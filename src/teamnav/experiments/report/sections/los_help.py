@@ -156,6 +156,15 @@ FULL_CPU_NOTE = ("Cost of the full reproduction here (measured with /usr/bin/tim
                  "(75 trials) about 7; on office_complex (619 CPU-s for 60 trials of 5 targets; most Avoid-Past and "
                  "potential-field trials end early, failed) `los-table2` takes about 14 CPU-hours and "
                  "`los-noise-complex` about 9. Wall time is that over the number of workers (`-j`).")
+#: The brains' gap-fills in the sharing rules that change the tables (each a flag of
+#: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
+GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
+                  "beat the stored D by one step (report_margin_steps; a helper walking back along the light "
+                  "path made ties that dragged R1 away from its goal); at a reached ghost a teammate further along "
+                  "the same light path leads on (lead_on); a report carries the point its D leads through, so R1 "
+                  "goes on from a helper's position to where the helper saw the goal (share_via); a goal seen "
+                  "directly is kept while a neighbouring beam still reaches it (keep_direct_view). Measured on "
+                  "office_simple, 5 tasks x 10 targets, Avoid-Past: R1..R4 went from 3/5 to 5/5 tasks finished.")
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
 QUICK_BUDGET_STEPS_PER_TARGET = 800
@@ -500,7 +509,7 @@ def build(ctx) -> list:
         f"{QUICK_BUDGET_STEPS_PER_TARGET if quick else ' / '.join(map(str, L.BUDGET_STEPS_PER_TARGET.values()))} "
         f"steps{'' if quick else ' (simple / complex map)'}: R1 then gives up and the run ends. As in §6, state "
         "sharing is used with the potential field only; the ablation shows what it does to the others. "
-        + FULL_CPU_NOTE)]
+        + GAP_FILLS_NOTE + " " + FULL_CPU_NOTE)]
     tables: dict[str, dict[int, list[dict]]] = {}
     comps: list[Comparison] = []
     alone: dict[str, dict[str, float]] = {}
