@@ -137,7 +137,12 @@ def _hallway(ctx) -> list:
             "Our times are mean ± std over runs of the per-run mean over robots, censored robots counted at the "
             "run's duration (a lower bound). The full report's verdict needs the paired per-seed reduction beyond "
             "two standard errors, not only a lower mean. Our hallway, sonar model and sample counts are not the paper's. "
-            "Collaboration needs sensor resetting on received trees (inject_fraction) with our sample sets.",
+            "Collaboration needs sensor resetting on received trees (inject_fraction) with our sample sets. In this "
+            "hallway (beyond the paper, each a scenario setting): the wanderer takes no side openings (with them a "
+            "robot shuttles along one stretch of corridor and the team splits into groups that never meet); a tree "
+            "becomes at least 500 draws whose headings come from the receiver's scan (a wrong robot here sits on a "
+            "rotated copy of its place); and the receiver weighs the chance that the sender is wrong, so two "
+            "confident robots that disagree no longer hand the receiver to the sender.",
         ),
         Plot("Fig. 12(b): localization error vs time, 8 sonar robots", "time [s]",
              "mean distance of samples to the true pose [m]",
