@@ -82,25 +82,37 @@ class Radio:
 
     def _receivers(self, s: int, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
         """Bool (N,): robots that can hear sender ``s`` now (mode only; no loss, no address)."""
+        return self._receivers_of([s], xs, ys)[0]
+
+    def _receivers_of(self, senders: list[int], xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+        """Bool (S, N): row k, the robots that can hear ``senders[k]`` now (mode only).
+
+        In range: ``(x - x_s)**2 + (y - y_s)**2 <= range_m**2``; in line of sight: the
+        segment from the sender to the receiver is clear (one kernel call for every
+        sender–receiver pair in range).
+        """
         mode = self.cfg.mode
+        sidx = np.asarray(senders, dtype=np.int64)
+        rows = np.arange(sidx.shape[0])
         if mode == "broadcast":
-            ok = np.ones(self.n, dtype=bool)
+            ok = np.ones((sidx.shape[0], self.n), dtype=bool)
         else:
             r = self.cfg.range_m
-            ok = (xs - xs[s]) ** 2 + (ys - ys[s]) ** 2 <= r * r
+            ok = (xs[None, :] - xs[sidx][:, None]) ** 2 + (ys[None, :] - ys[sidx][:, None]) ** 2 <= r * r
             if mode == "line_of_sight":
-                ok[s] = False
-                idx = np.flatnonzero(ok)
-                if idx.size:
+                ok[rows, sidx] = False
+                k, j = np.nonzero(ok)
+                if k.size:
                     # line_of_sight's kernels, called directly: the map was checked once in __init__
                     ox, oy, inv = self._geo_inv
-                    seen = np.empty(idx.size, dtype=np.bool_)
-                    kernel = _los_kernel if idx.size >= _PARALLEL_MIN_SEGMENTS else _los_kernel_serial
-                    kernel(self._blocking, ox, oy, inv, np.full(idx.size, float(xs[s])), np.full(idx.size, float(ys[s])),
-                           np.ascontiguousarray(xs[idx], dtype=np.float64), np.ascontiguousarray(ys[idx], dtype=np.float64),
-                           seen)
-                    ok[idx[~seen]] = False
-        ok[s] = False
+                    seen = np.empty(k.size, dtype=np.bool_)
+                    kernel = _los_kernel if k.size >= _PARALLEL_MIN_SEGMENTS else _los_kernel_serial
+                    s_of = sidx[k]
+                    kernel(self._blocking, ox, oy, inv, np.ascontiguousarray(xs[s_of], dtype=np.float64),
+                           np.ascontiguousarray(ys[s_of], dtype=np.float64), np.ascontiguousarray(xs[j], dtype=np.float64),
+                           np.ascontiguousarray(ys[j], dtype=np.float64), seen)
+                    ok[k[~seen], j[~seen]] = False
+        ok[rows, sidx] = False
         return ok
 
     def send(self, outgoing: Sequence[tuple[int, Message]], xs: np.ndarray, ys: np.ndarray) -> None:
@@ -116,6 +128,9 @@ class Radio:
         if not outgoing:
             return
         cache: dict[int, np.ndarray] = {}
+        senders = sorted({int(s) for s, _ in outgoing})
+        for s, ok in zip(senders, self._receivers_of(senders, xs, ys)):
+            cache[s] = ok
         p_loss = self.cfg.p_loss
         for s, msg in outgoing:
             if not isinstance(msg, Message):
@@ -124,9 +139,7 @@ class Radio:
             self.sent_messages[s] += 1
             self.sent_bytes[s] += size
             self.by_kind[msg.kind] = self.by_kind.get(msg.kind, 0) + 1
-            ok = cache.get(s)
-            if ok is None:
-                ok = cache[s] = self._receivers(s, xs, ys)
+            ok = cache[int(s)]
             if msg.to is not None:
                 to = msg.to
                 hear = np.zeros(self.n, dtype=bool)

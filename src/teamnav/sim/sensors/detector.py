@@ -212,7 +212,7 @@ class RobotDetector:
         dx = xs[b] - xs[a]
         dy = ys[b] - ys[a]
         rng_m = np.hypot(dx, dy)
-        bearing = wrap_angle(np.arctan2(dy, dx) - thetas[a]) if m else np.empty(0)
+        bearing = _wrap(np.arctan2(dy, dx) - thetas[a]) if m else np.empty(0)
         if not self.full_circle and m:
             keep = np.abs(bearing) <= self.fov_rad / 2
             row, a, b, rng_m, bearing = row[keep], a[keep], b[keep], rng_m[keep], bearing[keep]
@@ -221,6 +221,21 @@ class RobotDetector:
     # ------------------------------------------------------------------ noise
     def _noisy(self, d_r, a_r, size_m, rng):
         """Perceived range and bearing of true detections (rule 4)."""
+        return self._apply_noise(d_r, a_r, size_m, self._draw_noise(d_r.shape[0], rng))
+
+    def _draw_noise(self, m, rng):
+        """The draws of rule 4 for ``m`` true detections: (2, m) uniforms (occlusion) or
+        standard normals (gaussian), or None when the model is noise-free."""
+        cfg = self.cfg
+        if cfg.noise_model == "occlusion":
+            return rng.random((2, m))
+        if cfg.range_noise_std_m == 0.0 and cfg.bearing_noise_std_deg == 0.0:
+            return None
+        return rng.standard_normal((2, m))
+
+    def _apply_noise(self, d_r, a_r, size_m, u):
+        """Rule 4 with the draws ``u`` of :meth:`_draw_noise` (element by element, so the
+        detections of several groups can be corrupted in one call)."""
         cfg = self.cfg
         m = d_r.shape[0]
         if cfg.noise_model == "occlusion":
@@ -228,24 +243,22 @@ class RobotDetector:
             # atan(robotsize / 2 d_r) alpha_noise, d_noise ~ U[-err_max, err_max] and, as the paper
             # states, alpha_noise ~ U[-1, 1] (the bearing error of a partial occlusion is bounded
             # by the half-angle the seen robot subtends, whatever err_max is).
-            u = rng.random((2, m))
             d_noise = cfg.err_max * (2.0 * u[0] - 1.0)
             a_noise = 2.0 * u[1] - 1.0
             d_p = d_r + d_r * d_noise
             with np.errstate(divide="ignore"):
                 half_angle = np.arctan(size_m / (2.0 * d_r))  # d_r = 0 -> pi/2
             a_p = a_r + half_angle * a_noise
-            return d_p, wrap_angle(a_p) if m else a_p
+            return d_p, _wrap(a_p) if m else a_p
         # Fox et al. §4.2, Fig. 7: zero-mean Gaussian errors, independent in distance and
         # angle; a perceived range is kept >= 0.
+        if u is None:
+            return d_r, a_r
         s_r = cfg.range_noise_std_m
         s_b = math.radians(cfg.bearing_noise_std_deg)
-        if s_r == 0.0 and s_b == 0.0:
-            return d_r, a_r
-        z = rng.standard_normal((2, m))
-        d_p = np.maximum(d_r + s_r * z[0], 0.0)
-        a_p = a_r + s_b * z[1]
-        return d_p, wrap_angle(a_p) if m else a_p
+        d_p = np.maximum(d_r + s_r * u[0], 0.0)
+        a_p = a_r + s_b * u[1]
+        return d_p, _wrap(a_p) if m else a_p
 
     # ------------------------------------------------------------------ API
     def detect_arrays(self, xs, ys, thetas, radii, observers, rng: np.random.Generator, ids) -> DetectionArrays:
@@ -358,6 +371,18 @@ class RobotDetector:
         sizes = [o.shape[0] for o in observers]
         offs = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         cut = np.searchsorted(row, offs).tolist()
+        cfg = self.cfg
+        if cfg.p_false_negative == 0.0 and cfg.p_false_positive == 0.0:
+            # rule 4 only: each group's draws from its own stream, the arithmetic in one pass
+            draws = [self._draw_noise(cut[g + 1] - cut[g], rng) for g, rng in enumerate(rngs)]
+            u = None if draws[0] is None else draws[0] if len(draws) == 1 else np.concatenate(draws, axis=1)
+            d_p, a_p = self._apply_noise(d_r, a_r, 2.0 * radii[b], u)
+            rid = ids[b] if cfg.report_identity else np.full(b.shape[0], -1, dtype=np.int64)
+            rids = [None if v < 0 else v for v in rid.tolist()]
+            dets = [Detection(r, br, i) for r, br, i in zip(d_p.tolist(), a_p.tolist(), rids)]
+            bl = np.searchsorted(row, np.arange(obs.shape[0] + 1)).tolist()
+            per_row = [tuple(dets[bl[k]:bl[k + 1]]) for k in range(obs.shape[0])]
+            return [per_row[offs[g]:offs[g + 1]] for g in range(len(observers))]
         out = []
         for g, (o, rng) in enumerate(zip(observers, rngs)):
             s0, s1 = cut[g], cut[g + 1]
@@ -397,6 +422,14 @@ def _pairs_in_sight(xs, ys, obs, r2, los, blocking, ox, oy, inv, out):
                 out[2, m] = j
                 m += 1
     return m
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    """:func:`~teamnav.geometry.angles.wrap_angle` of an array, returned as is when every angle
+    is already in ``(-pi, pi]`` (which is what ``wrap_angle`` returns then, bit for bit)."""
+    if a.shape[0] and bool(((a > -math.pi) & (a <= math.pi)).all()):
+        return a
+    return wrap_angle(a)
 
 
 def _as_tuples(arr: DetectionArrays, n: int) -> list[tuple[Detection, ...]]:
