@@ -80,3 +80,22 @@ def test_potential_field_alone_sticks_in_room_1s_trap_where_visbug_gets_out():
     assert pf["los_finished"] == 0 and pf["los_gave_up"] == 1
     vb = _leg("visbug21", "room_1", "room_2", 0, 2000)
     assert vb["los_finished"] == 1 and vb["los_steps"] < 2000
+
+
+def _helper_log(timeout_steps: int) -> dict:
+    """R2 of los-help-complex sent first to a point inside the corridor's south wall (unreachable),
+    then back to its start; its last log after 12 s (120 steps)."""
+    start, _ = L.LAYOUTS["complex"].helpers[0]
+    patrol = L.world_to_frame(start, [(5.0, 10.7), start[:2]]).round(4).tolist()
+    over = {"robots.1.params.patrol_xy": patrol, "robots.1.params.waypoint_timeout_steps": timeout_steps,
+            "robots.2.count": 0, "robots.3.count": 0, "record_every": 1, "stop_when_finished": False}
+    data = run(load_scenario("los-help-complex", overrides=over, duration_s=12.0), progress=False).data
+    return [e["values"] for e in data.logs if e["robot"] == 1][-1]
+
+
+def test_a_helper_passes_over_a_waypoint_it_cannot_reach_after_its_timeout():
+    stuck = _helper_log(0)
+    assert stuck["target_index"] == 0 and stuck["waypoints_skipped"] == 0  # without a timeout it tries forever
+    moved = _helper_log(50)
+    # passed over at step 51, back at its start (2 m) ~10 steps later, passed over again at ~112
+    assert moved["waypoints_skipped"] == 2 and moved["targets_reached"] >= 1

@@ -102,6 +102,11 @@ RECORD_EVERY = 10
 #: 200 x 800 steps made each failing run burn 160 000 steps). Generous: Avoid-Past alone needs
 #: ~100-550 steps per target on office_simple (task 1, first 10 targets).
 BUDGET_STEPS_PER_TARGET: dict[str, int] = {"simple": 1500, "complex": 2500}
+#: A helper passes over a waypoint it has not reached within this many steps (``los-helper-v1``
+#: ``waypoint_timeout_steps``; ours). On office_complex R2 and R4 step into the same doorways
+#: from opposite sides and, both driven by a potential field, blocked each other in room 5's
+#: door for 2000 steps; the longest leg of a route there is under 60 steps.
+HELPER_WAYPOINT_TIMEOUT_STEPS: dict[str, int] = {"complex": 150}
 
 
 @dataclass(frozen=True)
@@ -358,7 +363,9 @@ def scenario_data(map_key: str, *, name: str | None = None, task: int = 1, n_tar
             "params": {"navigator": "potential_field", "patrol_xy": patrol_xy(map_key, k),
                        "goal_tolerance_m": HELPER_TOLERANCE_M, "goal_sharing": True,
                        "delayed_visibility": True, "state_sharing": True, "laser": "laser",
-                       "log_layers": False},
+                       "log_layers": False,
+                       **({"waypoint_timeout_steps": HELPER_WAYPOINT_TIMEOUT_STEPS[map_key]}
+                          if map_key in HELPER_WAYPOINT_TIMEOUT_STEPS else {})},
             "detector": det,
             "start": {"region": [x - 0.005, x + 0.005, y - 0.005, y + 0.005], "theta_deg": th},
         })

@@ -28,10 +28,18 @@ class LosHelperParams(_CommonParams):
         Waypoints [m] in the robot's own odometry frame. Empty: stays where it is.
     patrol_mode : {"ping_pong", "cycle"}
         After the last waypoint, go back through them (ping-pong) or start again (cycle).
+    waypoint_timeout_steps : int
+        A waypoint not reached within this many steps is passed over for the next one (0: never).
+        Ours, not the paper's (§6 only says helpers "patrol the corridors"): two helpers
+        heading for the same doorway from opposite sides, or a helper meeting R1 in a door,
+        block each other for good under a potential field (each is the other's local minimum;
+        measured on office_complex: R2 and R4 stood 2000 steps in room 5's doorway while R1
+        waited, out of their sight, for help).
     """
 
     patrol_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=10_000)
     patrol_mode: Literal["ping_pong", "cycle"] = "ping_pong"
+    waypoint_timeout_steps: int = Field(0, ge=0, le=1_000_000)
 
 
 
@@ -49,6 +57,8 @@ class LosHelper(_LosBrain):
         self.waypoint_index = 0
         self._dir = 1
         self.waypoints_reached = 0
+        self.waypoints_skipped = 0
+        self._steps_on_waypoint = 0
         self._k = 1
         self.mode = "patrol" if self.patrol else "stay"
         if self.patrol:
@@ -59,7 +69,11 @@ class LosHelper(_LosBrain):
         if not self.patrol:
             return
         wx, wy = self.patrol[self.waypoint_index]
-        if math.hypot(wx - self._pose[0], wy - self._pose[1]) >= self.params.goal_tolerance_m:
+        reached = math.hypot(wx - self._pose[0], wy - self._pose[1]) < self.params.goal_tolerance_m
+        self._steps_on_waypoint += 1
+        timeout = self.params.waypoint_timeout_steps
+        timed_out = not reached and timeout > 0 and self._steps_on_waypoint > timeout
+        if not (reached or timed_out):
             return
         if len(self.patrol) == 1:
             return  # one waypoint: it stays there
@@ -70,7 +84,11 @@ class LosHelper(_LosBrain):
             if not 0 <= self.waypoint_index + self._dir < n:
                 self._dir = -self._dir
             self.waypoint_index += self._dir
-        self.waypoints_reached += 1
+        if reached:
+            self.waypoints_reached += 1
+        else:
+            self.waypoints_skipped += 1
+        self._steps_on_waypoint = 0
         self._k += 1
         self._last_target = None
         self.sharing.set_own_goal(self._k, self.patrol[self.waypoint_index])
@@ -96,10 +114,11 @@ class LosHelper(_LosBrain):
 
     def log(self) -> dict[str, Any]:
         """As :meth:`LosExplorer.log` where meaningful: ``mode`` is ``"patrol"`` or ``"stay"``;
-        ``target_index`` is the current waypoint index and ``targets_reached`` counts waypoints
-        reached."""
+        ``target_index`` is the current waypoint index, ``targets_reached`` counts waypoints
+        reached and ``waypoints_skipped`` those passed over (``waypoint_timeout_steps``)."""
         out = self._common_log()
-        out.update(target_index=int(self.waypoint_index), targets_reached=int(self.waypoints_reached))
+        out.update(target_index=int(self.waypoint_index), targets_reached=int(self.waypoints_reached),
+                   waypoints_skipped=int(self.waypoints_skipped))
         layers = self._layers()
         if layers:
             out["layers"] = layers
