@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from teamnav.control.types import Message
 from teamnav.sim.config import RadioConfig
@@ -106,3 +108,29 @@ def test_loss_is_seeded():
 def test_outbox_must_hold_messages():
     with pytest.raises(ValueError, match="Message"):
         _radio().send([(0, "not a message")], XS, YS)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 12), st.sampled_from(["broadcast", "range", "line_of_sight"]))
+def test_receivers_of_many_senders_equal_one_sender_at_a_time(seed, n, mode):
+    """All senders' receivers in one call equal the rule applied sender by sender: in range
+    ``(x - x_s)**2 + (y - y_s)**2 <= range_m**2``, in sight by :func:`line_of_sight`, never the sender."""
+    from teamnav.world.los import line_of_sight
+
+    g = np.random.default_rng(seed)
+    cells = np.zeros((80, 80), np.uint8)
+    cells[40:42, 5:75] = WALL
+    grid = OccupancyGrid(cells, 0.1)
+    radio = Radio(RadioConfig(mode=mode, range_m=3.0), grid, n, np.random.default_rng(0))
+    xs, ys = g.uniform(0.1, 7.9, n), g.uniform(0.1, 7.9, n)
+    senders = sorted(set(g.integers(0, n, 3).tolist()))
+    got = radio._receivers_of(senders, xs, ys)
+    for k, s in enumerate(senders):
+        want = np.ones(n, bool) if mode == "broadcast" else (xs - xs[s]) ** 2 + (ys - ys[s]) ** 2 <= 9.0
+        want[s] = False
+        if mode == "line_of_sight":
+            idx = np.flatnonzero(want)
+            seen = line_of_sight(grid.blocking(RadioConfig().sees), 0.0, 0.0, 0.1, np.full(idx.size, xs[s]),
+                                 np.full(idx.size, ys[s]), xs[idx], ys[idx])
+            want[idx[~seen]] = False
+        assert np.array_equal(got[k], want), (s, got[k], want)
