@@ -482,6 +482,7 @@ class Simulation:
         xs, ys, ths = s.x_m, s.y_m, s.theta_rad
         shared = self._shared_readings() if self._scan_sets else None
         dets_of = self._shared_detections() if self._det_sets else None
+        delta = self.odometry.delta.copy() if self._any_per_robot else None  # fresh, one copy for all groups
         for grp in self._groups:
             sl = grp.sl
             gx, gy, gth = xs[sl], ys[sl], ths[sl]
@@ -497,7 +498,6 @@ class Simulation:
                 act = grp.brain.step_batch(obs)
                 self._apply_batch(grp, act)
                 continue
-            delta = self.odometry.delta.copy()
             readings = [
                 (sensor.name,
                  shared[(grp.index, k)] if shared is not None and (grp.index, k) in self._shared_scan
