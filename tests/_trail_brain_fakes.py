@@ -17,6 +17,7 @@ class RecordingNav:
         self.allow_reverse = []
         self.turn_arounds = []  # leave_m of each turn_around call
         self.mode = "fake"
+        self.leaving = False  # never in a turn_around's drive-off
 
     def step(self, obs, preferred_heading_rad=None, *, allow_reverse=True):
         self.headings.append(preferred_heading_rad)

@@ -215,6 +215,34 @@ def test_brain_vetoes_a_reversal_on_a_hint_from_too_few_crumbs(monkeypatch):
         assert b.nav.headings[-1] == pytest.approx(0.0) and b.nav.allow_reverse[-1] is allowed
 
 
+def test_brain_off_the_trail_heads_back_to_the_nearest_crumb_within_the_recovery_radius(monkeypatch):
+    """recover_radius_m: no crumb around the point ahead, the nearest within 6 m lies behind the
+    robot (it ran into a dead end): the hint points at it and may reverse the robot."""
+    for recover, hint in ((6.0, math.pi), (0.0, None), (3.0, None)):
+        (b,) = _brains(monkeypatch, n=1, radius_m=2.0, lookahead_m=1.0, recover_radius_m=recover)
+        b.global_crumbs.extend(CrumbBatch(np.array([[0.0, 0.0], [-1.0, 0.0], [-2.0, 0.0], [0.0, 9.0]]),
+                                          np.zeros(4)))
+        b.step(_obs(0, 0, [4.0, 0.0, 0.0]))  # heading east, 4 m past the trail's east end
+        got = b.nav.headings[-1]
+        assert (got is None) if hint is None else got == pytest.approx(hint)
+        assert b.nav.allow_reverse[-1] is (hint is not None)
+    # on the trail the paper's average rules, whatever the recovery radius
+    (b,) = _brains(monkeypatch, n=1, radius_m=2.0, lookahead_m=0.0, recover_radius_m=6.0)
+    b.global_crumbs.extend(CrumbBatch(np.array([[4.0, 0.5]]), np.array([0.3])))
+    b.step(_obs(0, 0, [4.0, 0.0, 0.0]))
+    assert b.nav.headings[-1] == pytest.approx(0.3)
+
+
+def test_nearest_crumb_within_a_radius():
+    c = CrumbList()
+    assert c.nearest(0.0, 0.0, 5.0) is None
+    for x in (0.0, 2.0, 7.0):
+        c.drop(x, 1.0, 0.0)
+    assert c.nearest(2.4, 1.0, 5.0) == (2.0, 1.0)
+    assert c.nearest(12.0, 1.0, 5.0) == (7.0, 1.0)
+    assert c.nearest(12.01, 1.0, 5.0) is None  # just beyond the radius
+
+
 # ---------------------------------------------------------------------------- closed loop
 def trail_scenario(controller: str, params: dict, duration_s: float = 40.0):
     """trail_office, robot 0 starting 2.4 m west of the source facing it, robot 1 at home."""

@@ -324,3 +324,28 @@ def test_brain_picks_the_best_crumb_around_a_point_ahead_and_heads_to_it_from_wh
         heads[look] = a.nav.headings[-1]
     assert heads[0.0] == pytest.approx(math.pi / 2)  # only the crumb beside it is within 1.5 m
     assert heads[1.0] == pytest.approx(0.0)  # around (1, 0) the better crumb at (2.5, 0) counts
+
+
+def test_brain_off_the_trail_heads_back_to_the_nearest_goal_crumb_below_its_bound(monkeypatch):
+    """recover_radius_m: no goal crumb around the point ahead; the nearest goal crumb within the
+    recovery radius (and below the descend-only bound) gives the hint."""
+    for recover, hint in ((6.0, math.pi), (0.0, None)):
+        (a,) = _brains(monkeypatch, n=1, round=["home", "source"], radius_m=1.5, lookahead_m=1.0,
+                       recover_radius_m=recover, broadcast_interval_s=600.0)
+        a.step(_obs(0, 0, [-50.0, 0.0, 0.0]))
+        # the trail to the source ends at x = 0 (behind the robot); a home crumb lies nearer
+        a.trail.add_crumbs(["source", "source", "home"], [[-1.0, 0.0], [0.0, 0.0], [3.5, 0.0]],
+                           [6.0, 5.0, 1.0], [0.0, 0.0, 0.0])
+        a.step(_obs(0, 1, [4.0, 0.0, 0.0]))
+        got = a.nav.headings[-1]
+        assert (got is None) if hint is None else got == pytest.approx(hint)
+
+
+def test_nearest_crumb_for_a_goal_below_a_time_to_place():
+    tr = Trail()
+    assert tr.nearest_crumb("A", 0.0, 0.0, 5.0) is None
+    tr.add_crumbs(["A", "A", "B"], [[1.0, 0.0], [3.0, 0.0], [0.5, 0.0]], [9.0, 4.0, 1.0], [0.0, 0.0, 0.0])
+    assert tr.nearest_crumb("A", 0.0, 0.0, 5.0) == (1.0, 0.0)
+    assert tr.nearest_crumb("A", 0.0, 0.0, 5.0, below_s=5.0) == (3.0, 0.0)
+    assert tr.nearest_crumb("A", 0.0, 0.0, 2.9, below_s=5.0) is None
+    assert tr.nearest_crumb("C", 0.0, 0.0, 5.0) is None

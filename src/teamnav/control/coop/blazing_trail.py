@@ -48,6 +48,14 @@ with all of them; each one flag away from the paper's rules as written):
   corridor's until the opening had left the extreme beams, and robots ran on into dead ends.
 - ``reverse_min_crumbs`` (3): no 180 deg reversal on a hint from fewer crumbs (a single
   drifted crumb in a dead end made robots reverse back into it).
+- ``recover_radius_m`` (6 m): with no crumb around the point ahead, the hint points at the
+  nearest crumb within 6 m of the position estimate (the trail the robot has just left, behind
+  it in a dead end: Navigate's 180 deg rule turns it back; a reversal on it is never vetoed).
+  The paper's robot explores when no crumb is near (§4.1); on ``trail_office`` a robot that lost
+  the trail at a corner (turned back by a teammate in the corridor, or the hint bending late)
+  drove the 17.6 m dead end east of corner 1 to its end and back, ≈ 90 s, and dead ends took
+  ≈ 20 % of robot time. Measured on ``blazing-a-trail``, seeds 0-7 x 30 min: 25.0 ± 3.2 ->
+  27.3 ± 0.7 units (mean ± std; per seed +2.3 ± 1.2 s.e.). 0 m: the paper's rule.
 
 Choices where the paper is silent: crumb interval 1 s and radius 2 m (the paper gives neither;
 1.8 m corridors, a radius about a corridor wide, reaches the crumbs of the corridor the robot is
@@ -124,6 +132,9 @@ class BlazingTrailParams(BaseModel):
         (0: around the position estimate, the paper).
     reverse_min_crumbs : int
         No 180 deg reversal on a hint from fewer crumbs than this (1: the paper).
+    recover_radius_m : float
+        No crumb around the point ahead: head for the nearest crumb within this distance of the
+        position estimate [m] (0: explore, the paper).
     leave_place_m : float
         After that turn, wall follow this far [m] before the trail rules apply again.
     sensor : str
@@ -149,6 +160,7 @@ class BlazingTrailParams(BaseModel):
     turn_at_place: bool = True
     lookahead_m: float = Field(1.0, ge=0.0, le=100.0)
     reverse_min_crumbs: int = Field(3, ge=1, le=1_000_000)
+    recover_radius_m: float = Field(6.0, ge=0.0, le=100.0)
     leave_place_m: float = Field(2.0, ge=0.0, le=100.0)
     prune_radius_m: float = Field(1.0, gt=0.0, le=100.0)
     prune_min_loop_m: float = Field(4.0, gt=0.0, le=1000.0)
@@ -195,6 +207,7 @@ class BlazingTrail:
         self._crumb_xy: tuple[float, float] | None = None
         self.loops_cut = 0
         self._following = False
+        self._recovering = False
         self._step = 0
         self._last_layer_step: int | None = None
 
@@ -249,13 +262,19 @@ class BlazingTrail:
         self._following = pref is not None
         allow = pref is not None and (p.reverse_min_crumbs <= 1
                                       or self.global_crumbs.count_near(qx, qy, p.radius_m) >= p.reverse_min_crumbs)
+        self._recovering = False
+        if pref is None and p.recover_radius_m > 0.0 and not self.nav.leaving:
+            near = self.global_crumbs.nearest(x, y, p.recover_radius_m)
+            if near is not None and (near[0] - x) ** 2 + (near[1] - y) ** 2 > 1e-12:
+                pref = math.atan2(near[1] - y, near[0] - x)
+                allow = self._recovering = True
         v, w = self.nav.step(obs, preferred_heading_rad=pref, allow_reverse=allow)
         return Action(float(v), float(w)), outbox
 
     def log(self) -> dict[str, Any]:
         """``carrying``, ``trips`` (units delivered), ``place_index``, ``n_crumbs`` (global list),
-        ``following``, ``mode`` (Navigate's), and every ``layer_every_steps`` a ``crumbs`` layer
-        (global crumbs, odometry frame)."""
+        ``following``, ``recovering`` (heading back to a trail it left), ``mode`` (Navigate's),
+        and every ``layer_every_steps`` a ``crumbs`` layer (global crumbs, odometry frame)."""
         out: dict[str, Any] = {
             "carrying": self.carrying,
             "trips": self.deliveries,
@@ -263,6 +282,7 @@ class BlazingTrail:
             "n_crumbs": len(self.global_crumbs),
             "n_private": len(self.private),
             "following": self._following,
+            "recovering": self._recovering,
             "mode": str(getattr(self.nav, "mode", "")),
         }
         if self._last_layer_step is None or self._step - self._last_layer_step >= self.params.layer_every_steps:

@@ -195,6 +195,26 @@ class CrumbList:
         """:func:`average_heading` over this list."""
         return average_heading(self.xy_m, self.heading_rad, x_odom_m, y_odom_m, radius_m)
 
+    def nearest(self, x_odom_m: float, y_odom_m: float, radius_m: float) -> tuple[float, float] | None:
+        """Position (x, y) [m] of the crumb nearest to (x, y) within ``radius_m`` (inclusive), or None.
+
+        Examples
+        --------
+        >>> c = CrumbList()
+        >>> c.drop(0.0, 0.0, 0.0); c.drop(3.0, 0.0, 0.0)
+        >>> c.nearest(2.0, 0.5, 5.0), c.nearest(9.0, 0.0, 5.0)
+        ((3.0, 0.0), None)
+        """
+        if self._n == 0:
+            return None
+        dx = self._buf[: self._n, 0] - x_odom_m
+        dy = self._buf[: self._n, 1] - y_odom_m
+        d2 = dx * dx + dy * dy
+        i = int(np.argmin(d2))
+        if d2[i] > radius_m * radius_m:
+            return None
+        return float(self._buf[i, 0]), float(self._buf[i, 1])
+
     def count_near(self, x_odom_m: float, y_odom_m: float, radius_m: float) -> int:
         """How many crumbs lie within ``radius_m`` (inclusive) of (x, y)."""
         if self._n == 0:

@@ -44,6 +44,11 @@ around the point 1 m ahead of the position estimate, the hint still points from 
 it: junction decisions no longer lag the corner). Measured on ``try-to-see-it-my-way``
 (4 seeds x 30 min): 61 % of cruise speed between places after the first trail.
 
+``recover_radius_m`` (a gap-fill, as in :mod:`~teamnav.control.coop.blazing_trail`): with no
+goal crumb around the point ahead, the hint points at the nearest goal crumb within that
+distance (the trail the robot has just left; in a dead end it lies behind and Navigate's 180 deg
+rule turns the robot back); 0 gives the paper's exploring.
+
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
 ``min_move_m`` since the previous temporary trail; radius 2 m (about a corridor's width);
 ``crumbs_for="every_place"`` is the §2.2 alternative the paper names for future work (one Crumb
@@ -106,6 +111,10 @@ class TrailShareParams(BaseModel):
         Pick the best crumb among those around the point this far ahead of the position
         estimate [m] (0: around the position estimate, the paper); the hint still points
         from the robot to that crumb.
+    recover_radius_m : float
+        No goal crumb around the point ahead: head for the nearest goal crumb (below the
+        descend-only bound) within this distance of the position estimate [m] (0: explore, the
+        paper; module docstring).
     leave_place_m : float
         After that turn, wall follow this far [m] before the trail rules apply again.
     sensor : str
@@ -134,6 +143,7 @@ class TrailShareParams(BaseModel):
     descend_only: bool = True
     turn_at_place: bool = True
     lookahead_m: float = Field(1.0, ge=0.0, le=100.0)
+    recover_radius_m: float = Field(0.0, ge=0.0, le=100.0)
     leave_place_m: float = Field(2.0, ge=0.0, le=100.0)
     reach_m: float = Field(0.6, gt=0.0, le=100.0)
     sensor: str = Field("laser", min_length=1)
@@ -177,6 +187,7 @@ class TrailShare:
         self._next_broadcast_s = 0.0
         self._last_broadcast_xy: np.ndarray | None = None
         self._following = False
+        self._recovering = False
         self._bound_s = math.inf  # own time-to-goal upper bound when last set [s]
         self._bound_t = 0.0
         self._step = 0
@@ -242,13 +253,19 @@ class TrailShare:
         qx, qy = x + p.lookahead_m * math.cos(th), y + p.lookahead_m * math.sin(th)
         heading = self.trail.heading_to_best(goal, qx, qy, p.radius_m, below_s=below, from_xy=(x, y))  # §2.3 step 1
         self._following = heading is not None
+        self._recovering = False
+        if heading is None and p.recover_radius_m > 0.0 and not self.nav.leaving:
+            near = self.trail.nearest_crumb(goal, x, y, p.recover_radius_m, below_s=below)
+            if near is not None and (near[0] - x) ** 2 + (near[1] - y) ** 2 > 1e-12:
+                heading = math.atan2(near[1] - y, near[0] - x)
+                self._recovering = True
         v, w = self.nav.step(obs, preferred_heading_rad=heading)
         return Action(float(v), float(w)), outbox
 
     def log(self) -> dict[str, Any]:
         """``carrying`` (seeking ``round[0]``, i.e. home), ``trips`` (places reached in order),
-        ``place_index``, ``n_crumbs`` (local Trail size), ``following``, ``mode`` (Navigate's),
-        and every ``layer_every_steps`` a ``crumbs`` layer (the Trail's crumbs) and a ``places``
+        ``place_index``, ``n_crumbs`` (local Trail size), ``following``, ``recovering`` (heading
+        back to a trail it left), ``mode`` (Navigate's), and every ``layer_every_steps`` a ``crumbs`` layer (the Trail's crumbs) and a ``places``
         layer, both in the own odometry frame."""
         out: dict[str, Any] = {
             "carrying": self.round.index == 0,
@@ -256,6 +273,7 @@ class TrailShare:
             "place_index": self.round.index,
             "n_crumbs": len(self.trail),
             "following": self._following,
+            "recovering": self._recovering,
             "mode": str(getattr(self.nav, "mode", "")),
             "refused": self.refused,
         }

@@ -349,6 +349,35 @@ class Trail:
         i = int(np.argmin(s))
         return i, float(s[i])
 
+    def nearest_crumb(self, goal: str, x_odom_m: float, y_odom_m: float, radius_m: float, *,
+                      below_s: float = math.inf) -> tuple[float, float] | None:
+        """Position (x, y) [m] of the crumb for ``goal`` nearest to (x, y) within ``radius_m``
+        (inclusive) with a time-to-place below ``below_s``, or None.
+
+        Not a rule of the paper: :class:`TrailShare <teamnav.control.coop.trail_share.TrailShare>`
+        heads for it when the trail-using rule finds no crumb (``recover_radius_m``).
+
+        Examples
+        --------
+        >>> tr = Trail()
+        >>> tr.add_crumbs(["A", "A", "B"], [[0.0, 0.0], [4.0, 0.0], [2.0, 0.0]], [5.0, 9.0, 1.0], [0.0, 0.0, 0.0])
+        >>> tr.nearest_crumb("A", 2.5, 0.0, 3.0), tr.nearest_crumb("A", 2.5, 0.0, 3.0, below_s=6.0)
+        ((4.0, 0.0), (0.0, 0.0))
+        """
+        code = self._codes.get(goal)
+        if code is None or self._n == 0:
+            return None
+        xys = self._xys[: self._n]
+        dx = xys[:, 0] - x_odom_m
+        dy = xys[:, 1] - y_odom_m
+        d2 = np.where(self._p[: self._n] == code, dx * dx + dy * dy, np.inf)
+        if below_s != math.inf:
+            d2 = np.where(xys[:, 2] < below_s, d2, np.inf)
+        i = int(np.argmin(d2))
+        if not d2[i] <= radius_m * radius_m:
+            return None
+        return float(xys[i, 0]), float(xys[i, 1])
+
     def heading_to_best(self, goal: str, x_odom_m: float, y_odom_m: float, radius_m: float, *,
                         below_s: float = math.inf, from_xy: tuple[float, float] | None = None) -> float | None:
         """Direction [rad] towards :meth:`best_crumb` around (x, y), or None (no crumb, or on it).
