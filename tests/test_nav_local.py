@@ -474,6 +474,26 @@ def test_visbug_resumes_afresh_when_the_excursion_ended_closer_than_its_hit_poin
     assert abs(math.remainder(h - math.pi / 2, 2 * math.pi)) < 1e-9
 
 
+def test_visbug_start_again_forgets_the_task_boundary_walk():
+    """§4.2 "start again ... with A": after start_again the task goal starts afresh (new M-line
+    from where the robot is, no hit point), both on the task goal itself and after a temporary
+    one (which would otherwise resume the suspended walk)."""
+    for temporary in (False, True):
+        nav = nav_of("visbug21")
+        loop = Loop(u_trap(), nav, U_START, U_GOAL)
+        task = loop.to_own(np.array(U_GOAL))
+        while nav.mode != MODE_FOLLOW and loop.steps < 200:
+            loop.step()
+        assert nav.mode == MODE_FOLLOW and nav.hit_xy is not None
+        if temporary:
+            nav.set_goal(loop.to_own(np.array([1.0, 1.0])), temporary=True)
+        nav.start_again()
+        nav.set_goal(task)
+        here = task + np.array([0.0, -3.0])
+        nav.direction(np.array([*here, 0.0]), FREE_SCAN)
+        assert np.allclose(nav.mline[0], here) and nav.hit_xy is None and nav.mode == MODE_TO_GOAL
+
+
 def test_potential_field_trapped_in_the_u_escapes_with_a_temporary_goal():
     """§5 rule 3 / §3 rule 5 on the potential field: trapped alone under the cup; a temporary
     goal at a teammate seen out of the cup's mouth takes it out, and from there the field

@@ -46,9 +46,17 @@ class LosExplorerParams(_CommonParams):
         field alone as failing without saying after how long; a budget per target, not per
         task, ends a hopeless run at its first trap instead of burning the whole task's
         budget. None: never abandon.
+    restart_navigator_at_ghost : bool
+        At a teammate's point (ghost) reached without seeing the goal, A starts again from
+        there (§4.2: "it will have to start again to explore the environment by relying on its
+        own navigation algorithm A, possibly from a better position"): VisBug-21 drops the
+        M-line and hit point it had suspended for the excursion and takes a new M-line from
+        the ghost. False: resume the suspended ones (measured: resuming walked R1 from the
+        corridor back into the south rooms it had been led out of).
     """
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
+    restart_navigator_at_ghost: bool = True
     keep_trouble_helper: bool = True
     max_steps_per_target: int | None = Field(None, ge=1, le=100_000_000)
     trouble_progress: Literal["goal", "moved"] = "goal"
@@ -182,6 +190,9 @@ class LosExplorer(_LosBrain):
                 # §4.2: at the ghost without seeing the goal: explore again with A, keeping the
                 # promise only to arbitrate later reports
                 self.sharing.mark_reached(self.me)
+                if p.restart_navigator_at_ghost and self._nav is not None and hasattr(self._nav, "start_again"):
+                    # "start again ... with A, possibly from a better position" (§4.2)
+                    self._nav.start_again()
                 if p.trust_direct_promise and path.d_point_m <= math.hypot(goal[0] - point[0], goal[1] - point[1]) + self.step_m:
                     # the teammate saw the goal itself from here (its D is the straight
                     # distance): head straight for it (see ``trust_direct_promise``)

@@ -343,6 +343,18 @@ class VisBug21:
         if self.params.turn == "random":
             self.side = 1 if self.rng.random() < 0.5 else -1
 
+    def start_again(self) -> None:
+        """Forget the task goal's M-line, hit point and mode: the next step on the task goal
+        starts VisBug afresh from where the robot is then (Sgorbissa & Arkin §4.2: at a ghost
+        without its goal in sight the robot "will have to start again to explore the
+        environment by relying on its own navigation algorithm A, possibly from a better
+        position"). During a temporary goal, the suspended task memory is dropped instead, so
+        that setting the task goal again starts afresh rather than resuming."""
+        if self._suspended is not None or self.temporary:
+            self._suspended = None
+        elif self.goal_xy is not None:
+            self._restart()
+
     @property
     def suspended_goal_xy(self) -> np.ndarray | None:
         """The task goal suspended by the current temporary goal (own frame), or None."""
