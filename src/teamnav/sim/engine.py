@@ -430,17 +430,29 @@ class Simulation:
             bodies = None
             if g0.bodies[k0] is not None:
                 bodies = (self.state.x_m, self.state.y_m, self.state.radius_m, idx)
-            self._scan_sets.append((g0.sensors[k0], members, idx, bodies))
-        self._shared_scan = {(g.index, k) for _, members, _, _ in self._scan_sets for g, k in members}
+            # equal noise parameters: every group's noise in one kernel call, with its own key
+            noise = {(g.sensors[k].noise_std_m, g.sensors[k].p_max, g.sensors[k].p_short) for g, k in members}
+            starts = np.cumsum([0] + [g.cfg.count for g, _ in members]).astype(np.int64)
+            self._scan_sets.append((g0.sensors[k0], members, idx, bodies, starts if len(noise) == 1 else None))
+        self._shared_scan = {(g.index, k) for _, members, _, _, _ in self._scan_sets for g, k in members}
 
     def _shared_readings(self) -> dict:
         """This step's ranges of the shared casts: ``{(group index, sensor k): (n, B) array}``."""
-        from teamnav.sim.sensors.range_sensors import _keyed_noise, draw_noise_key
+        from teamnav.sim.sensors.range_sensors import _counter_noise_blocks, _keyed_noise, draw_noise_key
 
         s = self.state
         out = {}
-        for sensor, members, idx, bodies in self._scan_sets:
+        for sensor, members, idx, bodies, starts in self._scan_sets:
             true = sensor._true_ranges(s.x_m[idx], s.y_m[idx], s.theta_rad[idx], bodies)
+            if starts is not None:
+                keys = np.array([draw_noise_key(grp.rngs[k]) for grp, k in members], dtype=np.uint64)
+                ranges = np.empty(true.shape)  # fresh this step; each group reads its own rows
+                _counter_noise_blocks(true, keys, starts, sensor.noise_std_m, sensor.p_max, sensor.p_short,
+                                      sensor.max_range_m, ranges)
+                sl = starts.tolist()
+                for j, (grp, k) in enumerate(members):
+                    out[(grp.index, k)] = ranges[sl[j]:sl[j + 1]]
+                continue
             r0 = 0
             for grp, k in members:
                 r1 = r0 + grp.cfg.count

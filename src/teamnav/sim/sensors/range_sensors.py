@@ -240,6 +240,17 @@ def _counter_noise_parallel(true, key, sigma, p_max, p_short, max_range, out):
         _counter_noise_rows(true, key, c * 64, min(n, c * 64 + 64), sigma, p_max, p_short, max_range, out)
 
 
+@njit(cache=True)
+def _counter_noise_blocks(true, keys, starts, sigma, p_max, p_short, max_range, out):
+    """Rows ``[starts[g], starts[g + 1])`` as one :func:`beam_noise_keyed` call of key
+    ``keys[g]`` each (the row index restarts at 0 in every block): several groups' scans of
+    one shared cast get their own streams' noise in one dispatch."""
+    for g in range(keys.shape[0]):
+        r0 = starts[g]
+        r1 = starts[g + 1]
+        _counter_noise_rows(true[r0:r1], keys[g], 0, r1 - r0, sigma, p_max, p_short, max_range, out[r0:r1])
+
+
 def _check_noise_args(true_m, noise_std_m, p_max, p_short, max_range_m, out):
     true_m = np.asarray(true_m, dtype=np.float64)
     if true_m.ndim != 2:
