@@ -25,7 +25,17 @@ sweep is shared with the try-to-see-it-my-way section).
 Cost of the full mode (measured on one core: 4 robots x 1 simulated hour = 30 CPU s for
 blazing-trail-v1, 37 CPU s for trail-share-v1): this section 5 (paper) + 5 (paper rules) + ≈ 1 (one
 robot, optimal and exploring) + 5 (no communication) + 30 (drift sweep) team-hours ≈ 24 CPU
-min; with the try-to-see-it-my-way section (≈ 52 CPU min more) ≈ 76 CPU min for both.
+min; with the try-to-see-it-my-way section (≈ 67 CPU min more) ≈ 91 CPU min for both.
+blazing-trail-v1's cost per simulated hour grows with its global crumb list (the 2000 paper has
+no expiry): a 2-hour profiled run at k = 1 (commit bec19bc, shared machine under a load of ~13)
+took 28, 42, 42, 50 CPU s per simulated hour in its four half-hours while the largest list grew
+4,464 → 7,946 → 10,584 → 12,058 crumbs (the try section's profile table).
+
+Drift sweep, measured (commit dcb435e, 1 h, mean ± std over seeds): units in the last 10 min
+k = 0: 9.7 ± 1.6 (n = 6), k = 1: 7.3 ± 1.2 (n = 10), k = 4: 2.3 ± 1.9 (n = 10; 5 of 10 runs broke
+down, at 42–55 min; units per 10 min fall from 6.0 in the first window to 2.3 in the last); the 2002 team at k = 4: 4.7 ± 1.7 (n = 10). At commit 541d99f (recovery
+towards the nearest crumb) the 2000 team at k = 4: 0, 0, 2 units in the last 10 min, breakdowns
+at 38, 44 and 54 min (3 seeds).
 """
 
 from __future__ import annotations
