@@ -10,7 +10,9 @@ One :meth:`Simulation.step` (STYLE habit 4, f1tenth's "move everyone first, then
 4. task events at places, from the new positions (:mod:`~teamnav.sim.events`);
 5. the radio delivers the messages sent in the previous step (:mod:`~teamnav.sim.radio`);
 6. sense: each group's range sensors in one call per sensor, the robot detector in one call
-   per group;
+   per group; groups whose sensors are alike share one pass (one detector truth pass for
+   equal detector configurations, one cast for equal range sensors: see
+   :meth:`Simulation._plan_shared_sensing`), each group still drawing from its own streams;
 7. build observations (fresh arrays, belief only) and call the brains: each per-robot
    :class:`~teamnav.control.protocol.Controller` with its :class:`Observation`, each
    :class:`~teamnav.control.protocol.BatchedController` once with a
