@@ -54,8 +54,9 @@ with all of them; each one flag away from the paper's rules as written):
   The paper's robot explores when no crumb is near (§4.1); on ``trail_office`` a robot that lost
   the trail at a corner (turned back by a teammate in the corridor, or the hint bending late)
   drove the 17.6 m dead end east of corner 1 to its end and back, ≈ 90 s, and dead ends took
-  ≈ 20 % of robot time. Measured on ``blazing-a-trail``, seeds 0-7 x 30 min: 25.0 ± 3.2 ->
-  27.3 ± 0.7 units (mean ± std; per seed +2.3 ± 1.2 s.e.). 0 m: the paper's rule.
+  ≈ 20 % of robot time (≈ 4 % with it). Measured on ``blazing-a-trail`` x 30 min (mean ± std):
+  seeds 0-7 25.0 ± 3.2 -> 27.3 ± 0.7 units; fresh seeds 8-11 23.8 ± 4.2 -> 27.8 ± 4.2; all 12
+  per seed +2.8 ± 1.0 (s.e.). 0 m: the paper's rule.
 
 Choices where the paper is silent: crumb interval 1 s and radius 2 m (the paper gives neither;
 1.8 m corridors, a radius about a corridor wide, reaches the crumbs of the corridor the robot is
