@@ -49,8 +49,8 @@ goal crumb around the point ahead, the hint points at the nearest goal crumb wit
 distance (the trail the robot has just left; in a dead end it lies behind and Navigate's 180 deg
 rule turns the robot back); 0 (the default) gives the paper's exploring. Unlike the 2000
 brain it did not pay here: on ``try-to-see-it-my-way`` (seeds 0-3 x 30 min) 6 m gave 21.8 ± 3.5
-units against 22.3 ± 1.5 without (probably because every robot's crumbs, wrong turns included, are in the Trail,
-so a nearest crumb is often not on the route).
+units against 22.3 ± 1.5 without (probably because every robot's crumbs, wrong turns included,
+are in the Trail, so a nearest crumb is often not on the route).
 
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
 ``min_move_m`` since the previous temporary trail; radius 2 m (about a corridor's width);
