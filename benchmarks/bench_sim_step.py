@@ -7,8 +7,8 @@ Wurm et al.'s trails: ``try-to-see-it-my-way``; Fox et al.'s hallway MCL:
 
 - CPU seconds per step (``time.process_time``: this process only, so other work on a shared
   machine changes it less than wall time, though cache and core contention still show);
-- the part spent inside the brains' ``step`` / ``step_batch`` (everything else is the
-  simulator: motion, odometry, sensing, radio, recording, metrics);
+- the part spent inside the brains' ``step`` / ``step_batch`` / ``log`` (everything else is
+  the simulator: motion, odometry, sensing, radio, recording, metrics);
 - the CPU time a full run costs at that rate: per simulated hour, and for the scenario's
   own ``duration_s`` when it runs it all (los-help stops when R1 has its 200 targets).
 
@@ -53,14 +53,14 @@ def _timed_run(name: str, duration_s: float, seed: int) -> tuple[float, float, i
         orig_init(self, *args, **kwargs)
         for group in self.brains:
             for brain in group if isinstance(group, list) else [group]:
-                for meth in ("step", "step_batch"):
+                for meth in ("step", "step_batch", "log"):
                     f = getattr(brain, meth, None)
-                    if f is None:
+                    if not callable(f):
                         continue
 
-                    def timed(obs, f=f):
+                    def timed(*args, f=f):
                         t = clock()
-                        out = f(obs)
+                        out = f(*args)
                         brain_s[0] += clock() - t
                         return out
 
@@ -108,7 +108,7 @@ def main(argv: list[str] | None = None) -> None:
         full = per_step * scn.n_steps
         print(f"{name:24s} {steps:6d} {1000 * per_step:8.3f} {1000 * brains:8.3f} {1000 * (per_step - brains):8.3f} "
               f"{per_hour:11.1f} {full / 3600:9.2f}h", flush=True)
-    print("ms/step: median CPU per step; brains: inside the brains' step(); sim: the rest. "
+    print("ms/step: median CPU per step; brains: inside the brains' step() and log(); sim: the rest. "
           "'full run' is duration_s at that rate (a los-help run usually stops earlier).")
 
 
