@@ -9,10 +9,17 @@ radio models; brains (``teamnav.control``, ``teamnav.localization``) read only t
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+
+
+@functools.lru_cache(maxsize=256)
+def _field_names(kind: type) -> tuple[str, ...]:
+    """A dataclass type's field names, looked up once (``dataclasses.fields`` is slow per call)."""
+    return tuple(f.name for f in dataclasses.fields(kind))
 
 
 def payload_size_bytes(value: Any) -> int:
@@ -21,6 +28,9 @@ def payload_size_bytes(value: Any) -> int:
     float/int: 8 bytes, bool: 1, str: its UTF-8 length, ndarray: ``nbytes``, None: 0,
     sequences and mappings: the sum of their items, dataclasses: the sum of their fields.
     """
+    kind = type(value)
+    if kind is float or kind is int:  # the common case first: most fields are plain numbers
+        return 8
     if value is None:
         return 0
     if isinstance(value, (bool, np.bool_)):
@@ -34,7 +44,7 @@ def payload_size_bytes(value: Any) -> int:
     if isinstance(value, np.ndarray):
         return int(value.nbytes)
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return sum(payload_size_bytes(getattr(value, f.name)) for f in dataclasses.fields(value))
+        return sum(payload_size_bytes(getattr(value, name)) for name in _field_names(kind))
     if isinstance(value, dict):
         return sum(payload_size_bytes(k) + payload_size_bytes(v) for k, v in value.items())
     if isinstance(value, (list, tuple, set, frozenset)):
