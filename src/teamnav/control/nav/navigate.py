@@ -22,7 +22,7 @@ One step, in priority order:
    (gap filled; it used to skip the turn and carry on down the wrong branch).
 3. **Against the trail**: "If the robot is heading in approximately the opposite direction to
    the trail it makes a sharp 180° right turn" (§4.2). "Approximately opposite" is taken as
-   more than ``reverse_threshold_deg`` (default 135 deg) between the odometry heading and the
+   more than ``reverse_threshold_deg`` (default 150 deg) between the odometry heading and the
    preferred heading; afterwards no second reversal for ``reverse_cooldown_s`` nor before the
    robot has driven ``reverse_cooldown_m`` (gap filled: with a time cooldown alone, a robot whose
    hint flips at the end of a trail, or near a place, turned back and forth on the spot every
