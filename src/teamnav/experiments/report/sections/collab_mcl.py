@@ -18,7 +18,7 @@ Time to localize: per run, the mean over robots of the first time the error fall
 lower bound and the table says how many robots were censored). Spreads are over runs.
 Quick mode (CI) runs few robots and particles, 1-2 seeds and 40-90 s runs (8 trials), and
 leaves the belief pictures and the §7.2 variants to the full report: its numbers show that the
-pipeline works, not the paper's result. The full report runs 16 hallway runs of 600 s (8 robots),
+pipeline works, not the paper's result. The full report runs 16 hallway runs of 600 s (8 robots, about 30 CPU s each),
 16 hexagon runs of 300 s, 20 + 50 two-robot runs of 150 s and one pictured run.
 """
 
