@@ -88,6 +88,7 @@ def _helper_log(timeout_steps: int) -> dict:
     start, _ = L.LAYOUTS["complex"].helpers[0]
     patrol = L.world_to_frame(start, [(5.0, 10.7), start[:2]]).round(4).tolist()
     over = {"robots.1.params.patrol_xy": patrol, "robots.1.params.waypoint_timeout_steps": timeout_steps,
+            "robots.1.params.navigator": "potential_field",  # straight back to its start once it gives up
             "robots.2.count": 0, "robots.3.count": 0, "record_every": 1, "stop_when_finished": False}
     data = run(load_scenario("los-help-complex", overrides=over, duration_s=12.0), progress=False).data
     return [e["values"] for e in data.logs if e["robot"] == 1][-1]

@@ -107,6 +107,13 @@ BUDGET_STEPS_PER_TARGET: dict[str, int] = {"simple": 1500, "complex": 2500}
 #: from opposite sides and, both driven by a potential field, blocked each other in room 5's
 #: door for 2000 steps; the longest leg of a route there is under 60 steps.
 HELPER_WAYPOINT_TIMEOUT_STEPS: dict[str, int] = {"complex": 150}
+#: The helpers' own navigator A (§6 does not say which one the helpers use). On office_complex a
+#: helper pushed off its route (by R1 in a doorway) into a room was trapped there by its own
+#: potential field, and R1, in trouble, followed it into the trap and stood by it for 2000 steps
+#: (PF with R2+R3, task 3); VisBug-21 always walks back out. Measured with R1 on the potential
+#: field, tasks 1-3 of 10 targets: targets reached 7/3/2 (R1+R2), 3/5/6 (R1..R3), 10/9/10 (R1..R4)
+#: with VisBug helpers against 0/1/2, 2/3/2, 7/4/6 with potential-field helpers.
+HELPER_NAVIGATOR: dict[str, str] = {"simple": "potential_field", "complex": "visbug21"}
 
 
 @dataclass(frozen=True)
@@ -360,7 +367,7 @@ def scenario_data(map_key: str, *, name: str | None = None, task: int = 1, n_tar
         x, y, th = start
         groups.append({
             "name": f"R{k + 2}", "count": 1 if k < helpers else 0, **_body(), "controller": "los-helper-v1",
-            "params": {"navigator": "potential_field", "patrol_xy": patrol_xy(map_key, k),
+            "params": {"navigator": HELPER_NAVIGATOR[map_key], "patrol_xy": patrol_xy(map_key, k),
                        "goal_tolerance_m": HELPER_TOLERANCE_M, "goal_sharing": True,
                        "delayed_visibility": True, "state_sharing": True, "laser": "laser",
                        "log_layers": False,
