@@ -31,11 +31,17 @@ no expiry): a 2-hour profiled run at k = 1 (commit bec19bc, shared machine under
 took 28, 42, 42, 50 CPU s per simulated hour in its four half-hours while the largest list grew
 4,464 → 7,946 → 10,584 → 12,058 crumbs (the try section's profile table).
 
-Drift sweep, measured (commit dcb435e, 1 h, mean ± std over seeds): units in the last 10 min
-k = 0: 9.7 ± 1.6 (n = 6), k = 1: 7.3 ± 1.2 (n = 10), k = 4: 2.3 ± 1.9 (n = 10; 5 of 10 runs broke
-down, at 42–55 min; units per 10 min fall from 6.0 in the first window to 2.3 in the last); the 2002 team at k = 4: 4.7 ± 1.7 (n = 10). At commit 541d99f (recovery
-towards the nearest crumb) the 2000 team at k = 4: 0, 0, 2 units in the last 10 min, breakdowns
-at 38, 44 and 54 min (3 seeds).
+Drift sweep, measured (commit dcb435e, 1 h, 10 seeds, mean ± std): units in the last 10 min
+(units in the hour), 2000 / 2002 team: k = 0: 9.7 ± 1.3 (54.7 ± 2.3) / 8.9 ± 2.4 (45.4 ± 3.3);
+k = 1: 7.3 ± 1.2 (49.6 ± 3.3) / 7.8 ± 1.9 (45.4 ± 2.7); k = 4: 2.3 ± 1.9 (25.1 ± 4.1) / 4.7 ± 1.7
+(29.8 ± 5.3). At k = 4 the 2000 team keeps 24 % of its drift-free throughput, 5 of 10 runs broke
+down (at 42–55 min; its units per 10 min fall from 6.0 in the first window to 2.3 in the last),
+the 2002 team keeps 53 % (1 of 10 broke down) and works on for 10 h (the try section's profiled
+run). At commit 541d99f (recovery towards the nearest crumb) the 2000 team, 3 seeds: k = 0
+12, 10, 9 units in the last 10 min; k = 4 0, 0, 2, breakdowns at 38, 44, 54 min.
+Paper conditions (commit 5d4a607, 30 min, 10 seeds): 27.9 ± 1.7 units (paper 28), no breakdown
+within 30 min, first source visit 2.2 ± 0.8 min, median trip after it 94 ± 3 s; one robot on the
+optimal route 11 units (3 seeds, trip 78 s): 2.5x.
 """
 
 from __future__ import annotations
