@@ -5,20 +5,30 @@ EXPERIMENTS.md rows, each a :class:`Comparison`:
 1. "first robot finds resource, others follow the optimal route" → after the first broadcast,
    trip times drop to near optimal (median trip time after the first source event vs the
    route-follow-v1 robot's trip time; holds within 1.5x).
-2. "4 robots ≈ 3x a single optimal robot" (§5.1: 28 units in 30 min vs a ~3 min round trip) →
-   units of the 4-robot team / units of one optimal robot in the same time (holds at >= 2.5x).
+2. "4 robots ≈ 3x a single optimal robot" (§5.1: "Since the time for a round-trip from home to
+   resource is approximately 3 minutes the robot group performed three times better than a single
+   robot performing under optimal conditions": 28 units vs 30 / 3 = 10, i.e. 2.8x) → two ratios.
+   The paper's method: the team's units / the units one robot delivers at the optimal round-trip
+   rate of the team's own controller, i.e. duration / (2 x the median trip time after its own
+   first trail) of ONE blazing-trail-v1 robot with the team's params, alone and without drift
+   (sweep trail-solo-blazing). Stricter, beside it: the team's units / the units a measured
+   route-follow-v1 robot delivers on the optimal route (trail-solo-optimal: a different, faster
+   controller, pure pursuit that cuts the corners without sharp turns). The verdict follows the
+   paper's method and holds at >= 2.7x (the paper's own figure, 2.8, is what it calls "three
+   times"); the route-follow ratio is shown with its value, not judged.
 3. "odometry drift makes the system break down (~27 min)" → breakdown time falls and the last
    10-minute window's throughput drops as the drift grows (blazing-drift sweep: each robot its
    own drift, k x the 2002 paper's Bug -1, Ant +1, Fly +2, Tanis +0.35 deg/min, k = 0, 1, 4).
 
-Baselines beside them: one optimal robot (route-follow-v1), one exploring robot
-(blazing-trail-v1 alone), the team without communication, and the team with the paper's rules
+Baselines beside them: one optimal robot (route-follow-v1), one robot with the team's own brain
+and params alone without drift (trail-solo-blazing, the paper's "optimal conditions"), one
+exploring robot (blazing-trail-v1 alone, trail-solo-explore), the team without communication, and the team with the paper's rules
 as written (blazing-paper-rules: blazing-trail-v1's navigation gap-fills off). Figures: units over time (Fig. 5
 left), units per 10 min (Fig. 5 right), breakdown time vs drift, the trails each robot
 announced in its own frame (Fig. 6) and all of them in a fixed frame of the places.
 
-Quick mode: 450 s runs (drift sweep 300 s), 2 seeds, drift k = 0 and 4 only, no explorer or
-no-communication baselines (≈ 30 s wall). Full: the paper's 30 min, 10 seeds; drift k = 0, 1, 4
+Quick mode: 450 s runs (drift sweep 300 s), 2 seeds (1 for each one-robot baseline), drift
+k = 0 and 4 only, no explorer or no-communication baselines (≈ 30 s wall). Full: the paper's 30 min, 10 seeds; drift k = 0, 1, 4
 for 1 h, 10 seeds (the sweep's k = 0.5 and 2 cases are there for ``teamnav sweep``; the drift
 sweep is shared with the try-to-see-it-my-way section).
 
@@ -42,6 +52,11 @@ run). At commit 541d99f (recovery towards the nearest crumb) the 2000 team, 3 se
 Paper conditions (commit 5d4a607, 30 min, 10 seeds): 27.9 ± 1.7 units (paper 28), no breakdown
 within 30 min, first source visit 2.2 ± 0.8 min, median trip after it 94 ± 3 s; one robot on the
 optimal route 11 units (3 seeds, trip 78 s): 2.5x.
+One blazing-trail-v1 robot alone, team params, no drift (trail-solo-blazing, commit 6ec1f6d + this
+sweep, 30 min, 10 seeds): median trip after its own first trail 88.6 ± 0.3 s (a 2.95 min round
+trip: the paper's "approximately 3 minutes"), so 1800 / 177 = 10.2 units at that rate and the
+team's 27.9 is 2.75x by the paper's method (the paper: 2.8x); measured, the robot delivered
+8.6 ± 1.0 units (first source visit at 4.5 ± 2.4 min; 42 CPU s for the 10 runs).
 """
 
 from __future__ import annotations
@@ -56,6 +71,41 @@ PAPER = "vaughan-stoy-sukhatme-mataric-blazing-a-trail.txt"
 PAPER_UNITS = {"Tanis": 7, "Ant": 7, "Bee": 6, "Punky": 8}
 #: scenario blazing-a-trail's robot order
 OUR_ROBOTS = ("ant", "bee", "punky", "tanis")
+#: claim 2 holds when the team delivers at least this many times the units of one robot at the
+#: team controller's optimal round-trip rate (§5.1's own figure, 28 / 10 = 2.8, is its "three times")
+PAPER_RATIO = 2.7
+
+
+def paper_method_ratio(team_units: float, solo_trip_s, duration_s: float) -> tuple[float, float]:
+    """§5.1's ratio: the team's units / the units of one robot at the optimal round-trip rate.
+
+    The paper divides the run by "the time for a round-trip from home to resource" under optimal
+    conditions (30 min / ~3 min = 10 units). A trip here is one way (home to source or back), so
+    one robot delivers ``duration_s / (2 x median trip)`` units; the median is over the runs'
+    medians of ``trip_time_s_after_median`` (the trips after the robot's own first trail).
+
+    Parameters
+    ----------
+    team_units : float
+        The team's mean units in ``duration_s``.
+    solo_trip_s : array_like
+        One robot's median one-way trip time per run [s].
+    duration_s : float
+
+    Returns
+    -------
+    ratio, solo_units : float
+        NaN when no run has a trip time.
+
+    >>> paper_method_ratio(28.0, [90.0, 90.0], 1800.0)
+    (2.8, 10.0)
+    """
+    trips = np.asarray(solo_trip_s, float)
+    trips = trips[np.isfinite(trips) & (trips > 0)]
+    if not trips.size or not np.isfinite(team_units):
+        return float("nan"), float("nan")
+    solo_units = float(duration_s / (2.0 * np.median(trips)))
+    return float(team_units / solo_units), solo_units
 
 
 def build(ctx) -> list:
@@ -71,6 +121,8 @@ def build(ctx) -> list:
 
     paper = T.ok(ctx.sweep("blazing-paper", seeds=seeds, duration_s=dur))
     opt = T.ok(ctx.sweep("trail-solo-optimal", seeds=1 if quick else 3, duration_s=dur))
+    # the paper's "single robot performing under optimal conditions": the team's own brain alone, no drift
+    solo = T.ok(ctx.sweep("trail-solo-blazing", seeds=1 if quick else seeds, duration_s=dur))
     # quick mode (CI) skips the two baselines: each sweep call costs a worker pool's start-up
     explore = [] if quick else T.ok(ctx.sweep("trail-solo-explore", seeds=seeds, duration_s=dur))
     # (the team with communication and no drift is the drift sweep's k = 0)
@@ -110,21 +162,29 @@ def build(ctx) -> list:
         "our exploration is the H3 navigate-v1 random explorer on a synthetic office; the paper reports one trial, "
         "we report the spread over seeds"))
 
-    # 2. team vs one optimal robot
+    # 2. team vs one robot under optimal conditions (§5.1): the paper's method and route-follow
     team_units = T.values(paper, "units_total")
     team0 = T.values(drift0, "units_total") if drift_dur == dur else np.array([])
     opt_units = T.values(opt, "units_total")
-    ratio = T.mean(team_units) / T.mean(opt_units) if opt_units.size and T.mean(opt_units) > 0 else float("nan")
+    solo_trip = T.values(solo, "trip_time_s_after_median")
+    ratio_paper, solo_units = paper_method_ratio(T.mean(team_units) if team_units.size else float("nan"),
+                                                 solo_trip, dur)
+    ratio_rf = T.mean(team_units) / T.mean(opt_units) if opt_units.size and T.mean(opt_units) > 0 else float("nan")
     blocks.append(Comparison(
         "4 robots ≈ 3x a single robot under optimal conditions",
-        "28 units in 30 min; one optimal robot: ~3 min round trip (≈ 10 units): ≈ 3x",
-        f"team {T.msd(team_units)} units, one optimal robot {T.msd(opt_units)} in {dur / 60:g} min: "
-        f"{ratio:.2f}x" + (f" (team without drift {T.msd(team0)})" if team0.size else ""),
-        bool(np.isfinite(ratio) and ratio >= 2.5) if np.isfinite(ratio) else None,
-        "the paper's single robot is an estimate (a ~3 min round trip, no run), ours a measured robot that drives "
-        "the optimal route at the team's cruise speed (round trip ≈ 2.6 min); the paper's ~3 min over the 2002 "
-        "paper's 2 x 31 m needs ≥ 0.34 m/s (the 2002 robots cruised at 0.25): a fast single robot, which makes its "
-        "3x if anything conservative; "
+        "28 units in 30 min; one robot on a ~3 min round trip ≈ 10 units: 2.8x, which the paper calls three times",
+        f"team {T.msd(team_units)} units in {dur / 60:g} min"
+        + (f" (team without drift {T.msd(team0)})" if team0.size else "") + "; "
+        + (f"one blazing-trail-v1 robot alone, no drift: median trip after its first trail "
+           f"{T.msd(solo_trip, '{:.0f}', 's')} (round trip {2 * float(np.median(solo_trip)) / 60:.1f} min) → "
+           f"{solo_units:.1f} units at that rate: {ratio_paper:.2f}x (the paper's method, judged at ≥ {PAPER_RATIO:g}x); "
+           if np.isfinite(ratio_paper) else "one blazing-trail-v1 robot alone: no trip after its first trail; ")
+        + f"stricter, one route-follow-v1 robot on the optimal route {T.msd(opt_units)} units: {ratio_rf:.2f}x",
+        bool(ratio_paper >= PAPER_RATIO) if np.isfinite(ratio_paper) else None,
+        "the paper's single robot is an estimate (a ~3 min round trip, no run); ours applies the same method to "
+        "the team's own controller, alone and without drift (its round trip after its first trail), and shows "
+        "beside it a measured route-follow-v1 robot, a faster controller (pure pursuit, cuts corners, no sharp "
+        "turns), whose ratio is not judged; "
         "in quick mode the runs are short and the initial search weighs more"))
 
     # 3. breakdown vs drift
@@ -169,7 +229,9 @@ def build(ctx) -> list:
          T.msd(T.values(nocomm, "trip_time_s_after_median"), "{:.0f}")],
         ["1 robot exploring (blazing-trail-v1)", T.msd(T.values(explore, "units_total")),
          T.msd(T.values(explore, "trip_time_s_after_median"), "{:.0f}")],
-        ["1 robot on the optimal route", T.msd(opt_units), T.msd(opt_trip, "{:.0f}")],
+        ["1 robot, the team's brain alone, no drift (trail-solo-blazing; its units include its search)",
+         T.msd(T.values(solo, "units_total")), T.msd(solo_trip, "{:.0f}")],
+        ["1 robot on the optimal route (route-follow-v1)", T.msd(opt_units), T.msd(opt_trip, "{:.0f}")],
     ]
     if quick:
         blocks.append(Missing("baselines: one exploring robot, no communication, the paper's rules as written",
@@ -183,6 +245,7 @@ def build(ctx) -> list:
         T.band_series("4 robots, the paper's rules as written", rules, t),
         T.band_series("4 robots, no communication", nocomm, t),
         T.band_series("1 robot exploring", explore, t),
+        T.band_series("1 robot, the team's brain, no drift", solo, t),
         T.band_series("1 robot, optimal route", opt, t),
     ) if s is not None]
     blocks.append(Plot("Units transported over time (Fig. 5 left)", "time [min]", "units (cumulative)", series,
