@@ -641,7 +641,8 @@ def test_in_trouble_progress_is_towards_the_own_goal_so_following_away_keeps_fol
     stuck = StraightNav(stuck=True)
     monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
     cr = 3
-    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False),
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False,
+                                        trouble_progress="goal"),
                      np.random.default_rng(0), info(0, 2))
     wall = [(0.0, 0.1, 0.5)]
     for k in range(cr):
@@ -681,3 +682,35 @@ def test_direct_view_is_kept_while_a_neighbouring_beam_still_reaches_the_goal(st
     # with every beam near the bearing blocked the view is lost either way
     r1.step(obs(2, walls=[(0.0, 2.0 * gap, 2.0)]))
     assert r1.sharing.path(0) is None
+
+
+@pytest.mark.parametrize("rule", ["goal", "helper"])
+def test_in_trouble_progress_towards_the_helper_is_fig_10s_reading(monkeypatch, rule):
+    # §5, Fig. 10: "R_1 is now progressing towards its goal (by setting G_icurr = R_2)": with
+    # trouble_progress="helper" closing in on a teammate that stands behind R1 (away from R1's
+    # goal) is progress, so Pr falls to 0 in about Nt·Cr steps and R1 leaves it (Nt -> 2); with
+    # "goal" the same steps take R1 away from its goal and it stays in trouble
+    stuck = StraightNav(stuck=True)
+    monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
+    cr = 3
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False,
+                                        trouble_progress=rule),
+                     np.random.default_rng(0), info(0, 2))
+    wall = [(0.0, 0.1, 0.5)]
+    for k in range(cr):
+        r1.step(obs(k, walls=wall))
+    assert r1.trouble.tr
+    x, k, out_at = 0.0, cr, None
+    for i in range(2 * cr):  # R2 stands at x = -4, R1 walks to it, away from its goal at +6
+        r1.step(obs(k, pose=(x, 0.0, 0.0), walls=wall, seen=[(1, 4.0 + x, math.pi)],
+                    inbox=[msg(1, k - 1, trouble=False)]))
+        if out_at is None and r1.trouble.tr:
+            assert r1.mode == "trouble_follow"
+        elif out_at is None:
+            out_at = i
+        x -= 0.2
+        k += 1
+    if rule == "helper":
+        assert out_at is not None and out_at <= cr + 1 and r1.trouble.nt == 2
+    else:
+        assert out_at is None and r1.trouble.tr and r1.trouble.nt == 1

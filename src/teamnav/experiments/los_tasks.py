@@ -14,8 +14,9 @@ What is ours (the paper leaves it open)
   targets are different rooms.
 - R1 starts at the map's ``base`` place with a heading of 90° (so R1's start frame is
   *not* the world frame, and a brain that confused them would miss every target).
-- Routes: on the simple map R2 and R3 patrol the whole corridor in opposite phases and R4
-  starts in the middle; on the complex map R2 and R4 walk the east-west corridor end to end in
+- Routes: on the simple map R2 and R3 patrol the whole corridor in opposite phases (R2
+  stepping into every door, south and north, R3 into the north doors) and R4 starts in the
+  middle; on the complex map R2 and R4 walk the east-west corridor end to end in
   opposite phases stepping into every room's doorway (each room of ``office_complex`` has one on
   it, from which the room's centre is in sight), and R3 walks the north-south corridor stopping
   in front of its four doors. The paper's Fig. 13 shows where its helpers are but gives no
@@ -183,10 +184,15 @@ LAYOUTS: dict[str, Layout] = {
         helpers=(
             # end to end: a room centre is seen from the corridor only through the room's door,
             # from a 1.5 m stretch beside it (the doors of S1 and N5 are at the corridor's ends).
-            # R2 steps into each south door on its way, R3 into each north door: from the doorway
-            # a helper sees the whole room, and a robot trapped inside sees it (§5 needs a
-            # teammate in sight; a potential field against a room's wall sees no corridor)
-            ((3.0, 6.5, 0.0), _door_route(6.5, SIMPLE_DOORS_S, 5.5)),  # R2: to the west end first
+            # R2 steps into every door on its way, south and north, R3 into each north door: from
+            # the doorway a helper sees the whole room, and a robot trapped inside sees it (§5
+            # needs a teammate in sight; a potential field against a room's wall sees no
+            # corridor). R2 stepped into south doors only until H7d: R1 alone with R2 on the
+            # potential field, trapped against the wall of N4 or N5, never saw it (5 tasks x 10
+            # targets: 19/50 targets reached, 0/5 tasks finished; both sides, with
+            # ``trouble_progress="helper"``: 29/50, 1/5)
+            ((3.0, 6.5, 0.0), _doors_route(7.0, [(x, 5.5) for x in SIMPLE_DOORS_S]
+                                           + [(x, 8.5) for x in SIMPLE_DOORS_N], 1.0, 29.0)),  # R2: west end first
             ((28.5, 7.5, 180.0), _door_route(7.5, SIMPLE_DOORS_N, 8.5)[::-1]),  # R3: to the east end first
             ((15.0, 7.0, 0.0), ((29.0, 7.0), (1.0, 7.0))),  # R4: whole corridor, from the middle
         ),
