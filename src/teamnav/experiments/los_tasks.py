@@ -15,8 +15,8 @@ What is ours (the paper leaves it open)
 - R1 starts at the map's ``base`` place with a heading of 90° (so R1's start frame is
   *not* the world frame, and a brain that confused them would miss every target).
 - Routes: on the simple map R2 and R3 patrol the whole corridor in opposite phases (R2
-  stepping into every door, south and north, R3 into the north doors) and R4 starts in the
-  middle; on the complex map R2 and R4 walk the east-west corridor end to end in
+  stepping into the south doors, R3 into the north doors; :data:`SIMPLE_R2_BOTH_SIDES`) and R4
+  starts in the middle; on the complex map R2 and R4 walk the east-west corridor end to end in
   opposite phases stepping into every room's doorway (each room of ``office_complex`` has one on
   it, from which the room's centre is in sight), and R3 walks the north-south corridor stopping
   in front of its four doors. The paper's Fig. 13 shows where its helpers are but gives no
@@ -150,6 +150,22 @@ def _door_route(y_m: float, doors_x: Sequence[float], door_y_m: float, x0_m: flo
     return tuple(out)
 
 
+#: R2 of office_simple steps into the north doors too (False: south doors only, lane y 6.5).
+#: Measured (H7d; potential field R1, trouble_progress "helper", 5 tasks x 10 targets): with R2
+#: alone, R1 trapped against the wall of N4 or N5 sees R2 in the north doorways and reaches
+#: 29/50 targets (1/5 tasks finished) against 19/50 (0/5); but R2's round is twice as long and
+#: with R2+R3 R1 then reached only 3 and 8 targets on tasks 1-2 (10 and 10 with the south-only
+#: route), so the default stays False.
+SIMPLE_R2_BOTH_SIDES: bool = False
+
+
+def _simple_r2_route() -> tuple[tuple[float, float], ...]:
+    """R2's route on office_simple (see :data:`SIMPLE_R2_BOTH_SIDES`)."""
+    if SIMPLE_R2_BOTH_SIDES:
+        return _doors_route(7.0, [(x, 5.5) for x in SIMPLE_DOORS_S] + [(x, 8.5) for x in SIMPLE_DOORS_N], 1.0, 29.0)
+    return _door_route(6.5, SIMPLE_DOORS_S, 5.5)
+
+
 #: office_complex's corridor doorways (places ``door_*``: 0.3 m past the corridor's edge), as
 #: (position along the corridor [m], doorway's other coordinate [m]): on H (x, y), on V (y, x).
 COMPLEX_DOORS_H: tuple[tuple[float, float], ...] = (
@@ -184,15 +200,11 @@ LAYOUTS: dict[str, Layout] = {
         helpers=(
             # end to end: a room centre is seen from the corridor only through the room's door,
             # from a 1.5 m stretch beside it (the doors of S1 and N5 are at the corridor's ends).
-            # R2 steps into every door on its way, south and north, R3 into each north door: from
-            # the doorway a helper sees the whole room, and a robot trapped inside sees it (§5
-            # needs a teammate in sight; a potential field against a room's wall sees no
-            # corridor). R2 stepped into south doors only until H7d: R1 alone with R2 on the
-            # potential field, trapped against the wall of N4 or N5, never saw it (5 tasks x 10
-            # targets: 19/50 targets reached, 0/5 tasks finished; both sides, with
-            # ``trouble_progress="helper"``: 29/50, 1/5)
-            ((3.0, 6.5, 0.0), _doors_route(7.0, [(x, 5.5) for x in SIMPLE_DOORS_S]
-                                           + [(x, 8.5) for x in SIMPLE_DOORS_N], 1.0, 29.0)),  # R2: west end first
+            # R2 steps into each south door on its way (or every door, SIMPLE_R2_BOTH_SIDES), R3
+            # into each north door: from the doorway a helper sees the whole room, and a robot
+            # trapped inside sees it (§5 needs a teammate in sight; a potential field against a
+            # room's wall sees no corridor)
+            ((3.0, 6.5, 0.0), _simple_r2_route()),  # R2: to the west end first
             ((28.5, 7.5, 180.0), _door_route(7.5, SIMPLE_DOORS_N, 8.5)[::-1]),  # R3: to the east end first
             ((15.0, 7.0, 0.0), ((29.0, 7.0), (1.0, 7.0))),  # R4: whole corridor, from the middle
         ),

@@ -153,9 +153,10 @@ FULL_CPU_NOTE = ("Cost of the full reproduction here (measured with /usr/bin/tim
                  "targets for R1 alone, 17 with R1..R4 on office_simple, so `teamnav sweep los-table1` (120 trials) "
                  "takes about 7 CPU-hours "
                  "(measured: 595 CPU-s for its 60 nested-team trials of 10 targets) and `los-noise-simple` "
-                 "(75 trials) about 7; on office_complex (619 CPU-s for 60 trials of 5 targets; most Avoid-Past and "
-                 "potential-field trials end early, failed) `los-table2` takes about 14 CPU-hours and "
-                 "`los-noise-complex` about 9. Wall time is that over the number of workers (`-j`).")
+                 "(75 trials) about 7; on office_complex (rebuilt map; measured on tasks of 10 targets) a "
+                 "VisBug-21 or Avoid-Past task costs 3-9 CPU-s per 10 targets and a potential-field task 3-20 "
+                 "(a failing one ends early), so `los-table2` (120 trials) takes about 4-8 CPU-hours and "
+                 "`los-noise-complex` (75 trials) about 3-5. Wall time is that over the number of workers (`-j`).")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
 GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
