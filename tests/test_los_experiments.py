@@ -70,6 +70,24 @@ def test_patrol_routes_and_starts_lie_in_the_corridors_with_clearance(m):
         assert any(x0 <= x <= x1 and y0 - 0.4 <= y <= y1 + 0.4 for x0, y0, x1, y1 in corridors), (x, y)
 
 
+@pytest.mark.parametrize("both", [False, True])
+def test_simple_r2_route_steps_into_the_south_doors_or_every_door(monkeypatch, both):
+    # SIMPLE_R2_BOTH_SIDES: R2 steps into the north doorways too (where R1 trapped in N4/N5 sees it)
+    monkeypatch.setattr(L, "SIMPLE_R2_BOTH_SIDES", both)
+    route = L._simple_r2_route()
+    env = builtin_map(L.MAPS["simple"])
+    clear = distance_field(env.grid)
+    for x, y in route:
+        r, c = env.grid.world_to_cell((x, y))
+        assert clear[r, c] >= L.RADIUS_M + 0.3, (x, y)
+    south = {x for x, y in route if y < 5.8}
+    north = {x for x, y in route if y > 8.2}
+    assert south == set(L.SIMPLE_DOORS_S)
+    assert north == (set(L.SIMPLE_DOORS_N) if both else set())
+    xs = [x for x, _ in route]
+    assert xs == sorted(xs) and route[0][0] == 1.0 and route[-1][0] == 29.0  # west to east, end to end
+
+
 def _sees(occ, res, a, b):
     """Line of sight between two world points on an occupancy grid (2 cm samples)."""
     n = int(math.hypot(b[0] - a[0], b[1] - a[1]) / 0.02) + 2
