@@ -42,8 +42,11 @@ class LosExplorerParams(_CommonParams):
         with ``"goal"`` a teammate walking away keeps R1 following it until it leaves R1's
         sight, 50-80 % of R1's steps on the potential field, after which A takes R1 back to the
         same trap. Measured, office_simple, potential field, 5 tasks x 10 targets, tasks
-        finished: R1..R3 4/5 -> 5/5, R1..R4 4/5 -> 5/5 with ``"helper"``; steps per target
-        on the tasks both finished are within the task-to-task spread);
+        finished: R1..R3 4/5 -> 5/5, R1..R4 4/5 -> 5/5 with ``"helper"`` (on the tasks both
+        finished 376 -> 388 and 294 -> 328 steps per target, within the task-to-task spread);
+        R1+R2 0/5 either way. office_complex, same protocol, targets reached (tasks finished)
+        "goal" -> "helper": R1+R2 24/50 (0/5) -> 31/50 (2/5), R1..R3 22/50 (0/5) -> 23/50 (0/5),
+        R1..R4 40/50 (3/5) -> 31/50 (1/5): no net change there);
         ``"moved"``, any step that was not blocked; ``"helper"``, the paper's own reading of
         Fig. 10 ("R_1 is now progressing towards its goal (by setting G_icurr = R_2)"): its
         distance to the teammate it heads for fell (its best so far, ``_head_to``), so Pr falls
