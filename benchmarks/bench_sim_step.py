@@ -2,7 +2,7 @@
 
 Runs, for a short simulated time and a fixed seed, the scenarios whose full reproductions
 take CPU hours (Sgorbissa & Arkin's Tables 1–2: ``los-help-simple`` / ``los-help-complex``;
-Wurm et al.'s trails: ``try-to-see-it-my-way``; Fox et al.'s hallway MCL:
+Vaughan et al.'s trails: ``try-to-see-it-my-way``; Fox et al.'s hallway MCL:
 ``collab-mcl-hallway``) and prints, per scenario, the median over ``--repeats`` runs of
 
 - CPU seconds per step (``time.process_time``: this process only, so other work on a shared
