@@ -41,14 +41,19 @@ no expiry): a 2-hour profiled run at k = 1 (commit bec19bc, shared machine under
 took 28, 42, 42, 50 CPU s per simulated hour in its four half-hours while the largest list grew
 4,464 → 7,946 → 10,584 → 12,058 crumbs (the try section's profile table).
 
-Drift sweep, measured (commit dcb435e, 1 h, 10 seeds, mean ± std): units in the last 10 min
-(units in the hour), 2000 / 2002 team: k = 0: 9.7 ± 1.3 (54.7 ± 2.3) / 8.9 ± 2.4 (45.4 ± 3.3);
-k = 1: 7.3 ± 1.2 (49.6 ± 3.3) / 7.8 ± 1.9 (45.4 ± 2.7); k = 4: 2.3 ± 1.9 (25.1 ± 4.1) / 4.7 ± 1.7
-(29.8 ± 5.3). At k = 4 the 2000 team keeps 24 % of its drift-free throughput, 5 of 10 runs broke
-down (at 42–55 min; its units per 10 min fall from 6.0 in the first window to 2.3 in the last),
-the 2002 team keeps 53 % (1 of 10 broke down) and works on for 10 h (the try section's profiled
-run). At commit 541d99f (recovery towards the nearest crumb) the 2000 team, 3 seeds: k = 0
-12, 10, 9 units in the last 10 min; k = 4 0, 0, 2, breakdowns at 38, 44, 54 min.
+Drift sweep, measured (commit 8ce20af, 1 h, 10 seeds per point, mean ± std; 13 CPU min for the
+30 runs of each algorithm under a load of 3-6): units in the last 10 min (units in the hour),
+2000 / 2002 team: k = 0: 10.5 ± 2.0 (57.9 ± 3.1) / 8.9 ± 2.4 (45.4 ± 3.3); k = 1: 7.3 ± 1.3
+(51.8 ± 2.0) / 7.8 ± 1.9 (45.4 ± 2.7); k = 4: 1.0 ± 1.3 (24.2 ± 4.3) / 4.7 ± 1.7 (29.8 ± 5.3).
+Breakdowns: the 2000 team none at k = 0 or 1, 8 of 10 at k = 4 (at 38, 44, 46, 46, 48, 49, 53,
+54 min; its units per 10 min fall from 5.7 in the first window to 1.0 in the last); the 2002 team
+1 of 10 at k = 1 and at k = 4 (56 min). At k = 4 the 2000 team keeps 10 % of its drift-free
+last-10-min throughput, the 2002 team 53 %, and works on for 10 h (the try section's profiled
+run). Against dcb435e (before recovery towards the nearest crumb, 541d99f) the 2000 team gained
+at k = 0 (9.7 ± 1.3 -> 10.5, 54.7 -> 57.9 units in the hour) and k = 1 (49.6 -> 51.8 in the
+hour) and collapses harder at k = 4 (2.3 ± 1.9 -> 1.0 ± 1.3 in the last 10 min, 5 -> 8 of 10
+broke down): recovery pulls a drifted robot back onto the nearest (drifted) crumbs. The 2002
+team's figures are unchanged (trail-share-v1 keeps recovery off).
 Paper conditions (commit 5d4a607, 30 min, 10 seeds): 27.9 ± 1.7 units (paper 28), no breakdown
 within 30 min, first source visit 2.2 ± 0.8 min, median trip after it 94 ± 3 s; one robot on the
 optimal route 11 units (3 seeds, trip 78 s): 2.5x.

@@ -21,6 +21,15 @@ EXPERIMENTS.md rows, each a :class:`Comparison`:
    crumbs in every sample (bound 4 x 121); RSS 248.9 MiB at 0.5 h and at 10 h; 40 CPU s per
    simulated hour (38–49 per interval; 58 in the first, which loads the compiled kernels).
 
+Drift sweeps, measured (commit 8ce20af, 1 h, 10 seeds per point, mean ± std): units in the last
+10 min (units in the hour), 2002 / 2000 team: k = 0: 8.9 ± 2.4 (45.4 ± 3.3) / 10.5 ± 2.0
+(57.9 ± 3.1); k = 1: 7.8 ± 1.9 (45.4 ± 2.7) / 7.3 ± 1.3 (51.8 ± 2.0); k = 4: 4.7 ± 1.7
+(29.8 ± 5.3) / 1.0 ± 1.3 (24.2 ± 4.3). Breakdowns: the 2002 team 1 of 10 at k = 1 and at k = 4
+(56 min); the 2000 team 8 of 10 at k = 4 (38–54 min), none below. At k = 4 the 2002 team keeps
+53 % of its k = 0 last-10-min throughput, the 2000 team 10 % (claim 3's verdict: >= 50 % and
+< 50 %). 2002 figures identical to dcb435e's; the 2000 team's changed with its recovery gap-fill
+(the blazing-a-trail section's docstring). 13.5 CPU min for try-drift's 30 runs.
+
 Beside them: Table 1 (trips, distance, lifetime per robot), units over time, the times each
 robot reached the places (Fig. 2 top), the crumbs each robot dropped in its own frame (Fig. 3)
 and all crumbs in the fixed frame of the Places (Fig. 4), the N-place mail round (§2.1), the
