@@ -144,10 +144,15 @@ def test_hallway_collaboration_is_faster(tmp_path):
     from teamnav.experiments.sweep import sweep
 
     rows = sweep("collab-mcl-hallway", out_dir=tmp_path, progress=False).rows()
-    ttl = {c: [r["metrics"]["loc_time_to_localize_s"] for r in rows
-               if r["params"]["robots.0.params.collaborate"] is c] for c in (False, True)}
-    assert len(ttl[False]) >= 8 and len(ttl[True]) >= 8
-    assert np.mean(ttl[True]) < np.mean(ttl[False])
+    ttl = {c: {r["seed"]: r["metrics"]["loc_time_to_localize_s"] for r in rows
+               if r["params"]["robots.0.params.collaborate"] is c} for c in (False, True)}
+    seeds = sorted(set(ttl[False]) & set(ttl[True]))
+    assert len(seeds) >= 8
+    # "clearly faster", as the report judges it: the same seed starts both conditions from the same
+    # poses, so the paired reduction must lie beyond two standard errors (measured: -87 +- 19 s, 8/8)
+    change = np.array([ttl[True][s] - ttl[False][s] for s in seeds])
+    assert change.mean() + 2 * change.std(ddof=1) / np.sqrt(len(seeds)) < 0
+    assert np.mean([ttl[True][s] for s in seeds]) < 0.7 * np.mean([ttl[False][s] for s in seeds])
 
 
 @pytest.mark.slow
