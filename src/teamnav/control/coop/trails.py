@@ -334,13 +334,11 @@ class Trail:
             Index of that crumb (into :attr:`crumb_xy_m`) and its time-to-place [s]; None when
             no crumb for ``goal`` is within ``radius_m`` (inclusive). Ties go to the earliest.
         """
-        code = self._codes.get(goal)
-        if code is None or self._n == 0:
+        near = self._goal_offsets(goal, x_odom_m, y_odom_m)
+        if near is None:
             return None
-        xys = self._xys[: self._n]
-        dx = xys[:, 0] - x_odom_m
-        dy = xys[:, 1] - y_odom_m
-        ok = (self._p[: self._n] == code) & (dx * dx + dy * dy <= radius_m * radius_m)
+        xys, is_goal, d2 = near
+        ok = is_goal & (d2 <= radius_m * radius_m)
         if below_s != math.inf:
             ok &= xys[:, 2] < below_s
         if not ok.any():
@@ -348,6 +346,18 @@ class Trail:
         s = np.where(ok, xys[:, 2], np.inf)
         i = int(np.argmin(s))
         return i, float(s[i])
+
+    def _goal_offsets(self, goal: str, x_odom_m: float, y_odom_m: float
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The held crumbs ``(x, y, s)``, which of them are for ``goal``, and their squared
+        distances to (x, y) [m^2]; None when there is no crumb for ``goal``'s Place at all."""
+        code = self._codes.get(goal)
+        if code is None or self._n == 0:
+            return None
+        xys = self._xys[: self._n]
+        dx = xys[:, 0] - x_odom_m
+        dy = xys[:, 1] - y_odom_m
+        return xys, self._p[: self._n] == code, dx * dx + dy * dy
 
     def nearest_crumb(self, goal: str, x_odom_m: float, y_odom_m: float, radius_m: float, *,
                       below_s: float = math.inf) -> tuple[float, float] | None:
@@ -364,13 +374,11 @@ class Trail:
         >>> tr.nearest_crumb("A", 2.5, 0.0, 3.0), tr.nearest_crumb("A", 2.5, 0.0, 3.0, below_s=6.0)
         ((4.0, 0.0), (0.0, 0.0))
         """
-        code = self._codes.get(goal)
-        if code is None or self._n == 0:
+        near = self._goal_offsets(goal, x_odom_m, y_odom_m)
+        if near is None:
             return None
-        xys = self._xys[: self._n]
-        dx = xys[:, 0] - x_odom_m
-        dy = xys[:, 1] - y_odom_m
-        d2 = np.where(self._p[: self._n] == code, dx * dx + dy * dy, np.inf)
+        xys, is_goal, d2 = near
+        d2 = np.where(is_goal, d2, np.inf)
         if below_s != math.inf:
             d2 = np.where(xys[:, 2] < below_s, d2, np.inf)
         i = int(np.argmin(d2))
