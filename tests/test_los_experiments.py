@@ -71,10 +71,9 @@ def test_patrol_routes_and_starts_lie_in_the_corridors_with_clearance(m):
 
 
 @pytest.mark.parametrize("both", [False, True])
-def test_simple_r2_route_steps_into_the_south_doors_or_every_door(monkeypatch, both):
-    # SIMPLE_R2_BOTH_SIDES: R2 steps into the north doorways too (where R1 trapped in N4/N5 sees it)
-    monkeypatch.setattr(L, "SIMPLE_R2_BOTH_SIDES", both)
-    route = L._simple_r2_route()
+def test_simple_r2_route_steps_into_the_south_doors_or_every_door(both):
+    # R2 alone steps into the north doorways too (where R1 trapped in N4/N5 sees it)
+    route = L.simple_r2_route(both)
     env = builtin_map(L.MAPS["simple"])
     clear = distance_field(env.grid)
     for x, y in route:
@@ -86,6 +85,44 @@ def test_simple_r2_route_steps_into_the_south_doors_or_every_door(monkeypatch, b
     assert north == (set(L.SIMPLE_DOORS_N) if both else set())
     xs = [x for x, _ in route]
     assert xs == sorted(xs) and route[0][0] == 1.0 and route[-1][0] == 29.0  # west to east, end to end
+
+
+def test_r1_r2_team_r2_passes_every_door_on_both_sides_and_sees_every_room_from_a_doorway():
+    env = builtin_map(L.MAPS["simple"])
+    occ, res = np.asarray(env.grid.occupied()), env.grid.resolution_m
+    route = L.team_routes("simple", 1)[0]
+    doorways = {(x, 5.5) for x in L.SIMPLE_DOORS_S} | {(x, 8.5) for x in L.SIMPLE_DOORS_N}
+    assert doorways <= set(route) and len(doorways) == 10
+    # from its doorways R2 sees each room's centre: a robot trapped in any room sees R2 (§5)
+    centres = L.room_centres("simple")
+    seen = {r for r, c in centres.items() for p in doorways if _sees(occ, res, p, c)
+            and math.hypot(c[0] - p[0], c[1] - p[1]) <= L.VISIBILITY_M}
+    assert seen == set(centres)
+    # the sweep's case carries that route in R2's own start frame
+    ov = L.team_overrides("simple", 1)
+    assert ov["robots.1.count"] == 1 and ov["robots.2.count"] == ov["robots.3.count"] == 0
+    world = L.frame_to_world(L.LAYOUTS["simple"].helpers[0][0], ov["robots.1.params.patrol_xy"])
+    np.testing.assert_allclose(world, np.array(route), atol=1e-4)
+
+
+@pytest.mark.parametrize("m", list(L.MAPS))
+def test_the_r1_to_r4_and_r1_to_r3_teams_keep_the_scenario_files_routes(m):
+    from teamnav.experiments.spec import load_scenario
+
+    scn = load_scenario(L.SCENARIOS[m])
+    shipped = [g.params["patrol_xy"] for g in scn.robots[1:]]
+    for h in (2, 3):
+        assert [L.patrol_xy(m, k, h) for k in range(3)] == [[list(p) for p in r] for r in shipped]
+        assert not [k for k in L.team_overrides(m, h) if "patrol_xy" in k]  # counts only
+    # R1..R4 on office_simple: R2 south doors only, R3 north doors only (the split)
+    if m == "simple":
+        r2, r3 = L.team_routes(m, 3)[:2]
+        assert {x for x, y in r2 if y < 5.8} == set(L.SIMPLE_DOORS_S) and all(y < 8.2 for _, y in r2)
+        assert {x for x, y in r3 if y > 8.2} == set(L.SIMPLE_DOORS_N) and all(y > 5.8 for _, y in r3)
+    else:
+        assert L.team_routes(m, 1) == L.team_routes(m, 3)  # one route per helper on office_complex
+    with pytest.raises(ValueError, match="team must be one of"):
+        L.team_routes(m, 4)
 
 
 def _sees(occ, res, a, b):
@@ -186,10 +223,19 @@ def test_sweeps_grid_what_the_paper_varies():
     from teamnav.experiments.sweep import load_sweep
 
     t1 = load_sweep("los-table1")
-    assert t1.n_trials == 3 * 8 * L.N_TASKS and not t1.set
+    # the paper's nested teams (R1; R1,2; R1..3; R1..4) x 3 algorithms x 5 tasks
+    assert t1.n_trials == 3 * 4 * L.N_TASKS and not t1.set and list(t1.grid) == [S.TARGETS_KEY]
     # §6: the potential field with state + goal sharing, Avoid-Past and VisBug with goal sharing only
     ties = {c[S.NAV_KEY]: c[S.STATE_KEY] for c in t1.cases}
     assert ties == {"potential_field": True, "avoid_past": False, "visbug21": False}
+    for t in (t1, load_sweep("los-table2")):
+        teams = {c["case"]: [c[f"robots.{k}.count"] for k in (1, 2, 3)] for c in t.cases}
+        assert teams["visbug21/R1"] == [0, 0, 0] and teams["pot-field/R1-2"] == [1, 0, 0]
+        assert teams["avoid-past/R1-3"] == [1, 1, 0] and teams["avoid-past/R1-4"] == [1, 1, 1]
+        assert sorted(map(tuple, teams.values())) == sorted([(0, 0, 0), (1, 0, 0), (1, 1, 0), (1, 1, 1)] * 3)
+    # the R1+R2 team's R2 walks both sides of office_simple's corridor, on the complex map no change
+    assert "robots.1.params.patrol_xy" in [c for c in t1.cases if c["case"] == "visbug21/R1-2"][0]
+    assert not any("robots.1.params.patrol_xy" in c for c in load_sweep("los-table2").cases)
     assert t1.grid["robots.0.params.targets_xy"][4] == L.task_targets_xy("simple", 5)
     from teamnav.experiments.sweep import sweep_names
 
@@ -238,7 +284,7 @@ def test_metrics_are_empty_without_an_explorer_log():
 
 # ---------------------------------------------------------------------------- section verdicts
 def _row(nav, steps, finished=1, **params):
-    return {"status": "ok", "params": {S.NAV_KEY: nav, **params},
+    return {"status": "ok", "params": {S.NAV_KEY: nav, S.TARGETS_KEY: [[1.0, 2.0]] * 20, **params},
             "metrics": {"los_steps": 10 * steps, "los_steps_per_target": steps, "los_finished": finished,
                         "los_msgs_per_robot": 10.0,
                         "los_bytes_per_robot": 1000.0}}
@@ -253,15 +299,18 @@ def _by_team(falling=True):
             for nav, s in base.items():
                 f = (s / (h + 1) if falling else s * (1 + 0.1 * h)) + 5 * task
                 rows.append(_row(nav, 9999 if (nav == "potential_field" and h == 0) else f,
-                                 finished=0 if (nav == "potential_field" and h == 0) else 1))
+                                 finished=0 if (nav == "potential_field" and h == 0) else 1,
+                                 **{f"robots.{k + 1}.count": int(k < h) for k in range(3)},
+                                 **{S.TARGETS_KEY: [[float(task), 0.0]] * 20}))
         out[h] = rows
     return out
 
 
 def test_table_cells_mean_and_relative_std_and_failures():
-    assert S.cell(np.array([100.0, 120.0]), np.array([1.0, 1.0])) == "110 (12.9 %)"
+    assert S.cell(np.array([100.0, 120.0]), np.array([1.0, 1.0])) == "110 (12.9 %) 2/2"
     assert S.cell(np.array([5000.0, 5000.0]), np.array([0.0, 0.0])) == "fails (0/2 finished)"
-    assert S.cell(np.array([100.0, 5000.0]), np.array([1.0, 0.0])) == "100 (0.0 %, 1/2 finished)"
+    assert S.cell(np.array([100.0, 5000.0]), np.array([1.0, 0.0])) == "100 (0.0 %) 1/2"
+    assert S.cell(np.array([]), np.array([])) == "not run"
 
 
 def test_comparisons_hold_when_steps_fall_and_pf_fails_alone_and_not_otherwise():
@@ -297,10 +346,11 @@ class _FakeCtx:
         self.calls = []
 
     def sweep(self, sweep_name, **kw):
-        name = sweep_name
-        self.calls.append((name, kw))
-        h = sum(v for k, v in (kw.get("set") or {}).items() if k.endswith(".count"))
-        rows = [r for r in _by_team(True)[h]] if "table" in name else [
+        name = sweep_name if isinstance(sweep_name, str) else sweep_name.sweep_name
+        self.calls.append((name, kw, sweep_name))
+        teams = ([S.team_of({"params": {k: v for k, v in c.items()}}) for c in sweep_name.cases]
+                 if not isinstance(sweep_name, str) else [])
+        rows = [r for h in sorted(set(teams)) for r in _by_team(True)[h]] if "table" in name else [
             _row(nav, 300 + 100 * e, **{S.ERR_KEY: e, S.DELAYED_KEY: True, S.STATE_KEY: True})
             for nav in L.NAVIGATORS for e in (0.0, 0.4)]
 
@@ -316,11 +366,17 @@ def test_full_build_asks_for_nested_teams_and_every_sweep_and_returns_every_bloc
     ctx = _FakeCtx(quick=False)
     blocks = S.build(ctx)
     names = [c[0] for c in ctx.calls]
-    assert names.count("los-table1") == names.count("los-table2") == 4
+    assert names.count("los-table1") == names.count("los-table2") == 1  # one call: algorithm x team cases
     assert {"los-noise-simple", "los-noise-complex", "los-ablation"} <= set(names)
     assert not any(n.endswith("-pf") for n in names)  # the algorithms are the sweeps' cases
-    sets = [c[1]["set"] for c in ctx.calls if c[0] == "los-table1"]
-    assert {"robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0} in sets  # R1+R2, not R1+R3
+    spec = [c[2] for c in ctx.calls if c[0] == "los-table1"][0]
+    assert len(spec.cases) == 12 and [c for c in ctx.calls if c[0] == "los-table1"][0][1] == {"name": "los-table1"}
+    tab = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Table 1")][0]
+    assert tab.rows[2][2:] == ["502 (0.7 %) 2/2", "252 (1.4 %) 2/2", "169 (2.1 %) 2/2", "128 (2.8 %) 2/2"]
+    assert "20 targets per task" in tab.note
+    noise = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Fig. 16")][0]
+    assert noise.columns[-1] == "R1 alone" and noise.rows[0][-1].startswith("fails") and noise.rows[1][-1] == "502 (0.7 %) 2/2"
+    assert noise.columns[1:3] == ["err_max 0", "err_max 0.4"]
     assert {Table, Plot, Comparison} <= {type(b) for b in blocks}
     assert not any(isinstance(b, Missing) for b in blocks)
     verdicts = {b.claim: b.holds for b in blocks if isinstance(b, Comparison)}
@@ -332,6 +388,9 @@ def test_quick_build_runs_short_tasks_and_says_what_it_left_out():
     ctx = _FakeCtx(quick=True)
     blocks = S.build(ctx)
     assert all(len(c[1]["grid"][S.TARGETS_KEY][0]) == S.QUICK_TARGETS for c in ctx.calls)
+    spec = [c[2] for c in ctx.calls if c[0] == "los-table1"][0]
+    assert sorted(c["case"] for c in spec.cases) == sorted(f"{a}/{t}" for a in ("pot-field", "avoid-past", "visbug21")
+                                                           for t in ("R1", "R1-4"))
     assert all(c[1]["set"][S.BUDGET_KEY] == S.QUICK_BUDGET_STEPS_PER_TARGET for c in ctx.calls)
     assert {b.what.split(" (")[0] for b in blocks if isinstance(b, Missing)} >= {"Table 2 / Fig. 14", "Fig. 17"}
     assert all("quick mode" in b.differs for b in blocks if isinstance(b, Comparison) and b.holds is not None)

@@ -59,6 +59,9 @@ from teamnav.geometry import se2
 
 __all__ = [
     "CASES",
+    "SIMPLE_R2_BOTH_SIDES_TEAMS",
+    "TEAMS",
+    "TEAM_TAGS",
     "ERR_MAX",
     "LAYOUTS",
     "MAPS",
@@ -70,6 +73,10 @@ __all__ = [
     "patrol_xy",
     "room_centres",
     "scenario_data",
+    "simple_r2_route",
+    "table_cases",
+    "team_overrides",
+    "team_routes",
     "task_rooms",
     "task_targets_world",
     "task_targets_xy",
@@ -150,18 +157,27 @@ def _door_route(y_m: float, doors_x: Sequence[float], door_y_m: float, x0_m: flo
     return tuple(out)
 
 
-#: R2 of office_simple steps into the north doors too (False: south doors only, lane y 6.5).
-#: Measured (H7d; potential field R1, trouble_progress "helper", 5 tasks x 10 targets): with R2
-#: alone, R1 trapped against the wall of N4 or N5 sees R2 in the north doorways and reaches
-#: 29/50 targets (1/5 tasks finished) against 19/50 (0/5); but R2's round is twice as long and
-#: with R2+R3 R1 then reached only 3 and 8 targets on tasks 1-2 (10 and 10 with the south-only
-#: route), so the default stays False.
-SIMPLE_R2_BOTH_SIDES: bool = False
+#: Helpers present in each of the paper's nested teams (§6, Tables 1-2: R1; R1,2; R1,2,3;
+#: R1,2,3,4): team ``h`` has R2..R(h+1). The table sweeps run these four teams only (a grid of
+#: every helper present or not ran 8 teams, twice the cost, and the report used the nested four).
+TEAMS: tuple[int, ...] = (0, 1, 2, 3)
+#: Case-label suffix of each team.
+TEAM_TAGS: dict[int, str] = {0: "R1", 1: "R1-2", 2: "R1-3", 3: "R1-4"}
+
+#: Teams in which R2 of office_simple steps into the north doors too (a route per team size,
+#: ours). With R2 alone and R2 stepping only into the south doors, R1 trapped against the wall
+#: of a north room never sees a teammate (§5 needs one in sight). Measured (H7d; potential
+#: field R1, trouble_progress "helper", 5 tasks x 10 targets): both sides took R1+R2 from 19/50
+#: to 29/50 targets (0/5 -> 1/5 tasks finished); but with R3 covering the north doors the
+#: longer round left R1..3 at 3 and 8 targets on tasks 1-2 (10 and 10 south only). So R2 covers
+#: both sides only when it is the only helper; with R3 present the split (R2 south, R3 north).
+SIMPLE_R2_BOTH_SIDES_TEAMS: frozenset[int] = frozenset({1})
 
 
-def _simple_r2_route() -> tuple[tuple[float, float], ...]:
-    """R2's route on office_simple (see :data:`SIMPLE_R2_BOTH_SIDES`)."""
-    if SIMPLE_R2_BOTH_SIDES:
+def simple_r2_route(both_sides: bool) -> tuple[tuple[float, float], ...]:
+    """R2's route on office_simple (world [m]): the corridor end to end, west to east, stepping
+    into every south door (lane y 6.5) or, ``both_sides``, into every door (lane y 7.0)."""
+    if both_sides:
         return _doors_route(7.0, [(x, 5.5) for x in SIMPLE_DOORS_S] + [(x, 8.5) for x in SIMPLE_DOORS_N], 1.0, 29.0)
     return _door_route(6.5, SIMPLE_DOORS_S, 5.5)
 
@@ -200,11 +216,11 @@ LAYOUTS: dict[str, Layout] = {
         helpers=(
             # end to end: a room centre is seen from the corridor only through the room's door,
             # from a 1.5 m stretch beside it (the doors of S1 and N5 are at the corridor's ends).
-            # R2 steps into each south door on its way (or every door, SIMPLE_R2_BOTH_SIDES), R3
+            # R2 steps into each south door on its way (every door with R2 alone: team_routes), R3
             # into each north door: from the doorway a helper sees the whole room, and a robot
             # trapped inside sees it (§5 needs a teammate in sight; a potential field against a
             # room's wall sees no corridor)
-            ((3.0, 6.5, 0.0), _simple_r2_route()),  # R2: to the west end first
+            ((3.0, 6.5, 0.0), simple_r2_route(False)),  # R2: to the west end first (R1+R2: team_routes)
             ((28.5, 7.5, 180.0), _door_route(7.5, SIMPLE_DOORS_N, 8.5)[::-1]),  # R3: to the east end first
             ((15.0, 7.0, 0.0), ((29.0, 7.0), (1.0, 7.0))),  # R4: whole corridor, from the middle
         ),
@@ -314,10 +330,40 @@ def task_targets_xy(map_key: str, task: int, n_targets: int = N_TARGETS) -> list
     return _rounded(world_to_frame(LAYOUTS[map_key].r1_start, task_targets_world(map_key, task, n_targets)))
 
 
-def patrol_xy(map_key: str, helper: int) -> list[list[float]]:
-    """Helper ``helper``'s (0 = R2) patrol route in its own start frame [m]."""
-    start, route = LAYOUTS[map_key].helpers[helper]
-    return _rounded(world_to_frame(start, route))
+def team_routes(map_key: str, team: int = 3) -> tuple[tuple[tuple[float, float], ...], ...]:
+    """Every helper's patrol route (world [m]) in the nested team with ``team`` helpers (0-3).
+
+    The routes of :data:`LAYOUTS` (the R1..R4 team's, and the scenario files'), except R2's on
+    office_simple in the teams of :data:`SIMPLE_R2_BOTH_SIDES_TEAMS` (both sides of the corridor).
+    Helpers not in the team keep their route (their ``count`` is 0).
+    """
+    if team not in TEAMS:
+        raise ValueError(f"team must be one of {TEAMS} (helpers present), got {team!r}")
+    routes = [route for _start, route in LAYOUTS[map_key].helpers]
+    if map_key == "simple" and team in SIMPLE_R2_BOTH_SIDES_TEAMS:
+        routes[0] = simple_r2_route(True)
+    return tuple(routes)
+
+
+def patrol_xy(map_key: str, helper: int, team: int = 3) -> list[list[float]]:
+    """Helper ``helper``'s (0 = R2) patrol route in its own start frame [m], in the nested team
+    with ``team`` helpers (:func:`team_routes`; default the full team R1..R4)."""
+    start, _route = LAYOUTS[map_key].helpers[helper]
+    return _rounded(world_to_frame(start, team_routes(map_key, team)[helper]))
+
+
+def team_overrides(map_key: str, team: int) -> dict[str, Any]:
+    """Sweep overrides that make the scenario (whose helpers are the R1..R4 team's) the nested
+    team with ``team`` helpers: each helper's ``count`` and, where the team's route differs from
+    the scenario's, its ``patrol_xy``."""
+    routes = team_routes(map_key, team)
+    out: dict[str, Any] = {}
+    for k in range(len(LAYOUTS[map_key].helpers)):
+        out[f"robots.{k + 1}.count"] = int(k < team)
+    for k in range(len(LAYOUTS[map_key].helpers)):
+        if k < team and routes[k] != LAYOUTS[map_key].helpers[k][1]:
+            out[f"robots.{k + 1}.params.patrol_xy"] = patrol_xy(map_key, k, team)
+    return out
 
 
 # ---------------------------------------------------------------------------- scenarios
@@ -451,6 +497,17 @@ CASES: list[dict[str, Any]] = [
 ]
 
 
+def table_cases(map_key: str) -> list[dict[str, Any]]:
+    """The table sweeps' cases: each algorithm of :data:`CASES` x each nested team of
+    :data:`TEAMS` (labels ``<algorithm>/<team>``, e.g. ``visbug21/R1-3``), a team setting its
+    helpers' counts and routes (:func:`team_overrides`)."""
+    out = []
+    for c in CASES:
+        for h in TEAMS:
+            out.append({**copy.deepcopy(c), "case": f"{c['case']}/{TEAM_TAGS[h]}", **team_overrides(map_key, h)})
+    return out
+
+
 def sweep_data(kind: str) -> dict[str, Any]:
     """The named sweep ``los-<kind>`` as YAML data (see :func:`write_files`)."""
     tasks = lambda m: [task_targets_xy(m, t) for t in range(1, N_TASKS + 1)]  # noqa: E731
@@ -458,16 +515,13 @@ def sweep_data(kind: str) -> dict[str, Any]:
         m = "simple" if kind == "table1" else "complex"
         return {
             "name": f"los-{kind}",
-            "description": (f"Sgorbissa & Arkin Table {kind[-1]}: R1's steps per algorithm (cases; the potential field "
-                            f"with state + goal sharing, the others with goal sharing) with helpers R2, R3, R4 each "
-                            f"present or not (the paper's rows are R1; R1+R2; R1..R3; R1..R4), 5 tasks of 200 targets, "
-                            f"{BUDGET_STEPS_PER_TARGET[m]} steps per target at most."),
+            "description": (f"Sgorbissa & Arkin Table {kind[-1]}: R1's steps per algorithm and nested team (cases "
+                            f"'<algorithm>/<team>': the potential field with state + goal sharing, the others with "
+                            f"goal sharing; teams R1, R1-2, R1-3, R1-4 as the paper's rows, each with its helpers' "
+                            f"routes), 5 tasks of 200 targets, {BUDGET_STEPS_PER_TARGET[m]} steps per target at most."),
             "scenario": SCENARIOS[m],
-            "cases": copy.deepcopy(CASES),
+            "cases": table_cases(m),
             "grid": {
-                "robots.1.count": [0, 1],
-                "robots.2.count": [0, 1],
-                "robots.3.count": [0, 1],
                 "robots.0.params.targets_xy": tasks(m),
             },
             "seeds": 1,

@@ -6,8 +6,11 @@ What it runs (sweeps ``los-table1``, ``los-table2``, ``los-noise-simple``,
 
 - Tables 1-2 / Figs. 12, 14: R1's motion steps per algorithm (potential field with state +
   goal sharing, Avoid-Past, VisBug-21) with R1 alone, R1+R2, R1..R3, R1..R4, over 5 tasks of
-  200 room-centre targets each; mean and std as % of the mean (§6). The helper team is
-  nested (R2, then R3, then R4), one sweep call per team size.
+  200 room-centre targets each; mean and std as % of the mean (§6). The helper teams are
+  the paper's nested ones (R2, then R3, then R4): the table sweeps' cases are algorithm x
+  team (:func:`~teamnav.experiments.los_tasks.table_cases`), a team setting its helpers'
+  counts and routes (on office_simple R2 alone steps into the doors on both sides of the
+  corridor, and with R3 present into the south doors only, R3 taking the north ones).
 - Figs. 16-17: steps vs err_max of eqs. 1-2 (every robot's detector) with all helpers, and
   the "R1 alone" level of the tables.
 - An ablation the paper implies (simple map, all helpers): reflected visibility only (§3),
@@ -30,10 +33,9 @@ Budget: R1 abandons its task when a target is not reached within
 complex); the run then ends and counts as failed (not in the means). A trapped run so ends
 at its first trap instead of burning a whole task's budget.
 
-Running it: ``teamnav report los-help --out DIR`` (full) runs 2 x 4 x 15 table trials, 2 x 75
-noise trials and 60 ablation trials; ``teamnav sweep los-table1 --out DIR`` alone grids every
-subset of R2, R3, R4 (3 cases x 8 teams x 5 tasks = 120 trials); :data:`FULL_CPU_NOTE` says
-what it costs here. Set ``NUMBA_NUM_THREADS=1`` for sweeps on a small box: the
+Running it: ``teamnav report los-help --out DIR`` (full) runs 2 x 60 table trials (3
+algorithms x 4 teams x 5 tasks; ``teamnav sweep los-table1 --out DIR`` runs the same 60), 2 x 75
+noise trials and 60 ablation trials; :data:`FULL_CPU_NOTE` says what it costs here. Set ``NUMBA_NUM_THREADS=1`` for sweeps on a small box: the
 line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread launch
 costs more than the work for four robots.
 
@@ -124,7 +126,8 @@ def stats(steps: np.ndarray) -> tuple[float, float]:
 
 
 def cell(steps: np.ndarray, finished: np.ndarray) -> str:
-    """A table cell: "mean (std %)" over finished runs, or a failure note."""
+    """A table cell: "mean (std %) k/n" (mean steps per target and std as % of the mean over the
+    finished tasks, then tasks finished of tasks run), or a failure note."""
     n = int(steps.size)
     if n == 0:
         return "not run"
@@ -132,8 +135,7 @@ def cell(steps: np.ndarray, finished: np.ndarray) -> str:
     if done == 0:
         return f"fails (0/{n} finished)"
     m, pct = stats(steps[finished > 0.5])
-    note = "" if done == n else f", {done}/{n} finished"
-    return f"{m:.0f} ({pct:.1f} %{note})"
+    return f"{m:.0f} ({pct:.1f} %) {done}/{n}"
 
 
 def _paper_cell(v: tuple[float, float] | None) -> str:
@@ -195,8 +197,21 @@ def _teams(map_key: str, quick: bool) -> list[int]:
     return [0, 3] if quick else [0, 1, 2, 3]
 
 
-def _team_set(h: int) -> dict[str, int]:
-    return {f"robots.{k + 1}.count": int(k < h) for k in range(3)}
+def team_of(row: dict) -> int:
+    """Helpers present in a row's run (its ``robots.K.count`` overrides; 3 when it sets none,
+    the scenario files' team)."""
+    p = row.get("params") or {}
+    counts = [p.get(f"robots.{k + 1}.count") for k in range(3)]
+    return 3 if all(c is None for c in counts) else sum(int(c or 0) for c in counts)
+
+
+def table_spec(map_key: str, teams: Sequence[int]):
+    """The table sweep of ``map_key`` with only the cases of the nested teams ``teams``."""
+    from teamnav.experiments.sweep import load_sweep
+
+    spec = load_sweep(TABLE_SWEEP[map_key])
+    tags = {L.TEAM_TAGS[h] for h in teams}
+    return spec.model_copy(update={"cases": [c for c in spec.cases if c["case"].rsplit("/", 1)[1] in tags]})
 
 
 def _rows(ctx, sweep: str, suffix: str, **kw: Any) -> list[dict]:
@@ -211,16 +226,18 @@ def _quick_set(team: dict[str, int] | None = None) -> dict[str, Any]:
 
 
 def run_tables(ctx, map_key: str) -> dict[int, list[dict]]:
-    """Rows of the table sweeps per team size (0..3 helpers, nested), two sweep calls per size."""
+    """Rows of the table sweep per team size (0..3 helpers, nested): one sweep call, whose cases
+    are algorithm x team (quick mode: the teams R1 and R1..R4 only, short tasks)."""
     quick = bool(ctx.quick)
-    out: dict[int, list[dict]] = {}
-    for h in _teams(map_key, quick):
-        kw: dict[str, Any] = {"set": _team_set(h)}
-        if quick:
-            kw["set"] = _quick_set(_team_set(h))
-            kw["grid"] = {TARGETS_KEY: _tasks(map_key, True)}
-            kw["duration_s"] = _budget_s(map_key, True)
-        out[h] = _rows(ctx, TABLE_SWEEP[map_key], f"-h{h}" + ("-quick" if quick else ""), **kw)
+    teams = _teams(map_key, quick)
+    kw: dict[str, Any] = {}
+    if quick:
+        kw = {"set": _quick_set(), "grid": {TARGETS_KEY: _tasks(map_key, True)}, "duration_s": _budget_s(map_key, True)}
+    name = TABLE_SWEEP[map_key] + ("-quick" if quick else "")
+    rows = ok_rows(ctx.sweep(table_spec(map_key, teams), name=name, **kw))
+    out: dict[int, list[dict]] = {h: [] for h in teams}
+    for r in rows:
+        out.setdefault(team_of(r), []).append(r)
     return out
 
 
@@ -253,13 +270,23 @@ def table_block(map_key: str, by_team: dict[int, list[dict]]) -> tuple[Table, di
         rows.append([NAV_LABEL[nav], "ours", *ours])
         rows.append(["", "paper", *(_paper_cell(v) for v in PAPER_TABLES[map_key][nav])])
     n = max((len(v) for v in by_team.values()), default=0)
-    title = f"Table {1 if map_key == 'simple' else 2} ({L.MAPS[map_key]}): R1's motion steps, mean (std as % of the mean)"
+    title = (f"Table {1 if map_key == 'simple' else 2} ({L.MAPS[map_key]}): R1's motion steps per target, mean "
+             "(std as % of the mean) tasks finished / run")
+    n_t = targets_per_task(by_team)
     note = (f"Ours: R1's motion steps per target (a task's steps over its targets; step {L.STEP_LENGTH_M} m), "
-            f"mean and std over the tasks run ({n // max(len(L.NAVIGATORS), 1)} per cell), counting finished "
-            f"tasks only; teams run: {', '.join(TEAM_LABEL[h] for h in teams)}. The paper's numbers must be per "
+            f"mean and std over the finished tasks of the {n // max(len(L.NAVIGATORS), 1)} run per cell, "
+            f"{n_t} targets per task; teams run: {', '.join(TEAM_LABEL[h] for h in teams)}. "
+            "The paper's numbers must be per "
             "target too (a 200-target task cannot take 554 steps), but its step length and maps are not ours: "
             "compare ratios along a row, not values.")
     return Table(title, ["algorithm", "", *TEAM_LABEL.values()], rows, note), means
+
+
+def targets_per_task(by_team: dict[int, list[dict]]) -> str:
+    """The number of targets per task in the rows ("200", "20", "1-20" when mixed; "?" unknown)."""
+    ns = sorted({len(t) for rs in by_team.values() for r in rs
+                 if isinstance(t := (r.get("params") or {}).get(TARGETS_KEY), list)})
+    return "?" if not ns else str(ns[0]) if len(ns) == 1 else f"{ns[0]}-{ns[-1]}"
 
 
 def robots_plot(map_key: str, by_team: dict[int, list[dict]]) -> Plot:
@@ -390,6 +417,28 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
     return out
 
 
+def noise_table(map_key: str, rows: list[dict], alone_rows: list[dict]) -> Table:
+    """Figs. 16-17 as a table: R1's steps per target with R1..R4 per err_max, and R1 alone."""
+    by_nav = group(rows, NAV_KEY)
+    alone_by_nav = group(alone_rows, NAV_KEY)
+    errs = sorted({float(e) for r in rows if (e := (r.get("params") or {}).get(ERR_KEY)) is not None})
+    out = []
+    for nav in L.NAVIGATORS:
+        per = {float(k): v for k, v in group(by_nav.get(nav, []), ERR_KEY).items() if k is not None}
+        if not per:
+            continue
+        cells = [cell(steps_of(per.get(e, [])), finished_of(per.get(e, []))) for e in errs]
+        a = alone_by_nav.get(nav, [])
+        out.append([NAV_LABEL[nav], *cells, cell(steps_of(a), finished_of(a))])
+    fig = 16 if map_key == "simple" else 17
+    n_t = targets_per_task({0: rows})
+    return Table(f"Fig. {fig} ({L.MAPS[map_key]}) as a table: R1's steps per target with R2..R4 vs err_max, "
+                 "mean (std %) tasks finished / run",
+                 ["algorithm", *(f"err_max {e:g}" for e in errs), "R1 alone"], out,
+                 f"{n_t} targets per task; eqs. 1-2 noise on every robot's detector; 'R1 alone' is Table "
+                 f"{1 if map_key == 'simple' else 2}'s first column (no detector in use).")
+
+
 def noise_comparisons(map_key: str, means: dict[str, dict[float, float]], alone: dict[str, float]) -> list[Comparison]:
     out: list[Comparison] = []
     fig = 16 if map_key == "simple" else 17
@@ -508,7 +557,8 @@ def build(ctx) -> list:
         f"R1 reaches {_n_targets(quick)} room-centre targets in sequence ({1 if quick else L.N_TASKS} task(s) per cell; "
         f"the paper: 5 tasks of 200) with a fixed step of {L.STEP_LENGTH_M} m, so steps measure path length. "
         "Helpers R2..R4 patrol the corridors end to end (on office_simple R2 steps into every south door and R3 "
-        "into every north door on its way, so that a robot trapped in a room sees a teammate, §5); "
+        "into every north door on its way, so that a robot trapped in a room sees a teammate, §5; R2 alone steps "
+        "into the doors on both sides); "
         f"every robot sees and talks only within {L.VISIBILITY_M:g} m in line of "
         f"sight; frames are each robot's start pose. A task counts as failed when a target is not reached within "
         f"{QUICK_BUDGET_STEPS_PER_TARGET if quick else ' / '.join(map(str, L.BUDGET_STEPS_PER_TARGET.values()))} "
@@ -537,7 +587,7 @@ def build(ctx) -> list:
             continue
         rows = run_noise(ctx, m, tables[m].get(3, []))
         plot, nmeans = noise_plot(m, rows, alone[m])
-        blocks.append(plot)
+        blocks += [noise_table(m, rows, tables[m].get(0, [])), plot]
         comps += noise_comparisons(m, nmeans, alone[m])
     if quick:
         blocks.append(Missing("the ablation (reflected only / + ghosts / + state sharing)", "full mode only (teamnav report los-help)"))
