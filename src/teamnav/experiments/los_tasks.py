@@ -15,8 +15,9 @@ What is ours (the paper leaves it open)
 - R1 starts at the map's ``base`` place with a heading of 90° (so R1's start frame is
   *not* the world frame, and a brain that confused them would miss every target).
 - Routes: on the simple map R2 and R3 patrol the whole corridor in opposite phases (R2
-  stepping into the south doors, R3 into the north doors; :data:`SIMPLE_R2_BOTH_SIDES`) and R4
-  starts in the middle; on the complex map R2 and R4 walk the east-west corridor end to end in
+  stepping into the south doors, R3 into the north doors) and R4 starts in the middle; a route
+  per team size: when R2 is the only helper it steps into the doors on both sides
+  (:data:`SIMPLE_R2_BOTH_SIDES_TEAMS`, :func:`team_routes`); on the complex map R2 and R4 walk the east-west corridor end to end in
   opposite phases stepping into every room's doorway (each room of ``office_complex`` has one on
   it, from which the room's centre is in sight), and R3 walks the north-south corridor stopping
   in front of its four doors. The paper's Fig. 13 shows where its helpers are but gives no
@@ -39,7 +40,8 @@ Files
 -----
 :func:`write_files` (re)writes ``scenarios/los-help-{simple,complex,noise}.yaml`` and the
 sweeps ``sweeps/los-{table1,table2,noise-simple,noise-complex}.yaml`` (the algorithms as
-``cases``, :data:`CASES`) and ``los-ablation.yaml``; run
+``cases``, :data:`CASES`; in the tables algorithm x nested team, :func:`table_cases`) and
+``los-ablation.yaml``; run
 ``python -m teamnav.experiments.los_tasks`` after changing anything here and commit them.
 """
 
