@@ -11,7 +11,7 @@ import json
 import numpy as np
 import pytest
 
-from teamnav.experiments.report.model import Comparison, Missing
+from teamnav.experiments.report.model import Comparison, Missing, Text
 from teamnav.experiments.report.sections import _trails as T
 from teamnav.experiments.report.sections import try_to_see_it_my_way as S
 from teamnav.experiments.spec import load_scenario
@@ -58,20 +58,21 @@ def _verdicts(prof_row, blaze_k_last, blaze_0_last):
     bk = [{"units_per_10min_last": v} for v in blaze_k_last]
     b0 = [{"units_per_10min_last": v} for v in blaze_0_last]
     blocks = S._profile_blocks([prof_row], [], bk, b0, 3600.0, quick=False)
-    return [b.holds for b in blocks if isinstance(b, Comparison)]
+    return [b.holds for b in blocks if isinstance(b, Comparison)], [b.text for b in blocks if isinstance(b, Text)]
 
 
 def test_section_verdicts_follow_the_numbers():
     flat = [400.0] * 20
     working = [5] * 60
-    assert _verdicts(_row(working, flat), [1, 0, 0], [9, 8, 10]) == [True, True]
-    # the 2002 team stopped in its last 3 hours: no "works for hours"
-    assert _verdicts(_row([5] * 42 + [0] * 18, flat), [1, 0, 0], [9, 8, 10])[0] is False
-    # the 2000 team did not collapse at that drift: no contrast to show
-    assert _verdicts(_row(working, flat), [7, 6, 8], [9, 8, 10])[0] is False
+    # the long-run claim is read from the hours runs (hours_blocks); the 10-h run reports its work as text
+    verdicts, texts = _verdicts(_row(working, flat), [1, 0, 0], [9, 8, 10])
+    assert verdicts == [True]
+    assert any("300 units" in x and "5.0 in the last 3 h" in x and "breakdown: none" in x for x in texts)
+    _, texts = _verdicts(_row([5] * 42 + [0] * 18, flat, censored=0), [1], [9])
+    assert any("0.0 in the last 3 h" in x and "breakdown: at 10.0 h" in x for x in texts)
     # crumbs growing (no expiry) or the process growing: memory not flat
-    assert _verdicts(_row(working, list(np.linspace(100, 3000, 20))), [0], [9])[1] is False
-    assert _verdicts(_row(working, flat, rss_growth=500.0), [0], [9])[1] is False
+    assert _verdicts(_row(working, list(np.linspace(100, 3000, 20))), [0], [9])[0] == [False]
+    assert _verdicts(_row(working, flat, rss_growth=500.0), [0], [9])[0] == [False]
 
 
 def test_section_without_the_long_run_says_why():

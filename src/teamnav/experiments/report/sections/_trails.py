@@ -195,6 +195,158 @@ def per_drift(rows: Sequence[dict], key: str, stat: Callable[[np.ndarray], float
     return xs, ys, lo, hi
 
 
+def first_part(row: dict, t_end_s: float, case: str | None = None) -> dict:
+    """The first ``t_end_s`` seconds of a longer run, as the row of a run that long.
+
+    The drift sweeps' 1-hour point at a drift k is read from the first hour of the long runs at
+    that drift (the 3-hour try-paper runs at k = 1, the hours runs at k = 4) instead of being run
+    again: a run does not know its length (no brain reads the clock's end), so its first hour is a
+    1-hour run of the same seed. Recomputed from the row's ``units_series`` (delivery times to
+    0.01 s): ``units_total``, the 10-minute windows (``units_per_10min_series``, ``_last``,
+    ``_peak``, ``_mean``) and the breakdown (:data:`teamnav.experiments.metric_sets.trails.BREAKDOWN_GAP_S`);
+    ``params`` get ``duration_s`` and, when given, ``case`` (e.g. ``"x4"``). Every other metric
+    of the long run is left out (it belongs to the whole run).
+
+    Raises
+    ------
+    ValueError
+        ``t_end_s`` not positive or the row has no ``units_series``.
+
+    >>> r = {"seed": 3, "status": "ok", "params": {}, "units_series": "[[0,0],[100,1],[700,2],[3500,3],[4000,4]]"}
+    >>> p = first_part(r, 3600.0, "x4")
+    >>> p["units_total"], p["units_per_10min_last"], p["breakdown_censored"], p["params"]["case"]
+    (3, 1, 1, 'x4')
+    >>> first_part(r, 3000.0)["breakdown_s"]
+    700.0
+    """
+    from teamnav.experiments.metric_sets.trails import BREAKDOWN_GAP_S, WINDOW_S
+
+    text = row.get("units_series")
+    if not (t_end_s > 0) or not isinstance(text, str):
+        raise ValueError(f"first_part: expected t_end_s > 0 and a row with units_series, got {t_end_s!r} and "
+                         f"{'no' if not isinstance(text, str) else 'a'} units_series")
+    pts = np.asarray(json.loads(text), dtype=float).reshape(-1, 2)
+    times = [float(t) for t, k in pts if k > 0 and t <= t_end_s]
+    n_win = max(1, int(math.ceil(t_end_s / WINDOW_S - 1e-9)))
+    win = np.zeros(n_win, dtype=int)
+    for t in times:
+        win[min(n_win - 1, int(t // WINDOW_S))] += 1
+    if not times:
+        bd, cens = 0.0, 0
+    elif t_end_s - times[-1] >= BREAKDOWN_GAP_S:
+        bd, cens = times[-1], 0
+    else:
+        bd, cens = float(t_end_s), 1
+    params = {**(row.get("params") or {}), "duration_s": float(t_end_s)}
+    if case is not None:
+        params["case"] = case
+    return {
+        "seed": row.get("seed"), "status": row.get("status", "ok"), "params": params,
+        "units_total": len(times), "units_per_10min_last": int(win[-1]), "units_per_10min_peak": int(win.max()),
+        "units_per_10min_mean": float(len(times) / (t_end_s / WINDOW_S)), "breakdown_s": float(bd),
+        "breakdown_censored": cens, "units_per_10min_series": json.dumps(win.tolist()),
+        "units_series": json.dumps([[0.0, 0]] + [[t, i + 1] for i, t in enumerate(times)], separators=(",", ":")),
+        "from_long_run_s": float(((row.get("params") or {}).get("duration_s")) or float("nan")),
+    }
+
+
+def survival(rows: Sequence[dict], t_s: np.ndarray) -> np.ndarray:
+    """Fraction of runs not broken down by each time in ``t_s`` (Kaplan–Meier).
+
+    A run's time is its ``breakdown_s``; ``breakdown_censored = 1`` marks a run that did not
+    break down before it ended (censored at its length). With runs of one length this is the
+    fraction of runs whose breakdown comes after t; the product-limit form also takes runs of
+    different lengths.
+
+    >>> rows = [{"breakdown_s": 600.0, "breakdown_censored": 0}, {"breakdown_s": 1200.0, "breakdown_censored": 0},
+    ...         {"breakdown_s": 3600.0, "breakdown_censored": 1}, {"breakdown_s": 3600.0, "breakdown_censored": 1}]
+    >>> survival(rows, np.array([0.0, 600.0, 900.0, 1200.0, 3600.0])).tolist()
+    [1.0, 0.75, 0.75, 0.5, 0.5]
+    """
+    t_s = np.asarray(t_s, dtype=float)
+    runs = [(float(r["breakdown_s"]), not bool(r.get("breakdown_censored")))
+            for r in rows if isinstance(r.get("breakdown_s"), (int, float)) and math.isfinite(r["breakdown_s"])]
+    out = np.ones(t_s.size)
+    if not runs:
+        return np.full(t_s.size, np.nan)
+    times = np.array([t for t, _ in runs])
+    s = 1.0
+    for te in sorted({t for t, broke in runs if broke}):
+        at_risk = int((times >= te).sum())
+        d = sum(1 for t, broke in runs if broke and t == te)
+        s *= 1.0 - d / at_risk
+        out[t_s >= te] = s
+    return out
+
+
+def breakdown_marks(rows: Sequence[dict]) -> tuple[list, list, list, list]:
+    """Each run's breakdown against its drift scale: (k, min) of the runs that broke down and
+    (k, min) of those that did not (censored: at the run's length)."""
+    bx, by, cx, cy = [], [], [], []
+    for k, group in by_scale(rows).items():
+        for r in group:
+            t = r.get("breakdown_s")
+            if not isinstance(t, (int, float)):
+                continue
+            if r.get("breakdown_censored"):
+                cx.append(k)
+                cy.append(float(t) / 60.0)
+            else:
+                bx.append(k)
+                by.append(float(t) / 60.0)
+    return bx, by, cx, cy
+
+
+def spearman(x: Sequence[float], y: Sequence[float]) -> float:
+    """Spearman's rank correlation (average ranks for ties); NaN for fewer than 3 pairs or a constant.
+
+    >>> round(spearman([0, 1, 2, 3], [9, 7, 7, 1]), 3)
+    -0.949
+    """
+    a, b = np.asarray(x, float), np.asarray(y, float)
+    if a.size < 3 or a.size != b.size:
+        return float("nan")
+
+    def ranks(v: np.ndarray) -> np.ndarray:
+        order = np.argsort(v, kind="mergesort")
+        r = np.empty(v.size)
+        r[order] = np.arange(v.size, dtype=float)
+        for u in np.unique(v):  # ties share their mean rank
+            m = v == u
+            r[m] = r[m].mean()
+        return r
+
+    ra, rb = ranks(a), ranks(b)
+    if ra.std() == 0 or rb.std() == 0:
+        return float("nan")
+    return float(np.corrcoef(ra, rb)[0, 1])
+
+
+def drift_trend(rows: Sequence[dict], key: str) -> float:
+    """Spearman correlation of metric ``key`` with the drift scale k over all runs of a drift sweep."""
+    xs, ys = [], []
+    for k, group in by_scale(rows).items():
+        v = values(group, key)
+        xs += [k] * v.size
+        ys += v.tolist()
+    return spearman(xs, ys)
+
+
+def units_per_hour(row: dict, duration_s: float) -> list[int]:
+    """Units delivered in each whole hour of a run (from its ``units_series``).
+
+    >>> units_per_hour({"units_series": "[[0,0],[100,1],[3700,2],[3800,3]]"}, 7200.0)
+    [1, 2]
+    """
+    text = row.get("units_series")
+    if not isinstance(text, str):
+        return []
+    pts = np.asarray(json.loads(text), dtype=float).reshape(-1, 2)
+    times = pts[pts[:, 1] > 0, 0]
+    n = int(duration_s // 3600.0)
+    return [int(((times > 3600.0 * h) & (times <= 3600.0 * (h + 1))).sum()) for h in range(n)]
+
+
 def crumb_views(row: dict, names: Sequence[str], what: str) -> list:
     """The papers' crumb figures from one run's ``trails_crumbs`` series (MapView blocks).
 

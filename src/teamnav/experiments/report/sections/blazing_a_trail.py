@@ -79,6 +79,28 @@ OUR_ROBOTS = ("ant", "bee", "punky", "tanis")
 #: claim 2 holds when the team delivers at least this many times the units of one robot at the
 #: team controller's optimal round-trip rate (§5.1's own figure, 28 / 10 = 2.8, is its "three times")
 PAPER_RATIO = 2.7
+#: the drift sweep's scales k in full mode (blazing-drift cases x<k>, 10 seeds x 1 h each)
+DRIFT_SCALES = (0.0, 1.0, 2.0, 3.0, 4.0, 6.0)
+
+
+def drift_verdict(rows, drift_dur_s: float) -> tuple[bool | None, str]:
+    """Claim 3 from the drift sweep's runs: (holds, the numbers it was read from).
+
+    Holds when (a) the drift-free team works (last-10-min mean >= WORKING_UNITS_PER_10MIN),
+    (b) at the highest drift most runs broke down (median breakdown before the run's end) and
+    its last-10-min mean is below the drift-free one, and (c) over all runs, breakdown time and
+    last-10-min units both fall with k (Spearman rank correlation < 0; censored runs count at
+    the run's length). None for fewer than two scales or runs shorter than MIN_VERDICT_S.
+    """
+    xs, bd, _, _ = T.per_drift(rows, "breakdown_s")
+    _, last, _, _ = T.per_drift(rows, "units_per_10min_last", np.mean)
+    rho_bd, rho_u = T.drift_trend(rows, "breakdown_s"), T.drift_trend(rows, "units_per_10min_last")
+    text = f"rank correlation with k: breakdown time {rho_bd:+.2f}, last-10-min units {rho_u:+.2f}"
+    if len(xs) < 2 or drift_dur_s < T.MIN_VERDICT_S:
+        return None, text
+    holds = bool(last[0] >= T.WORKING_UNITS_PER_10MIN and bd[-1] < drift_dur_s and last[-1] < last[0]
+                 and rho_bd < 0 and rho_u < 0)
+    return holds, text
 
 
 def paper_method_ratio(team_units: float, solo_trip_s, duration_s: float) -> tuple[float, float]:
@@ -121,7 +143,7 @@ def build(ctx) -> list:
     seeds = 2 if quick else 10
     dur = 450.0 if quick else 1800.0
     drift_dur = 300.0 if quick else 3600.0
-    scales = [0.0, 4.0] if quick else [0.0, 1.0, 4.0]
+    scales = [0.0, 4.0] if quick else list(DRIFT_SCALES)
     cruise = T.cruise_mps("blazing-a-trail")
 
     paper = T.ok(ctx.sweep("blazing-paper", seeds=seeds, duration_s=dur))
@@ -195,11 +217,8 @@ def build(ctx) -> list:
     # 3. breakdown vs drift
     xs, bd, bd_lo, bd_hi = T.per_drift(drift, "breakdown_s")
     _, last, last_lo, last_hi = T.per_drift(drift, "units_per_10min_last", np.mean)
-    holds3 = None
-    if len(xs) >= 2 and drift_dur >= T.MIN_VERDICT_S:
-        # the drift-free team must work at all before a collapse can be read from the curve
-        # a breakdown, not just a slower team: the highest drift's median breakdown must come before the run's end
-        holds3 = bool(last[0] >= T.WORKING_UNITS_PER_10MIN and last[-1] < last[0] and bd[-1] < bd[0])
+    holds3, trend = drift_verdict(drift, drift_dur)
+    groups = T.by_scale(drift)
     paper_bd = T.values(paper, "breakdown_s")
     cens = T.values(paper, "breakdown_censored")
     blocks.append(Comparison(
@@ -207,12 +226,14 @@ def build(ctx) -> list:
         "no unit after ~27 min of 30 (rate falls from the start, Fig. 5 right)",
         f"paper conditions: breakdown at {T.msd(paper_bd / 60, '{:.1f}', 'min')} "
         f"({int(cens.sum()) if cens.size else 0} of {cens.size} runs did not break down within {dur / 60:g} min); "
-        + "; ".join(f"k = {d:g}: median breakdown {b / 60:.1f} min, last-10-min units {u:.1f}"
-                    for d, b, u in zip(xs, bd, last)),
+        f"drift sweep ({drift_dur / 60:g} min): "
+        + "; ".join(f"k = {d:g}: {_n_broke(groups.get(d, []))} broke down, median breakdown {b / 60:.0f} min, "
+                    f"last-10-min units {u:.1f}" for d, b, u in zip(xs, bd, last))
+        + f"; {trend}",
         holds3,
         "the sweep scales the 2002 paper's per-robot drift (the 2000 paper gives no rates); heading drift only "
-        "(both papers report rotation only; the wheel-scale cases are in the try-to-see-it-my-way section); "
-        "censored runs count at the run's length"))
+        "(both papers report rotation only; the wheel-scale and slip cases are in the try-to-see-it-my-way "
+        "section); censored runs count at the run's length"))
 
     # per-robot units (paper's table)
     rows = []
@@ -266,16 +287,46 @@ def build(ctx) -> list:
                                    W.min(0).tolist(), W.max(0).tolist(), style="bar")],
                            caption="mean over seeds, band min..max"))
     if xs:
-        blocks.append(Plot("Breakdown time vs per-robot heading drift (blazing-trail-v1)", T.DRIFT_AXIS,
-                           "breakdown [min]",
-                           [Series("median (25–75 %)", xs, [b / 60 for b in bd], [b / 60 for b in bd_lo],
-                                   [b / 60 for b in bd_hi], style="line+points")],
-                           hlines=[(27.0, "paper: ~27 min"), (drift_dur / 60, "run length (no breakdown)")]))
-        blocks.append(Plot("Units per 10 minutes at the end of the run vs per-robot drift", T.DRIFT_AXIS, "units",
-                           [Series("mean (25–75 %)", xs, last, last_lo, last_hi, style="line+points")],
-                           caption=f"the last 10 minutes of {drift_dur / 60:g}-minute runs"))
+        blocks += drift_plots("blazing-trail-v1 (2000)", drift, drift_dur)
     blocks += T.crumb_views(paper[0], [n.capitalize() for n in OUR_ROBOTS], "blazing-a-trail")
     return blocks
+
+
+def _n_broke(rows) -> str:
+    c = T.values(rows, "breakdown_censored")
+    return f"{int((c == 0).sum())}/{c.size}"
+
+
+def drift_plots(label: str, rows, drift_dur_s: float, *, with_units_over_time: bool = True) -> list:
+    """The drift sweep's figures for one algorithm: breakdown time vs k (median, 25–75 %, every
+    run marked; censored runs at the run's length), the fraction of runs not broken down over time
+    per k (Kaplan–Meier), and units over time per k."""
+    xs, bd, lo, hi = T.per_drift(rows, "breakdown_s")
+    bx, by, cx, cy = T.breakdown_marks(rows)
+    groups = T.by_scale(rows)
+    out = [Plot(f"Breakdown time vs per-robot heading drift, {label}", T.DRIFT_AXIS, "breakdown [min]",
+                [Series("median (25–75 %)", xs, [b / 60 for b in bd], [b / 60 for b in lo], [b / 60 for b in hi],
+                        style="line+points"),
+                 Series(f"a run that broke down ({len(bx)})", bx, by, style="points"),
+                 Series(f"a run with no breakdown (censored at its end, {len(cx)})", cx, cy, style="points")],
+                hlines=[(27.0, "Blazing §5.1: ~27 min"), (drift_dur_s / 60, "run length (no breakdown)")],
+                caption="runs broken down per k: " + ", ".join(f"k = {k:g}: {_n_broke(g)}" for k, g in groups.items()))]
+    t = T.time_grid(drift_dur_s, 121)
+    out.append(Plot(f"Fraction of runs not broken down by time t, {label}", "t [min]", "fraction still delivering",
+                    [Series(f"k = {k:g} (n = {len(g)})", (t / 60).tolist(), T.survival(g, t).tolist(), style="step")
+                     for k, g in groups.items()],
+                    caption="Kaplan–Meier: a run breaks down at its last delivery when none followed in the last "
+                            "180 s of the run; runs that did not are censored at their end"))
+    if with_units_over_time:
+        tg = T.time_grid(drift_dur_s)
+        out.append(Plot(f"Units over time per drift scale k, {label}", "time [min]", "units (cumulative)",
+                        [s for s in (T.band_series(f"k = {k:g}", g, tg) for k, g in groups.items()) if s is not None],
+                        caption="mean over seeds with a 10–90 % band: the curves flatten as drift grows"))
+    _, last, llo, lhi = T.per_drift(rows, "units_per_10min_last", np.mean)
+    out.append(Plot(f"Units in the last 10 minutes vs per-robot drift, {label}", T.DRIFT_AXIS, "units",
+                    [Series("mean (25–75 %)", xs, last, llo, lhi, style="line+points")],
+                    caption=f"the last 10 minutes of {drift_dur_s / 60:g}-minute runs"))
+    return out
 
 
 SECTION = SectionSpec(
