@@ -326,6 +326,36 @@ def test_comparisons_hold_when_steps_fall_and_pf_fails_alone_and_not_otherwise()
     assert comps[4].claim.startswith("Table 2: with 3 helpers")
 
 
+def test_a_team_that_finishes_nothing_counts_as_worst_in_the_falling_verdict():
+    def rows(h, fins, steps):
+        return [_row("avoid_past", s, finished=f, **{f"robots.{k + 1}.count": int(k < h) for k in range(3)},
+                     **{S.TARGETS_KEY: [[float(t), 0.0]] * 20})
+                for t, (f, s) in enumerate(zip(fins, steps))]
+    # R1 alone finishes no task, the teams with helpers all finish with falling steps: holds
+    by_team = {0: rows(0, [0, 0], [700, 800]), 1: rows(1, [1, 1], [400, 420]), 2: rows(2, [1, 1], [300, 310]),
+               3: rows(3, [1, 1], [200, 220])}
+    comp = [c for c in S.table_comparisons("simple", S.table_block("simple", by_team)[1], by_team)
+            if "Av. Past" in c.claim][0]
+    assert comp.holds is True and comp.ours.startswith("fails (0/2) → 410 → 305 → 210")
+    # a team with more helpers failing everything after one that finished: does not hold
+    by_team[3] = rows(3, [0, 0], [900, 900])
+    comp = [c for c in S.table_comparisons("simple", S.table_block("simple", by_team)[1], by_team)
+            if "Av. Past" in c.claim][0]
+    assert comp.holds is False and comp.ours.startswith("fails (0/2) → 410 → 305 → fails (0/2)")
+
+
+def test_r1_alone_level_is_the_finished_mean_or_steps_per_reached_target_when_tasks_failed():
+    def r(nav, spt, fin, reached):
+        row = _row(nav, spt, finished=fin)
+        row["metrics"]["los_targets_reached"] = reached
+        return row
+    lv = S.alone_levels([r("visbug21", 300, 1, 20), r("visbug21", 500, 1, 20),
+                         r("avoid_past", 600, 0, 10), r("avoid_past", 800, 1, 20), r("avoid_past", 1500, 0, 0),
+                         r("potential_field", 1500, 0, 0)])
+    assert lv["visbug21"] == 400.0 and lv["avoid_past"] == 700.0  # a task that reached nothing has no rate
+    assert math.isnan(lv["potential_field"])
+
+
 def test_noise_verdicts_follow_the_paper_rows():
     alone = {"avoid_past": 500.0, "visbug21": 800.0, "potential_field": float("nan")}
     rows = [_row(nav, s, **{S.ERR_KEY: e}) for nav, base in (("avoid_past", 200), ("visbug21", 300))

@@ -337,7 +337,9 @@ def noise_plot(map_key: str, rows: list[dict], alone: dict[str, float]) -> tuple
     fig = 16 if map_key == "simple" else 17
     return Plot(f"Fig. {fig} ({L.MAPS[map_key]}): R1's steps vs err_max, R2..R4 present", "err_max (eqs. 1-2)",
                 "R1's motion steps per target (finished tasks)", series, hlines=hl,
-                caption="Horizontal lines: R1 alone (Tables 1-2, noise has no effect without teammates); "
+                caption="Horizontal lines: R1 alone (Tables 1-2, noise has no effect without teammates; where R1 "
+                        "alone failed tasks, its steps per reached target with the abandoned target's budget, "
+                        "alone_levels); "
                         "the potential field alone fails and has no line. Means over finished tasks only"
                         + (" (finished: " + "; ".join(unfinished) + ")." if unfinished else "; every task finished.")), means
 
@@ -372,20 +374,30 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
     teams = sorted(by_team)
     for nav in L.NAVIGATORS:
         hs = [h for h in teams if not (nav == "potential_field" and h == 0)]
-        ms = [means[nav][h] for h in hs]
-        paired = paired_means(by_team, nav, hs)
+        # a team that finished no task is worse than any that did: the trend holds through it
+        # when such teams come before (fewer helpers than) every team that finished tasks
+        fin = {h: finished_of(group(by_team.get(h, []), NAV_KEY).get(nav, [])) for h in hs}
+        failing = [h for h in hs if fin[h].size and not (fin[h] > 0.5).any()]
+        ok_hs = [h for h in hs if h not in failing]
+        ms = [means[nav][h] for h in ok_hs]
+        paired = paired_means(by_team, nav, ok_hs) if ok_hs else None
         note = ""
         if paired is not None:
             ms, k, n = paired
-            note = f" (paired: the {k} of {n} tasks finished with every team)"
+            note = f" (paired: the {k} of {n} tasks finished with every team that finished one)"
         p = [paper[nav][h][0] for h in hs if paper[nav][h] is not None]
+        fails_first = not failing or not ok_hs or max(failing) < min(ok_hs)
         if len(ms) < 2:
-            holds = None  # one team size: no trend to judge (quick mode, potential field)
+            # one team size with results: a trend only if teams with fewer helpers failed outright
+            holds = (fails_first and bool(ok_hs)) if failing else None
         else:
-            holds = strictly_falling(ms) if all(np.isfinite(ms)) else (False if any(np.isfinite(ms)) else None)
-        ours = " → ".join("n/a" if not np.isfinite(m) else f"{m:.0f}" for m in ms)
+            trend = strictly_falling(ms) if all(np.isfinite(ms)) else (False if any(np.isfinite(ms)) else None)
+            holds = None if trend is None else bool(trend and fails_first)
+        ours = " → ".join([f"fails ({int(fin[h].sum())}/{fin[h].size})" for h in failing if h < min(ok_hs, default=9)]
+                          + ["n/a" if not np.isfinite(m) else f"{m:.0f}" for m in ms]
+                          + [f"fails ({int(fin[h].sum())}/{fin[h].size})" for h in failing if h > min(ok_hs, default=9)])
         ratio = (f"; last/first {ms[-1] / ms[0]:.2f} (paper {p[-1] / p[0]:.2f})"
-                 if len(ms) >= 2 and np.isfinite(ms[0]) and np.isfinite(ms[-1]) and ms[0] > 0 else "")
+                 if len(ms) >= 2 and np.isfinite(ms[0]) and np.isfinite(ms[-1]) and ms[0] > 0 and not failing else "")
         out.append(Comparison(
             f"Table {tab}: {NAV_LABEL[nav]} steps fall as helpers are added ({', '.join(TEAM_LABEL[h] for h in hs)})",
             " → ".join(f"{v:.1f}" for v in p), ours + ratio + note, holds,
@@ -395,8 +407,10 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
     alone_fin, help_fin = finished_of(pf), finished_of(pf_help)
     if alone_fin.size and help_fin.size:
         holds = bool(np.all(alone_fin < 0.5) and np.all(help_fin > 0.5))
+        per_team = ", ".join(f"{TEAM_LABEL[h]} {int(f.sum())}/{f.size}" for h in teams if h > 0
+                             and (f := finished_of(group(by_team[h], NAV_KEY).get("potential_field", []))).size)
         ours = (f"alone: {int(alone_fin.sum())}/{alone_fin.size} finished; with helpers: "
-                f"{int(help_fin.sum())}/{help_fin.size} finished")
+                f"{int(help_fin.sum())}/{help_fin.size} finished ({per_team})")
     else:
         holds, ours = None, "not run"
     out.append(Comparison(f"Table {tab}: the potential field alone fails, and finishes with helpers (state + goal sharing)",
@@ -414,6 +428,26 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         out.append(Comparison("Table 2: with 3 helpers the algorithm still matters (best and worst differ by > 10 %)",
                               "Av. Past 682.6, VisBug 373.4, Pot. Fields 913.6 (+145 %)", ours, holds,
                               "" if holds or holds is None else "with 3 helpers our algorithms end up close"))
+    return out
+
+
+def alone_levels(rows: list[dict]) -> dict[str, float]:
+    """R1 alone's steps per target per algorithm, the reference line of Figs. 16-17: the mean
+    over its tasks when every task finished; otherwise the mean steps per *reached* target over
+    every task, the abandoned target's budget included (a failed task has no finished mean, and
+    a mean over the finished tasks only would keep the easy ones); NaN when none reached any."""
+    out: dict[str, float] = {}
+    for nav in L.NAVIGATORS:
+        rs = group(rows, NAV_KEY).get(nav, [])
+        st, fin = steps_of(rs), finished_of(rs)
+        if not rs:
+            out[nav] = float("nan")
+        elif (fin > 0.5).all():
+            out[nav] = stats(st)[0]
+        else:
+            reached = np.array([_metric(r, "los_targets_reached") for r in rs])
+            ok = reached > 0
+            out[nav] = float(np.mean(st[ok])) if ok.any() and nav != "potential_field" else float("nan")
     return out
 
 
@@ -580,7 +614,7 @@ def build(ctx) -> list:
         tab, means = table_block(m, by_team)
         blocks += [tab, robots_plot(m, by_team)]
         comps += table_comparisons(m, means, by_team)
-        alone[m] = {nav: means[nav][0] for nav in L.NAVIGATORS}
+        alone[m] = alone_levels(by_team.get(0, []))
     for m in L.MAPS:
         if m not in maps:
             blocks.append(Missing(f"Fig. 17 ({L.MAPS[m]}, noise)", "full mode only (teamnav report los-help)"))
