@@ -388,7 +388,8 @@ def test_brain_state_sharing_follows_teammate_not_in_trouble(monkeypatch):
     monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
     cr = 3
     r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False,
-                                        trouble_progress="moved"),  # any unblocked step is progress
+                                        trouble_progress="moved",  # any unblocked step is progress
+                                        trouble_helper_towards_goal=False),  # §5 rule 3 as written
                      np.random.default_rng(0), info(0, 2))
     wall = [(0.0, 0.1, 0.5)]
     for k in range(cr):
@@ -642,7 +643,7 @@ def test_in_trouble_progress_is_towards_the_own_goal_so_following_away_keeps_fol
     monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
     cr = 3
     r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False,
-                                        trouble_progress="goal"),
+                                        trouble_progress="goal", trouble_helper_towards_goal=False),
                      np.random.default_rng(0), info(0, 2))
     wall = [(0.0, 0.1, 0.5)]
     for k in range(cr):
@@ -694,7 +695,7 @@ def test_in_trouble_progress_towards_the_helper_is_fig_10s_reading(monkeypatch, 
     monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
     cr = 3
     r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False,
-                                        trouble_progress=rule),
+                                        trouble_progress=rule, trouble_helper_towards_goal=False),
                      np.random.default_rng(0), info(0, 2))
     wall = [(0.0, 0.1, 0.5)]
     for k in range(cr):
@@ -714,3 +715,45 @@ def test_in_trouble_progress_towards_the_helper_is_fig_10s_reading(monkeypatch, 
         assert out_at is not None and out_at <= cr + 1 and r1.trouble.nt == 2
     else:
         assert out_at is None and r1.trouble.tr and r1.trouble.nt == 1
+
+
+@pytest.mark.parametrize("towards", [True, False])
+def test_in_trouble_only_a_teammate_closing_in_on_the_goal_is_followed(monkeypatch, towards):
+    # trouble_helper_towards_goal (gap-fill of §5 rule 3): stuck R1 (goal at +x) sees R2 walk
+    # away from its goal (-x): not followed (the paper's rule follows it); R2 turns and walks
+    # towards the goal: followed; R2 turns away again: let go once it is trouble_recede_m
+    # farther from the goal than its nearest while followed
+    stuck = StraightNav(stuck=True)
+    monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
+    cr, recede = 3, 1.0
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False,
+                                        trouble_helper_towards_goal=towards, trouble_recede_m=recede,
+                                        trouble_heading_steps=3, keep_trouble_helper=False,
+                                        trouble_progress="goal"),  # R1 stands still: stays in trouble
+                     np.random.default_rng(0), info(0, 2))
+    wall = [(0.0, 0.1, 0.5)]
+    for k in range(cr):
+        r1.step(obs(k, walls=wall))
+    assert r1.trouble.tr
+    k, modes = cr, []
+
+    def see(x2):  # R2 at (x2, 3) seen from R1 standing at the origin
+        nonlocal k
+        r, b = polar((0.0, 0.0), (x2, 3.0))
+        r1.step(obs(k, walls=wall, seen=[(1, r, b)], inbox=[msg(1, k - 1, trouble=False)]))
+        k += 1
+        return r1.mode
+
+    away = [see(-0.2 * i) for i in range(8)]
+    back = [see(-1.6 + 0.2 * i) for i in range(8)]
+    if not towards:
+        assert set(away) == {"trouble_follow"} and set(back) == {"trouble_follow"}
+        return
+    assert set(away) == {"own_goal"}  # walking away from R1's goal: A goes on
+    assert back[0] == "own_goal" and back[-1] == "trouble_follow"  # closing in: followed
+    turned = [see(-0.2 - 0.2 * i) for i in range(12)]  # nearest at x = -0.2, 6.2 m from the goal
+    assert turned[0] == "trouble_follow" and turned[-1] == "own_goal"
+    # let go once more than `recede` farther than the nearest distance while followed
+    first_off = turned.index("own_goal")
+    d_at = math.hypot(6.0 + 0.2 + 0.2 * first_off, 3.0) - math.hypot(6.2, 3.0)
+    assert recede < d_at <= recede + 0.25

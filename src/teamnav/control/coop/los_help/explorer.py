@@ -52,6 +52,26 @@ class LosExplorerParams(_CommonParams):
         distance to the teammate it heads for fell (its best so far, ``_head_to``), so Pr falls
         while R1 closes in and R1 leaves the teammate after about Nt·Cr steps, each episode
         longer than the last (Nt grows).
+    trouble_helper_towards_goal : bool
+        In trouble (§5 rule 3), head only to a teammate that is *closing in on R1's goal*: its
+        straight distance (seen position, own frame) to R1's current goal fell by more than
+        ``trouble_recede_m`` / 10 over the last ``trouble_heading_steps`` steps it was seen,
+        and stop following it once that distance has grown by more than
+        ``trouble_recede_m`` above the smallest seen while following (the teammate turned
+        away). Without such a teammate R1 drives with A as if not in trouble (Pr keeps its
+        value, so the next teammate that qualifies is followed at once). Gap filled: §5
+        says R1 "believes temporarily that R_j is in a better area of the environment for
+        reaching its own goal"; a patrolling helper walking *away* from the goal is not, and
+        following it was where the potential field's steps went on office_complex (traced:
+        R1 trapped by room 2's west wall with its goal in room 1 followed R2 east 26 m to the
+        corridor's end, was released there and trapped in room 5; 1868 of 3637 steps of that
+        task). False: the nearest teammate not in trouble (the paper's rule).
+    trouble_heading_steps : int
+        Steps of a teammate's sightings over which its approach to the goal is judged
+        (``trouble_helper_towards_goal``).
+    trouble_recede_m : float
+        Hysteresis [m] of ``trouble_helper_towards_goal`` (a helper stepping into a doorway
+        moves across the goal's direction by about a metre).
     max_steps_per_target : int or None
         Step budget per target: when the current target is not reached within this many steps
         (from the step it became current), R1 abandons the task (``gave_up``, and ``finished``
@@ -73,6 +93,9 @@ class LosExplorerParams(_CommonParams):
     keep_trouble_helper: bool = True
     max_steps_per_target: int | None = Field(None, ge=1, le=100_000_000)
     trouble_progress: Literal["goal", "moved", "helper"] = "helper"
+    trouble_helper_towards_goal: bool = True
+    trouble_heading_steps: int = Field(5, ge=1, le=1000)
+    trouble_recede_m: float = Field(2.0, ge=0.0, le=100.0)
 
 
 
@@ -122,6 +145,9 @@ class LosExplorer(_LosBrain):
         self.promised_steps = 0
         self.goal_seen_steps = 0
         self._trouble_target: tuple[int, XY] | None = None
+        #: teammates' recent straight distances to R1's goal, (step, d) (trouble_helper_towards_goal)
+        self._mate_goal_d: dict[int, list[tuple[int, float]]] = {}
+        self._tt_best_d = math.inf
         self._set_goal()
 
     def _set_goal(self) -> None:
@@ -148,6 +174,7 @@ class LosExplorer(_LosBrain):
             self._moves_since = self.moves
             self.target_index += 1
             self.targets_reached += 1
+            self._mate_goal_d = {}
             self.finished = self.target_index >= len(self.targets)
             self._set_goal()
             self._last_target = None
@@ -225,6 +252,8 @@ class LosExplorer(_LosBrain):
                     self.sharing.mark_reached(self.me)
         if not self.trouble.tr:
             self._trouble_target = None
+        if p.state_sharing and p.trouble_helper_towards_goal:
+            self._track_mates(goal)
         me_xy = self._me_xy()
         goal_d = math.hypot(goal[0] - me_xy[0], goal[1] - me_xy[1])
         if action is None and p.state_sharing and self.trouble.tr:
@@ -234,12 +263,22 @@ class LosExplorer(_LosBrain):
             # names only these two ends)
             near = 2.0 * self.radius_m + self.step_m
             cands = [(rid, xy[0], xy[1], self._teammate_tr.get(rid)) for rid, xy in self._seen_now.items()]
+            if p.trouble_helper_towards_goal:
+                # only a teammate closing in on R1's goal (see ``trouble_helper_towards_goal``)
+                cands = [(rid, x, y, tr if self._mate_approaches(rid) else None) for rid, x, y, tr in cands]
             tt = self._trouble_target
+            if tt is not None and tt[0] in self._seen_now and p.trouble_helper_towards_goal:
+                d_mate = self._mate_goal_d[tt[0]][-1][1]
+                self._tt_best_d = min(self._tt_best_d, d_mate)
+                if d_mate > self._tt_best_d + p.trouble_recede_m:
+                    tt = self._trouble_target = None  # it turned away from the goal: let it go
             if tt is not None and tt[0] in self._seen_now:
                 tt = self._trouble_target = (tt[0], self._seen_now[tt[0]])
             elif tt is None or math.hypot(tt[1][0] - self._pose[0], tt[1][1] - self._pose[1]) <= near:
                 helper = choose_helper(True, self._me_xy(), cands)
                 tt = self._trouble_target = None if helper is None else (helper, self._seen_now[helper])
+                if helper is not None and p.trouble_helper_towards_goal:
+                    self._tt_best_d = self._mate_goal_d[helper][-1][1]
             if tt is not None and (tt[0] in self._seen_now or p.keep_trouble_helper):
                 self.mode = "trouble_follow"
                 action, towards = self._head_to(tt[1], ("helper", tt[0]), stop_within_m=near, end_margin_m=near)
@@ -266,6 +305,27 @@ class LosExplorer(_LosBrain):
         self.trouble.update(progressing)
         self._prev_goal_d = goal_d
         return action
+
+    def _track_mates(self, goal: XY) -> None:
+        """Keep each teammate's straight distance to R1's goal over the last
+        ``trouble_heading_steps`` steps it was seen (``trouble_helper_towards_goal``)."""
+        keep = self._step - self.params.trouble_heading_steps
+        for rid, xy in self._seen_now.items():
+            hist = self._mate_goal_d.setdefault(rid, [])
+            hist.append((self._step, math.hypot(xy[0] - goal[0], xy[1] - goal[1])))
+        for rid in list(self._mate_goal_d):
+            hist = [e for e in self._mate_goal_d[rid] if e[0] >= keep]
+            if hist:
+                self._mate_goal_d[rid] = hist
+            else:
+                del self._mate_goal_d[rid]
+
+    def _mate_approaches(self, rid: int) -> bool:
+        """Whether teammate ``rid``, seen now, came closer to R1's goal over its kept sightings."""
+        hist = self._mate_goal_d.get(rid)
+        if not hist or len(hist) < 2 or hist[-1][0] != self._step:
+            return False
+        return hist[-1][1] < hist[0][1] - 0.1 * self.params.trouble_recede_m
 
     def log(self) -> dict[str, Any]:
         """Per-step values (keep these keys stable; experiments read them).
