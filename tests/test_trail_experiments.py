@@ -378,6 +378,34 @@ def test_blazing_three_times_is_judged_by_the_papers_method_not_route_follow(sol
     assert solo_call == {"seeds": 1, "duration_s": 450.0}
 
 
+def _drift_runs(k, last, broke_min):
+    """Runs at drift scale k: last-10-min units and breakdown minute (None: no breakdown in the hour)."""
+    return [_row(5, 90.0, k, {"units_per_10min_last": u, "breakdown_s": 60.0 * (b if b is not None else 60),
+                              "breakdown_censored": int(b is None)}) for u, b in zip(last, broke_min)]
+
+
+@pytest.mark.parametrize("runs, dur_s, holds", [
+    # collapse: 10 -> 1 per 10 min, breakdowns from k = 4 on
+    (_drift_runs(0, [10, 11], [None, None]) + _drift_runs(2, [6, 5], [None, 57]) + _drift_runs(4, [1, 0], [45, 40]),
+     3600.0, True),
+    # the highest scales swap (a trickle by exploration at k = 6): the trend still falls
+    (_drift_runs(0, [10, 11], [None, None]) + _drift_runs(4, [1, 0], [45, 40]) + _drift_runs(6, [2, 2], [None, 50]),
+     3600.0, True),
+    # slower but not collapsed (6 of 10.5 per 10 min), no breakdown anywhere
+    (_drift_runs(0, [10, 11], [None, None]) + _drift_runs(4, [6, 6], [None, None]), 3600.0, False),
+    # fewer units but breakdowns later with more drift: no falling breakdown time
+    (_drift_runs(0, [4, 4], [None, 40]) + _drift_runs(4, [1, 1], [None, None]), 3600.0, False),
+    # runs too short to see a breakdown
+    (_drift_runs(0, [10, 11], [None, None]) + _drift_runs(4, [1, 0], [4, 3]), 300.0, None),
+])
+def test_blazing_drift_verdict_reads_the_trend_over_all_runs(runs, dur_s, holds):
+    from teamnav.experiments.report.sections.blazing_a_trail import drift_verdict
+
+    verdict, text = drift_verdict(runs, dur_s)
+    assert verdict is holds
+    assert text.startswith("rank correlation with k: breakdown time ")
+
+
 def test_paper_method_ratio_on_the_papers_numbers_and_without_trips():
     from teamnav.experiments.report.sections.blazing_a_trail import paper_method_ratio
 

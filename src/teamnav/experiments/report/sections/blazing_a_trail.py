@@ -87,10 +87,13 @@ def drift_verdict(rows, drift_dur_s: float) -> tuple[bool | None, str]:
     """Claim 3 from the drift sweep's runs: (holds, the numbers it was read from).
 
     Holds when (a) the drift-free team works (last-10-min mean >= WORKING_UNITS_PER_10MIN),
-    (b) at the highest drift most runs broke down (median breakdown before the run's end) and
-    its last-10-min mean is below the drift-free one, and (c) over all runs, breakdown time and
-    last-10-min units both fall with k (Spearman rank correlation < 0; censored runs count at
-    the run's length). None for fewer than two scales or runs shorter than MIN_VERDICT_S.
+    (b) at the highest drift the last-10-min mean is below half the drift-free one (collapsed,
+    not just slower), (c) some drift scale has most of its runs broken down (median breakdown
+    before the run's end), and (d) over all runs breakdown time and last-10-min units both fall
+    with k (Spearman rank correlation < 0; censored runs count at the run's length). The trend,
+    not each step, is judged: a breakdown is 180 s without a delivery at the run's end, and a
+    collapsed team still delivers a trickle of units by random exploration, so neighbouring
+    scales can swap. None for fewer than two scales or runs shorter than MIN_VERDICT_S.
     """
     xs, bd, _, _ = T.per_drift(rows, "breakdown_s")
     _, last, _, _ = T.per_drift(rows, "units_per_10min_last", np.mean)
@@ -98,8 +101,8 @@ def drift_verdict(rows, drift_dur_s: float) -> tuple[bool | None, str]:
     text = f"rank correlation with k: breakdown time {rho_bd:+.2f}, last-10-min units {rho_u:+.2f}"
     if len(xs) < 2 or drift_dur_s < T.MIN_VERDICT_S:
         return None, text
-    holds = bool(last[0] >= T.WORKING_UNITS_PER_10MIN and bd[-1] < drift_dur_s and last[-1] < last[0]
-                 and rho_bd < 0 and rho_u < 0)
+    holds = bool(last[0] >= T.WORKING_UNITS_PER_10MIN and last[-1] < 0.5 * last[0]
+                 and min(bd) < drift_dur_s and rho_bd < 0 and rho_u < 0)
     return holds, text
 
 
