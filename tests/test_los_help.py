@@ -718,11 +718,11 @@ def test_in_trouble_progress_towards_the_helper_is_fig_10s_reading(monkeypatch, 
 
 
 @pytest.mark.parametrize("towards", [True, False])
-def test_in_trouble_only_a_teammate_closing_in_on_the_goal_is_followed(monkeypatch, towards):
+def test_in_trouble_a_teammate_walking_away_from_the_goal_is_let_go(monkeypatch, towards):
     # trouble_helper_towards_goal (gap-fill of §5 rule 3): stuck R1 (goal at +x) sees R2 walk
-    # away from its goal (-x): not followed (the paper's rule follows it); R2 turns and walks
-    # towards the goal: followed; R2 turns away again: let go once it is trouble_recede_m
-    # farther from the goal than its nearest while followed
+    # away from its goal (-x): followed at first sight, let go once R2 is trouble_recede_m
+    # farther from the goal than its nearest while followed, and not taken again while it
+    # recedes (the paper's rule follows it all along); R2 turns back: followed again
     stuck = StraightNav(stuck=True)
     monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
     cr, recede = 3, 1.0
@@ -735,7 +735,7 @@ def test_in_trouble_only_a_teammate_closing_in_on_the_goal_is_followed(monkeypat
     for k in range(cr):
         r1.step(obs(k, walls=wall))
     assert r1.trouble.tr
-    k, modes = cr, []
+    k = cr
 
     def see(x2):  # R2 at (x2, 3) seen from R1 standing at the origin
         nonlocal k
@@ -744,16 +744,14 @@ def test_in_trouble_only_a_teammate_closing_in_on_the_goal_is_followed(monkeypat
         k += 1
         return r1.mode
 
-    away = [see(-0.2 * i) for i in range(8)]
-    back = [see(-1.6 + 0.2 * i) for i in range(8)]
+    xs = [-0.2 * i for i in range(12)]
+    away = [see(x) for x in xs]
+    back = [see(-2.2 + 0.2 * i) for i in range(8)]
     if not towards:
         assert set(away) == {"trouble_follow"} and set(back) == {"trouble_follow"}
         return
-    assert set(away) == {"own_goal"}  # walking away from R1's goal: A goes on
-    assert back[0] == "own_goal" and back[-1] == "trouble_follow"  # closing in: followed
-    turned = [see(-0.2 - 0.2 * i) for i in range(12)]  # nearest at x = -0.2, 6.2 m from the goal
-    assert turned[0] == "trouble_follow" and turned[-1] == "own_goal"
-    # let go once more than `recede` farther than the nearest distance while followed
-    first_off = turned.index("own_goal")
-    d_at = math.hypot(6.0 + 0.2 + 0.2 * first_off, 3.0) - math.hypot(6.2, 3.0)
-    assert recede < d_at <= recede + 0.25
+    off = away.index("own_goal")
+    assert set(away[:off]) == {"trouble_follow"} and set(away[off:]) == {"own_goal"}
+    d = [math.hypot(6.0 - x, 3.0) for x in xs]
+    assert d[off] - d[0] > recede >= d[off - 1] - d[0]  # let go just past the hysteresis
+    assert back[0] == "own_goal" and set(back[1:]) == {"trouble_follow"}  # turned back: followed

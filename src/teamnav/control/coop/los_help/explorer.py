@@ -53,19 +53,22 @@ class LosExplorerParams(_CommonParams):
         while R1 closes in and R1 leaves the teammate after about Nt·Cr steps, each episode
         longer than the last (Nt grows).
     trouble_helper_towards_goal : bool
-        In trouble (§5 rule 3), head only to a teammate that is *closing in on R1's goal*: its
-        straight distance (seen position, own frame) to R1's current goal fell by more than
-        ``trouble_recede_m`` / 10 over the last ``trouble_heading_steps`` steps it was seen,
-        and stop following it once that distance has grown by more than
-        ``trouble_recede_m`` above the smallest seen while following (the teammate turned
-        away). Without such a teammate R1 drives with A as if not in trouble (Pr keeps its
-        value, so the next teammate that qualifies is followed at once). Gap filled: §5
-        says R1 "believes temporarily that R_j is in a better area of the environment for
-        reaching its own goal"; a patrolling helper walking *away* from the goal is not, and
-        following it was where the potential field's steps went on office_complex (traced:
-        R1 trapped by room 2's west wall with its goal in room 1 followed R2 east 26 m to the
-        corridor's end, was released there and trapped in room 5; 1868 of 3637 steps of that
-        task). False: the nearest teammate not in trouble (the paper's rule).
+        In trouble (§5 rule 3), do not head to a teammate that is *walking away from R1's
+        goal*: one whose straight distance (seen position, own frame) to R1's current goal grew
+        by more than ``trouble_recede_m`` / 10 over its sightings of the last
+        ``trouble_heading_steps`` steps is no candidate, and a teammate being followed is let
+        go once that distance has grown by more than ``trouble_recede_m`` above the smallest
+        seen while following it. Without a candidate R1 drives with A as if not in trouble
+        (Pr keeps its value, so the next teammate that qualifies is followed at once).
+        Gap filled: §5 says R1 "believes temporarily that R_j is in a better area of the
+        environment for reaching its own goal"; a patrolling helper walking away from the
+        goal is not, and following it was where the potential field's steps went on
+        office_complex (traced: R1 trapped by room 2's west wall with its goal in room 1
+        followed R2 east 26 m to the corridor's end, was released there and trapped in room 5;
+        1868 of 3637 steps of that task). A first version that followed only a teammate
+        already *closing in* on the goal lost R1 in office_simple's room N5, whose door shows
+        R1 a helper only while it steps into the doorway and out (away, then towards).
+        False: the nearest teammate not in trouble (the paper's rule).
     trouble_heading_steps : int
         Steps of a teammate's sightings over which its approach to the goal is judged
         (``trouble_helper_towards_goal``).
@@ -264,8 +267,8 @@ class LosExplorer(_LosBrain):
             near = 2.0 * self.radius_m + self.step_m
             cands = [(rid, xy[0], xy[1], self._teammate_tr.get(rid)) for rid, xy in self._seen_now.items()]
             if p.trouble_helper_towards_goal:
-                # only a teammate closing in on R1's goal (see ``trouble_helper_towards_goal``)
-                cands = [(rid, x, y, tr if self._mate_approaches(rid) else None) for rid, x, y, tr in cands]
+                # not a teammate walking away from R1's goal (see ``trouble_helper_towards_goal``)
+                cands = [(rid, x, y, None if self._mate_recedes(rid) else tr) for rid, x, y, tr in cands]
             tt = self._trouble_target
             if tt is not None and tt[0] in self._seen_now and p.trouble_helper_towards_goal:
                 d_mate = self._mate_goal_d[tt[0]][-1][1]
@@ -320,12 +323,12 @@ class LosExplorer(_LosBrain):
             else:
                 del self._mate_goal_d[rid]
 
-    def _mate_approaches(self, rid: int) -> bool:
-        """Whether teammate ``rid``, seen now, came closer to R1's goal over its kept sightings."""
+    def _mate_recedes(self, rid: int) -> bool:
+        """Whether teammate ``rid`` went farther from R1's goal over its kept sightings."""
         hist = self._mate_goal_d.get(rid)
-        if not hist or len(hist) < 2 or hist[-1][0] != self._step:
+        if not hist or len(hist) < 2:
             return False
-        return hist[-1][1] < hist[0][1] - 0.1 * self.params.trouble_recede_m
+        return hist[-1][1] > hist[0][1] + 0.1 * self.params.trouble_recede_m
 
     def log(self) -> dict[str, Any]:
         """Per-step values (keep these keys stable; experiments read them).
