@@ -68,6 +68,11 @@ class LosExplorerParams(_CommonParams):
         1868 of 3637 steps of that task). A first version that followed only a teammate
         already *closing in* on the goal lost R1 in office_simple's room N5, whose door shows
         R1 a helper only while it steps into the doorway and out (away, then towards).
+        Measured, potential field, 5 tasks x 10 targets, paper rule -> this, targets reached
+        (tasks finished): office_complex R1+R2 31/50 (2/5) -> 38/50 (3/5), R1..3 23/50 (0/5)
+        -> 32/50 (2/5), R1..4 31/50 (1/5) -> 43/50 (3/5); office_simple unchanged within the
+        task-to-task spread (R1+R2 19/50 both; R1..3 383 -> 363 steps per target, 5/5 -> 4/5;
+        R1..4 331 -> 341, 5/5 both).
         False: the nearest teammate not in trouble (the paper's rule).
     trouble_heading_steps : int
         Steps of a teammate's sightings over which its approach to the goal is judged
