@@ -368,6 +368,20 @@ def test_noise_verdicts_follow_the_paper_rows():
     assert fade.holds is False  # gain 300 -> 200 keeps more than half: help did not fade
 
 
+def test_noise_growth_is_judged_on_the_tasks_finished_at_both_noise_levels():
+    alone = {"avoid_past": 900.0}
+    def r(task, e, steps, fin=1):
+        return _row("avoid_past", steps, finished=fin, **{S.ERR_KEY: e, S.TARGETS_KEY: [[float(task), 0.0]] * 20})
+    # at 0 the hard task 2 failed: unpaired means 200 -> 300 "grow", paired (task 1) 200 -> 150 do not
+    rows = [r(1, 0.0, 200), r(2, 0.0, 800, fin=0), r(1, 0.4, 150), r(2, 0.4, 450)]
+    _plot, means = S.noise_plot("simple", rows, alone)
+    assert means["avoid_past"] == {0.0: 200.0, 0.4: 300.0}
+    assert S.noise_comparisons("simple", means, alone)[0].holds is True
+    grow = S.noise_comparisons("simple", means, alone, rows)[0]
+    assert grow.holds is False and "200 → 150 (paired, 1 tasks)" in grow.ours
+    assert S.paired_noise(rows, "avoid_past", (0.0, 0.4)) == ([200.0, 150.0], 1)
+
+
 class _FakeCtx:
     """A ctx whose sweeps return hand-made rows (no simulation)."""
 
