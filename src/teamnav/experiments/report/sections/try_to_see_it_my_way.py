@@ -5,30 +5,37 @@ EXPERIMENTS.md rows, each a :class:`Comparison`:
 1. "4 robots, 3 h 8 min, 262 trips, 8.2 km, ≈ 92 % of cruise speed" → the try-paper runs go on
    for hours under the paper's per-robot drift with no breakdown; efficiency (§3.6: route length
    / (total lifetime / trips) / cruise speed) near the paper's.
-2. "trails shared despite diverged frames" → the same drift for 1 h with and without Place
+2. EXPERIMENTS.md "runs for hours of simulated time with drift that breaks the Blazing-a-trail
+   system, with no breakdown" and the issue's "the 2002 one keeps working for hours under the
+   same drift" → :func:`hours_blocks`: the 2002 team for 3 h at drift k = 4 (where the 2000
+   team collapses within the hour), 8 seeds: breakdowns and units per hour per seed, beside the
+   2000 team's 1-hour runs at k = 4.
+3. "trails shared despite diverged frames" → the same drift for 1 h with and without Place
    transforms, and the 2000 algorithm (the drift sweeps' k = 1 case: the paper's drift).
-3. The drift sweep of both algorithms (each robot its own drift, k x Bug -1, Ant +1, Fly +2,
-   Tanis +0.35 deg/min): breakdown time and last-10-minute throughput vs k.
-4. Memory stays flat (crumbs held, first vs second half of the long runs: 4-minute expiry).
-5. The issue's "the 2002 one keeps working for hours under the same drift", "memory stays flat
-   over a 10-hour simulated run" and "a simulated hour of 4 robots runs in well under a minute on
-   one core": one 10-hour run of trail-share-v1 at k = 4 (the drift where the 2000 algorithm
-   collapses within the hour), sampled every 30 min in the trial (:func:`_trails.profile_trial`:
-   the largest Trail any robot holds, the process's RSS, CPU seconds per simulated hour), and a
-   2-hour run of blazing-trail-v1 at k = 1 for its CPU cost and its ever-growing crumb list.
-   Measured (commit bec19bc, seed 0, machine shared with ~12 other runs): 341 units in 10 h,
-   5.7 per 10 min on average and 5.7 in the last 3 h (no breakdown); largest Trail 462–476
-   crumbs in every sample (bound 4 x 121); RSS 248.9 MiB at 0.5 h and at 10 h; 40 CPU s per
-   simulated hour (38–49 per interval; 58 in the first, which loads the compiled kernels).
+4. The drift sweep of both algorithms (each robot its own drift, k x Bug -1, Ant +1, Fly +2,
+   Tanis +0.35 deg/min): breakdown time and last-10-minute throughput vs k; the 2002 team's
+   k = 1 and k = 4 points are the first hour of the try-paper and hours runs
+   (:func:`_trails.first_part`: a run does not know its length, tests/test_trail_experiments.py
+   checks it), its k = 0, 2, 6 points 1-hour runs (8 seeds); the 2000 team's k = 0, 1, 2, 3, 4, 6
+   1-hour runs (10 seeds, the blazing-a-trail section's).
+5. Memory stays flat (crumbs held, first vs second half of the long runs: 4-minute expiry).
+6. The issue's "memory stays flat over a 10-hour simulated run" and "a simulated hour of 4 robots
+   runs in well under a minute on one core": one 10-hour run of trail-share-v1 at k = 4, sampled
+   every 30 min in the trial (:func:`_trails.profile_trial`: the largest Trail any robot holds,
+   the process's RSS, CPU seconds per simulated hour), and a 2-hour run of blazing-trail-v1 at
+   k = 1 for its CPU cost and its ever-growing crumb list. Measured (commit bec19bc, seed 0,
+   machine shared with ~12 other runs): 341 units in 10 h, 5.7 per 10 min on average and 5.7 in
+   the last 3 h (no breakdown); largest Trail 462–476 crumbs in every sample (bound 4 x 121);
+   RSS 248.9 MiB at 0.5 h and at 10 h; 40 CPU s per simulated hour (38–49 per interval; 58 in
+   the first, which loads the compiled kernels). One seed: the long-run claim is item 2's.
 
-Drift sweeps, measured (commit 8ce20af, 1 h, 10 seeds per point, mean ± std): units in the last
-10 min (units in the hour), 2002 / 2000 team: k = 0: 8.9 ± 2.4 (45.4 ± 3.3) / 10.5 ± 2.0
-(57.9 ± 3.1); k = 1: 7.8 ± 1.9 (45.4 ± 2.7) / 7.3 ± 1.3 (51.8 ± 2.0); k = 4: 4.7 ± 1.7
-(29.8 ± 5.3) / 1.0 ± 1.3 (24.2 ± 4.3). Breakdowns: the 2002 team 1 of 10 at k = 1 and at k = 4
-(56 min); the 2000 team 8 of 10 at k = 4 (38–54 min), none below. At k = 4 the 2002 team keeps
-53 % of its k = 0 last-10-min throughput, the 2000 team 10 % (claim 3's verdict: >= 50 % and
-< 50 %). 2002 figures identical to dcb435e's; the 2000 team's changed with its recovery gap-fill
-(the blazing-a-trail section's docstring). 13.5 CPU min for try-drift's 30 runs.
+Measured so far. The 2000 team (final, see the blazing-a-trail section's table): units in the
+last 10 min at k = 0, 1, 2, 3, 4, 6: 10.5, 7.3, 3.4, 3.2, 1.0, 2.1 (57.9 → 18.4 units in the hour);
+with k = 1 and wheel slip 5.0 ± 1.8 (41.4 ± 6.0 units in the hour, 1 of 10 broke down; k = 1
+alone 7.3 ± 1.3, 51.8 ± 2.0): slip costs the 2000 team a fifth of its throughput. The 2002 team
+(commit 8ce20af, before this session's trail-share changes; 1 h, 10 seeds): k = 0: 8.9 ± 2.4
+(45.4 ± 3.3 in the hour), k = 1: 7.8 ± 1.9 (45.4 ± 2.7), k = 4: 4.7 ± 1.7 (29.8 ± 5.3); 1 of 10
+broke down at k = 1 and at k = 4.
 
 Beside them: Table 1 (trips, distance, lifetime per robot), units over time, the times each
 robot reached the places (Fig. 2 top), the crumbs each robot dropped in its own frame (Fig. 3)
@@ -37,19 +44,23 @@ drift sweep as a table (mean ± std per k, both algorithms) and the wheel-scale-
 the drift sweeps (Bug +5 %, Ant −5 %, Fly +3 %, Tanis −3 %, alone and with k = 1; 3 seeds).
 
 Quick mode: 300 s runs, 2 seeds, drift k = 0 and 4 (the blazing section's quick drift trials,
-reused), no run without Place transforms, no long 2000-algorithm runs, no mail round, no
-profiled or scale-error runs (≈ 45 s wall on an idle machine; 81 s under a load of 13 on 2 cores,
-38 CPU s for both trail sections). Full: 3 h x 10 seeds (the paper's trial lasted 3 h 8 min)
-and the 2000 algorithm under the same drift for 3 h x 5 seeds; the drift sweeps at k = 0, 1, 4
-and the no-transform control 1 h x 10 seeds per point; the mail round 30 min x 3 seeds; the
-10-hour and 2-hour profiled runs; the scale cases 1 h x 3 seeds.
+reused), no hours runs, no run without Place transforms, no long 2000-algorithm runs, no mail
+round, no profiled, scale-error or slip runs (≈ 45 s wall on an idle machine; 75 s under a load
+of 6.6 on 2 cores, 50 CPU s for both trail sections). Full: try-paper 3 h x 10 seeds (the
+paper's trial lasted 3 h 8 min); the hours runs 3 h x 8 seeds at k = 4; the 2000 algorithm
+under the paper's drift for 3 h x 5 seeds; the 2002 drift points k = 0, 2, 6 1 h x 8 seeds (k = 1
+and 4 read from the long runs), the 2000 drift sweep k = 0..6 1 h x 10 seeds, the no-transform
+control 1 h x 10 seeds; the slip case (k = 1 + wheel slip) 1 h x 10 (2000) and x 5 (2002) seeds;
+the scale cases 1 h x 3 seeds; the mail round 30 min x 3 seeds; the 10-hour and 2-hour profiled
+runs.
 
 Cost of the full mode (measured on one core: 4 robots x 1 simulated hour = 37 CPU s for
-trail-share-v1, 30 CPU s for blazing-trail-v1; 40 and ≈ 33 under a heavy shared load):
-30 team-hours of try-paper (≈ 19 CPU min), 15 of blazing-under-try-drift (≈ 8), 30 of try-drift
-(≈ 19), 10 without transforms (≈ 6), the mail round (≈ 1), the profiled runs 12 (≈ 8), the scale
-cases 12 (≈ 7); blazing-drift is the blazing-a-trail section's (≈ 15, run once for both):
-≈ 67 CPU min here, ≈ 91 for both sections (≈ 1.5 CPU-hours).
+trail-share-v1, 26–30 for blazing-trail-v1; more under a heavy shared load): trail-share-v1
+30 (try-paper) + 24 (hours) + 24 (drift k = 0, 2, 6) + 10 (no transforms) + 5 (slip) + 6 (scale)
++ 10 (profiled) + 1 (mail round) ≈ 110 team-hours ≈ 68 CPU min; blazing-trail-v1 15 (3-h runs)
++ 10 (slip) + 6 (scale) + 2 (profiled) ≈ 33 team-hours ≈ 16 CPU min; blazing-drift is the
+blazing-a-trail section's (60 team-hours, run once for both): ≈ 85 CPU min here, ≈ 2 CPU-hours
+for both sections.
 """
 
 from __future__ import annotations
