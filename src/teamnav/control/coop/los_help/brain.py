@@ -28,7 +28,8 @@ One step of either brain (belief only: its odometry pose, its omnidirectional ra
 5. choose what to head to (explorer, in this priority): its goal when it sees it (straight,
    suppressing A, §2 point 4) — ``own_goal``; the point offering the shortest D: a teammate
    that reports now (``follow_teammate``) or a ghost (``ghost``) (§3 rule 5, §4.2); when in
-   trouble, the nearest teammate it sees that is not (``trouble_follow``, §5 rule 3); else
+   trouble, the nearest teammate it sees that is not (``trouble_follow``, §5 rule 3; by
+   default not one walking away from its goal, ``trouble_helper_towards_goal``); else
    its navigator towards its goal (``own_goal``);
 6. update Pr/Tr/Nt from this step's progress (§5);
 7. broadcast its sightings, goals, reports and Tr if it sees a teammate (§4.4: O(M) terms).
