@@ -44,13 +44,28 @@ around the point 1 m ahead of the position estimate, the hint still points from 
 it: junction decisions no longer lag the corner). Measured on ``try-to-see-it-my-way``
 (4 seeds x 30 min): 61 % of cruise speed between places after the first trail.
 
-``recover_radius_m`` (a gap-fill, as in :mod:`~teamnav.control.coop.blazing_trail`): with no
-goal crumb around the point ahead, the hint points at the nearest goal crumb within that
-distance (the trail the robot has just left; in a dead end it lies behind and Navigate's 180 deg
-rule turns the robot back); 0 (the default) gives the paper's exploring. Unlike the 2000
-brain it did not pay here: on ``try-to-see-it-my-way`` (seeds 0-3 x 30 min) 6 m gave 21.8 ± 3.5
-units against 22.3 ± 1.5 without (probably because every robot's crumbs, wrong turns included,
-are in the Trail, so a nearest crumb is often not on the route).
+``recover_radius_m`` (a gap-fill, as in :mod:`~teamnav.control.coop.blazing_trail`; 4 m by
+default, 0 gives the paper's exploring): with no goal crumb below the descend-only bound around
+the point ahead, the hint points at the nearest such goal crumb within that distance of the
+position estimate (the trail the robot has just left; in a dead end it lies behind and
+Navigate's 180 deg rule turns the robot back). Why: with 4 robots the slow trips start where
+two robots meet, mostly at the corners (measured with the true trajectories on
+``try-to-see-it-my-way``, seeds 0-3 x 30 min, no drift, trips from 10 min on: 78 % of the
+2870 s spent off the route or backwards along it began within 10 s of a meeting). Panic, or the
+wall follower (which follows the other robot as a wall), leaves the robot facing a wrong
+branch, the opening cool-down lets it pass the right one, and once no crumb below its bound is
+around its point ahead the paper's rule explores: down the 17.6 m dead end east of corner 1 or
+the spurs at corner 2 to their ends (35-90 s each; 2060 s of the 2870 s in wrong branches).
+With recovery: 1680 s off the route, 770 s in wrong branches. Measured on 30-min runs, seeds
+0-7 (efficiency from ``place_interval_s``, mean ± s.e.): no drift 58.2 ± 1.1 % against 52.7 ±
+2.5 % (trips from 10 min on 117.5 ± 2.4 s against 129.8 ± 4.7 s); with the scenario's drift 53.5
+± 1.3 % against 51.9 ± 1.1 % (trips from 10 min on 129.0 ± 4.0 s against 125.0 ± 3.8 s: within
+the noise; probably drifted trails leave holes that trigger it needlessly). Tried and dropped:
+the *lowest*-s crumb within 4 m instead of the nearest (no drift, seeds 0-3: trips from 10 min
+124.5 ± 1.7 s against 112.2 ± 2.7 s), waiting until the robot has driven 2 m without a hint
+(55.3 ± 1.8 % without drift, 53.5 ± 1.0 % with it), Navigate's ``advance_hold_heading`` on top
+(53.6 ± 2.4 %, no drift), a 1.5 m ``reverse_memory_m`` on top (no better). An earlier
+measurement (6 m, seeds 0-3, units delivered) saw no gain within its noise.
 
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
 ``min_move_m`` since the previous temporary trail; radius 2 m (about a corridor's width);
@@ -117,7 +132,7 @@ class TrailShareParams(BaseModel):
     recover_radius_m : float
         No goal crumb around the point ahead: head for the nearest goal crumb (below the
         descend-only bound) within this distance of the position estimate [m] (0: explore, the
-        paper; module docstring).
+        paper; 4 m by default, a gap-fill: module docstring).
     leave_place_m : float
         After that turn, wall follow this far [m] before the trail rules apply again.
     sensor : str
@@ -146,7 +161,7 @@ class TrailShareParams(BaseModel):
     descend_only: bool = True
     turn_at_place: bool = True
     lookahead_m: float = Field(1.0, ge=0.0, le=100.0)
-    recover_radius_m: float = Field(0.0, ge=0.0, le=100.0)
+    recover_radius_m: float = Field(4.0, ge=0.0, le=100.0)
     leave_place_m: float = Field(2.0, ge=0.0, le=100.0)
     reach_m: float = Field(0.6, gt=0.0, le=100.0)
     sensor: str = Field("laser", min_length=1)
