@@ -42,6 +42,32 @@ costs more than the work for four robots.
 Quick mode (CI): the simple map only, the first target of task 1 with an 800-step budget,
 teams {R1, R1..R4}, err_max 0.4 (err_max 0 is the tables' R1..R4 run), no ablation: 9 short
 runs.
+
+Measured (H7c, 2026-11-23; the 5 tasks' first 20 targets, the tables' budgets, workers=1;
+raw rows in the session's notes; "mean (std %) finished/run" as the tables print them)
+----------------------------------------------------------------------------------------
+office_simple, Table 1 (brains of 713397d for the potential field, f9d6cb5 for the others)::
+
+    algorithm    R1           R1,2          R1,2,3        R1,2,3,4
+    Pot. Fields  fails 0/5    fails 0/5     371 (13 %) 4/5  355 (6 %) 4/5
+    Av. Past     fails 0/5    541 (24 %) 2/5  374 (2 %) 3/5   295 (25 %) 5/5
+    VisBug       253 (34 %) 5/5  227 (21 %) 5/5  199 (22 %) 4/5  178 (27 %) 3/5
+
+Targets reached of 100 per cell: Pot. Fields 0 / 32 / 85 / 97, Av. Past 53 / 78 / 82 / 100,
+VisBug 100 / 100 / 85 / 91. Steps fall with every added helper on the tasks finished by every
+team that finished one (paired), but Avoid-Past alone gives up a target on every task (1500
+steps), the potential field with R2 alone finishes no task (R2 walks both sides; R1 trapped in
+a room waits up to R2's round, ~500 steps, per trap) and VisBug with helpers loses tasks that
+it finishes alone (traced: VisBug restarted at a ghost in the east corridor with its goal in
+room N5 followed the north rooms' walls west and gave up there).
+
+Fig. 16 (office_simple, R1..R4, brains of 12d8dc9), err_max 0 / 0.2 / 0.4 and R1 alone::
+
+    Av. Past  295 (25 %) 5/5  398 (25 %) 4/5  475 (15 %) 4/5   alone: fails 0/5 (686 per reached target)
+    VisBug    178 (27 %) 3/5  195 (27 %) 5/5  206 (18 %) 5/5   alone: 253 (34 %) 5/5
+
+Paired over the tasks finished at both: Av. Past 269 -> 475, VisBug 178 -> 192; both below R1
+alone at 0.4.
 """
 
 from __future__ import annotations
