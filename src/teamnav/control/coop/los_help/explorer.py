@@ -81,7 +81,7 @@ class LosExplorerParams(_CommonParams):
         Hysteresis [m] of ``trouble_helper_towards_goal`` (a helper stepping into a doorway
         moves across the goal's direction by about a metre). Measured with it, office_complex
         PF, 5 tasks x 10 targets, targets reached with R1+R2 / R1..3 / R1..4: 2 m 38 / 32 / 43
-        of 50; 1 m 43 / 31 / 26 of 40 (no gain); and ``trouble_progress="goal"`` with the
+        of 50; 1 m 43 / 31 / 36 (no gain); and ``trouble_progress="goal"`` with the
         filter 14 / 24 / 36 (worse: "helper" stays the default).
     max_steps_per_target : int or None
         Step budget per target: when the current target is not reached within this many steps
