@@ -175,16 +175,16 @@ def strictly_falling(means: Sequence[float]) -> bool:
 
 # ---------------------------------------------------------------------------- sweeps
 #: What the full reproduction costs on this machine (measured, see the note's numbers).
-FULL_CPU_NOTE = ("Cost of the full reproduction here (measured with /usr/bin/time on prefixes of the tasks, 10 "
-                 "targets on office_simple and 5 on office_complex, and scaled to 200; a trial's CPU time grows with "
-                 "its steps and team, and a failing trial ends at its first target over budget): 5 CPU-s per 10 "
-                 "targets for R1 alone, 17 with R1..R4 on office_simple, so `teamnav sweep los-table1` (120 trials) "
-                 "takes about 7 CPU-hours "
-                 "(measured: 595 CPU-s for its 60 nested-team trials of 10 targets) and `los-noise-simple` "
-                 "(75 trials) about 7; on office_complex (rebuilt map; measured on tasks of 10 targets) a "
-                 "VisBug-21 or Avoid-Past task costs 3-9 CPU-s per 10 targets and a potential-field task 3-20 "
-                 "(a failing one ends early), so `los-table2` (120 trials) takes about 4-8 CPU-hours and "
-                 "`los-noise-complex` (75 trials) about 3-5. Wall time is that over the number of workers (`-j`).")
+FULL_CPU_NOTE = ("Cost of the full reproduction here (CPU time of `teamnav sweep` with one worker, measured on the "
+                 "5 tasks' first 20 targets on 2026-11-23 and scaled to 200: a finishing trial's CPU grows with its "
+                 "targets, a failing one ends at its first target over budget, so x10 is an upper bound): "
+                 "`los-table1` (3 algorithms x 4 nested teams x 5 tasks = 60 trials) 529 CPU-s for 20 targets, so "
+                 "at most about 1.5 CPU-hours for 200; `los-table2` (60 trials) 615 CPU-s, at most about 1.7 "
+                 "CPU-hours; `los-noise-simple` (75 trials, all helpers) 15 CPU-s per trial of 20 targets "
+                 "(Avoid-Past and VisBug at err_max 0.2 and 0.4), about 3 CPU-hours; `los-noise-complex` and "
+                 "`los-ablation` were not measured, about 3-4 and 2.5 CPU-hours by the same rates. The nested "
+                 "teams halved the table sweeps (a grid of every helper subset ran 120 trials each). Wall time is "
+                 "that over the number of workers (`-j`).")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
 GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
