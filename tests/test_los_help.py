@@ -381,6 +381,34 @@ def test_brain_keeps_ghost_and_falls_back_to_a_when_there(straight_nav):
     assert straight_nav and straight_nav[0].goal.tolist() == [6.0, 0.0]
 
 
+@pytest.mark.parametrize("via_in_sight, blocked, goes_via", [
+    (True, False, True), (True, True, False), (False, True, True)])
+def test_at_a_ghost_r1_goes_on_to_the_via_point_only_while_it_sees_it(straight_nav, via_in_sight, blocked, goes_via):
+    # share_via: R2 at (0, 3), facing +x, reports D = 3 + 4.3 through its via point (3, 3);
+    # via_in_sight: R1 at the ghost goes on to the via point only if its own scan shows it
+    # (office_simple, Avoid-Past: a via point behind the N3/N2 wall pulled R1 into the wall)
+    goal = (6.0, 0.0)
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[goal], goal_tolerance_m=0.3, via_in_sight=via_in_sight),
+                     np.random.default_rng(0), info(0, 2))
+    wall = [(0.0, 0.3, 2.0)]
+    r2 = (0.0, 3.0)
+    r1.step(obs(0, walls=wall, seen=[(1, *polar((0, 0), r2))]))
+    r1.step(obs(1, walls=wall, seen=[(1, *polar((0, 0), r2))], inbox=[
+        msg(1, 0, sightings=[Sighting(0, -math.pi / 2, 3.0)], reports=[VisReport(0, 2, 7.3, 3.0, 0.0, 4.3)])]))
+    assert r1.mode == "follow_teammate"
+    r1.step(obs(2, pose=(0.0, 1.0, 0.0), walls=wall))
+    hide_goal = (math.atan2(-2.9, 6.0), 0.2, 1.0)
+    via_bearing = math.atan2(0.1, 3.0)
+    walls = [hide_goal, (via_bearing, 0.1, 1.0)] if blocked else [hide_goal]
+    a, _ = r1.step(obs(3, pose=(0.0, 2.9, 0.0), walls=walls))
+    assert r1.vias_taken == int(goes_via)
+    if goes_via:
+        assert r1.mode == "ghost" and a.direction_rad == pytest.approx(via_bearing, abs=1e-6)
+        assert (r1.sharing.path(0).px_m, r1.sharing.path(0).py_m) == pytest.approx((3.0, 3.0))
+    else:  # §4.2: at the ghost without its goal in sight, A again
+        assert r1.mode == "own_goal" and r1.sharing.path(0).reached
+
+
 def test_brain_state_sharing_follows_teammate_not_in_trouble(monkeypatch):
     """Fig. 10: stuck R1 (A makes no progress) is in trouble after Cr steps, heads to R2 which
     is not, recovers (Pr back to 0, Nt = 2) and returns to its own goal."""

@@ -175,6 +175,15 @@ class _CommonParams(BaseModel):
         R1 reached a helper's corridor position next to room N5's door, did not see the
         goal the helper had seen from the doorway, and A took it round the corridor. False:
         the paper's message.
+    via_in_sight : bool
+        Explorer only, with ``share_via``: go on to a via point only while it is in the robot's
+        own sight (``_sees``, with the margin of stored points); otherwise the reached point is
+        handled as §4.2 says (A starts again). Gap filled (fixes ``share_via``): the via point
+        is where the *reporter* saw the goal or the next point from, a straight line from the
+        reporter's position, not from R1's; measured, office_simple, Avoid-Past, task 5, R1..3:
+        R1 reached R3's promise at N3's door and went on towards the point from which R3 saw
+        N2's centre, straight into the N3/N2 wall, and stuck in N3's south-west corner (task
+        lost at target 8). False: follow any via point (the earlier gap-fill).
     keep_direct_view : bool
         Hysteresis of the direct view of a goal (§2 point 4): it is *acquired* when the beam
         nearest its bearing reaches past it, and *kept* while any beam within 1.5 beam spacings
@@ -209,6 +218,7 @@ class _CommonParams(BaseModel):
     report_margin_steps: float = Field(1.0, ge=0.0, le=1000.0)
     lead_on: bool = True
     share_via: bool = True
+    via_in_sight: bool = True
     keep_direct_view: bool = True
 
 

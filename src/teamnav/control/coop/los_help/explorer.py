@@ -229,6 +229,8 @@ class LosExplorer(_LosBrain):
             reach = max(p.goal_tolerance_m, 2.0 * self.radius_m + self.step_m) if live else p.ghost_tolerance_m
             me = self._me_xy()
             if (math.hypot(point[0] - me[0], point[1] - me[1]) < reach and p.share_via
+                    and (not p.via_in_sight or path.via_d_m is None
+                         or self._sees(path.via_x_m, path.via_y_m, self.sharing.point_margin_m))
                     and self.sharing.go_via(self.me, self._step)):
                 # at the teammate's point without seeing the goal: on to where its D leads
                 # (``share_via``; a straight line, the teammate saw it from here, §4.3)
