@@ -15,13 +15,15 @@ class RecordingNav:
     def __init__(self, params, rng, info, laser="laser"):
         self.headings = []
         self.allow_reverse = []
+        self.ignore_memory = []  # reverse_ignore_memory of each step
         self.turn_arounds = []  # leave_m of each turn_around call
         self.mode = "fake"
         self.leaving = False  # never in a turn_around's drive-off
 
-    def step(self, obs, preferred_heading_rad=None, *, allow_reverse=True):
+    def step(self, obs, preferred_heading_rad=None, *, allow_reverse=True, reverse_ignore_memory=False):
         self.headings.append(preferred_heading_rad)
         self.allow_reverse.append(allow_reverse)
+        self.ignore_memory.append(reverse_ignore_memory)
         return 0.3, 0.0
 
     def turn_around(self, leave_m=0.0):

@@ -137,6 +137,9 @@ class TrailShareParams(BaseModel):
         No goal crumb around the point ahead: head for the nearest goal crumb (below the
         descend-only bound) within this distance of the position estimate [m] (0: explore, the
         paper; 4 m by default, a gap-fill: module docstring).
+    recover_reverse : bool
+        While recovering, Navigate's 180 deg rule ignores its reversal memory and distance
+        cool-down (off by default; module docstring).
     leave_place_m : float
         After that turn, wall follow this far [m] before the trail rules apply again.
     sensor : str
@@ -166,6 +169,7 @@ class TrailShareParams(BaseModel):
     turn_at_place: bool = True
     lookahead_m: float = Field(1.0, ge=0.0, le=100.0)
     recover_radius_m: float = Field(4.0, ge=0.0, le=100.0)
+    recover_reverse: bool = False
     leave_place_m: float = Field(2.0, ge=0.0, le=100.0)
     reach_m: float = Field(0.6, gt=0.0, le=100.0)
     sensor: str = Field("laser", min_length=1)
@@ -281,7 +285,10 @@ class TrailShare:
             if near is not None and (near[0] - x) ** 2 + (near[1] - y) ** 2 > 1e-12:
                 heading = math.atan2(near[1] - y, near[0] - x)
                 self._recovering = True
-        v, w = self.nav.step(obs, preferred_heading_rad=heading)
+        if self._recovering and p.recover_reverse:
+            v, w = self.nav.step(obs, preferred_heading_rad=heading, reverse_ignore_memory=True)
+        else:
+            v, w = self.nav.step(obs, preferred_heading_rad=heading)
         return Action(float(v), float(w)), outbox
 
     def log(self) -> dict[str, Any]:

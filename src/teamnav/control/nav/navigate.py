@@ -53,6 +53,22 @@ One step, in priority order:
    trail's hint changes as the robot nears a corner), and the cooldown follows a turn.
 5. Otherwise **wall following** with the sliding box (:mod:`teamnav.control.nav.wall_follow`).
 
+Meeting flags (gap-fills, all off by default, i.e. the rules above; for trail robots that meet
+at corners, where Panic or the wall follower tracing round the other robot leaves a robot facing
+a wrong branch; see :mod:`teamnav.control.coop.trail_share` for their measurements):
+
+6. ``hint_skips_cooldown``: with a trail hint, the opening cool-down that follows a Panic or a
+   sharp turn is ignored (an opening already decided keeps its own cool-down).
+   ``face_hint_after_panic``: the first hint after a Panic more than ``face_hint_min_deg`` off
+   the heading (and short of the 180 deg rule) turns the robot on the spot towards it before the
+   wall follower picks a side. ``give_way_s`` > 0: an obstacle within ``give_way_m`` inside
+   ``±give_way_half_angle_deg`` that was not there ``give_way_window_s`` ago (the front's
+   nearest return fell by more than the distance driven plus ``give_way_jump_m``, heading held
+   within 15 deg: another robot, not a wall approached) stops the robot (v = w = 0) until it is
+   gone or ``give_way_s`` has passed, before Panic's emergency stop; once per metre driven.
+   ``step(..., reverse_ignore_memory=True)`` lets the 180 deg rule ignore the reversal memory and
+   distance cool-down for one step (the caller's recovery hint points back to its trail).
+
 Odometry is used only as the robot's own dead reckoning over short spans (how far it has turned,
 how far it has driven), never as a position in any shared frame.
 """
@@ -98,6 +114,10 @@ class NavigateParams(BaseModel):
     ``straight_*``, ``reverse_*``); sharp turns (``turn_rate_radps``, ``turn_tolerance_deg``,
     ``turn_timeout_s``); Panic (``panic_*``: critical within ``panic_clearance_m`` of the body
     inside ``±panic_half_angle_deg``; free when a box ``panic_free_m`` deep is clear ahead).
+
+    Meeting flags (all off by default = the behaviour above; gap-fills for robots that meet at
+    corners, module docstring item 6): ``hint_skips_cooldown``, ``face_hint_after_panic``
+    (``face_hint_min_deg``), ``give_way_s`` (``give_way_*``).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
@@ -136,6 +156,14 @@ class NavigateParams(BaseModel):
     panic_free_m: float = Field(0.8, gt=0.0, le=20.0)
     panic_forward_s: float = Field(2.0, ge=0.0, le=60.0)
     panic_turn_timeout_s: float = Field(8.0, gt=0.0, le=600.0)
+    hint_skips_cooldown: bool = False
+    face_hint_after_panic: bool = False
+    face_hint_min_deg: float = Field(45.0, ge=0.0, le=180.0)
+    give_way_s: float = Field(0.0, ge=0.0, le=600.0)
+    give_way_m: float = Field(0.8, gt=0.0, le=20.0)
+    give_way_half_angle_deg: float = Field(30.0, gt=0.0, le=90.0)
+    give_way_window_s: float = Field(1.0, gt=0.0, le=60.0)
+    give_way_jump_m: float = Field(0.3, ge=0.0, le=20.0)
 
     @model_validator(mode="after")
     def _ordered(self) -> "NavigateParams":
@@ -222,6 +250,7 @@ class Navigate:
         self._side_rule_rad = math.radians(p.side_rule_min_deg)
         self._turn_tol_rad = math.radians(p.turn_tolerance_deg)
         self._turn_max_steps = max(1, int(round(p.turn_timeout_s / self.dt_s)))
+        self._gw_front = np.flatnonzero(np.abs(self.angles_rad) <= math.radians(p.give_way_half_angle_deg))
         self.reset()
 
     # ------------------------------------------------------------------ state
@@ -250,6 +279,12 @@ class Navigate:
         self._pending_heading_rad = 0.0
         self._advance_heading_rad = 0.0
         self._leave_until_m = 0.0  # no reversal and no openings before this odometry length
+        self._cool_manoeuvre = [False, False]  # per side: the cool-down follows a Panic or a turn
+        self._face_hint = False  # a Panic just ended: turn to the hint first (face_hint_after_panic)
+        self._front_hist: list[tuple[float, float, float]] = []  # (front min [m], odo [m], th [rad])
+        self._give_way_until_s = -math.inf
+        self._give_way_after_m = -math.inf
+        self._gw_active = False
 
     def turn_around(self, leave_m: float = 0.0) -> None:
         """Start a sharp 180 deg right turn now (any manoeuvre or Panic is dropped), then wall
@@ -282,6 +317,24 @@ class Navigate:
 
     def _cool(self, extra_m: float) -> None:
         self._cool_until_m = [self._odo_m + extra_m, self._odo_m + extra_m]
+        self._cool_manoeuvre = [True, True]
+
+    def _appeared_ahead(self, ranges_m: np.ndarray, th: float) -> bool:
+        """``give_way_s``: an obstacle within ``give_way_m`` ahead that was not there
+        ``give_way_window_s`` ago (the front's nearest return has dropped by more than the
+        distance driven plus ``give_way_jump_m``, while the heading held within 15 deg)."""
+        p = self.params
+        front = float(ranges_m[self._gw_front].min()) if self._gw_front.size else math.inf
+        hist = self._front_hist
+        hist.append((front, self._odo_m, th))
+        n = max(1, int(round(p.give_way_window_s / self.dt_s)))
+        if len(hist) > n + 1:
+            del hist[0]
+        if front >= p.give_way_m or len(hist) <= n:
+            return False
+        f0, o0, th0 = hist[0]
+        return (abs(_wrap(th - th0)) < math.radians(15.0)
+                and f0 - front > (self._odo_m - o0) + p.give_way_jump_m)
 
     def _start_turn(self, direction: float, amount_rad: float) -> None:
         self.mode = "turn"
@@ -340,7 +393,7 @@ class Navigate:
 
     # ------------------------------------------------------------------ step
     def step(self, obs: Observation, preferred_heading_rad: float | None = None, *,
-             allow_reverse: bool = True) -> tuple[float, float]:
+             allow_reverse: bool = True, reverse_ignore_memory: bool = False) -> tuple[float, float]:
         """The command ``(v_mps, omega_radps)`` for this step.
 
         Parameters
@@ -353,6 +406,9 @@ class Navigate:
         allow_reverse : bool, default True
             False: no 180 deg reversal this step whatever the hint (the hint still steers at
             openings).
+        reverse_ignore_memory : bool, default False
+            True: a reversal this step ignores ``reverse_memory_m`` and ``reverse_cooldown_m``
+            (the time cooldown still holds), e.g. for a hint back to a trail the robot left.
 
         Returns
         -------
@@ -383,7 +439,22 @@ class Navigate:
             if not self.panic.active:
                 self.mode = "navigate"
                 self._cool(self.params.opening_cooldown_m)
+                self._face_hint = self.params.face_hint_after_panic
             return self._clip(v, w)
+        # 1b. Give way (give_way_s > 0): an obstacle that has just appeared ahead (another
+        # robot) stops the robot for up to give_way_s, until it is gone.
+        if self.params.give_way_s > 0.0:
+            appeared = self._appeared_ahead(r, th) and self.mode in ("navigate", "advance")
+            if (appeared and obs.time_s >= self._give_way_until_s and self._odo_m >= self._give_way_after_m
+                    and not obs.stalled):
+                self._give_way_until_s = obs.time_s + self.params.give_way_s
+                self._give_way_after_m = self._odo_m + 1.0  # drive 1 m before giving way again
+                self._gw_active = True
+            if self._gw_active:
+                gw_front = float(r[self._gw_front].min()) if self._gw_front.size else math.inf
+                if obs.time_s < self._give_way_until_s and gw_front < self.params.give_way_m and not obs.stalled:
+                    return 0.0, 0.0
+                self._gw_active = False
         if obs.stalled or self.panic.critical(r):
             self.panic.start(self.rng)
             self.mode = "panic"
@@ -422,9 +493,8 @@ class Navigate:
             preferred_heading_rad = None
         # 3. Heading against the trail: a sharp 180 deg right turn.
         if (preferred_heading_rad is not None and allow_reverse and obs.time_s >= self._reverse_after_s
-                and self._odo_m >= self._reverse_after_m
                 and abs(_wrap(preferred_heading_rad - th)) > self._reverse_rad
-                and not self._reversed_near(x, y)):
+                and (reverse_ignore_memory or (self._odo_m >= self._reverse_after_m and not self._reversed_near(x, y)))):
             self._reversed_at = self._reversed_at[-15:] + [(x, y)]  # bounded: a leg may never end
             self._reverse_after_s = obs.time_s + self.params.reverse_cooldown_s
             self._reverse_after_m = self._odo_m + self.params.reverse_cooldown_m
@@ -433,14 +503,26 @@ class Navigate:
             if cmd is not None:
                 return self._clip(*cmd)
             self.mode = "navigate"
+        # 3b. face_hint_after_panic: the first hint after a Panic turns the robot on the spot
+        # towards it (more than face_hint_min_deg away) before the wall follower picks a side.
+        if self._face_hint and preferred_heading_rad is not None and self.mode == "navigate":
+            self._face_hint = False
+            err = _wrap(preferred_heading_rad - th)
+            if abs(err) > math.radians(self.params.face_hint_min_deg):
+                self._start_turn(1.0 if err > 0 else -1.0, abs(err))
+                cmd = self._turn_command()
+                if cmd is not None:
+                    return self._clip(*cmd)
+                self.mode = "navigate"
 
         box: BoxCommand = self.box.command(r)
         self.box_state, self.box_offset_m = box.state, box.offset_m
         # 4. Openings: decided once each, not while the box has the robot turning on the spot.
         if box.state != "blocked" and not leaving:
             left, right = self.openings.detect(r)
+            skip = self.params.hint_skips_cooldown and preferred_heading_rad is not None
             found = [o for k, o in enumerate((left, right))
-                     if o is not None and self._odo_m >= self._cool_until_m[k]]
+                     if o is not None and (self._odo_m >= self._cool_until_m[k] or (skip and self._cool_manoeuvre[k]))]
             if found:
                 choice = self._choose_opening(found, r, th, preferred_heading_rad)
                 # A random decision is made once per opening; a trail decision is looked at
@@ -450,6 +532,7 @@ class Navigate:
                         k = 0 if o.side > 0 else 1
                         span = o.width_m if math.isfinite(o.width_m) else 0.0
                         self._cool_until_m[k] = self._odo_m + max(self.params.opening_cooldown_m, span)
+                        self._cool_manoeuvre[k] = False
                 if choice is not None:
                     self.last_opening = "left" if choice.side > 0 else "right"
                     self.mode = "advance"

@@ -1,0 +1,136 @@
+"""Meeting flags of Navigate / trail-share-v1 (all off by default): gap-fills for robots that
+meet at corners (trail_share module docstring). Hand-made situations: synthetic scans and
+odometry poses fed step by step, the fake Navigate for the brain-level flag."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from _trail_brain_fakes import make_brains, make_obs
+from test_nav_navigate import MAX_R, cast, nav, observe, t_junction
+
+CLEAR = np.full(181, MAX_R)
+
+
+def _panic_then_navigate(n):
+    """A stall starts Panic; open space ends it (stop, no turn needed, drive on 2 s): the robot
+    stands at the origin facing +x with the post-Panic opening cool-down set."""
+    k = 0
+    n.step(observe(CLEAR, (0.0, 0.0, 0.0), k, stalled=True))
+    assert n.mode == "panic"
+    while n.mode == "panic":
+        k += 1
+        n.step(observe(CLEAR, (0.0, 0.0, 0.0), k))
+        assert k < 100
+    return k + 1
+
+
+@pytest.mark.parametrize(("flag", "mode"), [(False, "navigate"), (True, "advance")])
+def test_hint_skips_the_post_panic_opening_cooldown(flag, mode):
+    # After a Panic the 1.5 m cool-down hides the right branch of a T-junction; with the flag a
+    # trail hint down that branch takes it at once.
+    n = nav(hint_skips_cooldown=flag)
+    k = _panic_then_navigate(n)
+    pose = (0.6, 0.0, 0.0)
+    n.step(observe(cast(t_junction(), pose), pose, k), -math.pi / 2)
+    assert n.mode == mode
+
+
+def test_hint_skips_no_cooldown_of_an_opening_already_decided():
+    # Exploring, a decided opening stays cooled down (a hint later does not re-open it early:
+    # only the cool-down that follows a Panic or a turn is skipped).
+    n = nav(hint_skips_cooldown=True, p_take_opening=0.0)
+    pose = (0.6, 0.0, 0.0)
+    n.step(observe(cast(t_junction(), pose), pose, 0))  # exploring, p = 0: seen, not taken
+    assert n.mode == "navigate"
+    n.step(observe(cast(t_junction(), pose), pose, 1), -math.pi / 2)
+    assert n.mode == "navigate"
+
+
+@pytest.mark.parametrize(("flag", "hint_deg", "turns"), [(False, 90.0, False), (True, 90.0, True),
+                                                         (True, -70.0, True), (True, 30.0, False)])
+def test_face_hint_after_panic_turns_towards_the_hint_first(flag, hint_deg, turns):
+    n = nav(face_hint_after_panic=flag)
+    k = _panic_then_navigate(n)
+    cmd = n.step(observe(CLEAR, (0.0, 0.0, 0.0), k), math.radians(hint_deg))
+    assert (n.mode == "turn") == turns
+    if turns:
+        assert cmd[0] == 0.0 and math.copysign(1.0, cmd[1]) == math.copysign(1.0, hint_deg)
+        assert n._turn_goal_rad == pytest.approx(math.radians(abs(hint_deg)))
+        # Once only: the next Panic-free hint far off does not turn the robot again.
+        n.mode = "navigate"
+        n.step(observe(CLEAR, (0.0, 0.0, 0.0), k + 1), math.radians(hint_deg))
+        assert n.mode == "navigate"
+
+
+def _approach(n, obstacle, n_clear=15, n_after=50, v_mps=0.4):
+    """Drive along +x in open space; after n_clear steps ``obstacle(x)`` (segments) is in the
+    scan. Returns the commands from then on."""
+    x, cmds = 0.0, []
+    for k in range(n_clear + n_after):
+        walls = obstacle(x) if k >= n_clear else []
+        r = cast(walls, (x, 0.0, 0.0)) if walls else CLEAR
+        v, w = n.step(observe(r, (x, 0.0, 0.0), k))
+        if k >= n_clear:
+            cmds.append((v, w))
+        x += 0.1 * v_mps if k < n_clear else 0.0  # after it appears the pose is held
+    return cmds
+
+
+def _robot_ahead(x):
+    return [(x + 0.6, -0.25, x + 0.6, 0.25)]  # a robot-sized obstacle 0.6 m ahead
+
+
+def test_give_way_stops_for_an_obstacle_that_appears_ahead_then_times_out():
+    cmds = _approach(nav(give_way_s=3.0), _robot_ahead)
+    stopped = [c == (0.0, 0.0) for c in cmds]
+    assert all(stopped[:29]) and not all(stopped[30:])  # 3 s at 0.1 s a step, then Navigate again
+
+
+def test_give_way_ends_when_the_obstacle_is_gone():
+    n = nav(give_way_s=3.0)
+    cmds = _approach(n, _robot_ahead, n_after=1)
+    assert cmds == [(0.0, 0.0)]
+    v, w = n.step(observe(CLEAR, (0.56, 0.0, 0.0), 100))
+    assert v > 0.0  # gone: drives on
+
+
+def test_give_way_off_by_default_and_not_for_a_wall_approached_steadily():
+    cmds = _approach(nav(), _robot_ahead)
+    assert cmds[0] != (0.0, 0.0)
+    n = nav(give_way_s=3.0)
+    wall = [(3.0, -5.0, 3.0, 5.0)]
+    x = 0.0
+    for k in range(60):  # 0.04 m a step up to 0.6 m from the wall: ranges fall as driven
+        r = cast(wall, (x, 0.0, 0.0))
+        n.step(observe(r, (x, 0.0, 0.0), k))
+        assert not n._gw_active
+        x = min(x + 0.04, 2.4)
+
+
+@pytest.mark.parametrize(("ignore", "reverses"), [(False, False), (True, True)])
+def test_reversal_inside_the_reversal_memory_only_when_told(ignore, reverses):
+    n = nav(reverse_cooldown_s=0.0, reverse_cooldown_m=3.0, reverse_memory_m=3.0)
+    n.step(observe(CLEAR, (0.0, 0.0, math.pi), 0), 0.0)
+    assert n.mode == "turn"
+    n.mode = "navigate"  # as if the turn had ended; the robot is back 1 m from that spot
+    n.step(observe(CLEAR, (1.0, 0.0, math.pi), 1), 0.0, reverse_ignore_memory=ignore)
+    assert (n.mode == "turn") == reverses
+
+
+@pytest.mark.parametrize(("flag", "told"), [(False, False), (True, True)])
+def test_recover_reverse_tells_navigate_only_while_recovering(monkeypatch, flag, told):
+    from teamnav.control.coop import trail_share as TS
+
+    (b,) = make_brains(monkeypatch, TS, TS.TrailShare, 1, round=["home", "source"], radius_m=2.0,
+                       lookahead_m=1.0, broadcast_interval_s=600.0, recover_reverse=flag)
+    b.step(make_obs(0, 0, [-50.0, 0.0, 0.0]))
+    xs = [0.0, 1.0, 2.0, 3.0, 4.0]
+    b.trail.add_crumbs(["source"] * 5, [[x, 0.0] for x in xs], [30.0 - x for x in xs], [0.0] * 5)
+    b.step(make_obs(0, 1, [4.0, 0.0, 0.0]))  # on the trail: following, not recovering
+    b.step(make_obs(0, 2, [4.0, 3.0, math.pi / 2]))  # off it up a branch: recovering
+    assert b.nav.ignore_memory == [False, False, told]
+    assert b.log()["recovering"] is True
