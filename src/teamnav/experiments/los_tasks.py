@@ -17,7 +17,8 @@ What is ours (the paper leaves it open)
 - Routes: on the simple map R2 and R3 patrol the whole corridor in opposite phases (R2
   stepping into the south doors, R3 into the north doors) and R4 starts in the middle; a route
   per team size: when R2 is the only helper it steps into the doors on both sides
-  (:data:`SIMPLE_R2_BOTH_SIDES_TEAMS`, :func:`team_routes`); on the complex map R2 and R4 walk the east-west corridor end to end in
+  (:data:`SIMPLE_R2_BOTH_SIDES_TEAMS`, :func:`team_routes`); on the complex map R2 and R4
+  walk the east-west corridor end to end in
   opposite phases stepping into every room's doorway (each room of ``office_complex`` has one on
   it, from which the room's centre is in sight), and R3 walks the north-south corridor stopping
   in front of its four doors. The paper's Fig. 13 shows where its helpers are but gives no
