@@ -305,6 +305,19 @@ def test_visbug_wrong_way_round_still_arrives():
     assert steps is not None and steps > 1500 and loop.stalls == 0
 
 
+def test_visbug_reverse_walk_turns_back_from_the_wrong_way_round_and_still_gives_up_when_enclosed():
+    """``reverse_walk_factor``: the wrong way round (above) turns back after 3 d_H and arrives
+    in a fraction of the lap; an enclosed goal is still declared unreachable (a full lap)."""
+    em = builtin_map("office_simple")
+    loop = Loop(em.grid, nav_of("visbug21", {"turn": "left", "reverse_walk_factor": 3.0}), (21.0, 7.0),
+                em.places["room_S4"])
+    steps = loop.run(3000)
+    assert steps is not None and steps < 600 and loop.stalls == 0
+    b = MapBuilder(10.0, 10.0, 0.1).border(0.2).rect(6.0, 3.0, 9.0, 7.0, filled=False, thickness_m=0.2)
+    box = Loop(b.build("box"), nav_of("visbug21", {"reverse_walk_factor": 1.0}), (2.0, 5.0), (7.5, 5.0))
+    assert box.run(1500) is None and box.nav.mode == MODE_UNREACHABLE
+
+
 def test_visbug_new_goal_restarts_and_same_goal_does_not():
     nav = nav_of("visbug21")
     assert isinstance(nav, VisBug21)

@@ -180,6 +180,16 @@ class VisBugParams(BaseModel):
     progress_window_steps : int, default 30
     progress_fraction : float, default 0.5
         As for the potential field (Step 1's progress estimate).
+    reverse_walk_factor : float or None, default None
+        Alternating boundary walk (our deviation; None: Lumelsky & Skewis' walk in one local
+        direction until a leave point or back at H). A walk longer than this many times the
+        hit point's distance to T, ``d_H`` (at least ``2 m``), turns back in the other local
+        direction, passes H and goes on twice as far beyond H; each reversal doubles the reach
+        (the doubling of the "reverse" Bug variants: the walk stays within a constant factor
+        of the shorter side's), and the lap count at H starts over, so T is still declared unreachable
+        only after a full lap in one direction. Meant for the trap that ``turn="nearer_end"``
+        falls into in an office: T straight behind the side wall of a room whose door is the
+        nearer sensed end (office_simple, S1 -> N5: a lap of every north room, ~1300 steps).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
@@ -197,6 +207,7 @@ class VisBugParams(BaseModel):
     follow_patience_m: float = Field(20.0, gt=0.0, le=10_000.0)
     progress_window_steps: int = Field(30, ge=1, le=100_000)
     progress_fraction: float = Field(0.5, gt=0.0, le=10.0)
+    reverse_walk_factor: float | None = Field(None, gt=0.0, le=1000.0)
 
     @model_validator(mode="after")
     def _hysteresis_below_follow(self) -> "VisBugParams":
@@ -292,6 +303,9 @@ class VisBug21:
         self._walked_m = 0.0
         self._left_hit = False
         self._returns = 0
+        self._dir_walked_m = 0.0
+        self._reverse_limit_m = math.inf
+        self._reverse_reach_m = math.inf
         self._last_xy: np.ndarray | None = None
         self._leave_target: np.ndarray | None = None
         self._leave_steps = 0
@@ -303,7 +317,7 @@ class VisBug21:
 
     # the task's Bug2 memory, kept across a temporary goal
     _TASK_STATE = ("goal_xy", "side", "mode", "mline", "hit_xy", "hit_dist_m", "_t_anchor", "_walked_m",
-                   "_left_hit", "_returns")
+                   "_left_hit", "_returns", "_dir_walked_m", "_reverse_limit_m", "_reverse_reach_m")
 
     # ------------------------------------------------------------------ protocol
     def set_goal(self, goal_xy: np.ndarray, temporary: bool = False) -> None:
@@ -388,7 +402,9 @@ class VisBug21:
         if self.mline is None:
             self.mline = (xy.copy(), goal.copy())
         if self._last_xy is not None and self.mode == MODE_FOLLOW:
-            self._walked_m += math.hypot(*(xy - self._last_xy))
+            step_m = math.hypot(*(xy - self._last_xy))
+            self._walked_m += step_m
+            self._dir_walked_m += step_m
         self._last_xy = xy.copy()
         self._monitor.update(math.hypot(*(goal - xy)))
         p = self.params
@@ -415,6 +431,14 @@ class VisBug21:
                     if self._returns >= 2:
                         self.mode = MODE_UNREACHABLE
                         return None
+                if self._dir_walked_m > self._reverse_limit_m:
+                    # alternating walk (``reverse_walk_factor``): back the other way, twice as far
+                    self.side = -self.side
+                    self._dir_walked_m = 0.0
+                    self._reverse_limit_m = 3.0 * self._reverse_reach_m  # back to H, then twice as far
+                    self._reverse_reach_m *= 2.0
+                    self._left_hit = False
+                    self._returns = 0
                 heading = boundary_heading(xy, self._followed(pose, scan), r_safe + p.follow_margin_m, self.side,
                                            p.follow_gain)
                 if heading is None:  # nothing sensed at all: the obstacle is gone
@@ -468,6 +492,10 @@ class VisBug21:
         self._left_hit = False
         self._returns = 0
         self._follow_ref = None
+        self._dir_walked_m = 0.0
+        f = self.params.reverse_walk_factor
+        self._reverse_limit_m = math.inf if f is None else max(2.0, f * math.hypot(*(self.goal_xy - xy)))
+        self._reverse_reach_m = self._reverse_limit_m
 
     def _followed(self, pose: np.ndarray, scan: RangeScan) -> np.ndarray:
         """Sensed points of the obstacle being followed (own frame), shape (K, 2).
