@@ -469,27 +469,26 @@ def _hours_row(seed, per_hour, broke_at_s=None):
             "units_series": json.dumps([[0.0, 0]] + [[x, i + 1] for i, x in enumerate(times)])}
 
 
-@pytest.mark.parametrize("broken, blaze_last, holds", [
-    (0, 0.5, True),     # 8 of 8 without breakdown, 30 units an hour; the 2000 team at 0.5 of 9 per 10 min
-    (1, 0.5, True),     # 7 of 8 (>= 80 %)
-    (2, 0.5, False),    # 6 of 8: too many breakdowns
-    (0, 6.0, False),    # the 2000 team did not collapse (6 of 9, and none broke down)
+@pytest.mark.parametrize("hourly, broke_at_s, blaze_last, holds", [
+    ([30, 28, 31], None, 0.5, True),     # 8 of 8 work every hour; the 2000 team at 0.5 of 9 per 10 min
+    ([16, 24, 29], 10560.0, 0.5, True),  # a lull in the last 5 minutes (the 180-s rule's breakdown): still working
+    ([30, 28, 3], None, 0.5, False),     # one run nearly stopped in its third hour
+    ([30, 28, 31], None, 6.0, False),    # the 2000 team did not collapse (6 of 9, and none broke down)
 ])
-def test_hours_claim_reads_breakdowns_and_units_per_hour_from_the_runs(broken, blaze_last, holds):
+def test_hours_claim_reads_units_per_hour_and_breakdowns_from_the_runs(hourly, broke_at_s, blaze_last, holds):
     from teamnav.experiments.report.sections import try_to_see_it_my_way as S
 
-    hours = [_hours_row(s, [30, 28, 31], broke_at_s=9000.0 if s < broken else None) for s in range(8)]
+    hours = [_hours_row(s, [30, 28, 31]) for s in range(7)] + [_hours_row(7, hourly, broke_at_s=broke_at_s)]
     collapsed = blaze_last < 1.0
     blaze_k = [_row(20, 100.0, 4.0, {"units_per_10min_last": blaze_last, "breakdown_censored": 0 if collapsed else 1,
                                      "breakdown_s": 2700.0 if collapsed else 3600.0}) for _ in range(10)]
     blaze_0 = [_row(50, 90.0, 0.0, {"units_per_10min_last": 9.0}) for _ in range(10)]
-    blocks = S.hours_blocks(hours, blaze_k, blaze_0, 3600.0, quick=False)
-    comp, table = blocks
+    comp, table = S.hours_blocks(hours, blaze_k, blaze_0, 3600.0, quick=False)
     assert comp.holds is holds
-    assert f"no breakdown in {8 - broken} of 8" in comp.ours
-    assert "hour 1: 30.0 ± 0.0 (n = 8)" in comp.ours
-    assert ("hour 3: 31.0 ± 0.0 (n = 8)" in comp.ours) is (broken == 0)
-    assert table.rows[0][1:4] == (["30", "28", "16"] if broken else ["30", "28", "31"])
+    assert f"no breakdown in {7 if broke_at_s else 8} of 8" in comp.ours
+    assert f"fewest in any hour of any run: {min(hourly + [28])}" in comp.ours
+    assert table.rows[7][1:3] == [str(u) for u in hourly[:2]]  # the lull cuts the last hour's final units
+    assert table.rows[7][-1] == ("175 min" if broke_at_s else "none")  # its last delivery at 10490 s
     assert (f"{10 if collapsed else 0} of 10 broke down") in comp.ours
     # quick mode and no runs: no verdict
     assert isinstance(S.hours_blocks(hours, blaze_k, blaze_0, 300.0, quick=True)[0], Missing)

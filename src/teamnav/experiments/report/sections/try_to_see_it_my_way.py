@@ -459,10 +459,14 @@ def hours_blocks(hours: list, blaze_k: list, blaze_0: list, drift_dur: float, qu
     """The long-run claim: the 2002 team for HOURS_S at drift k = HOURS_SCALE, HOURS_SEEDS seeds,
     beside the 2000 team at the same drift (the drift sweep's 1-hour runs).
 
-    Holds when at least 80 % of the 2002 runs did not break down, their mean units in the last hour
-    are at least 6 x WORKING_UNITS_PER_10MIN, and the 2000 team at that drift collapsed: at least
-    half its runs broke down within the hour and its last-10-min units are below half its
-    drift-free ones. None in quick mode or when either side has no runs.
+    Holds when every 2002 run delivered at least 6 x WORKING_UNITS_PER_10MIN units in every whole
+    hour (no hour in which the team stopped working), and the 2000 team at that drift collapsed:
+    at least half its runs broke down within the hour and its last-10-min units are below half its
+    drift-free ones. None in quick mode or when either side has no runs. The 180-s rule's
+    breakdowns (no delivery in the run's last 180 s) are shown but not judged here: over hours a
+    team delivering ~5 units per 10 minutes has such a lull at the end of about one run in five
+    by chance (one seed at k = 4: 16, 24, 29 units in its three hours, last delivery at 176 min),
+    which is not the paper's breakdown ("no more units were transported after this time").
     """
     what = f"{HOURS_S / 3600:g} h at drift k = {HOURS_SCALE:g}"
     if quick or not hours:
@@ -470,26 +474,30 @@ def hours_blocks(hours: list, blaze_k: list, blaze_0: list, drift_dur: float, qu
                         "full mode only" if quick else "every hours trial failed")]
     per_h = [T.units_per_hour(r, HOURS_S) for r in hours]
     cens = T.values(hours, "breakdown_censored")
-    last_h = np.array([u[-1] for u in per_h if u], float)
     b_last, b0_last = T.values(blaze_k, "units_per_10min_last"), T.values(blaze_0, "units_per_10min_last")
     b_cens = T.values(blaze_k, "breakdown_censored")
     b_bd = T.values([r for r in blaze_k if not r.get("breakdown_censored")], "breakdown_s")
     holds = None
-    if cens.size and last_h.size and b_last.size and b0_last.size and drift_dur >= T.MIN_VERDICT_S:
-        holds = bool(cens.mean() >= 0.8 and last_h.mean() >= 6 * T.WORKING_UNITS_PER_10MIN
+    if cens.size and any(per_h) and b_last.size and b0_last.size and drift_dur >= T.MIN_VERDICT_S:
+        worst_hour = min((min(u) for u in per_h if u), default=0)
+        holds = bool(worst_hour >= 6 * T.WORKING_UNITS_PER_10MIN
                      and (b_cens == 0).mean() >= 0.5 and b_last.mean() < 0.5 * b0_last.mean())
     hourly = np.array([u for u in per_h if len(u) == int(HOURS_S // 3600)], float)
     blocks: list = [Comparison(
         f"Runs for hours under drift that breaks the 2000 system, with no breakdown ({what})",
         "2002: 3 h 8 min of work under 0.35–2 deg/min drift (the trial ended on hardware failures); "
         "2000: breakdown at ~27 min",
-        f"2002 team, {cens.size} seeds x {HOURS_S / 3600:g} h: no breakdown in {int(cens.sum())} of {cens.size}; units per hour: "
+        f"2002 team, {cens.size} seeds x {HOURS_S / 3600:g} h: units per hour: "
         + (", ".join(f"hour {h + 1}: {T.msd(hourly[:, h])}" for h in range(hourly.shape[1])) if hourly.size else "n/a")
+        + f" (fewest in any hour of any run: {min((min(u) for u in per_h if u), default=0)}); by the 180-s rule "
+        f"no breakdown in {int(cens.sum())} of {cens.size}"
         + f"; 2000 team at the same drift ({drift_dur / 60:g}-min runs): {int((b_cens == 0).sum())} of {b_cens.size} broke "
         f"down (at {T.msd(b_bd / 60, '{:.0f}', 'min')}), last-10-min units {T.msd(b_last)} (no drift: {T.msd(b0_last)})",
         holds,
         f"k = {HOURS_SCALE:g} is Fly at {2 * HOURS_SCALE:g} deg/min, {HOURS_SCALE:g}x the paper's worst robot; our robots "
-        "never fail, so a run ends on the clock; a breakdown is 180 s without a delivery at the run's end")]
+        "never fail, so a run ends on the clock; judged by every hour of every run delivering at least "
+        f"{6 * T.WORKING_UNITS_PER_10MIN:g} units: the 180-s rule flags a chance lull at the end of a long run "
+        "(about one run in five at ~5 units per 10 min)")]
     rows = [[str(r.get("seed")), *[str(u) for u in per_h[i]], str(r.get("units_total")),
              "none" if r.get("breakdown_censored") else f"{float(r.get('breakdown_s', 0)) / 60:.0f} min"]
             for i, r in enumerate(hours)]
