@@ -87,6 +87,11 @@ same for these two algorithms), err_max 0 / 0.1 / 0.2 / 0.3 / 0.4 and R1 alone::
 
 Paired over the tasks finished at both: Av. Past 269 -> 475, VisBug 178 -> 192; both below R1
 alone at 0.4. VisBug with helpers finishes every task under noise but 3/5 without it.
+
+Fig. 17 (office_complex, R1..R4, err_max 0.4 only, brains of 1f48407): Av. Past 544 (16 %)
+4/5, VisBug 293 (20 %) 5/5 (err_max 0: 456 5/5 and 326 5/5; alone 527 3/5 and 332 5/5).
+Avoid-Past's gain over R1 alone shrinks from 142 to 54 steps (the paper's "help fades");
+VisBug has next to no gain to lose (5 -> 38 steps, paired).
 """
 
 from __future__ import annotations
