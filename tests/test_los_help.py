@@ -783,3 +783,33 @@ def test_in_trouble_a_teammate_walking_away_from_the_goal_is_let_go(monkeypatch,
     d = [math.hypot(6.0 - x, 3.0) for x in xs]
     assert d[off] - d[0] > recede >= d[off - 1] - d[0]  # let go just past the hysteresis
     assert back[0] == "own_goal" and set(back[1:]) == {"trouble_follow"}  # turned back: followed
+
+
+@pytest.mark.parametrize("navigator, factor, want", [
+    ("visbug21", 3.0, {"reverse_walk_factor": 3.0}), ("visbug21", None, {}), ("straight", 3.0, {})])
+def test_at_a_ghost_visbug_starts_again_with_the_explorers_reverse_walk_factor(monkeypatch, navigator, factor, want):
+    # visbug_reverse_walk_factor: at a ghost reached without the goal in sight (§4.2, A starts
+    # again), VisBug's boundary walks to this goal alternate; other navigators start as before
+    class Restartable(StraightNav):
+        def start_again(self, **kw):
+            self.restarts.append(kw)
+
+    def make(name, params, *, rng, step_length_m, radius_m):
+        nav = Restartable()
+        nav.restarts = []
+        made.append(nav)
+        return nav
+
+    made = []
+    monkeypatch.setattr(brain_mod, "make_navigator", make)
+    nav_name = "visbug21" if navigator == "visbug21" else "avoid_past"
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], goal_tolerance_m=0.3, navigator=nav_name,
+                                        visbug_reverse_walk_factor=factor), np.random.default_rng(0), info(0, 2))
+    wall = [(0.0, 0.3, 2.0)]
+    r2 = (0.0, 3.0)
+    r1.step(obs(0, walls=wall, seen=[(1, *polar((0, 0), r2))]))
+    r1.step(obs(1, walls=wall, seen=[(1, *polar((0, 0), r2))], inbox=[
+        msg(1, 0, sightings=[Sighting(0, -math.pi / 2, 3.0)], reports=[VisReport(0, 2, 9.0)])]))
+    r1.step(obs(2, pose=(0.0, 1.0, 0.0), walls=wall))
+    r1.step(obs(3, pose=(0.0, 2.95, 0.0), walls=[(math.atan2(-2.95, 6.0), 0.2, 1.0)]))
+    assert r1.sharing.path(0).reached and made[0].restarts == [want]

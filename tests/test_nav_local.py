@@ -313,6 +313,13 @@ def test_visbug_reverse_walk_turns_back_from_the_wrong_way_round_and_still_gives
                 em.places["room_S4"])
     steps = loop.run(3000)
     assert steps is not None and steps < 600 and loop.stalls == 0
+    # the same, switched on for one goal by start_again (at a ghost, Sgorbissa & Arkin §4.2)
+    nav = nav_of("visbug21", {"turn": "left"})
+    again = Loop(em.grid, nav, (21.0, 7.0), em.places["room_S4"])
+    nav.start_again(reverse_walk_factor=3.0)
+    assert again.run(3000) == steps
+    nav.set_goal(again.to_own(np.array([1.0, 1.0])))
+    assert nav._reverse_for is None
     b = MapBuilder(10.0, 10.0, 0.1).border(0.2).rect(6.0, 3.0, 9.0, 7.0, filled=False, thickness_m=0.2)
     box = Loop(b.build("box"), nav_of("visbug21", {"reverse_walk_factor": 1.0}), (2.0, 5.0), (7.5, 5.0))
     assert box.run(1500) is None and box.nav.mode == MODE_UNREACHABLE

@@ -97,6 +97,20 @@ class LosExplorerParams(_CommonParams):
         M-line and hit point it had suspended for the excursion and takes a new M-line from
         the ghost. False: resume the suspended ones (measured: resuming walked R1 from the
         corridor back into the south rooms it had been led out of).
+    visbug_reverse_walk_factor : float or None
+        With ``navigator="visbug21"`` and ``restart_navigator_at_ghost``: when VisBug starts
+        again at a ghost reached without the goal in sight (§4.2), its boundary walks towards
+        that target alternate (``VisBug21.start_again(reverse_walk_factor=...)``, see
+        ``VisBugParams.reverse_walk_factor``): a walk longer than this many times the hit
+        point's distance to the goal turns back. R1's walks elsewhere, and R1 alone, are
+        VisBug's as before. Gap filled (a deviation from VisBug-21's one local direction;
+        near the ghost the goal is close, and a wrong side is a lap): traced, office_simple,
+        R1..3, task 3, target N5 from S1: R3's §4.3 point led R1 east to the corridor below
+        N4's door; VisBug, restarted there (§4.2), hit the corridor's north wall and took the
+        west side (the sensed end nearer to the goal is N4's east door jamb, with the N4/N5
+        wall behind it): a lap of every north room, the target's 1500-step budget spent
+        (R1 alone laps too on this target, 1270 steps). MEASURED_REVERSE. None: VisBug's
+        one-direction walk.
     """
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
@@ -107,6 +121,7 @@ class LosExplorerParams(_CommonParams):
     trouble_helper_towards_goal: bool = True
     trouble_heading_steps: int = Field(5, ge=1, le=1000)
     trouble_recede_m: float = Field(2.0, ge=0.0, le=100.0)
+    visbug_reverse_walk_factor: float | None = Field(None, gt=0.0, le=1000.0)
 
 
 
@@ -245,7 +260,10 @@ class LosExplorer(_LosBrain):
                 self.sharing.mark_reached(self.me)
                 if p.restart_navigator_at_ghost and self._nav is not None and hasattr(self._nav, "start_again"):
                     # "start again ... with A, possibly from a better position" (§4.2)
-                    self._nav.start_again()
+                    if p.navigator == "visbug21" and p.visbug_reverse_walk_factor is not None:
+                        self._nav.start_again(reverse_walk_factor=p.visbug_reverse_walk_factor)
+                    else:
+                        self._nav.start_again()
                 if p.trust_direct_promise and path.d_point_m <= math.hypot(goal[0] - point[0], goal[1] - point[1]) + self.step_m:
                     # the teammate saw the goal itself from here (its D is the straight
                     # distance): head straight for it (see ``trust_direct_promise``)

@@ -291,6 +291,8 @@ class VisBug21:
         self.temporary = False
         self._suspended: dict | None = None
         self._suspended_at: np.ndarray | None = None
+        #: (task goal, reverse_walk_factor) set by start_again, kept while that goal stays
+        self._reverse_for: tuple[np.ndarray, float] | None = None
         self._monitor = ProgressMonitor(params.progress_window_steps, params.progress_fraction, self.step_length_m)
         self._restart()
 
@@ -354,16 +356,25 @@ class VisBug21:
             return
         self.goal_xy = g
         self._restart()
+        if self._reverse_for is not None and math.hypot(*(g - self._reverse_for[0])) > GOAL_SAME_TOL_M:
+            self._reverse_for = None
         if self.params.turn == "random":
             self.side = 1 if self.rng.random() < 0.5 else -1
 
-    def start_again(self) -> None:
+    def start_again(self, reverse_walk_factor: float | None = None) -> None:
         """Forget the task goal's M-line, hit point and mode: the next step on the task goal
         starts VisBug afresh from where the robot is then (Sgorbissa & Arkin §4.2: at a ghost
         without its goal in sight the robot "will have to start again to explore the
         environment by relying on its own navigation algorithm A, possibly from a better
         position"). During a temporary goal, the suspended task memory is dropped instead, so
-        that setting the task goal again starts afresh rather than resuming."""
+        that setting the task goal again starts afresh rather than resuming.
+
+        ``reverse_walk_factor``: the boundary walks towards this task goal are alternating
+        (see ``VisBugParams.reverse_walk_factor``) until the goal changes; None: the params'."""
+        task_goal = self._suspended["goal_xy"] if self._suspended is not None else (
+            None if self.temporary else self.goal_xy)
+        if reverse_walk_factor is not None and task_goal is not None:
+            self._reverse_for = (np.array(task_goal, dtype=np.float64), float(reverse_walk_factor))
         if self._suspended is not None or self.temporary:
             self._suspended = None
         elif self.goal_xy is not None:
@@ -494,6 +505,9 @@ class VisBug21:
         self._follow_ref = None
         self._dir_walked_m = 0.0
         f = self.params.reverse_walk_factor
+        rf = self._reverse_for
+        if rf is not None and math.hypot(*(self.goal_xy - rf[0])) <= GOAL_SAME_TOL_M:
+            f = rf[1]  # set by start_again for this goal
         self._reverse_limit_m = math.inf if f is None else max(2.0, f * math.hypot(*(self.goal_xy - xy)))
         self._reverse_reach_m = self._reverse_limit_m
 
