@@ -109,8 +109,12 @@ class LosExplorerParams(_CommonParams):
         N4's door; VisBug, restarted there (§4.2), hit the corridor's north wall and took the
         west side (the sensed end nearer to the goal is N4's east door jamb, with the N4/N5
         wall behind it): a lap of every north room, the target's 1500-step budget spent
-        (R1 alone laps too on this target, 1270 steps). MEASURED_REVERSE. None: VisBug's
-        one-direction walk.
+        (R1 alone laps too on this target, 1270 steps). Measured, office_simple, VisBug,
+        5 tasks x 20 targets, None -> 3, steps per target over finished tasks (tasks
+        finished, targets reached): R1+R2 201 (4/5, 85/100) -> 226 (5/5, 100/100), R1..3
+        178 (4/5, 85/100) -> 190 (5/5, 100/100), R1..4 168 -> 169 (5/5 both); on the tasks
+        finished both ways unchanged (R1+R2 identical, R1..3 178 -> 176); R1 alone
+        unaffected (253, 5/5). None: VisBug's one-direction walk (the paper's A).
     """
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
@@ -121,7 +125,7 @@ class LosExplorerParams(_CommonParams):
     trouble_helper_towards_goal: bool = True
     trouble_heading_steps: int = Field(5, ge=1, le=1000)
     trouble_recede_m: float = Field(2.0, ge=0.0, le=100.0)
-    visbug_reverse_walk_factor: float | None = Field(None, gt=0.0, le=1000.0)
+    visbug_reverse_walk_factor: float | None = Field(3.0, gt=0.0, le=1000.0)
 
 
 
