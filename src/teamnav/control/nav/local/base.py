@@ -25,13 +25,14 @@ import math
 from typing import Protocol, runtime_checkable
 
 import numpy as np
+from numba import njit
 
 from teamnav.control.types import RangeScan
 from teamnav.geometry import wrap_angle
 
 __all__ = [
     "GOAL_SAME_TOL_M", "LocalNavigator", "ProgressMonitor", "check_goal", "check_pose", "check_scan",
-    "safe_heading", "scan_points", "seen_free", "segment_clearance",
+    "corridor_clear", "safe_heading", "scan_points", "seen_free", "segment_clearance", "wrap_scalar",
 ]
 
 #: Two goals closer than this [m] are "the same goal" for :meth:`LocalNavigator.set_goal`.
@@ -81,6 +82,60 @@ class LocalNavigator(Protocol):
     @property
     def progressing(self) -> bool:
         """After the last :meth:`direction` call: is the robot making progress to the goal (§5)?"""
+
+
+# ---------------------------------------------------------------------------- fast scalar paths
+# Speed only (H7a): these give the same bits as the numpy expressions they replace (same IEEE
+# operations in the same order; numba's math.cos/sin/atan2/hypot call the same libm as numpy's
+# ufuncs; ``tests/test_los_speed_equivalence.py`` pins them against the numpy versions).
+_TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True, inline="always")
+def pymod(a, b):
+    """``np.mod(a, b)`` for floats (numpy's ``npy_divmod``: the result takes the sign of ``b``)."""
+    m = np.fmod(a, b)
+    if m != 0.0:
+        if (b < 0.0) != (m < 0.0):
+            m += b
+    else:
+        m = math.copysign(0.0, b)
+    return m
+
+
+def wrap_scalar(a: float) -> float:
+    """``float(wrap_angle(a))`` for one angle, without numpy when it is already in (-π, π]."""
+    if -math.pi < a <= math.pi:
+        return float(a)
+    return float(wrap_angle(a))
+
+
+@njit(cache=True)
+def corridor_clear(ranges_m, angles_rad, max_range_m, theta_rad, heading_rad, length_m, min_clear_m):
+    """Whether a body can travel ``length_m`` from the robot along ``heading_rad`` (own frame)
+    keeping ``min_clear_m`` from every return of the scan (beams reading less than
+    ``max_range_m · (1 − 1e-9)``); the robot's heading is ``theta_rad``.
+
+    The brains' ``_corridor_clear`` test: for each return at ``rel = angle + (θ − heading)``,
+    ``along = r cos rel``, ``across = |r sin rel|``, distance ``hypot(along − clip(along, 0, L),
+    across)``; clear when the smallest is at least ``min_clear_m``.
+    """
+    thr = max_range_m * (1.0 - 1e-9)
+    off = theta_rad - heading_rad
+    for i in range(ranges_m.shape[0]):
+        r = ranges_m[i]
+        if r < thr:
+            rel = angles_rad[i] + off
+            along = r * math.cos(rel)
+            across = abs(r * math.sin(rel))
+            t = along
+            if t < 0.0:
+                t = 0.0
+            if t > length_m:
+                t = length_m
+            if not math.hypot(along - t, across) >= min_clear_m:
+                return False
+    return True
 
 
 # ---------------------------------------------------------------------------- input checks
@@ -232,11 +287,11 @@ def safe_heading(heading_rad: float, xy: np.ndarray, points: np.ndarray, step_le
     step straight away from the nearest point).
     """
     if points.shape[0] == 0:
-        return float(wrap_angle(heading_rad))
+        return wrap_scalar(heading_rad)
     near = points[np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1]) < step_length_m + hard_clearance_m + 1e-9]
     want_end = xy + step_length_m * np.array([[math.cos(heading_rad), math.sin(heading_rad)]])
     if segment_clearance(near, xy, want_end)[0] >= hard_clearance_m:
-        return float(wrap_angle(heading_rad))
+        return wrap_scalar(heading_rad)
     n = int(round(math.pi / GUARD_STEP_RAD))
     k = np.arange(1, n + 1)
     offs = np.concatenate(([0.0], np.column_stack((k, -k)).reshape(-1) * GUARD_STEP_RAD))
