@@ -81,13 +81,65 @@ def avoid_past_vector(xy: np.ndarray, visits: dict[tuple[int, int], float], cell
              if (n := visits.get((i, j), 0.0)) > 0.0]
     if not cells:
         return np.zeros(2)
-    arr = np.asarray(cells, dtype=np.float64)
+    return _vector_of_cells(xy, np.asarray(cells, dtype=np.float64), cell_m, memory_radius_m, avoid_gain_per_m,
+                            avoid_max)
+
+
+def _vector_of_cells(xy: np.ndarray, arr: np.ndarray, cell_m: float, memory_radius_m: float,
+                     avoid_gain_per_m: float, avoid_max: float) -> np.ndarray:
+    """:func:`avoid_past_vector` from the visited cells near ``xy``: rows (i, j, metres), in
+    row-major order (i, then j)."""
     away = xy - (arr[:, :2] + 0.5) * cell_m
     d = np.hypot(away[:, 0], away[:, 1])
     w = np.where((d < memory_radius_m) & (d > 1e-12), arr[:, 2] * (1.0 - d / memory_radius_m), 0.0)
     v = avoid_gain_per_m * ((w / np.maximum(d, 1e-12)) @ away)
     norm = math.hypot(v[0], v[1])
     return v * (avoid_max / norm) if norm > avoid_max else v
+
+
+class _VisitGrid:
+    """A dense mirror of ``AvoidPast.visits`` (speed only, H7a): the same metres per cell in an
+    array that grows as the robot explores, so the cells near the robot are one slice, not
+    (2k + 1)² dictionary look-ups. It gives the rows of :func:`avoid_past_vector`'s ``cells``
+    exactly (same order, same values)."""
+
+    _PAD = 32
+
+    def __init__(self) -> None:
+        self.grid = np.zeros((0, 0))
+        self.i0 = self.j0 = 0
+
+    def set(self, i: int, j: int, value: float) -> None:
+        gi, gj = i - self.i0, j - self.j0
+        h, w = self.grid.shape
+        if not (0 <= gi < h and 0 <= gj < w):
+            pad = self._PAD
+            lo_i, lo_j = min(i - pad, self.i0), min(j - pad, self.j0)
+            hi_i = max(i + pad + 1, self.i0 + h) if h else i + pad + 1
+            hi_j = max(j + pad + 1, self.j0 + w) if w else j + pad + 1
+            if not h:
+                lo_i, lo_j = i - pad, j - pad
+            grid = np.zeros((hi_i - lo_i, hi_j - lo_j))
+            if h:
+                grid[self.i0 - lo_i:self.i0 - lo_i + h, self.j0 - lo_j:self.j0 - lo_j + w] = self.grid
+            self.grid, self.i0, self.j0 = grid, lo_i, lo_j
+            gi, gj = i - self.i0, j - self.j0
+        self.grid[gi, gj] = value
+
+    def cells(self, ci: int, cj: int, k: int) -> np.ndarray:
+        """Rows (i, j, metres) of the visited cells with |i − ci| ≤ k and |j − cj| ≤ k, row-major."""
+        h, w = self.grid.shape
+        a0, a1 = max(ci - k - self.i0, 0), min(ci + k + 1 - self.i0, h)
+        b0, b1 = max(cj - k - self.j0, 0), min(cj + k + 1 - self.j0, w)
+        if a0 >= a1 or b0 >= b1:
+            return np.zeros((0, 3))
+        win = self.grid[a0:a1, b0:b1]
+        ii, jj = np.nonzero(win > 0.0)
+        out = np.empty((ii.shape[0], 3))
+        out[:, 0] = ii + (a0 + self.i0)
+        out[:, 1] = jj + (b0 + self.j0)
+        out[:, 2] = win[ii, jj]
+        return out
 
 
 class AvoidPast(PotentialField):
@@ -113,11 +165,29 @@ class AvoidPast(PotentialField):
                  radius_m: float) -> None:
         super().__init__(params, rng, step_length_m, radius_m)
         self.visits: dict[tuple[int, int], float] = {}
+        self._grid = _VisitGrid()
+        self._grid_of: dict | None = None
+        self._grid_len = 0
 
     def _vector(self, pose: np.ndarray, points: np.ndarray, n_beams: int) -> np.ndarray:
         p: AvoidPastParams = self.params  # type: ignore[assignment]
         key = (int(math.floor(pose[0] / p.cell_m)), int(math.floor(pose[1] / p.cell_m)))
+        # speed (H7a): the cells near the robot come from a dense mirror of ``visits`` (rebuilt
+        # when ``visits`` was replaced or changed size behind its back): the same rows as
+        # avoid_past_vector's dictionary walk, so the same vector to the bit
+        stale = self._grid_of is not self.visits or self._grid_len != len(self.visits)
         self.visits[key] = self.visits.get(key, 0.0) + self.step_length_m
         v = super()._vector(pose, points, n_beams)
-        return v + avoid_past_vector(pose[:2], self.visits, p.cell_m, p.memory_radius_m, p.avoid_gain_per_m,
-                                     p.avoid_max)
+        if stale:
+            self._grid, self._grid_of = _VisitGrid(), self.visits
+            for (i, j), n in self.visits.items():
+                self._grid.set(i, j, n)
+        else:
+            self._grid.set(key[0], key[1], self.visits[key])
+        self._grid_len = len(self.visits)
+        k = int(math.ceil(p.memory_radius_m / p.cell_m)) + 1
+        xy = pose[:2]
+        cells = self._grid.cells(int(math.floor(xy[0] / p.cell_m)), int(math.floor(xy[1] / p.cell_m)), k)
+        if not cells.shape[0]:
+            return v + np.zeros(2)
+        return v + _vector_of_cells(xy, cells, p.cell_m, p.memory_radius_m, p.avoid_gain_per_m, p.avoid_max)

@@ -1,0 +1,161 @@
+"""CPU per step of the line-of-sight help runs, this tree against an older one, in one session.
+
+Sgorbissa & Arkin's Tables 1–2 (``los-table1`` / ``los-table2``) are 2 maps × 3 algorithms ×
+8 teams × 5 tasks of up to 200 targets; their CPU is the CPU per simulated step of
+``los-help-simple`` / ``los-help-complex`` times the steps. This script measures that, per
+configuration (map × algorithm case of ``los-table1.yaml`` × R1 alone / R1..R4), for two
+source trees: this one and a *base* (by default the branch base f9d6cb5, unpacked with
+``git archive`` into a temporary folder). Each measurement runs in a fresh process with
+``PYTHONPATH=<tree>/src`` (one numba thread), after a warm-up run that loads the numba
+kernels; base and new alternate, ``--repeats`` times each, so that both see the same load. It
+prints, per configuration, the median CPU [ms] per step, the brains' share of it (inside the
+brains' ``step`` and ``log``), and the ratio base / new.
+
+Usage::
+
+    python benchmarks/bench_los_brains.py                        # 12 configurations, ~5 min CPU
+    python benchmarks/bench_los_brains.py --quick                # 1 repeat, 600 steps
+    python benchmarks/bench_los_brains.py --only simple/visbug21 --steps 3000
+    python benchmarks/bench_los_brains.py --base-src /path/to/old/src
+
+The runs are those of the Tables (``record_every`` 10, no step budget reached: the targets'
+step budget is lifted so a potential field trapped alone keeps running for the whole time).
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+CASES = {
+    "pot-field": {"robots.0.params.navigator": "potential_field", "robots.0.params.state_sharing": True},
+    "avoid-past": {"robots.0.params.navigator": "avoid_past", "robots.0.params.state_sharing": False},
+    "visbug21": {"robots.0.params.navigator": "visbug21", "robots.0.params.state_sharing": False},
+}
+MAPS = {"simple": "los-help-simple", "complex": "los-help-complex"}
+TEAMS = {"R1": 0, "R1-R4": 1}
+BASE_COMMIT = "f9d6cb5"
+
+
+def _overrides(case: str, team: str) -> dict:
+    ov = dict(CASES[case])
+    for k in (1, 2, 3):
+        ov[f"robots.{k}.count"] = TEAMS[team]
+    ov["robots.0.params.max_steps_per_target"] = 100_000_000
+    return ov
+
+
+def _worker(map_key: str, case: str, team: str, steps: int) -> dict:
+    """(in the measuring process) CPU of one warm run: total and inside the brains."""
+    from teamnav import load_scenario
+    from teamnav.experiments.runner import run
+    from teamnav.sim import engine
+
+    brain_s = [0.0]
+    clock = time.process_time
+    orig_init = engine.Simulation.__init__
+
+    def init(self, *args, **kwargs):
+        orig_init(self, *args, **kwargs)
+        for group in self.brains:
+            for brain in group if isinstance(group, list) else [group]:
+                for meth in ("step", "log"):
+                    f = getattr(brain, meth, None)
+                    if not callable(f):
+                        continue
+
+                    def timed(*args, f=f):
+                        t = clock()
+                        out = f(*args)
+                        brain_s[0] += clock() - t
+                        return out
+
+                    setattr(brain, meth, timed)
+
+    ov = _overrides(case, team)
+    run(load_scenario(MAPS[map_key], overrides=ov, duration_s=3.0, seed=0), progress=False)  # warm-up
+    engine.Simulation.__init__ = init
+    try:
+        scn = load_scenario(MAPS[map_key], overrides=ov, duration_s=steps * 0.1, seed=0)
+        t0 = clock()
+        res = run(scn, progress=False)
+        total = clock() - t0
+    finally:
+        engine.Simulation.__init__ = orig_init
+    import teamnav
+
+    return {"cpu_s": total, "brain_s": brain_s[0], "steps": int(res.sim.step_index), "tree": teamnav.__file__}
+
+
+def _measure(src: Path, key: str, steps: int) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(src), NUMBA_NUM_THREADS="1")
+    map_key, case, team = key.split("/")
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--worker", map_key, case, team, str(steps)],
+                         env=env, check=True, capture_output=True, text=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _base_src(commit: str) -> Path:
+    dest = Path(tempfile.gettempdir()) / f"teamnav-base-{commit}"
+    if not (dest / "src" / "teamnav").is_dir():
+        dest.mkdir(parents=True, exist_ok=True)
+        arch = subprocess.run(["git", "-C", str(REPO), "archive", commit, "src"], check=True, capture_output=True)
+        subprocess.run(["tar", "-x", "-C", str(dest)], input=arch.stdout, check=True)
+    return dest / "src"
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--worker", nargs=4, metavar=("MAP", "CASE", "TEAM", "STEPS"), help=argparse.SUPPRESS)
+    ap.add_argument("--steps", type=int, default=2000, help="simulated steps per timed run (default 2000)")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="one repeat of 600 steps")
+    ap.add_argument("--only", action="append", help="substring filter on MAP/CASE/TEAM (repeatable: any)")
+    ap.add_argument("--base-src", help=f"the older tree's src folder (default: git archive {BASE_COMMIT})")
+    ap.add_argument("--base-commit", default=BASE_COMMIT)
+    args = ap.parse_args(argv)
+    if args.worker:
+        m, c, t, n = args.worker
+        print(json.dumps(_worker(m, c, t, int(n))))
+        return
+    steps = 600 if args.quick else args.steps
+    repeats = 1 if args.quick else max(1, args.repeats)
+    base = Path(args.base_src) if args.base_src else _base_src(args.base_commit)
+    new = REPO / "src"
+    print(f"base {base}\nnew  {new}\n{steps} steps per run, {repeats} repeat(s), load {os.getloadavg()[0]:.1f}")
+    print(f"{'configuration':26s} {'base ms/step':>12s} {'(brains)':>9s} {'new ms/step':>12s} {'(brains)':>9s} "
+          f"{'ratio':>6s} {'brains':>7s}")
+    ratios = []
+    for key in ("/".join(k) for k in itertools.product(MAPS, CASES, TEAMS)):
+        if args.only and not any(s in key for s in args.only):
+            continue
+        b, n = [], []
+        for _ in range(repeats):  # alternate: both trees see the same load
+            b.append(_measure(base, key, steps))
+            n.append(_measure(new, key, steps))
+        if b[0]["steps"] != n[0]["steps"]:
+            print(f"{key}: steps differ ({b[0]['steps']} vs {n[0]['steps']})", file=sys.stderr)
+        bt = statistics.median(r["cpu_s"] / r["steps"] for r in b)
+        bb = statistics.median(r["brain_s"] / r["steps"] for r in b)
+        nt = statistics.median(r["cpu_s"] / r["steps"] for r in n)
+        nb = statistics.median(r["brain_s"] / r["steps"] for r in n)
+        ratios.append(bt / nt)
+        print(f"{key:26s} {1000 * bt:12.3f} {1000 * bb:9.3f} {1000 * nt:12.3f} {1000 * nb:9.3f} "
+              f"{bt / nt:6.2f} {bb / nb:7.2f}", flush=True)
+    if ratios:
+        print(f"ratio base/new per step: min {min(ratios):.2f}, median {statistics.median(ratios):.2f}, "
+              f"max {max(ratios):.2f} (CPU time.process_time, one numba thread)")
+
+
+if __name__ == "__main__":
+    main()
