@@ -211,3 +211,33 @@ def test_avoid_past_visit_grid_gives_the_dictionary_walks_vector(seed, step):
 def test_point_visible_of_an_empty_scan_still_raises():
     with pytest.raises(ValueError, match="empty sequence"):
         point_visible((1.0, 0.0), np.zeros(0), np.zeros(0), 8.0)
+
+
+@given(seeds, coord, coord, angle, st.booleans(), st.sampled_from(["nearer_end", "left"]))
+@FAST
+def test_visbug_followed_equals_numpy(seed, x, y, th, with_ref, turn):
+    """VisBug-21's obstacle cut (the followed points, the reference point it keeps and the
+    sensed ends of ``turn="nearer_end"``) from the kernel and from the numpy version."""
+    from teamnav.control.nav.local.visbug21 import VisBug21, VisBugParams
+
+    rng = np.random.default_rng(seed)
+    scan = _scan(rng, n=int(rng.choice([8, 36, 72])))
+    if seed % 7 == 0:  # a closed room seen all round: no ends
+        scan = RangeScan(np.full(len(scan.ranges_m), 2.0), scan.angles_rad, 8.0)
+    if seed % 11 == 0:  # nothing sensed
+        scan = RangeScan(np.full(len(scan.ranges_m), 8.0), scan.angles_rad, 8.0)
+    pose = np.array([x, y, th])
+    navs = [VisBug21(VisBugParams(turn=turn), np.random.default_rng(0), 0.2, 0.2) for _ in range(2)]
+    for nav in navs:
+        nav._follow_ref = pose[:2] + rng.uniform(-3, 3, 2) if with_ref else None
+        nav._ends = "unset"
+    navs[1]._follow_ref = None if navs[0]._follow_ref is None else navs[0]._follow_ref.copy()
+    got, want = navs[0]._followed(pose, scan), navs[1]._followed_numpy(pose, scan)
+    assert np.array_equal(_bits(got), _bits(want))
+    a, b = navs[0]._follow_ref, navs[1]._follow_ref
+    assert (a is None and b is None) or np.array_equal(_bits(a), _bits(b))
+    a, b = navs[0]._ends, navs[1]._ends
+    if isinstance(b, tuple):
+        assert all(np.array_equal(_bits(u), _bits(v)) for u, v in zip(a, b))
+    else:
+        assert a == b
