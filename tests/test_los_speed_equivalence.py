@@ -48,12 +48,20 @@ def _scan(rng: np.random.Generator, n: int = 72, max_range_m: float = 8.0, fov_d
 
 
 # ------------------------------------------------------------------ scalar helpers
-@given(st.floats(-1e6, 1e6, allow_nan=False) | st.sampled_from([0.0, -0.0, math.pi, -math.pi, 2 * math.pi,
-                                                                 -1e-300, 1e-17, -1e-17]))
+@given(st.floats(-1e6, 1e6, allow_nan=False) | st.floats(-10.0, 10.0) | st.sampled_from(
+    [0.0, -0.0, math.pi, -math.pi, 2 * math.pi, -2 * math.pi, 3 * math.pi, -3 * math.pi, -1e-300, 1e-17, -1e-17,
+     math.pi + 1e-16, -math.pi - 1e-16, math.nextafter(-math.pi, 0.0), math.nextafter(math.pi, 4.0), math.inf,
+     -math.inf, math.nan]))
 @FAST
 def test_pymod_and_wrap_scalar_equal_numpy(a):
-    assert _bits(base.pymod(a, 2 * math.pi)) == _bits(np.mod(a, 2 * math.pi))
-    assert _bits(base.wrap_scalar(a)) == _bits(float(wrap_angle(a)))
+    with np.errstate(invalid="ignore"):
+        want_mod, want_wrap = np.mod(a, 2 * math.pi), float(wrap_angle(a))
+    got_mod, got_wrap = base.pymod(a, 2 * math.pi), base.wrap_scalar(a)
+    if math.isnan(want_wrap):
+        assert math.isnan(got_wrap) and math.isnan(got_mod) == math.isnan(want_mod)
+    else:
+        assert _bits(got_mod) == _bits(want_mod)
+        assert _bits(got_wrap) == _bits(want_wrap)
 
 
 # ------------------------------------------------------------------ visibility (goal_sharing, brain)
@@ -241,3 +249,33 @@ def test_visbug_followed_equals_numpy(seed, x, y, th, with_ref, turn):
         assert all(np.array_equal(_bits(u), _bits(v)) for u, v in zip(a, b))
     else:
         assert a == b
+
+
+@given(seeds, st.integers(0, 12), st.sampled_from([0.0, 0.1, 0.4]))
+@FAST
+def test_detector_range_bearing_and_occlusion_noise_equal_numpy(seed, m, err_max):
+    """The detector's kernels (Sgorbissa & Arkin eqs. 1-2) against the numpy lines they replace."""
+    from teamnav.sim.sensors.detector import _occlusion_noise, _range_bearing, _wrap
+
+    rng = np.random.default_rng(seed)
+    n = 5
+    xs, ys = rng.uniform(-10, 10, n), rng.uniform(-10, 10, n)
+    thetas = rng.uniform(-math.pi, math.pi, n)
+    thetas[0] = math.pi
+    a = rng.integers(0, n, m)
+    b = (a + rng.integers(1, n, m)) % n
+    b[: m // 3] = a[: m // 3]  # a zero range (d_r = 0: the half angle is pi/2)
+    dx, dy = xs[b] - xs[a], ys[b] - ys[a]
+    want_r = np.hypot(dx, dy)
+    want_b = _wrap(np.arctan2(dy, dx) - thetas[a]) if m else np.empty(0)
+    got_r, got_b = _range_bearing(xs, ys, thetas, a, b)
+    assert np.array_equal(_bits(got_r), _bits(want_r)) and np.array_equal(_bits(got_b), _bits(want_b))
+    u = rng.random((2, m))
+    size = np.full(m, 0.4)
+    with np.errstate(divide="ignore"):
+        half = np.arctan(size / (2.0 * want_r))
+    want_d = want_r + want_r * (err_max * (2.0 * u[0] - 1.0))
+    want_a = want_b + half * (2.0 * u[1] - 1.0)
+    want_a = _wrap(want_a) if m else want_a
+    got_d, got_a = _occlusion_noise(want_r, want_b, size, u[0], u[1], err_max)
+    assert np.array_equal(_bits(got_d), _bits(want_d)) and np.array_equal(_bits(got_a), _bits(want_a))

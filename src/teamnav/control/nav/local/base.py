@@ -104,10 +104,17 @@ def pymod(a, b):
 
 
 def wrap_scalar(a: float) -> float:
-    """``float(wrap_angle(a))`` for one angle, without numpy when it is already in (-π, π]."""
-    if -math.pi < a <= math.pi:
-        return float(a)
-    return float(wrap_angle(a))
+    """``float(wrap_angle(a))`` for one angle, on Python floats (the same operations:
+    Python's float ``%`` is numpy's ``np.mod``)."""
+    a = float(a)
+    if -math.pi < a <= math.pi or a != a:
+        return a
+    w = (a + math.pi) % _TWO_PI - math.pi
+    if w <= -math.pi:
+        w += _TWO_PI
+    if w > math.pi:
+        w = math.pi
+    return w
 
 
 @njit(cache=True)
