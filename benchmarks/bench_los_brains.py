@@ -83,7 +83,7 @@ def _worker(map_key: str, case: str, team: str, steps: int) -> dict:
                     setattr(brain, meth, timed)
 
     ov = _overrides(case, team)
-    run(load_scenario(MAPS[map_key], overrides=ov, duration_s=3.0, seed=0), progress=False)  # warm-up
+    run(load_scenario(MAPS[map_key], overrides=ov, duration_s=40.0, seed=0), progress=False)  # warm-up: kernels loaded
     engine.Simulation.__init__ = init
     try:
         scn = load_scenario(MAPS[map_key], overrides=ov, duration_s=steps * 0.1, seed=0)

@@ -393,7 +393,12 @@ class GoalSharing:
     @property
     def own_id(self) -> int | None:
         """``Id = k·M`` of the current own goal (None without a goal)."""
-        return None if self.own_k is None else goal_id(self.own_k, self.team_size)
+        k = self.own_k
+        if k is None:
+            return None
+        if k < 1:
+            return goal_id(k, self.team_size)  # raises
+        return int(k) * self.team_size
 
     def set_own_goal(self, k: int | None, goal_xy=None) -> None:
         """Set the robot's own k-th goal (own frame), or none; a new k forgets the old path."""

@@ -232,9 +232,12 @@ class PotentialField:
         self._monitor.update(math.hypot(*(self.goal_xy - pose[:2])))
         points = scan_points(pose, scan)
         v = self._vector(pose, points, len(scan.ranges_m))
-        scale = max(math.hypot(v[0], v[1]), self.params.attraction_gain)
-        v = v + self.params.perturbation * scale * self.rng.standard_normal(2)
-        heading = math.atan2(v[1], v[0])
+        v0, v1 = float(v[0]), float(v[1])
+        scale = max(math.hypot(v0, v1), self.params.attraction_gain)
+        k = self.params.perturbation * scale
+        noise = self.rng.standard_normal(2)
+        # v + k · noise, on floats (the same two additions as the array expression)
+        heading = math.atan2(v1 + k * float(noise[1]), v0 + k * float(noise[0]))
         return safe_heading(heading, pose[:2], points, self.step_length_m, self.radius_m + self.params.guard_margin_m)
 
     @property
