@@ -17,8 +17,14 @@ Usage::
     python benchmarks/bench_los_brains.py --quick                # 1 repeat, 600 steps
     python benchmarks/bench_los_brains.py --only simple/visbug21 --steps 3000
     python benchmarks/bench_los_brains.py --base-src /path/to/old/src
+    python benchmarks/bench_los_brains.py --targets 10 --repeats 1   # CPU of a 10-target task
 
-The runs are those of the Tables (``record_every`` 10, no step budget reached: the targets'
+``--targets N``: instead of a fixed number of steps, each run is the first N targets of task 1
+(the scenario's own step budget per target and ``stop_when_finished``), and the table gives
+the CPU seconds of the whole task (the run, not the process start) and its steps: the unit of
+FULL_CPU_NOTE in ``teamnav/experiments/report/sections/los_help.py``.
+
+Otherwise the runs are those of the Tables (``record_every`` 10, no step budget reached: the targets'
 step budget is lifted so a potential field trapped alone keeps running for the whole time).
 """
 
@@ -47,15 +53,21 @@ TEAMS = {"R1": 0, "R1-R4": 1}
 BASE_COMMIT = "f9d6cb5"
 
 
-def _overrides(case: str, team: str) -> dict:
+def _overrides(case: str, team: str, map_key: str = "", targets: int = 0) -> dict:
     ov = dict(CASES[case])
     for k in (1, 2, 3):
         ov[f"robots.{k}.count"] = TEAMS[team]
-    ov["robots.0.params.max_steps_per_target"] = 100_000_000
+    if targets:
+        from teamnav import load_scenario
+
+        task = load_scenario(MAPS[map_key]).robots[0].params["targets_xy"]
+        ov["robots.0.params.targets_xy"] = [list(t) for t in task[:targets]]
+    else:
+        ov["robots.0.params.max_steps_per_target"] = 100_000_000
     return ov
 
 
-def _worker(map_key: str, case: str, team: str, steps: int) -> dict:
+def _worker(map_key: str, case: str, team: str, steps: int, targets: int = 0) -> dict:
     """(in the measuring process) CPU of one warm run: total and inside the brains."""
     from teamnav import load_scenario
     from teamnav.experiments.runner import run
@@ -82,11 +94,14 @@ def _worker(map_key: str, case: str, team: str, steps: int) -> dict:
 
                     setattr(brain, meth, timed)
 
-    ov = _overrides(case, team)
+    ov = _overrides(case, team, map_key, targets)
     run(load_scenario(MAPS[map_key], overrides=ov, duration_s=40.0, seed=0), progress=False)  # warm-up: kernels loaded
     engine.Simulation.__init__ = init
     try:
-        scn = load_scenario(MAPS[map_key], overrides=ov, duration_s=steps * 0.1, seed=0)
+        if targets:
+            scn = load_scenario(MAPS[map_key], overrides=ov, seed=0)  # its own duration: stops when R1 is done
+        else:
+            scn = load_scenario(MAPS[map_key], overrides=ov, duration_s=steps * 0.1, seed=0)
         t0 = clock()
         res = run(scn, progress=False)
         total = clock() - t0
@@ -94,14 +109,17 @@ def _worker(map_key: str, case: str, team: str, steps: int) -> dict:
         engine.Simulation.__init__ = orig_init
     import teamnav
 
-    return {"cpu_s": total, "brain_s": brain_s[0], "steps": int(res.sim.step_index), "tree": teamnav.__file__}
+    brain = res.sim.brains[0]
+    brain = brain[0] if isinstance(brain, list) else brain
+    return {"cpu_s": total, "brain_s": brain_s[0], "steps": int(res.sim.step_index), "tree": teamnav.__file__,
+            "reached": int(getattr(brain, "targets_reached", -1))}
 
 
-def _measure(src: Path, key: str, steps: int) -> dict:
+def _measure(src: Path, key: str, steps: int, targets: int = 0) -> dict:
     env = dict(os.environ, PYTHONPATH=str(src), NUMBA_NUM_THREADS="1")
     map_key, case, team = key.split("/")
-    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--worker", map_key, case, team, str(steps)],
-                         env=env, check=True, capture_output=True, text=True)
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--worker", map_key, case, team, str(steps),
+                          str(targets)], env=env, check=True, capture_output=True, text=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -116,23 +134,28 @@ def _base_src(commit: str) -> Path:
 
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--worker", nargs=4, metavar=("MAP", "CASE", "TEAM", "STEPS"), help=argparse.SUPPRESS)
+    ap.add_argument("--worker", nargs=5, metavar=("MAP", "CASE", "TEAM", "STEPS", "TARGETS"), help=argparse.SUPPRESS)
+    ap.add_argument("--targets", type=int, default=0, help="time whole tasks of the first N targets of task 1")
     ap.add_argument("--steps", type=int, default=2000, help="simulated steps per timed run (default 2000)")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="one repeat of 600 steps")
     ap.add_argument("--only", action="append", help="substring filter on MAP/CASE/TEAM (repeatable: any)")
     ap.add_argument("--base-src", help=f"the older tree's src folder (default: git archive {BASE_COMMIT})")
     ap.add_argument("--base-commit", default=BASE_COMMIT)
+    ap.add_argument("--new-src", help="the newer tree's src folder (default: this checkout's)")
     args = ap.parse_args(argv)
     if args.worker:
-        m, c, t, n = args.worker
-        print(json.dumps(_worker(m, c, t, int(n))))
+        m, c, t, n, k = args.worker
+        print(json.dumps(_worker(m, c, t, int(n), int(k))))
         return
     steps = 600 if args.quick else args.steps
     repeats = 1 if args.quick else max(1, args.repeats)
     base = Path(args.base_src) if args.base_src else _base_src(args.base_commit)
-    new = REPO / "src"
-    print(f"base {base}\nnew  {new}\n{steps} steps per run, {repeats} repeat(s), load {os.getloadavg()[0]:.1f}")
+    new = Path(args.new_src) if args.new_src else REPO / "src"
+    what = f"tasks of {args.targets} targets" if args.targets else f"{steps} steps per run"
+    print(f"base {base}\nnew  {new}\n{what}, {repeats} repeat(s), load {os.getloadavg()[0]:.1f}")
+    if args.targets:
+        return _tasks(base, new, args, repeats)
     print(f"{'configuration':26s} {'base ms/step':>12s} {'(brains)':>9s} {'new ms/step':>12s} {'(brains)':>9s} "
           f"{'ratio':>6s} {'brains':>7s}")
     ratios = []
@@ -155,6 +178,24 @@ def main(argv: list[str] | None = None) -> None:
     if ratios:
         print(f"ratio base/new per step: min {min(ratios):.2f}, median {statistics.median(ratios):.2f}, "
               f"max {max(ratios):.2f} (CPU time.process_time, one numba thread)")
+
+
+def _tasks(base: Path, new: Path, args, repeats: int) -> None:
+    """CPU seconds of whole tasks (``--targets``), base and new alternating."""
+    print(f"{'configuration':26s} {'steps':>6s} {'reached':>7s} {'base CPU s':>10s} {'new CPU s':>10s} {'ratio':>6s}")
+    for key in ("/".join(k) for k in itertools.product(MAPS, CASES, TEAMS)):
+        if args.only and not any(s in key for s in args.only):
+            continue
+        b, n = [], []
+        for _ in range(repeats):
+            b.append(_measure(base, key, 0, args.targets))
+            n.append(_measure(new, key, 0, args.targets))
+        if (b[0]["steps"], b[0]["reached"]) != (n[0]["steps"], n[0]["reached"]):
+            print(f"{key}: runs differ: base {b[0]['steps']} steps {b[0]['reached']} reached, new "
+                  f"{n[0]['steps']} / {n[0]['reached']}", file=sys.stderr)
+        bt = statistics.median(r["cpu_s"] for r in b)
+        nt = statistics.median(r["cpu_s"] for r in n)
+        print(f"{key:26s} {n[0]['steps']:6d} {n[0]['reached']:7d} {bt:10.2f} {nt:10.2f} {bt / nt:6.2f}", flush=True)
 
 
 if __name__ == "__main__":
