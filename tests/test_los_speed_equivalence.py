@@ -279,3 +279,40 @@ def test_detector_range_bearing_and_occlusion_noise_equal_numpy(seed, m, err_max
     want_a = _wrap(want_a) if m else want_a
     got_d, got_a = _occlusion_noise(want_r, want_b, size, u[0], u[1], err_max)
     assert np.array_equal(_bits(got_d), _bits(want_d)) and np.array_equal(_bits(got_a), _bits(want_a))
+
+
+@given(seeds, st.integers(0, 40), st.integers(1, 30), st.floats(0.0, 1.0), st.booleans())
+@FAST
+def test_segment_clear_is_segment_clearance_at_least(seed, k, j, lim, slack):
+    rng = np.random.default_rng(seed)
+    pts = rng.uniform(-3, 3, (k, 2))
+    ends = rng.uniform(-3, 3, (j, 2))
+    start = rng.uniform(-3, 3, (j, 2)) if seed % 2 else rng.uniform(-3, 3, 2)
+    s = rng.uniform(0, 0.3, k) if slack else None
+    assert np.array_equal(base.segment_clear(pts, start, ends, lim, s),
+                          base._segment_clearance_numpy(pts, start, ends, s) >= lim)
+
+
+def _boundary_heading_numpy(xy, points, follow_distance_m, side, gain):
+    """visbug21.boundary_heading as it was at f9d6cb5."""
+    if points.shape[0] == 0:
+        return None
+    rel = points - xy
+    d2 = np.einsum("ij,ij->i", rel, rel)
+    i = int(np.argmin(d2))
+    d = math.sqrt(d2[i])
+    err = max(-1.0, min(1.0, (follow_distance_m - d) / follow_distance_m))
+    corr = max(-math.pi / 3, min(math.pi / 3, gain * err))
+    return math.atan2(rel[i, 1], rel[i, 0]) + side * (0.5 * math.pi + corr)
+
+
+@given(seeds, st.integers(1, 50), st.sampled_from([1, -1]))
+@FAST
+def test_boundary_heading_equals_numpy(seed, k, side):
+    from teamnav.control.nav.local.visbug21 import boundary_heading
+
+    rng = np.random.default_rng(seed)
+    xy = rng.uniform(-3, 3, 2)
+    pts = xy + rng.uniform(-2, 2, (k, 2))
+    pts[k // 2] = pts[0]  # equal distances: the first one
+    assert _bits(boundary_heading(xy, pts, 0.4, side, 1.5)) == _bits(_boundary_heading_numpy(xy, pts, 0.4, side, 1.5))

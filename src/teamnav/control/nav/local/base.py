@@ -32,7 +32,7 @@ from teamnav.geometry import wrap_angle
 
 __all__ = [
     "GOAL_SAME_TOL_M", "LocalNavigator", "ProgressMonitor", "check_goal", "check_pose", "check_scan",
-    "corridor_clear", "safe_heading", "scan_points", "seen_free", "segment_clearance", "wrap_scalar",
+    "corridor_clear", "safe_heading", "scan_points", "seen_free", "segment_clear", "segment_clearance", "wrap_scalar",
 ]
 
 #: Two goals closer than this [m] are "the same goal" for :meth:`LocalNavigator.set_goal`.
@@ -262,6 +262,51 @@ def segment_clearance(points: np.ndarray, start_xy: np.ndarray, ends_xy: np.ndar
 
 
 _NO_SLACK = np.zeros(0)
+
+
+def segment_clear(points: np.ndarray, start_xy: np.ndarray, ends_xy: np.ndarray, min_clear_m: float,
+                  slack_m: np.ndarray | None = None) -> np.ndarray:
+    """``segment_clearance(points, start_xy, ends_xy, slack_m) >= min_clear_m``, stopping at the
+    first point that is too close to a segment (the same distances, so the same answers).
+
+    Returns
+    -------
+    ndarray of shape (J,), bool
+    """
+    ends = np.atleast_2d(np.asarray(ends_xy, dtype=np.float64))
+    if points.shape[0] == 0:
+        return np.full(ends.shape[0], np.inf) >= min_clear_m
+    starts = np.asarray(start_xy, dtype=np.float64)
+    if starts.ndim == 1:
+        starts = np.broadcast_to(starts, ends.shape)
+    pts = np.asarray(points, dtype=np.float64)
+    slack = _NO_SLACK if slack_m is None else np.ascontiguousarray(slack_m, dtype=np.float64)
+    return _segment_clear(pts[:, 0], pts[:, 1], starts[:, 0], starts[:, 1], ends[:, 0], ends[:, 1], slack,
+                          slack_m is not None, float(min_clear_m))
+
+
+@njit(cache=True)
+def _segment_clear(px, py, sx, sy, ex, ey, slack, has_slack, lim):
+    """:func:`segment_clear` (numba): per segment, no point's distance (less its slack) is
+    below ``lim`` or NaN."""
+    nj = ex.shape[0]
+    out = np.empty(nj, dtype=np.bool_)
+    for j in range(nj):
+        d0 = ex[j] - sx[j]
+        d1 = ey[j] - sy[j]
+        len2 = d0 * d0 + d1 * d1
+        if len2 < 1e-24:
+            len2 = 1e-24
+        ok = True
+        for k in range(px.shape[0]):
+            v = _point_segment(px[k], py[k], sx[j], sy[j], d0, d1, len2)
+            if has_slack:
+                v = v - slack[k]
+            if not v >= lim:
+                ok = False
+                break
+        out[j] = ok
+    return out
 
 
 @njit(cache=True, inline="always")

@@ -118,6 +118,7 @@ from teamnav.control.nav.local.base import (
     safe_heading,
     scan_points,
     seen_free,
+    segment_clear,
     segment_clearance,
 )
 from teamnav.control.types import RangeScan
@@ -225,13 +226,34 @@ def boundary_heading(xy: np.ndarray, points: np.ndarray, follow_distance_m: floa
     """
     if points.shape[0] == 0:
         return None
-    rel = points - xy
-    d2 = np.einsum("ij,ij->i", rel, rel)
-    i = int(np.argmin(d2))
-    d = math.sqrt(d2[i])
+    pts = np.asarray(points, dtype=np.float64)
+    # speed (H7a): the nearest point in a kernel (same squared distances, first of equals)
+    i, d2 = _nearest_sq(pts[:, 0], pts[:, 1], float(xy[0]), float(xy[1]))
+    rx, ry = float(pts[i, 0] - xy[0]), float(pts[i, 1] - xy[1])
+    d = math.sqrt(d2)
     err = max(-1.0, min(1.0, (follow_distance_m - d) / follow_distance_m))
     corr = max(-math.pi / 3, min(math.pi / 3, gain * err))
-    return math.atan2(rel[i, 1], rel[i, 0]) + side * (0.5 * math.pi + corr)
+    return math.atan2(ry, rx) + side * (0.5 * math.pi + corr)
+
+
+@njit(cache=True)
+def _nearest_sq(px, py, x, y):
+    """(index, squared distance) of the point nearest (x, y): ``np.argmin`` of
+    ``einsum("ij,ij->i", rel, rel)`` with ``rel = points − xy``."""
+    best = 0
+    rx = px[0] - x
+    ry = py[0] - y
+    best_d2 = rx * rx + ry * ry
+    if best_d2 == best_d2:
+        for k in range(1, px.shape[0]):
+            rx = px[k] - x
+            ry = py[k] - y
+            d2 = rx * rx + ry * ry
+            if d2 != d2:
+                return k, d2
+            if d2 < best_d2:
+                best, best_d2 = k, d2
+    return best, best_d2
 
 
 class VisBug21:
@@ -634,7 +656,7 @@ class VisBug21:
             rng_p = np.hypot(pts[:, 0] - xy[0], pts[:, 1] - xy[1])
             keep = rng_p <= reach_m + 2.0 * r_safe
             idx = np.flatnonzero(ok)
-            ok[idx] = segment_clearance(pts[keep], xy, cand[idx], self._slack * rng_p[keep]) >= r_safe
+            ok[idx] = segment_clear(pts[keep], xy, cand[idx], r_safe, self._slack * rng_p[keep])
         return ok
 
     def _intermediate_target(self, xy, points, r_safe, reach_m) -> np.ndarray | None:
@@ -670,7 +692,7 @@ class VisBug21:
             ahead = cand[idx] + run[:, None] * u
             if points.shape[0]:
                 slack = self._slack * np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1])
-                ok[idx] = segment_clearance(points, cand[idx], ahead, slack) >= r_safe - self.params.leave_hysteresis_m
+                ok[idx] = segment_clear(points, cand[idx], ahead, r_safe - self.params.leave_hysteresis_m, slack)
             # ... and the robot must have *seen* that run free, not merely sensed nothing near
             # it: from afar it sees the near face of a wall, never its far side (a door jamb's
             # thickness), and a run grazing an unseen face made it leave, hit at once, and walk
