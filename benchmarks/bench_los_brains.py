@@ -18,6 +18,7 @@ Usage::
     python benchmarks/bench_los_brains.py --only simple/visbug21 --steps 3000
     python benchmarks/bench_los_brains.py --base-src /path/to/old/src
     python benchmarks/bench_los_brains.py --targets 10 --repeats 1   # CPU of a 10-target task
+    python benchmarks/bench_los_brains.py --kernels                  # each fast path vs its numpy version
 
 ``--targets N``: instead of a fixed number of steps, each run is the first N targets of task 1
 (the scenario's own step budget per target and ``stop_when_finished``), and the table gives
@@ -136,6 +137,7 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--worker", nargs=5, metavar=("MAP", "CASE", "TEAM", "STEPS", "TARGETS"), help=argparse.SUPPRESS)
     ap.add_argument("--targets", type=int, default=0, help="time whole tasks of the first N targets of task 1")
+    ap.add_argument("--kernels", action="store_true", help="time each fast path against its numpy version")
     ap.add_argument("--steps", type=int, default=2000, help="simulated steps per timed run (default 2000)")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="one repeat of 600 steps")
@@ -147,6 +149,9 @@ def main(argv: list[str] | None = None) -> None:
     if args.worker:
         m, c, t, n, k = args.worker
         print(json.dumps(_worker(m, c, t, int(n), int(k))))
+        return
+    if args.kernels:
+        _kernels()
         return
     steps = 600 if args.quick else args.steps
     repeats = 1 if args.quick else max(1, args.repeats)
@@ -178,6 +183,67 @@ def main(argv: list[str] | None = None) -> None:
     if ratios:
         print(f"ratio base/new per step: min {min(ratios):.2f}, median {statistics.median(ratios):.2f}, "
               f"max {max(ratios):.2f} (CPU time.process_time, one numba thread)")
+
+
+def _kernels() -> None:
+    """µs per call of each fast path and of the numpy version it replaced (kept as ``_*_numpy``
+    or, for code that was inline, written out in ``tests/test_los_speed_equivalence.py``), on a
+    72-beam scan in an office corridor (this process, this tree)."""
+    import math
+
+    import numpy as np
+
+    sys.path.insert(0, str(REPO / "tests"))
+    import test_los_speed_equivalence as eq
+
+    from teamnav.control.coop.los_help.goal_sharing import beam_near_reaches, point_visible
+    from teamnav.control.nav.local import base
+    from teamnav.control.nav.local.potential_field import PotentialFieldParams, _field_vector_numpy, field_vector
+    from teamnav.control.nav.local.visbug21 import VisBug21, VisBugParams, boundary_heading
+    from teamnav.control.types import RangeScan
+
+    angles = np.linspace(-math.pi, math.pi, 72, endpoint=False)
+    # a corridor 2 m wide along x, open ends beyond 8 m
+    with np.errstate(divide="ignore"):
+        r = np.minimum(np.abs(1.0 / np.sin(angles)), 8.0)
+    scan = RangeScan(r, angles, 8.0)
+    pose = np.array([0.3, 0.1, 0.2])
+    pts = base.scan_points(pose, scan)
+    xy = pose[:2].copy()
+    ends = xy + np.column_stack((np.linspace(0.5, 6, 60), np.linspace(-1, 1, 60)))
+    params = PotentialFieldParams()
+    nav_new = VisBug21(VisBugParams(), np.random.default_rng(0), 0.2, 0.2)
+    nav_old = VisBug21(VisBugParams(), np.random.default_rng(0), 0.2, 0.2)
+    a64 = np.ascontiguousarray(angles)
+    pairs = {
+        "point_visible (brain._sees)": (lambda: point_visible((3.0, 0.5), r, angles, 8.0, 0.0, 0.1),
+                                        lambda: eq._point_visible_numpy((3.0, 0.5), r, angles, 8.0, 0.0, 0.1)),
+        "keep view (brain._keeps)": (lambda: beam_near_reaches(r, a64, 3.0, 0.2, 0.13),
+                                     lambda: eq._keeps_numpy(scan, 3.0, 0.6, 0.087, 8.0)),
+        "corridor (brain._corridor_clear)": (lambda: base.corridor_clear(r, a64, 8.0, 0.2, 0.1, 3.0, 0.21),
+                                             lambda: eq._corridor_clear_numpy(scan, 0.2, 0.1, 3.0, 0.2)),
+        "scan_points": (lambda: base.scan_points(pose, scan), lambda: base._scan_points_numpy(pose, scan)),
+        "segment_clearance (60 segments)": (lambda: base.segment_clearance(pts, xy, ends),
+                                            lambda: base._segment_clearance_numpy(pts, xy, ends)),
+        "safe_heading (blocked ahead)": (lambda: base.safe_heading(1.5, xy, pts, 0.2, 0.9),
+                                         lambda: base._safe_heading_numpy(1.5, xy, pts, 0.2, 0.9)),
+        "field_vector": (lambda: field_vector(pose, np.array([5.0, 0.0]), pts, 72, params, 0.2),
+                         lambda: _field_vector_numpy(pose, np.array([5.0, 0.0]), pts, 72, params, 0.2)),
+        "VisBug _followed (+ ends)": (lambda: nav_new._followed(pose, scan), lambda: nav_old._followed_numpy(pose, scan)),
+        "VisBug boundary_heading": (lambda: boundary_heading(xy, pts, 0.33, 1, 1.5),
+                                    lambda: eq._boundary_heading_numpy(xy, pts, 0.33, 1, 1.5)),
+    }
+    print(f"{'fast path':34s} {'new us':>8s} {'numpy us':>9s} {'ratio':>6s}")
+    for name, (new, old) in pairs.items():
+        new(), old()  # compiled / loaded
+        times = []
+        for f in (new, old):
+            n = 2000
+            t0 = time.process_time()
+            for _ in range(n):
+                f()
+            times.append(1e6 * (time.process_time() - t0) / n)
+        print(f"{name:34s} {times[0]:8.1f} {times[1]:9.1f} {times[1] / times[0]:6.1f}", flush=True)
 
 
 def _tasks(base: Path, new: Path, args, repeats: int) -> None:
