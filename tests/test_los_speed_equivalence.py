@@ -26,7 +26,7 @@ from teamnav.control.nav.local.potential_field import (
 from teamnav.control.types import RangeScan
 from teamnav.geometry.angles import wrap_angle
 
-FAST = settings(max_examples=60, deadline=None)
+FAST = settings(max_examples=40, deadline=None)
 coord = st.floats(-30.0, 30.0, allow_nan=False)
 angle = st.floats(-20.0, 20.0, allow_nan=False)
 seeds = st.integers(0, 2**32 - 1)

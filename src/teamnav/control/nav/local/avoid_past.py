@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 from pydantic import Field
 
 from teamnav.control.nav.local.potential_field import PotentialField, PotentialFieldParams
@@ -187,7 +188,45 @@ class AvoidPast(PotentialField):
         self._grid_len = len(self.visits)
         k = int(math.ceil(p.memory_radius_m / p.cell_m)) + 1
         xy = pose[:2]
-        cells = self._grid.cells(int(math.floor(xy[0] / p.cell_m)), int(math.floor(xy[1] / p.cell_m)), k)
-        if not cells.shape[0]:
+        g = self._grid
+        coef, away = _avoid_terms(g.grid, g.i0, g.j0, int(math.floor(xy[0] / p.cell_m)),
+                                  int(math.floor(xy[1] / p.cell_m)), k, float(xy[0]), float(xy[1]), p.cell_m,
+                                  p.memory_radius_m)
+        if not coef.shape[0]:
             return v + np.zeros(2)
-        return v + _vector_of_cells(xy, cells, p.cell_m, p.memory_radius_m, p.avoid_gain_per_m, p.avoid_max)
+        va = p.avoid_gain_per_m * (coef @ away)  # numpy's matmul, as _vector_of_cells
+        norm = math.hypot(va[0], va[1])
+        return v + (va * (p.avoid_max / norm) if norm > p.avoid_max else va)
+
+
+@njit(cache=True)
+def _avoid_terms(grid, i0, j0, ci, cj, k, x, y, cell_m, memory_radius_m):
+    """The visited cells within ``k`` cells of (ci, cj), row-major, as :func:`_vector_of_cells`
+    weighs them (numba): ``away = xy − (cell + 0.5)·cell_m`` and its weight
+    ``w / max(d, 1e-12)``, ``w = n (1 − d / R)`` for ``1e-12 < d < R``, else 0."""
+    h, w = grid.shape
+    a0 = max(ci - k - i0, 0)
+    a1 = min(ci + k + 1 - i0, h)
+    b0 = max(cj - k - j0, 0)
+    b1 = min(cj + k + 1 - j0, w)
+    m = 0
+    for a in range(a0, a1):
+        for b in range(b0, b1):
+            if grid[a, b] > 0.0:
+                m += 1
+    coef = np.empty(m)
+    away = np.empty((m, 2))
+    m = 0
+    for a in range(a0, a1):
+        for b in range(b0, b1):
+            n = grid[a, b]
+            if n > 0.0:
+                ax = x - (float(a + i0) + 0.5) * cell_m
+                ay = y - (float(b + j0) + 0.5) * cell_m
+                d = math.hypot(ax, ay)
+                wt = n * (1.0 - d / memory_radius_m) if (d < memory_radius_m and d > 1e-12) else 0.0
+                coef[m] = wt / (d if d > 1e-12 or d != d else 1e-12)
+                away[m, 0] = ax
+                away[m, 1] = ay
+                m += 1
+    return coef, away
