@@ -100,9 +100,9 @@ def _vector_of_cells(xy: np.ndarray, arr: np.ndarray, cell_m: float, memory_radi
 
 class _VisitGrid:
     """A dense mirror of ``AvoidPast.visits`` (speed only, H7a): the same metres per cell in an
-    array that grows as the robot explores, so the cells near the robot are one slice, not
-    (2k + 1)² dictionary look-ups. It gives the rows of :func:`avoid_past_vector`'s ``cells``
-    exactly (same order, same values)."""
+    array that grows as the robot explores, so the cells near the robot are one window
+    (:func:`_avoid_terms`), not (2k + 1)² dictionary look-ups; the window's visited cells are
+    :func:`avoid_past_vector`'s ``cells`` (same order, same values)."""
 
     _PAD = 32
 
@@ -126,21 +126,6 @@ class _VisitGrid:
             self.grid, self.i0, self.j0 = grid, lo_i, lo_j
             gi, gj = i - self.i0, j - self.j0
         self.grid[gi, gj] = value
-
-    def cells(self, ci: int, cj: int, k: int) -> np.ndarray:
-        """Rows (i, j, metres) of the visited cells with |i − ci| ≤ k and |j − cj| ≤ k, row-major."""
-        h, w = self.grid.shape
-        a0, a1 = max(ci - k - self.i0, 0), min(ci + k + 1 - self.i0, h)
-        b0, b1 = max(cj - k - self.j0, 0), min(cj + k + 1 - self.j0, w)
-        if a0 >= a1 or b0 >= b1:
-            return np.zeros((0, 3))
-        win = self.grid[a0:a1, b0:b1]
-        ii, jj = np.nonzero(win > 0.0)
-        out = np.empty((ii.shape[0], 3))
-        out[:, 0] = ii + (a0 + self.i0)
-        out[:, 1] = jj + (b0 + self.j0)
-        out[:, 2] = win[ii, jj]
-        return out
 
 
 class AvoidPast(PotentialField):
