@@ -233,6 +233,7 @@ def _kernels() -> None:
         "VisBug boundary_heading": (lambda: boundary_heading(xy, pts, 0.33, 1, 1.5),
                                     lambda: eq._boundary_heading_numpy(xy, pts, 0.33, 1, 1.5)),
     }
+    pairs.update(_radio_pairs())
     print(f"{'fast path':34s} {'new us':>8s} {'numpy us':>9s} {'ratio':>6s}")
     for name, (new, old) in pairs.items():
         new(), old()  # compiled / loaded
@@ -244,6 +245,44 @@ def _kernels() -> None:
                 f()
             times.append(1e6 * (time.process_time() - t0) / n)
         print(f"{name:34s} {times[0]:8.1f} {times[1]:9.1f} {times[1] / times[0]:6.1f}", flush=True)
+
+
+def _radio_pairs() -> dict:
+    """H7a-2: a los-help message's size (per-type sizers vs the generic walk) and one step of
+    a 4-robot line-of-sight radio (kernel vs numpy; send + collect vs the numpy version written
+    out in ``tests/test_radio_speed.py``)."""
+    import numpy as np
+
+    import test_radio_speed as rs
+
+    from teamnav.control.coop.los_help.messages import GoalShare, LosHelpMsg, Sighting, VisReport
+    from teamnav.control.types import Message, _payload_size_bytes_generic, payload_size_bytes
+    from teamnav.sim.config import RadioConfig
+    from teamnav.sim.radio import Radio
+
+    body = LosHelpMsg(812, tuple(Sighting(j, 0.1 * j, 2.0 + j) for j in range(3)),
+                      tuple(GoalShare(j, 40 * j, 1.5, -2.0) for j in range(4)),
+                      tuple(VisReport(j, 40 * j, 3.0, 1.0, 0.5, 2.0) for j in range(4)), False)
+    radio = Radio(RadioConfig(mode="line_of_sight", range_m=1e9), rs._grid(1), 4, np.random.default_rng(0))
+    ref = rs._Reference(radio, 4, 0.0, 0)
+    xs, ys = np.array([0.5, 1.0, 2.5, 4.0]), np.array([1.0, 3.0, 2.0, 1.5])
+    out = [(i, Message(i, 0.0, body, kind="los_help")) for i in range(4)]
+    senders = np.arange(4)
+
+    def new_radio():
+        radio.send(out, xs, ys)
+        radio.collect()
+
+    def old_radio():
+        ref.send(out, xs, ys)
+        ref.collect()
+
+    return {
+        "size_bytes (los-help message)": (lambda: payload_size_bytes(body), lambda: _payload_size_bytes_generic(body)),
+        "Radio._receivers_of (4 of 4)": (lambda: radio._receivers_of([0, 1, 2, 3], xs, ys),
+                                         lambda: radio._receivers_of_numpy(senders, xs, ys)),
+        "Radio send+collect (4 messages)": (new_radio, old_radio),
+    }
 
 
 def _tasks(base: Path, new: Path, args, repeats: int) -> None:
