@@ -145,3 +145,28 @@ def test_unsizable_values_raise_the_same_error(value):
             payload_size_bytes(value)
         assert str(got.value) == str(want.value)
         assert "cannot size a message field of type" in str(got.value)
+
+
+# ------------------------------------------------------------------ fast frozen __init__
+def test_fast_init_keeps_the_dataclass_contract():
+    import inspect
+    import pickle
+
+    from teamnav.control.types import Action, Detection, Observation, RangeScan
+
+    pose = np.zeros(3)
+    a, b = Observation(1, 2, 0.1, pose, pose), Observation(1, 2, 0.1, pose, pose)
+    assert a.scans == {} and a.scans is not b.scans  # default_factory called per instance
+    assert (a.detections, a.stalled, a.inbox, a.events) == ((), False, (), ())
+    assert str(inspect.signature(Observation)).endswith("scans=<factory>, detections=(), stalled=False, inbox=(), events=())")
+    assert Action() == Action(0.0, 0.0, None) and Detection(1.0, 0.5).robot_id is None
+    m = Message(3, 1.5, (1, 2.0), kind="k")
+    assert (m.sender, m.stamp_s, m.body, m.to, m.kind) == (3, 1.5, (1, 2.0), None, "k")
+    assert pickle.loads(pickle.dumps(m)) == m and dataclasses.replace(m, to=2).to == 2
+    assert repr(RangeScan(1, 2, 3.0)) == "RangeScan(ranges_m=1, angles_rad=2, max_range_m=3.0)"
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        m.to = 1
+    with pytest.raises(TypeError, match="missing 2 required positional arguments: 'stamp_s' and 'body'"):
+        Message(1)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'speed'"):
+        Action(speed=1.0)

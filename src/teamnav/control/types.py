@@ -157,6 +157,53 @@ def _payload_size_bytes_generic(value: Any) -> int:
     raise TypeError(f"cannot size a message field of type {type(value).__name__}; use plain data")
 
 
+class _Factory:
+    """"No argument": the field's default_factory is called (shown as dataclasses shows it)."""
+
+    def __repr__(self) -> str:
+        return "<factory>"
+
+
+_FACTORY = _Factory()
+
+
+def _fast_frozen_init(cls: type) -> type:
+    """Give a frozen, slotted dataclass an ``__init__`` that stores through the slots' own
+    descriptors (the generated one calls ``object.__setattr__`` per field: ~0.45 µs more per
+    field; the simulator builds an Observation, RangeScan and Action per robot per step).
+
+    Same parameters, order, defaults and default factories as the generated ``__init__``;
+    the instance stays frozen (assignment still raises ``FrozenInstanceError``).
+    """
+    params = cls.__dataclass_params__
+    if not (params.frozen and "__slots__" in cls.__dict__) or hasattr(cls, "__post_init__"):
+        raise TypeError(f"{cls.__name__}: only frozen slotted dataclasses without __post_init__")
+    namespace: dict[str, Any] = {"_FACTORY": _FACTORY}
+    args, body = [], []
+    for f in dataclasses.fields(cls):
+        if not f.init or f.kw_only:
+            raise TypeError(f"{cls.__name__}.{f.name}: init=False / kw_only fields are not supported")
+        namespace[f"_set_{f.name}"] = cls.__dict__[f.name].__set__
+        if f.default is not dataclasses.MISSING:
+            namespace[f"_default_{f.name}"] = f.default
+            args.append(f"{f.name}=_default_{f.name}")
+            body.append(f"    _set_{f.name}(self, {f.name})")
+        elif f.default_factory is not dataclasses.MISSING:
+            namespace[f"_factory_{f.name}"] = f.default_factory
+            args.append(f"{f.name}=_FACTORY")
+            body.append(f"    _set_{f.name}(self, _factory_{f.name}() if {f.name} is _FACTORY else {f.name})")
+        else:
+            args.append(f.name)
+            body.append(f"    _set_{f.name}(self, {f.name})")
+    exec(f"def __init__(self, {', '.join(args)}):\n" + "\n".join(body) + "\n", namespace)  # noqa: S102
+    init = namespace["__init__"]
+    init.__qualname__ = f"{cls.__qualname__}.__init__"
+    init.__doc__ = cls.__init__.__doc__
+    cls.__init__ = init
+    return cls
+
+
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class Message:
     """A radio message: plain data, sized so bandwidth can be counted.
@@ -186,6 +233,7 @@ class Message:
         return 24 + payload_size_bytes(self.body)
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class Detection:
     """One robot seen by the robot detector, in the observer's body frame.
@@ -199,6 +247,7 @@ class Detection:
     robot_id: int | None = None
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class RangeScan:
     """One range sensor's reading.
@@ -212,6 +261,7 @@ class RangeScan:
     max_range_m: float
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class Observation:
     """Everything a robot knows at one step, built fresh by the simulator each step.
@@ -254,6 +304,7 @@ class Observation:
     events: tuple[str, ...] = ()
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class Action:
     """A motion command.
