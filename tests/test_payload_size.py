@@ -89,7 +89,7 @@ def _trail(names: tuple, k: int) -> TrailMessage:
                         np.zeros(k))
 
 
-names = st.lists(st.text(max_size=5), min_size=1, max_size=3).map(tuple)
+names = st.lists(st.text(max_size=5), min_size=1, max_size=3, unique=True).map(tuple)
 bodies = st.one_of(
     los_msgs,
     st.builds(_trail, names, st.integers(0, 4)),
