@@ -29,13 +29,46 @@ from __future__ import annotations
 from typing import Sequence
 
 import numpy as np
+from numba import njit
 
 from teamnav.control.types import Message
 from teamnav.world.grid import OccupancyGrid
-from teamnav.world.los import _PARALLEL_MIN_SEGMENTS, _los_kernel, _los_kernel_serial
+from teamnav.world.los import _PARALLEL_MIN_SEGMENTS, _los_kernel, _los_kernel_serial, _segment_visible
 from teamnav.world.raycast import _check_blocking
 
 __all__ = ["Radio"]
+
+_MODE_CODE = {"broadcast": 0, "range": 1, "line_of_sight": 2}
+
+#: Teams whose sender-receiver pairs number at most this go through :func:`_receivers_kernel`
+#: (one call instead of ~15 small numpy operations); larger ones keep the numpy path, whose
+#: line-of-sight kernel runs in parallel from ``_PARALLEL_MIN_SEGMENTS`` pairs on.
+_KERNEL_MAX_PAIRS = 256
+_NO_MAP = np.zeros((1, 1), dtype=np.uint8)  # the kernel's map argument when no mode needs one
+
+
+@njit(cache=True)
+def _receivers_kernel(blocking, ox, oy, inv, xs, ys, sidx, r2, mode, ok):
+    """:meth:`Radio._receivers_of` in one pass (same arithmetic, same answers): ``ok[k, j]``
+    is whether robot ``j`` hears sender ``sidx[k]``; ``mode`` 0 broadcast, 1 range, 2 line
+    of sight (range first, then the segment through ``blocking`` as ``line_of_sight``)."""
+    n = xs.shape[0]
+    for k in range(sidx.shape[0]):
+        s = sidx[k]
+        sx = xs[s]
+        sy = ys[s]
+        for j in range(n):
+            if mode == 0:
+                hear = True
+            else:
+                dx = xs[j] - sx
+                dy = ys[j] - sy
+                hear = dx * dx + dy * dy <= r2
+                if hear and mode == 2 and j != s:
+                    hear = _segment_visible(blocking, (sx - ox) * inv, (sy - oy) * inv, (xs[j] - ox) * inv,
+                                            (ys[j] - oy) * inv)
+            ok[k, j] = hear
+        ok[k, s] = False
 
 
 class Radio:
@@ -71,14 +104,36 @@ class Radio:
         if self._blocking is not None:
             self._blocking = _check_blocking(self._blocking)
         self._geo_inv = (float(self._geo[0]), float(self._geo[1]), 1.0 / float(self._geo[2]))
-        self.sent_messages = np.zeros(self.n, np.int64)
-        self.sent_bytes = np.zeros(self.n, np.int64)
-        self.delivered_messages = np.zeros(self.n, np.int64)
-        self.delivered_bytes = np.zeros(self.n, np.int64)
+        # per-robot counts as Python ints (a numpy scalar update costs more than the rest of a
+        # delivery); read as int64 arrays through the properties below
+        self._sent_messages = [0] * self.n
+        self._sent_bytes = [0] * self.n
+        self._delivered_messages = [0] * self.n
+        self._delivered_bytes = [0] * self.n
         self.lost = 0
         self.by_kind: dict[str, int] = {}
         self._pending: list[list[tuple[Message, int]]] = [[] for _ in range(self.n)]
         self.has_pending = False
+
+    @property
+    def sent_messages(self) -> np.ndarray:
+        """int64 (N,): messages each robot sent."""
+        return np.array(self._sent_messages, dtype=np.int64)
+
+    @property
+    def sent_bytes(self) -> np.ndarray:
+        """int64 (N,): bytes each robot sent (:meth:`Message.size_bytes`)."""
+        return np.array(self._sent_bytes, dtype=np.int64)
+
+    @property
+    def delivered_messages(self) -> np.ndarray:
+        """int64 (N,): messages delivered to each robot (in its inbox)."""
+        return np.array(self._delivered_messages, dtype=np.int64)
+
+    @property
+    def delivered_bytes(self) -> np.ndarray:
+        """int64 (N,): bytes delivered to each robot."""
+        return np.array(self._delivered_bytes, dtype=np.int64)
 
     def _receivers(self, s: int, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
         """Bool (N,): robots that can hear sender ``s`` now (mode only; no loss, no address)."""
@@ -93,6 +148,20 @@ class Radio:
         """
         mode = self.cfg.mode
         sidx = np.asarray(senders, dtype=np.int64)
+        if sidx.shape[0] * self.n <= _KERNEL_MAX_PAIRS:
+            ok = np.empty((sidx.shape[0], self.n), dtype=np.bool_)
+            blocking = self._blocking if self._blocking is not None else _NO_MAP
+            ox, oy, inv = self._geo_inv
+            r = self.cfg.range_m
+            _receivers_kernel(blocking, ox, oy, inv, np.ascontiguousarray(xs, dtype=np.float64),
+                              np.ascontiguousarray(ys, dtype=np.float64), sidx,
+                              0.0 if mode == "broadcast" else r * r, _MODE_CODE[mode], ok)
+            return ok
+        return self._receivers_of_numpy(sidx, xs, ys)
+
+    def _receivers_of_numpy(self, sidx: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+        """:meth:`_receivers_of` with numpy (large teams; the reference of the kernel's tests)."""
+        mode = self.cfg.mode
         rows = np.arange(sidx.shape[0])
         if mode == "broadcast":
             ok = np.ones((sidx.shape[0], self.n), dtype=bool)
@@ -127,34 +196,36 @@ class Radio:
         """
         if not outgoing:
             return
-        cache: dict[int, np.ndarray] = {}
         senders = sorted({int(s) for s, _ in outgoing})
-        for s, ok in zip(senders, self._receivers_of(senders, xs, ys)):
-            cache[s] = ok
+        hears = dict(zip(senders, self._receivers_of(senders, xs, ys).tolist()))
+        listeners: dict[int, list[int]] = {}  # sender -> the robots that hear its broadcasts
         p_loss = self.cfg.p_loss
+        n = self.n
+        by_kind = self.by_kind
+        pending = self._pending
         for s, msg in outgoing:
             if not isinstance(msg, Message):
                 raise ValueError(f"robot {s}'s outbox must hold Message objects, got {type(msg).__name__}")
+            s = int(s)
             size = msg.size_bytes()
-            self.sent_messages[s] += 1
-            self.sent_bytes[s] += size
-            self.by_kind[msg.kind] = self.by_kind.get(msg.kind, 0) + 1
-            ok = cache[int(s)]
-            if msg.to is not None:
-                to = msg.to
-                hear = np.zeros(self.n, dtype=bool)
-                if isinstance(to, (int, np.integer)) and 0 <= to < self.n:
-                    hear[to] = ok[to]
-                idx = np.flatnonzero(hear)
+            self._sent_messages[s] += 1
+            self._sent_bytes[s] += size
+            by_kind[msg.kind] = by_kind.get(msg.kind, 0) + 1
+            to = msg.to
+            if to is not None:
+                idx = [int(to)] if isinstance(to, (int, np.integer)) and 0 <= to < n and hears[s][to] else []
             else:
-                idx = np.flatnonzero(ok)
-            if p_loss > 0.0 and idx.size:
-                keep = self.rng.random(idx.size) >= p_loss
-                self.lost += int(idx.size - keep.sum())
-                idx = idx[keep]
-            for r in idx.tolist():
-                self._pending[r].append((msg, size))
-            self.has_pending = self.has_pending or idx.size > 0
+                idx = listeners.get(s)
+                if idx is None:
+                    idx = listeners[s] = [j for j, hear in enumerate(hears[s]) if hear]
+            if p_loss > 0.0 and idx:
+                keep = (self.rng.random(len(idx)) >= p_loss).tolist()
+                self.lost += len(idx) - sum(keep)
+                idx = [r for r, k in zip(idx, keep) if k]
+            for r in idx:
+                pending[r].append((msg, size))
+            if idx:
+                self.has_pending = True
 
     def collect(self) -> list[tuple[Message, ...]]:
         """Inboxes for this step (messages sent last step), one tuple per robot, and clear them."""
@@ -163,9 +234,11 @@ class Radio:
         boxes = []
         for r, pend in enumerate(self._pending):
             if pend:
-                self.delivered_messages[r] += len(pend)
-                self.delivered_bytes[r] += sum(size for _, size in pend)
-            boxes.append(tuple(m for m, _ in pend))
+                self._delivered_messages[r] += len(pend)
+                self._delivered_bytes[r] += sum(size for _, size in pend)
+                boxes.append(tuple(m for m, _ in pend))
+            else:
+                boxes.append(())
         self._pending = [[] for _ in range(self.n)]
         self.has_pending = False
         return boxes

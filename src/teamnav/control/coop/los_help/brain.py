@@ -66,8 +66,9 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from teamnav.control.coop.los_help.goal_sharing import (
     GoalSharing,
+    beam_near_reaches,
     max_beam_gap,
-    point_visible,
+    nearest_beam_visible,
     sender_frame,
 )
 from teamnav.control.coop.los_help.messages import (
@@ -79,9 +80,9 @@ from teamnav.control.coop.los_help.messages import (
     message_size_bytes,
 )
 from teamnav.control.coop.los_help.state_sharing import TroubleState
+from teamnav.control.nav.local.base import corridor_clear, wrap_scalar
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, Message, Observation, RangeScan
-from teamnav.geometry.angles import wrap_angle
 
 __all__ = ["make_navigator"]
 
@@ -269,10 +270,12 @@ class _LosBrain(abc.ABC):
         self.msgs_sent = 0
         self.bytes_sent = 0
         self.msgs_received = 0
-        self._pose = np.zeros(3)
         self._scan: RangeScan | None = None
         self._gap_for: Any = None
         self._gap_rad = 0.0
+        self._a64 = self._r64 = np.zeros(0)
+        self._max_range = 0.0
+        self._set_pose(np.zeros(3))
         self._step = 0
         #: steps spent per mode, cumulative (where the steps go: own goal seen, navigator,
         #: teammate, ghost, trouble helper)
@@ -285,25 +288,47 @@ class _LosBrain(abc.ABC):
         self._temp_key: Any = None
 
     # ------------------------------------------------------------------ sensing helpers
+    # Speed (H7a): the pose is kept as Python floats with its cosine and sine, once per step
+    # (``_px``, ``_py``, ``_th``, ``_c``, ``_s``), and the scan as float64 arrays (``_r64``,
+    # ``_a64``); the per-point tests run in numba kernels. Same arithmetic in the same order as
+    # before: the results are bit-identical (benchmarks/los_fingerprint.py).
+    def _set_pose(self, pose: np.ndarray) -> None:
+        self._pose = pose
+        self._px, self._py, self._th = float(pose[0]), float(pose[1]), float(pose[2])
+        self._c, self._s = math.cos(self._th), math.sin(self._th)
+
     def _odom_to_body(self, x: float, y: float) -> XY:
-        px, py, th = self._pose
-        dx, dy = x - px, y - py
-        c, s = math.cos(th), math.sin(th)
+        dx, dy = x - self._px, y - self._py
+        c, s = self._c, self._s
         return c * dx + s * dy, -s * dx + c * dy
 
-    def _body_to_odom(self, pose: np.ndarray, bx: float, by: float) -> XY:
+    def _body_to_odom(self, pose, bx: float, by: float) -> XY:
         c, s = math.cos(pose[2]), math.sin(pose[2])
         return pose[0] + c * bx - s * by, pose[1] + s * bx + c * by
 
+    def _set_scan(self, scan: RangeScan | None) -> None:
+        self._scan = scan
+        if scan is None:
+            return
+        angles = scan.angles_rad
+        if self._gap_for is not angles:  # the beam layout rarely changes: measure its gaps once
+            self._a64 = np.ascontiguousarray(angles, dtype=np.float64)
+            self._gap_for, self._gap_rad = angles, max_beam_gap(self._a64)
+        self._r64 = np.ascontiguousarray(scan.ranges_m, dtype=np.float64)
+        self._max_range = float(scan.max_range_m)
+
     def _sees(self, x: float, y: float, margin_m: float = 0.0) -> bool:
-        """V(R): the point (own frame) is in sight, from this step's omnidirectional scan (§2)."""
+        """V(R): the point (own frame) is in sight, from this step's omnidirectional scan (§2)
+        (:func:`~.goal_sharing.point_visible`)."""
         if self._scan is None:
             return False
         bx, by = self._odom_to_body(x, y)
-        angles = self._scan.angles_rad
-        if self._gap_for is not angles:  # the beam layout rarely changes: measure its gaps once
-            self._gap_for, self._gap_rad = angles, max_beam_gap(np.asarray(angles, dtype=np.float64))
-        return point_visible((bx, by), self._scan.ranges_m, angles, self.vis_radius_m, margin_m, self._gap_rad)
+        d = math.hypot(bx, by)
+        if d > self.vis_radius_m:
+            return False
+        if d < 1e-9:
+            return True
+        return nearest_beam_visible(self._r64, self._a64, d, math.atan2(by, bx), margin_m, self._gap_rad)
 
     def _keeps(self, x: float, y: float) -> bool:
         """The lenient test that keeps a goal already seen directly (``keep_direct_view``): in
@@ -316,35 +341,37 @@ class _LosBrain(abc.ABC):
             return False
         if d < 1e-9:
             return True
-        angles = np.asarray(self._scan.angles_rad, dtype=np.float64)
-        diff = np.abs(np.mod(angles - math.atan2(by, bx) + math.pi, 2 * math.pi) - math.pi)
-        near = diff <= 1.5 * max(self._gap_rad, 1e-6)
-        return bool(near.any() and np.any(np.asarray(self._scan.ranges_m)[near] >= d))
+        return beam_near_reaches(self._r64, self._a64, d, math.atan2(by, bx), 1.5 * max(self._gap_rad, 1e-6))
 
     def _me_xy(self) -> XY:
-        return float(self._pose[0]), float(self._pose[1])
+        return self._px, self._py
 
     # ------------------------------------------------------------------ the step
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
         """One step (see the module docstring)."""
         try:
-            self._scan = obs.scans[self.params.laser]
+            scan = obs.scans[self.params.laser]
         except KeyError:
             raise ValueError(
                 f"observation of robot {obs.robot_id} must carry scan {self.params.laser!r}, has {sorted(obs.scans)}"
             ) from None
-        self._pose = np.asarray(obs.odom_pose, dtype=np.float64).copy()
+        self._set_scan(scan)
+        self._set_pose(np.asarray(obs.odom_pose, dtype=np.float64).copy())
         self._step = int(obs.step)
         sightings = {}
         for det in obs.detections:
             if det.robot_id is None or det.robot_id == self.me:
                 continue  # without an identity a teammate cannot be paired with its messages
             sightings[int(det.robot_id)] = (float(det.range_m), float(det.bearing_rad))
-        self._history[int(obs.step)] = (self._pose.copy(), sightings)
+        self._history[int(obs.step)] = ((self._px, self._py, self._th), sightings)
         for old in [k for k in self._history if k <= obs.step - _HISTORY_STEPS]:
             del self._history[old]
-        self._seen_now = {rid: self._body_to_odom(self._pose, r * math.cos(b), r * math.sin(b))
-                          for rid, (r, b) in sightings.items()}
+        px, py, c, sn = self._px, self._py, self._c, self._s
+        seen_now = {}
+        for rid, (r, b) in sightings.items():
+            bx, by = r * math.cos(b), r * math.sin(b)
+            seen_now[rid] = (px + c * bx - sn * by, py + sn * bx + c * by)
+        self._seen_now = seen_now
 
         if self.params.goal_sharing:
             self.sharing.begin_step()
@@ -390,23 +417,25 @@ class _LosBrain(abc.ABC):
             back = next((sg for sg in body.sightings if sg.robot_id == self.me), None)
             if back is None:
                 continue  # the sender did not see me: no mutual bearing
-            pose_k, seen_k = hist
+            (kx, ky, kth), seen_k = hist
+            ck, sk = math.cos(kth), math.sin(kth)
             rng_m, bearing = seen_k[s]
             # §3.1: the sender's body frame in mine (at the sending step), θ21 = 180° + α21 − α12
             rel = sender_frame(bearing, back.bearing_rad, rng_m)
-            sender_xy = self._body_to_odom(pose_k, float(rel[0]), float(rel[1]))
+            r0, r1 = rel[0], rel[1]
+            sender_xy = (kx + ck * r0 - sk * r1, ky + sk * r0 + ck * r1)
             c, sn = math.cos(rel[2]), math.sin(rel[2])
             for g in body.goals:
                 if g.owner == self.me:
                     continue
-                gxy = self._body_to_odom(pose_k, rel[0] + c * g.gx_m - sn * g.gy_m, rel[1] + sn * g.gx_m + c * g.gy_m)
-                self.sharing.receive_goal(g.owner, g.goal_id, gxy)
-            me_k = (float(pose_k[0]), float(pose_k[1]))
+                bx, by = r0 + c * g.gx_m - sn * g.gy_m, r1 + sn * g.gx_m + c * g.gy_m
+                self.sharing.receive_goal(g.owner, g.goal_id, (kx + ck * bx - sk * by, ky + sk * bx + ck * by))
+            me_k = (kx, ky)
             for r in body.reports:
                 via = None
                 if r.via_d_m is not None:
-                    via = self._body_to_odom(pose_k, rel[0] + c * r.via_x_m - sn * r.via_y_m,
-                                             rel[1] + sn * r.via_x_m + c * r.via_y_m)
+                    bx, by = r0 + c * r.via_x_m - sn * r.via_y_m, r1 + sn * r.via_x_m + c * r.via_y_m
+                    via = (kx + ck * bx - sk * by, ky + sk * bx + ck * by)
                 self.sharing.receive_report(r.owner, r.goal_id, s, sender_xy, r.d_m, me_xy=me_k, step=int(body.step),
                                             via_xy=via, via_d_m=r.via_d_m)
 
@@ -464,7 +493,7 @@ class _LosBrain(abc.ABC):
                 self._nav, self._nav_goal = None, None
                 self.nav_restarts += 1
             return Action(), progressing
-        return Action(direction_rad=float(wrap_angle(heading - self._pose[2]))), progressing
+        return Action(direction_rad=wrap_scalar(heading - self._th)), progressing
 
     def _corridor_clear(self, heading_rad: float, length_m: float) -> bool:
         """Whether the robot's body can travel ``length_m`` straight along ``heading_rad`` (own
@@ -472,16 +501,8 @@ class _LosBrain(abc.ABC):
         1.05 radius from the segment), and the laser sees that far."""
         if length_m > self.vis_radius_m:
             return False
-        scan = self._scan
-        r = np.asarray(scan.ranges_m, dtype=np.float64)
-        hit = r < float(scan.max_range_m) * (1.0 - 1e-9)
-        if not hit.any():
-            return True
-        rel = np.asarray(scan.angles_rad, dtype=np.float64)[hit] + (float(self._pose[2]) - heading_rad)
-        along = r[hit] * np.cos(rel)
-        across = np.abs(r[hit] * np.sin(rel))
-        t = np.clip(along, 0.0, length_m)
-        return bool(np.hypot(along - t, across).min() >= self.radius_m * 1.05)
+        return corridor_clear(self._r64, self._a64, self._max_range, self._th, heading_rad, length_m,
+                              self.radius_m * 1.05)
 
     def _head_to(self, target: XY, key: Any, *, stop_within_m: float = 0.0,
                  end_margin_m: float = 0.0, trust: bool = False) -> tuple[Action, bool]:
@@ -505,13 +526,13 @@ class _LosBrain(abc.ABC):
             return Action(), True
         heading = math.atan2(target[1] - me[1], target[0] - me[0])
         if self.params.straight_when_visible and self._corridor_clear(heading, max(self.step_m, dist - end_margin_m)):
-            return Action(direction_rad=float(wrap_angle(heading - self._pose[2]))), progressing
+            return Action(direction_rad=wrap_scalar(heading - self._th)), progressing
         if (self.params.straight_when_visible and self.params.slide_when_blocked
                 and (trust or self._sees(*target, 2.0 * self.radius_m))):
             slide = self._slide_heading(heading, min(dist - end_margin_m, self.params.slide_lookahead_m))
             if slide is not None:
                 self.slide_steps += 1
-                return Action(direction_rad=float(wrap_angle(slide - self._pose[2]))), progressing
+                return Action(direction_rad=wrap_scalar(slide - self._th)), progressing
         temporary = not (isinstance(key, tuple) and key and key[0] in ("goal", "waypoint", "promised"))
         action, _ = self._navigate(target, temporary=temporary)
         return action, progressing

@@ -54,7 +54,9 @@ from dataclasses import dataclass, replace
 from typing import Callable, Iterable
 
 import numpy as np
+from numba import njit
 
+from teamnav.control.nav.local.base import pymod
 from teamnav.geometry.bearings import relative_frame_from_bearings, transform_goal
 from teamnav.geometry.se2 import compose, transform_points
 
@@ -63,6 +65,8 @@ __all__ = [
     "GoalSharing",
     "KnownGoal",
     "accept_goal_id",
+    "beam_near_reaches",
+    "nearest_beam_visible",
     "goal_in_own_frame",
     "sender_frame",
     "sender_pose_in_own_frame",
@@ -215,13 +219,48 @@ def point_visible(point_body_xy, ranges_m: np.ndarray, angles_rad: np.ndarray, r
     if d < 1e-9:
         return True
     b = math.atan2(y, x)
-    diff = np.abs(np.mod(np.asarray(angles_rad, dtype=np.float64) - b + math.pi, 2 * math.pi) - math.pi)
-    i = int(np.argmin(diff))
+    angles = np.ascontiguousarray(angles_rad, dtype=np.float64)
     if max_gap_rad is None:
-        max_gap_rad = max_beam_gap(np.asarray(angles_rad, dtype=np.float64))
-    if diff[i] > max_gap_rad:
+        max_gap_rad = max_beam_gap(angles)
+    return nearest_beam_visible(np.ascontiguousarray(ranges_m, dtype=np.float64), angles, d, b, float(margin_m),
+                                float(max_gap_rad))
+
+
+_TWO_PI = 2 * math.pi
+
+
+@njit(cache=True)
+def nearest_beam_visible(ranges_m, angles_rad, d_m, bearing_rad, margin_m, max_gap_rad):
+    """The core of :func:`point_visible` (numba): the beam nearest ``bearing_rad`` (the first
+    of equals, as ``np.argmin``) reads at least ``d_m − margin_m``, and lies within
+    ``max_gap_rad`` of it. Angular distance ``|mod(angle − b + π, 2π) − π|`` as numpy computes it."""
+    n = angles_rad.shape[0]
+    if n == 0:
+        raise ValueError("attempt to get argmin of an empty sequence")
+    best = 0
+    best_diff = abs(pymod(angles_rad[0] - bearing_rad + math.pi, _TWO_PI) - math.pi)
+    if best_diff == best_diff:  # NaN: np.argmin returns the first NaN
+        for i in range(1, n):
+            diff = abs(pymod(angles_rad[i] - bearing_rad + math.pi, _TWO_PI) - math.pi)
+            if diff != diff:
+                best, best_diff = i, diff
+                break
+            if diff < best_diff:
+                best, best_diff = i, diff
+    if best_diff > max_gap_rad:
         return False
-    return bool(ranges_m[i] >= d - margin_m)
+    return ranges_m[best] >= d_m - margin_m
+
+
+@njit(cache=True)
+def beam_near_reaches(ranges_m, angles_rad, d_m, bearing_rad, max_diff_rad):
+    """Some beam within ``max_diff_rad`` of ``bearing_rad`` reads at least ``d_m`` (numba; the
+    brains' lenient ``keep_direct_view`` test)."""
+    for i in range(angles_rad.shape[0]):
+        diff = abs(pymod(angles_rad[i] - bearing_rad + math.pi, _TWO_PI) - math.pi)
+        if diff <= max_diff_rad and ranges_m[i] >= d_m:
+            return True
+    return False
 
 
 def max_beam_gap(angles: np.ndarray) -> float:
@@ -354,7 +393,12 @@ class GoalSharing:
     @property
     def own_id(self) -> int | None:
         """``Id = k·M`` of the current own goal (None without a goal)."""
-        return None if self.own_k is None else goal_id(self.own_k, self.team_size)
+        k = self.own_k
+        if k is None:
+            return None
+        if k < 1:
+            return goal_id(k, self.team_size)  # raises
+        return int(k) * self.team_size
 
     def set_own_goal(self, k: int | None, goal_xy=None) -> None:
         """Set the robot's own k-th goal (own frame), or none; a new k forgets the old path."""

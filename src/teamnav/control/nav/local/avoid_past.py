@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 from pydantic import Field
 
 from teamnav.control.nav.local.potential_field import PotentialField, PotentialFieldParams
@@ -81,13 +82,50 @@ def avoid_past_vector(xy: np.ndarray, visits: dict[tuple[int, int], float], cell
              if (n := visits.get((i, j), 0.0)) > 0.0]
     if not cells:
         return np.zeros(2)
-    arr = np.asarray(cells, dtype=np.float64)
+    return _vector_of_cells(xy, np.asarray(cells, dtype=np.float64), cell_m, memory_radius_m, avoid_gain_per_m,
+                            avoid_max)
+
+
+def _vector_of_cells(xy: np.ndarray, arr: np.ndarray, cell_m: float, memory_radius_m: float,
+                     avoid_gain_per_m: float, avoid_max: float) -> np.ndarray:
+    """:func:`avoid_past_vector` from the visited cells near ``xy``: rows (i, j, metres), in
+    row-major order (i, then j)."""
     away = xy - (arr[:, :2] + 0.5) * cell_m
     d = np.hypot(away[:, 0], away[:, 1])
     w = np.where((d < memory_radius_m) & (d > 1e-12), arr[:, 2] * (1.0 - d / memory_radius_m), 0.0)
     v = avoid_gain_per_m * ((w / np.maximum(d, 1e-12)) @ away)
     norm = math.hypot(v[0], v[1])
     return v * (avoid_max / norm) if norm > avoid_max else v
+
+
+class _VisitGrid:
+    """A dense mirror of ``AvoidPast.visits`` (speed only, H7a): the same metres per cell in an
+    array that grows as the robot explores, so the cells near the robot are one window
+    (:func:`_avoid_terms`), not (2k + 1)² dictionary look-ups; the window's visited cells are
+    :func:`avoid_past_vector`'s ``cells`` (same order, same values)."""
+
+    _PAD = 32
+
+    def __init__(self) -> None:
+        self.grid = np.zeros((0, 0))
+        self.i0 = self.j0 = 0
+
+    def set(self, i: int, j: int, value: float) -> None:
+        gi, gj = i - self.i0, j - self.j0
+        h, w = self.grid.shape
+        if not (0 <= gi < h and 0 <= gj < w):
+            pad = self._PAD
+            lo_i, lo_j = min(i - pad, self.i0), min(j - pad, self.j0)
+            hi_i = max(i + pad + 1, self.i0 + h) if h else i + pad + 1
+            hi_j = max(j + pad + 1, self.j0 + w) if w else j + pad + 1
+            if not h:
+                lo_i, lo_j = i - pad, j - pad
+            grid = np.zeros((hi_i - lo_i, hi_j - lo_j))
+            if h:
+                grid[self.i0 - lo_i:self.i0 - lo_i + h, self.j0 - lo_j:self.j0 - lo_j + w] = self.grid
+            self.grid, self.i0, self.j0 = grid, lo_i, lo_j
+            gi, gj = i - self.i0, j - self.j0
+        self.grid[gi, gj] = value
 
 
 class AvoidPast(PotentialField):
@@ -113,11 +151,67 @@ class AvoidPast(PotentialField):
                  radius_m: float) -> None:
         super().__init__(params, rng, step_length_m, radius_m)
         self.visits: dict[tuple[int, int], float] = {}
+        self._grid = _VisitGrid()
+        self._grid_of: dict | None = None
+        self._grid_len = 0
 
     def _vector(self, pose: np.ndarray, points: np.ndarray, n_beams: int) -> np.ndarray:
         p: AvoidPastParams = self.params  # type: ignore[assignment]
         key = (int(math.floor(pose[0] / p.cell_m)), int(math.floor(pose[1] / p.cell_m)))
+        # speed (H7a): the cells near the robot come from a dense mirror of ``visits`` (rebuilt
+        # when ``visits`` was replaced or changed size behind its back): the same rows as
+        # avoid_past_vector's dictionary walk, so the same vector to the bit
+        stale = self._grid_of is not self.visits or self._grid_len != len(self.visits)
         self.visits[key] = self.visits.get(key, 0.0) + self.step_length_m
         v = super()._vector(pose, points, n_beams)
-        return v + avoid_past_vector(pose[:2], self.visits, p.cell_m, p.memory_radius_m, p.avoid_gain_per_m,
-                                     p.avoid_max)
+        if stale:
+            self._grid, self._grid_of = _VisitGrid(), self.visits
+            for (i, j), n in self.visits.items():
+                self._grid.set(i, j, n)
+        else:
+            self._grid.set(key[0], key[1], self.visits[key])
+        self._grid_len = len(self.visits)
+        k = int(math.ceil(p.memory_radius_m / p.cell_m)) + 1
+        xy = pose[:2]
+        g = self._grid
+        coef, away = _avoid_terms(g.grid, g.i0, g.j0, int(math.floor(xy[0] / p.cell_m)),
+                                  int(math.floor(xy[1] / p.cell_m)), k, float(xy[0]), float(xy[1]), p.cell_m,
+                                  p.memory_radius_m)
+        if not coef.shape[0]:
+            return v + np.zeros(2)
+        va = p.avoid_gain_per_m * (coef @ away)  # numpy's matmul, as _vector_of_cells
+        norm = math.hypot(va[0], va[1])
+        return v + (va * (p.avoid_max / norm) if norm > p.avoid_max else va)
+
+
+@njit(cache=True)
+def _avoid_terms(grid, i0, j0, ci, cj, k, x, y, cell_m, memory_radius_m):
+    """The visited cells within ``k`` cells of (ci, cj), row-major, as :func:`_vector_of_cells`
+    weighs them (numba): ``away = xy − (cell + 0.5)·cell_m`` and its weight
+    ``w / max(d, 1e-12)``, ``w = n (1 − d / R)`` for ``1e-12 < d < R``, else 0."""
+    h, w = grid.shape
+    a0 = max(ci - k - i0, 0)
+    a1 = min(ci + k + 1 - i0, h)
+    b0 = max(cj - k - j0, 0)
+    b1 = min(cj + k + 1 - j0, w)
+    m = 0
+    for a in range(a0, a1):
+        for b in range(b0, b1):
+            if grid[a, b] > 0.0:
+                m += 1
+    coef = np.empty(m)
+    away = np.empty((m, 2))
+    m = 0
+    for a in range(a0, a1):
+        for b in range(b0, b1):
+            n = grid[a, b]
+            if n > 0.0:
+                ax = x - (float(a + i0) + 0.5) * cell_m
+                ay = y - (float(b + j0) + 0.5) * cell_m
+                d = math.hypot(ax, ay)
+                wt = n * (1.0 - d / memory_radius_m) if (d < memory_radius_m and d > 1e-12) else 0.0
+                coef[m] = wt / (d if d > 1e-12 or d != d else 1e-12)
+                away[m, 0] = ax
+                away[m, 1] = ay
+                m += 1
+    return coef, away

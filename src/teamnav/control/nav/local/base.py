@@ -25,13 +25,14 @@ import math
 from typing import Protocol, runtime_checkable
 
 import numpy as np
+from numba import njit
 
 from teamnav.control.types import RangeScan
 from teamnav.geometry import wrap_angle
 
 __all__ = [
     "GOAL_SAME_TOL_M", "LocalNavigator", "ProgressMonitor", "check_goal", "check_pose", "check_scan",
-    "safe_heading", "scan_points", "seen_free", "segment_clearance",
+    "corridor_clear", "safe_heading", "scan_points", "seen_free", "segment_clear", "segment_clearance", "wrap_scalar",
 ]
 
 #: Two goals closer than this [m] are "the same goal" for :meth:`LocalNavigator.set_goal`.
@@ -83,6 +84,67 @@ class LocalNavigator(Protocol):
         """After the last :meth:`direction` call: is the robot making progress to the goal (§5)?"""
 
 
+# ---------------------------------------------------------------------------- fast scalar paths
+# Speed only (H7a): these give the same bits as the numpy expressions they replace (same IEEE
+# operations in the same order; numba's math.cos/sin/atan2/hypot call the same libm as numpy's
+# ufuncs; ``tests/test_los_speed_equivalence.py`` pins them against the numpy versions).
+_TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True, inline="always")
+def pymod(a, b):
+    """``np.mod(a, b)`` for floats (numpy's ``npy_divmod``: the result takes the sign of ``b``)."""
+    m = np.fmod(a, b)
+    if m != 0.0:
+        if (b < 0.0) != (m < 0.0):
+            m += b
+    else:
+        m = math.copysign(0.0, b)
+    return m
+
+
+def wrap_scalar(a: float) -> float:
+    """``float(wrap_angle(a))`` for one angle, on Python floats (the same operations:
+    Python's float ``%`` is numpy's ``np.mod``)."""
+    a = float(a)
+    if -math.pi < a <= math.pi or a != a:
+        return a
+    w = (a + math.pi) % _TWO_PI - math.pi
+    if w <= -math.pi:
+        w += _TWO_PI
+    if w > math.pi:
+        w = math.pi
+    return w
+
+
+@njit(cache=True)
+def corridor_clear(ranges_m, angles_rad, max_range_m, theta_rad, heading_rad, length_m, min_clear_m):
+    """Whether a body can travel ``length_m`` from the robot along ``heading_rad`` (own frame)
+    keeping ``min_clear_m`` from every return of the scan (beams reading less than
+    ``max_range_m · (1 − 1e-9)``); the robot's heading is ``theta_rad``.
+
+    The brains' ``_corridor_clear`` test: for each return at ``rel = angle + (θ − heading)``,
+    ``along = r cos rel``, ``across = |r sin rel|``, distance ``hypot(along − clip(along, 0, L),
+    across)``; clear when the smallest is at least ``min_clear_m``.
+    """
+    thr = max_range_m * (1.0 - 1e-9)
+    off = theta_rad - heading_rad
+    for i in range(ranges_m.shape[0]):
+        r = ranges_m[i]
+        if r < thr:
+            rel = angles_rad[i] + off
+            along = r * math.cos(rel)
+            across = abs(r * math.sin(rel))
+            t = along
+            if t < 0.0:
+                t = 0.0
+            if t > length_m:
+                t = length_m
+            if not math.hypot(along - t, across) >= min_clear_m:
+                return False
+    return True
+
+
 # ---------------------------------------------------------------------------- input checks
 def check_goal(goal_xy) -> np.ndarray:
     """``goal_xy`` as a finite float (2,) array, or ValueError."""
@@ -94,6 +156,9 @@ def check_goal(goal_xy) -> np.ndarray:
 
 def check_pose(pose) -> np.ndarray:
     """``pose`` as a finite float (3,) array, or ValueError."""
+    if (type(pose) is np.ndarray and pose.dtype == np.float64 and pose.shape == (3,)
+            and math.isfinite(pose[0]) and math.isfinite(pose[1]) and math.isfinite(pose[2])):
+        return pose
     p = np.asarray(pose, dtype=np.float64).reshape(-1)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
         raise ValueError(f"pose must be three finite numbers (x [m], y [m], theta [rad]), got {pose!r}")
@@ -128,6 +193,31 @@ def scan_points(pose: np.ndarray, scan: RangeScan) -> np.ndarray:
     >>> scan_points(np.array([1.0, 2.0, np.pi / 2]), s).round(6).tolist()
     [[1.0, 3.0]]
     """
+    r = np.ascontiguousarray(scan.ranges_m, dtype=np.float64)
+    a = np.ascontiguousarray(scan.angles_rad, dtype=np.float64)
+    return _scan_points(float(pose[0]), float(pose[1]), float(pose[2]), r, a, float(scan.max_range_m) * (1.0 - 1e-9))
+
+
+@njit(cache=True)
+def _scan_points(px, py, th, r, a, thr):
+    """:func:`scan_points` (numba): ``(px + r cos(th + a), py + r sin(th + a))`` of each r < thr."""
+    k = 0
+    for i in range(r.shape[0]):
+        if r[i] < thr:
+            k += 1
+    out = np.empty((k, 2))
+    k = 0
+    for i in range(r.shape[0]):
+        if r[i] < thr:
+            ang = th + a[i]
+            out[k, 0] = px + r[i] * math.cos(ang)
+            out[k, 1] = py + r[i] * math.sin(ang)
+            k += 1
+    return out
+
+
+def _scan_points_numpy(pose: np.ndarray, scan: RangeScan) -> np.ndarray:
+    """The numpy :func:`scan_points` (kept for the equivalence tests and the benchmark)."""
     r = np.asarray(scan.ranges_m, dtype=np.float64)
     a = np.asarray(scan.angles_rad, dtype=np.float64)
     hit = r < float(scan.max_range_m) * (1.0 - 1e-9)
@@ -158,6 +248,112 @@ def segment_clearance(points: np.ndarray, start_xy: np.ndarray, ends_xy: np.ndar
     >>> segment_clearance(np.array([[1.0, 1.0]]), np.zeros(2), np.array([[2.0, 0.0], [0.0, -2.0]])).tolist()
     [1.0, 1.4142135623730951]
     """
+    ends_xy = np.atleast_2d(ends_xy)
+    if points.shape[0] == 0:
+        return np.full(ends_xy.shape[0], np.inf)
+    ends = np.asarray(ends_xy, dtype=np.float64)
+    starts = np.asarray(start_xy, dtype=np.float64)
+    if starts.ndim == 1:
+        starts = np.broadcast_to(starts, ends.shape)
+    pts = np.asarray(points, dtype=np.float64)
+    slack = _NO_SLACK if slack_m is None else np.ascontiguousarray(slack_m, dtype=np.float64)
+    return _segment_clearance(pts[:, 0], pts[:, 1], starts[:, 0], starts[:, 1], ends[:, 0], ends[:, 1], slack,
+                              slack_m is not None)
+
+
+_NO_SLACK = np.zeros(0)
+
+
+def segment_clear(points: np.ndarray, start_xy: np.ndarray, ends_xy: np.ndarray, min_clear_m: float,
+                  slack_m: np.ndarray | None = None) -> np.ndarray:
+    """``segment_clearance(points, start_xy, ends_xy, slack_m) >= min_clear_m``, stopping at the
+    first point that is too close to a segment (the same distances, so the same answers).
+
+    Returns
+    -------
+    ndarray of shape (J,), bool
+    """
+    ends = np.atleast_2d(np.asarray(ends_xy, dtype=np.float64))
+    if points.shape[0] == 0:
+        return np.full(ends.shape[0], np.inf) >= min_clear_m
+    starts = np.asarray(start_xy, dtype=np.float64)
+    if starts.ndim == 1:
+        starts = np.broadcast_to(starts, ends.shape)
+    pts = np.asarray(points, dtype=np.float64)
+    slack = _NO_SLACK if slack_m is None else np.ascontiguousarray(slack_m, dtype=np.float64)
+    return _segment_clear(pts[:, 0], pts[:, 1], starts[:, 0], starts[:, 1], ends[:, 0], ends[:, 1], slack,
+                          slack_m is not None, float(min_clear_m))
+
+
+@njit(cache=True)
+def _segment_clear(px, py, sx, sy, ex, ey, slack, has_slack, lim):
+    """:func:`segment_clear` (numba): per segment, no point's distance (less its slack) is
+    below ``lim`` or NaN."""
+    nj = ex.shape[0]
+    out = np.empty(nj, dtype=np.bool_)
+    for j in range(nj):
+        d0 = ex[j] - sx[j]
+        d1 = ey[j] - sy[j]
+        len2 = d0 * d0 + d1 * d1
+        if len2 < 1e-24:
+            len2 = 1e-24
+        ok = True
+        for k in range(px.shape[0]):
+            v = _point_segment(px[k], py[k], sx[j], sy[j], d0, d1, len2)
+            if has_slack:
+                v = v - slack[k]
+            if not v >= lim:
+                ok = False
+                break
+        out[j] = ok
+    return out
+
+
+@njit(cache=True, inline="always")
+def _point_segment(px, py, sx, sy, d0, d1, len2):
+    """Distance from (px, py) to the segment from (sx, sy) along (d0, d1), as
+    :func:`segment_clearance` computes it (t clipped to [0, 1])."""
+    rx = px - sx
+    ry = py - sy
+    t = (rx * d0 + ry * d1) / len2
+    if t < 0.0:
+        t = 0.0
+    if t > 1.0:
+        t = 1.0
+    ex = rx - t * d0
+    ey = ry - t * d1
+    return math.sqrt(ex * ex + ey * ey)
+
+
+@njit(cache=True)
+def _segment_clearance(px, py, sx, sy, ex, ey, slack, has_slack):
+    """:func:`segment_clearance` (numba; the same operations per point and segment, the
+    minimum over points propagating NaN as ``ndarray.min``)."""
+    nj = ex.shape[0]
+    out = np.empty(nj)
+    for j in range(nj):
+        d0 = ex[j] - sx[j]
+        d1 = ey[j] - sy[j]
+        len2 = d0 * d0 + d1 * d1
+        if len2 < 1e-24 or len2 != len2:
+            len2 = 1e-24 if len2 == len2 else len2
+        best = np.inf
+        for k in range(px.shape[0]):
+            v = _point_segment(px[k], py[k], sx[j], sy[j], d0, d1, len2)
+            if has_slack:
+                v = v - slack[k]
+            if v != v:
+                best = v
+                break
+            if v < best:
+                best = v
+        out[j] = best
+    return out
+
+
+def _segment_clearance_numpy(points: np.ndarray, start_xy: np.ndarray, ends_xy: np.ndarray,
+                             slack_m: np.ndarray | None = None) -> np.ndarray:
+    """The numpy :func:`segment_clearance` (kept for the equivalence tests and the benchmark)."""
     ends_xy = np.atleast_2d(ends_xy)
     if points.shape[0] == 0:
         return np.full(ends_xy.shape[0], np.inf)
@@ -232,21 +428,89 @@ def safe_heading(heading_rad: float, xy: np.ndarray, points: np.ndarray, step_le
     step straight away from the nearest point).
     """
     if points.shape[0] == 0:
+        return wrap_scalar(heading_rad)
+    pts = np.asarray(points, dtype=np.float64)
+    h = _safe_heading(float(heading_rad), float(xy[0]), float(xy[1]), pts[:, 0], pts[:, 1], float(step_length_m),
+                      float(hard_clearance_m), int(round(math.pi / GUARD_STEP_RAD)), GUARD_STEP_RAD)
+    return wrap_scalar(h)
+
+
+@njit(cache=True)
+def _safe_heading(heading, x, y, px, py, step, hard, n, guard):
+    """:func:`safe_heading` before wrapping (numba): the headings ``heading + 0, +g, −g, +2g, …``
+    in that order, the first whose step is clear, else the one whose end is farthest from the
+    points near the robot (first of equals, as ``np.argmax``)."""
+    lim = step + hard + 1e-9
+    m = 0
+    for k in range(px.shape[0]):
+        if math.hypot(px[k] - x, py[k] - y) < lim:
+            m += 1
+    nx = np.empty(m)
+    ny = np.empty(m)
+    m = 0
+    for k in range(px.shape[0]):
+        if math.hypot(px[k] - x, py[k] - y) < lim:
+            nx[m] = px[k]
+            ny[m] = py[k]
+            m += 1
+    heads = np.empty(2 * n + 1)
+    heads[0] = heading + 0.0
+    for k in range(1, n + 1):
+        heads[2 * k - 1] = heading + k * guard
+        heads[2 * k] = heading + (-k) * guard
+    best_j = 0
+    best_d = -np.inf
+    for j in range(2 * n + 1):
+        ex = x + step * math.cos(heads[j])
+        ey = y + step * math.sin(heads[j])
+        d0 = ex - x
+        d1 = ey - y
+        len2 = d0 * d0 + d1 * d1
+        if len2 < 1e-24:
+            len2 = 1e-24
+        clear = np.inf
+        for k in range(m):
+            v = _point_segment(nx[k], ny[k], x, y, d0, d1, len2)
+            if v != v or v < clear:
+                clear = v
+                if v != v:
+                    break
+        if clear >= hard:
+            return heading if j == 0 else heads[j]
+        # the fallback's score: the nearest point to the step's end (m > 0 here)
+        d_end = np.inf
+        for k in range(m):
+            v = math.hypot(nx[k] - ex, ny[k] - ey)
+            if v != v or v < d_end:
+                d_end = v
+                if v != v:
+                    break
+        if d_end > best_d or (d_end != d_end and best_d == best_d):
+            best_d = d_end
+            best_j = j
+            if d_end != d_end:
+                best_d = d_end
+    return heads[best_j]
+
+
+def _safe_heading_numpy(heading_rad: float, xy: np.ndarray, points: np.ndarray, step_length_m: float,
+                        hard_clearance_m: float) -> float:
+    """The numpy :func:`safe_heading` (kept for the equivalence tests and the benchmark)."""
+    if points.shape[0] == 0:
         return float(wrap_angle(heading_rad))
     near = points[np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1]) < step_length_m + hard_clearance_m + 1e-9]
     want_end = xy + step_length_m * np.array([[math.cos(heading_rad), math.sin(heading_rad)]])
-    if segment_clearance(near, xy, want_end)[0] >= hard_clearance_m:
+    if _segment_clearance_numpy(near, xy, want_end)[0] >= hard_clearance_m:
         return float(wrap_angle(heading_rad))
     n = int(round(math.pi / GUARD_STEP_RAD))
     k = np.arange(1, n + 1)
     offs = np.concatenate(([0.0], np.column_stack((k, -k)).reshape(-1) * GUARD_STEP_RAD))
     heads = heading_rad + offs
     ends = xy + step_length_m * np.column_stack((np.cos(heads), np.sin(heads)))
-    clear = segment_clearance(near, xy, ends)
+    clear = _segment_clearance_numpy(near, xy, ends)
     ok = np.flatnonzero(clear >= hard_clearance_m)
     if ok.size:
         return float(wrap_angle(heads[ok[0]]))
-    # everything is too close already: the step whose end is farthest from the sensed points
     d_end = np.hypot(near[:, None, 0] - ends[None, :, 0], near[:, None, 1] - ends[None, :, 1]).min(axis=0)
     return float(wrap_angle(heads[int(np.argmax(d_end))]))
 

@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 from pydantic import BaseModel, ConfigDict, Field
 
 from teamnav.control.nav.local.base import (
@@ -121,6 +122,48 @@ def field_vector(pose: np.ndarray, goal_xy: np.ndarray, points: np.ndarray, n_be
     if points.shape[0]:
         r_safe = radius_m + params.safety_margin_m
         s_inf = r_safe + params.influence_m
+        pts = np.asarray(points, dtype=np.float64)
+        coef, away = _repulsion_terms(float(pose[0]), float(pose[1]), pts[:, 0], pts[:, 1], r_safe, s_inf,
+                                      params.repulsion_gain * 2.0 * math.pi / max(n_beams, 1))
+        v = v + coef @ away  # numpy's matmul (its summation order), as before
+    return v
+
+
+@njit(cache=True)
+def _repulsion_terms(x, y, px, py, r_safe, s_inf, scale):
+    """The per-point terms of avoid-static-obstacle (numba): ``away = (x, y) − point`` and its
+    weight ``mag / max(d, 1e-9)`` (``mag`` as in :func:`field_vector`), so that the field's
+    repulsion is ``weight @ away``; the same operations per point as the numpy version."""
+    n = px.shape[0]
+    coef = np.empty(n)
+    away = np.empty((n, 2))
+    for k in range(n):
+        ax = x - px[k]
+        ay = y - py[k]
+        away[k, 0] = ax
+        away[k, 1] = ay
+        d = math.hypot(ax, ay)
+        if d > s_inf:
+            mag = 0.0
+        elif d <= r_safe:
+            mag = INSIDE_GAIN
+        else:
+            mag = (s_inf - d) / (s_inf - r_safe)
+        mag = mag * scale
+        dm = d if d > 1e-9 or d != d else 1e-9
+        coef[k] = mag / dm
+    return coef, away
+
+
+def _field_vector_numpy(pose: np.ndarray, goal_xy: np.ndarray, points: np.ndarray, n_beams: int,
+                        params: PotentialFieldParams, radius_m: float) -> np.ndarray:
+    """The numpy :func:`field_vector` (kept for the equivalence tests and the benchmark)."""
+    to_goal = goal_xy - pose[:2]
+    dist = math.hypot(to_goal[0], to_goal[1])
+    v = params.attraction_gain * to_goal / dist if dist > 0.0 else np.zeros(2)
+    if points.shape[0]:
+        r_safe = radius_m + params.safety_margin_m
+        s_inf = r_safe + params.influence_m
         away = pose[:2] - points
         d = np.hypot(away[:, 0], away[:, 1])
         mag = np.where(d <= r_safe, INSIDE_GAIN, (s_inf - d) / (s_inf - r_safe))
@@ -189,9 +232,12 @@ class PotentialField:
         self._monitor.update(math.hypot(*(self.goal_xy - pose[:2])))
         points = scan_points(pose, scan)
         v = self._vector(pose, points, len(scan.ranges_m))
-        scale = max(math.hypot(v[0], v[1]), self.params.attraction_gain)
-        v = v + self.params.perturbation * scale * self.rng.standard_normal(2)
-        heading = math.atan2(v[1], v[0])
+        v0, v1 = float(v[0]), float(v[1])
+        scale = max(math.hypot(v0, v1), self.params.attraction_gain)
+        k = self.params.perturbation * scale
+        noise = self.rng.standard_normal(2)
+        # v + k · noise, on floats (the same two additions as the array expression)
+        heading = math.atan2(v1 + k * float(noise[1]), v0 + k * float(noise[0]))
         return safe_heading(heading, pose[:2], points, self.step_length_m, self.radius_m + self.params.guard_margin_m)
 
     @property

@@ -106,6 +106,7 @@ import math
 from typing import Literal
 
 import numpy as np
+from numba import njit
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from teamnav.control.nav.local.base import (
@@ -117,6 +118,7 @@ from teamnav.control.nav.local.base import (
     safe_heading,
     scan_points,
     seen_free,
+    segment_clear,
     segment_clearance,
 )
 from teamnav.control.types import RangeScan
@@ -235,13 +237,34 @@ def boundary_heading(xy: np.ndarray, points: np.ndarray, follow_distance_m: floa
     """
     if points.shape[0] == 0:
         return None
-    rel = points - xy
-    d2 = np.einsum("ij,ij->i", rel, rel)
-    i = int(np.argmin(d2))
-    d = math.sqrt(d2[i])
+    pts = np.asarray(points, dtype=np.float64)
+    # speed (H7a): the nearest point in a kernel (same squared distances, first of equals)
+    i, d2 = _nearest_sq(pts[:, 0], pts[:, 1], float(xy[0]), float(xy[1]))
+    rx, ry = float(pts[i, 0] - xy[0]), float(pts[i, 1] - xy[1])
+    d = math.sqrt(d2)
     err = max(-1.0, min(1.0, (follow_distance_m - d) / follow_distance_m))
     corr = max(-math.pi / 3, min(math.pi / 3, gain * err))
-    return math.atan2(rel[i, 1], rel[i, 0]) + side * (0.5 * math.pi + corr)
+    return math.atan2(ry, rx) + side * (0.5 * math.pi + corr)
+
+
+@njit(cache=True)
+def _nearest_sq(px, py, x, y):
+    """(index, squared distance) of the point nearest (x, y): ``np.argmin`` of
+    ``einsum("ij,ij->i", rel, rel)`` with ``rel = points − xy``."""
+    best = 0
+    rx = px[0] - x
+    ry = py[0] - y
+    best_d2 = rx * rx + ry * ry
+    if best_d2 == best_d2:
+        for k in range(1, px.shape[0]):
+            rx = px[k] - x
+            ry = py[k] - y
+            d2 = rx * rx + ry * ry
+            if d2 != d2:
+                return k, d2
+            if d2 < best_d2:
+                best, best_d2 = k, d2
+    return best, best_d2
 
 
 class VisBug21:
@@ -293,6 +316,8 @@ class VisBug21:
         self._suspended_at: np.ndarray | None = None
         #: (task goal, reverse_walk_factor) set by start_again, kept while that goal stays
         self._reverse_for: tuple[np.ndarray, float] | None = None
+        self._order_for = None
+        self._samples_key = None
         self._monitor = ProgressMonitor(params.progress_window_steps, params.progress_fraction, self.step_length_m)
         self._restart()
 
@@ -316,6 +341,7 @@ class VisBug21:
         self._blocked_xy: np.ndarray | None = None
         self._resumed = False
         self._monitor.reset()
+        self._samples_key: tuple | None = None
 
     # the task's Bug2 memory, kept across a temporary goal
     _TASK_STATE = ("goal_xy", "side", "mode", "mline", "hit_xy", "hit_dist_m", "_t_anchor", "_walked_m",
@@ -520,6 +546,43 @@ class VisBug21:
         (or when that point is lost) the obstacle nearest the robot. Without this, a robot
         passing between two obstacles (a U in a room, a pillar near a wall) would switch to
         following the other one, which is not Bug2.
+
+        Speed (H7a): one numba kernel (:func:`_follow_kernel`) with the arithmetic of
+        :meth:`_followed_numpy`, the beams' angular order kept per beam layout.
+        """
+        angles = scan.angles_rad
+        if self._order_for is not angles:
+            a = np.asarray(angles, dtype=np.float64)
+            self._order = np.argsort(np.mod(a, 2.0 * math.pi), kind="stable")
+            self._a_sorted = np.ascontiguousarray(a[self._order])
+            self._order_for = angles
+        r = np.asarray(scan.ranges_m, dtype=np.float64)[self._order]
+        ref = self._follow_ref
+        ends = self.params.turn == "nearer_end"
+        n_members, members, near, pts, found, e = _follow_kernel(
+            float(pose[0]), float(pose[1]), float(pose[2]), r, self._a_sorted,
+            float(scan.max_range_m) * (1.0 - 1e-9), ref is not None,
+            0.0 if ref is None else float(ref[0]), 0.0 if ref is None else float(ref[1]),
+            self.step_length_m + FOLLOW_GAP_M, 2.5 * (2.0 * math.pi / r.size), ends)
+        if n_members < 0:
+            self._follow_ref = None
+            return np.zeros((0, 2))
+        self._follow_ref = pts[near].copy()
+        if ends:
+            self._ends = (e[0].copy(), e[1].copy()) if found else None
+        return pts[members[:n_members]]
+
+    def _followed_numpy(self, pose: np.ndarray, scan: RangeScan) -> np.ndarray:
+        """The numpy :meth:`_followed` (kept for the equivalence tests and the benchmark).
+
+        Sensed points of the obstacle being followed (own frame), shape (K, 2).
+
+        The scan is cut into obstacles: beams adjacent in angle whose points are closer than
+        ``FOLLOW_GAP_M`` (or 2.5 beam gaps at that range) belong to one. The followed one is
+        the obstacle holding the point nearest to last step's followed point; at the hit point
+        (or when that point is lost) the obstacle nearest the robot. Without this, a robot
+        passing between two obstacles (a U in a room, a pillar near a wall) would switch to
+        following the other one, which is not Bug2.
         """
         r = np.asarray(scan.ranges_m, dtype=np.float64)
         a = np.asarray(scan.angles_rad, dtype=np.float64)
@@ -612,12 +675,20 @@ class VisBug21:
 
     def _mline_samples(self, t_from: float) -> tuple[np.ndarray, np.ndarray]:
         """M-line points with parameter t in [t_from, 1] (goal last), and their t."""
+        # speed (H7a): kept while the M-line and t_from are the same (read-only arrays)
+        key = self._samples_key
+        if key is not None and key[0] is self.mline and key[1] == t_from:
+            return key[2], key[3]
         s, g = self.mline
         length = math.hypot(*(g - s))
         n = max(1, int(math.ceil(length / self.params.mline_sample_m)))
         t = np.linspace(0.0, 1.0, n + 1)
         t = t[t >= t_from - 1e-12]
-        return s + t[:, None] * (g - s), t
+        pts = s + t[:, None] * (g - s)
+        pts.flags.writeable = False
+        t.flags.writeable = False
+        self._samples_key = (self.mline, t_from, pts, t)
+        return pts, t
 
     def _visible(self, xy: np.ndarray, pts: np.ndarray, cand: np.ndarray, r_safe: float, reach_m: float) -> np.ndarray:
         """Which candidate points the robot reaches through a free corridor of half-width ``r_safe``."""
@@ -627,7 +698,7 @@ class VisBug21:
             rng_p = np.hypot(pts[:, 0] - xy[0], pts[:, 1] - xy[1])
             keep = rng_p <= reach_m + 2.0 * r_safe
             idx = np.flatnonzero(ok)
-            ok[idx] = segment_clearance(pts[keep], xy, cand[idx], self._slack * rng_p[keep]) >= r_safe
+            ok[idx] = segment_clear(pts[keep], xy, cand[idx], r_safe, self._slack * rng_p[keep])
         return ok
 
     def _intermediate_target(self, xy, points, r_safe, reach_m) -> np.ndarray | None:
@@ -663,7 +734,7 @@ class VisBug21:
             ahead = cand[idx] + run[:, None] * u
             if points.shape[0]:
                 slack = self._slack * np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1])
-                ok[idx] = segment_clearance(points, cand[idx], ahead, slack) >= r_safe - self.params.leave_hysteresis_m
+                ok[idx] = segment_clear(points, cand[idx], ahead, r_safe - self.params.leave_hysteresis_m, slack)
             # ... and the robot must have *seen* that run free, not merely sensed nothing near
             # it: from afar it sees the near face of a wall, never its far side (a door jamb's
             # thickness), and a run grazing an unseen face made it leave, hit at once, and walk
@@ -696,3 +767,114 @@ class VisBug21:
         probe = np.concatenate((centres, centres + normal, centres - normal), axis=1)  # (K, 3(n+1), 2)
         seen = seen_free(pose, scan, probe.reshape(-1, 2)).reshape(probe.shape[:2])
         return seen.all(axis=1)
+
+
+@njit(cache=True)
+def _follow_kernel(px, py, th, r, a, thr, has_ref, refx, refy, ref_lim, gap_per_m, want_ends):
+    """:meth:`VisBug21._followed_numpy` and :meth:`VisBug21._sensed_ends` in one pass (numba),
+    on beams sorted by angle. Returns (number of members, member indices, nearest member,
+    points (n, 2), ends found, ends (2, 2)); -1 members when no beam returned."""
+    n = r.shape[0]
+    pts = np.empty((n, 2))
+    dirs = np.empty((n, 2))
+    hit = np.empty(n, dtype=np.bool_)
+    any_hit = False
+    for i in range(n):
+        ang = th + a[i]
+        c = math.cos(ang)
+        s = math.sin(ang)
+        pts[i, 0] = px + r[i] * c
+        pts[i, 1] = py + r[i] * s
+        dirs[i, 0] = c
+        dirs[i, 1] = s
+        hit[i] = r[i] < thr
+        any_hit = any_hit or hit[i]
+    e = np.zeros((2, 2))
+    members = np.empty(n, dtype=np.int64)
+    if not any_hit:
+        return -1, members, -1, pts, False, e
+    joined = np.empty(n, dtype=np.bool_)
+    for i in range(n):
+        j = i + 1 if i + 1 < n else 0
+        gap = math.hypot(pts[j, 0] - pts[i, 0], pts[j, 1] - pts[i, 1])
+        allowed = gap_per_m * max(r[i], r[j])
+        if not allowed > FOLLOW_GAP_M:
+            allowed = FOLLOW_GAP_M if allowed == allowed else allowed
+        joined[i] = hit[i] and hit[j] and gap <= allowed
+    labels = np.empty(n, dtype=np.int64)
+    labels[0] = 0
+    for i in range(1, n):
+        labels[i] = labels[i - 1] + (0 if joined[i - 1] else 1)
+    if joined[n - 1]:
+        last = labels[n - 1]
+        for i in range(n):
+            if labels[i] == last:
+                labels[i] = labels[0]
+    choice = -1
+    best = np.inf
+    for i in range(n):
+        if hit[i]:
+            d = math.hypot(pts[i, 0] - px, pts[i, 1] - py)
+            if choice < 0 or d < best:
+                choice, best = i, d
+    if has_ref:
+        k = -1
+        best = np.inf
+        for i in range(n):
+            if hit[i]:
+                d = math.hypot(pts[i, 0] - refx, pts[i, 1] - refy)
+                if k < 0 or d < best:
+                    k, best = i, d
+        if best <= ref_lim:
+            choice = k
+    m = 0
+    near = -1
+    best = np.inf
+    for i in range(n):
+        if hit[i] and labels[i] == labels[choice]:
+            members[m] = i
+            m += 1
+            d = math.hypot(pts[i, 0] - px, pts[i, 1] - py)
+            if near < 0 or d < best:
+                near, best = i, d
+    found = False
+    if want_ends:
+        found = True
+        for side in range(2):
+            step = 1 if side == 0 else -1
+            i = near
+            j = near
+            walked = 0
+            while walked < n:
+                k = (i + step) % n
+                close = joined[i] if step == 1 else joined[k]
+                if not (close and hit[k]) and not (j != i and _continues(pts, dirs, r, hit, px, py, i, j, k)):
+                    break
+                j = i
+                i = k
+                walked += 1
+            if walked >= n:
+                found = False
+                break
+            e[side, 0] = pts[i, 0]
+            e[side, 1] = pts[i, 1]
+    return m, members, near, pts, found, e
+
+
+@njit(cache=True)
+def _continues(pts, dirs, r, hit, px, py, i, j, k):
+    """Does beam k continue the surface through points j (older) and i (newest)?
+    (:meth:`VisBug21._sensed_ends`'s ``continues``, numba)."""
+    if not hit[k]:
+        return False
+    v0 = pts[i, 0] - pts[j, 0]
+    v1 = pts[i, 1] - pts[j, 1]
+    den = dirs[k, 0] * v1 - dirs[k, 1] * v0
+    w0 = pts[i, 0] - px
+    w1 = pts[i, 1] - py
+    if abs(den) <= 1e-12:
+        return False
+    r_line = (w0 * v1 - w1 * v0) / den
+    if not r_line > 0.0:
+        return False
+    return r[k] <= r_line + END_TOL_M + END_TOL_FRACTION * min(r[k], r_line)

@@ -1,0 +1,307 @@
+"""CPU per step of the line-of-sight help runs, this tree against an older one, in one session.
+
+Sgorbissa & Arkin's Tables 1–2 (``los-table1`` / ``los-table2``) are 2 maps × 3 algorithms ×
+8 teams × 5 tasks of up to 200 targets; their CPU is the CPU per simulated step of
+``los-help-simple`` / ``los-help-complex`` times the steps. This script measures that, per
+configuration (map × algorithm case of ``los-table1.yaml`` × R1 alone / R1..R4), for two
+source trees: this one and a *base* (by default the branch base f9d6cb5, unpacked with
+``git archive`` into a temporary folder). Each measurement runs in a fresh process with
+``PYTHONPATH=<tree>/src`` (one numba thread), after a warm-up run that loads the numba
+kernels; base and new alternate, ``--repeats`` times each, so that both see the same load. It
+prints, per configuration, the median CPU [ms] per step, the brains' share of it (inside the
+brains' ``step`` and ``log``), and the ratio base / new.
+
+Usage::
+
+    python benchmarks/bench_los_brains.py                        # 12 configurations, ~5 min CPU
+    python benchmarks/bench_los_brains.py --quick                # 1 repeat, 600 steps
+    python benchmarks/bench_los_brains.py --only simple/visbug21 --steps 3000
+    python benchmarks/bench_los_brains.py --base-src /path/to/old/src
+    python benchmarks/bench_los_brains.py --targets 10 --repeats 1   # CPU of a 10-target task
+    python benchmarks/bench_los_brains.py --kernels                  # each fast path vs its numpy version
+
+``--targets N``: instead of a fixed number of steps, each run is the first N targets of task 1
+(the scenario's own step budget per target and ``stop_when_finished``), and the table gives
+the CPU seconds of the whole task (the run, not the process start) and its steps: the unit of
+FULL_CPU_NOTE in ``teamnav/experiments/report/sections/los_help.py``.
+
+Otherwise the runs are those of the Tables (``record_every`` 10, no step budget reached: the targets'
+step budget is lifted so a potential field trapped alone keeps running for the whole time).
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+CASES = {
+    "pot-field": {"robots.0.params.navigator": "potential_field", "robots.0.params.state_sharing": True},
+    "avoid-past": {"robots.0.params.navigator": "avoid_past", "robots.0.params.state_sharing": False},
+    "visbug21": {"robots.0.params.navigator": "visbug21", "robots.0.params.state_sharing": False},
+}
+MAPS = {"simple": "los-help-simple", "complex": "los-help-complex"}
+TEAMS = {"R1": 0, "R1-R4": 1}
+BASE_COMMIT = "f9d6cb5"
+
+
+def _overrides(case: str, team: str, map_key: str = "", targets: int = 0) -> dict:
+    ov = dict(CASES[case])
+    for k in (1, 2, 3):
+        ov[f"robots.{k}.count"] = TEAMS[team]
+    if targets:
+        from teamnav import load_scenario
+
+        task = load_scenario(MAPS[map_key]).robots[0].params["targets_xy"]
+        ov["robots.0.params.targets_xy"] = [list(t) for t in task[:targets]]
+    else:
+        ov["robots.0.params.max_steps_per_target"] = 100_000_000
+    return ov
+
+
+def _worker(map_key: str, case: str, team: str, steps: int, targets: int = 0) -> dict:
+    """(in the measuring process) CPU of one warm run: total and inside the brains."""
+    from teamnav import load_scenario
+    from teamnav.experiments.runner import run
+    from teamnav.sim import engine
+
+    brain_s = [0.0]
+    clock = time.process_time
+    orig_init = engine.Simulation.__init__
+
+    def init(self, *args, **kwargs):
+        orig_init(self, *args, **kwargs)
+        for group in self.brains:
+            for brain in group if isinstance(group, list) else [group]:
+                for meth in ("step", "log"):
+                    f = getattr(brain, meth, None)
+                    if not callable(f):
+                        continue
+
+                    def timed(*args, f=f):
+                        t = clock()
+                        out = f(*args)
+                        brain_s[0] += clock() - t
+                        return out
+
+                    setattr(brain, meth, timed)
+
+    ov = _overrides(case, team, map_key, targets)
+    run(load_scenario(MAPS[map_key], overrides=ov, duration_s=40.0, seed=0), progress=False)  # warm-up: kernels loaded
+    engine.Simulation.__init__ = init
+    try:
+        if targets:
+            scn = load_scenario(MAPS[map_key], overrides=ov, seed=0)  # its own duration: stops when R1 is done
+        else:
+            scn = load_scenario(MAPS[map_key], overrides=ov, duration_s=steps * 0.1, seed=0)
+        t0 = clock()
+        res = run(scn, progress=False)
+        total = clock() - t0
+    finally:
+        engine.Simulation.__init__ = orig_init
+    import teamnav
+
+    brain = res.sim.brains[0]
+    brain = brain[0] if isinstance(brain, list) else brain
+    return {"cpu_s": total, "brain_s": brain_s[0], "steps": int(res.sim.step_index), "tree": teamnav.__file__,
+            "reached": int(getattr(brain, "targets_reached", -1))}
+
+
+def _measure(src: Path, key: str, steps: int, targets: int = 0) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(src), NUMBA_NUM_THREADS="1")
+    map_key, case, team = key.split("/")
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--worker", map_key, case, team, str(steps),
+                          str(targets)], env=env, check=True, capture_output=True, text=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _base_src(commit: str) -> Path:
+    dest = Path(tempfile.gettempdir()) / f"teamnav-base-{commit}"
+    if not (dest / "src" / "teamnav").is_dir():
+        dest.mkdir(parents=True, exist_ok=True)
+        arch = subprocess.run(["git", "-C", str(REPO), "archive", commit, "src"], check=True, capture_output=True)
+        subprocess.run(["tar", "-x", "-C", str(dest)], input=arch.stdout, check=True)
+    return dest / "src"
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--worker", nargs=5, metavar=("MAP", "CASE", "TEAM", "STEPS", "TARGETS"), help=argparse.SUPPRESS)
+    ap.add_argument("--targets", type=int, default=0, help="time whole tasks of the first N targets of task 1")
+    ap.add_argument("--kernels", action="store_true", help="time each fast path against its numpy version")
+    ap.add_argument("--steps", type=int, default=2000, help="simulated steps per timed run (default 2000)")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="one repeat of 600 steps")
+    ap.add_argument("--only", action="append", help="substring filter on MAP/CASE/TEAM (repeatable: any)")
+    ap.add_argument("--base-src", help=f"the older tree's src folder (default: git archive {BASE_COMMIT})")
+    ap.add_argument("--base-commit", default=BASE_COMMIT)
+    ap.add_argument("--new-src", help="the newer tree's src folder (default: this checkout's)")
+    args = ap.parse_args(argv)
+    if args.worker:
+        m, c, t, n, k = args.worker
+        print(json.dumps(_worker(m, c, t, int(n), int(k))))
+        return
+    if args.kernels:
+        _kernels()
+        return
+    steps = 600 if args.quick else args.steps
+    repeats = 1 if args.quick else max(1, args.repeats)
+    base = Path(args.base_src) if args.base_src else _base_src(args.base_commit)
+    new = Path(args.new_src) if args.new_src else REPO / "src"
+    what = f"tasks of {args.targets} targets" if args.targets else f"{steps} steps per run"
+    print(f"base {base}\nnew  {new}\n{what}, {repeats} repeat(s), load {os.getloadavg()[0]:.1f}")
+    if args.targets:
+        return _tasks(base, new, args, repeats)
+    print(f"{'configuration':26s} {'base ms/step':>12s} {'(brains)':>9s} {'new ms/step':>12s} {'(brains)':>9s} "
+          f"{'ratio':>6s} {'brains':>7s}")
+    ratios = []
+    for key in ("/".join(k) for k in itertools.product(MAPS, CASES, TEAMS)):
+        if args.only and not any(s in key for s in args.only):
+            continue
+        b, n = [], []
+        for _ in range(repeats):  # alternate: both trees see the same load
+            b.append(_measure(base, key, steps))
+            n.append(_measure(new, key, steps))
+        if b[0]["steps"] != n[0]["steps"]:
+            print(f"{key}: steps differ ({b[0]['steps']} vs {n[0]['steps']})", file=sys.stderr)
+        bt = statistics.median(r["cpu_s"] / r["steps"] for r in b)
+        bb = statistics.median(r["brain_s"] / r["steps"] for r in b)
+        nt = statistics.median(r["cpu_s"] / r["steps"] for r in n)
+        nb = statistics.median(r["brain_s"] / r["steps"] for r in n)
+        ratios.append(bt / nt)
+        print(f"{key:26s} {1000 * bt:12.3f} {1000 * bb:9.3f} {1000 * nt:12.3f} {1000 * nb:9.3f} "
+              f"{bt / nt:6.2f} {bb / nb:7.2f}", flush=True)
+    if ratios:
+        print(f"ratio base/new per step: min {min(ratios):.2f}, median {statistics.median(ratios):.2f}, "
+              f"max {max(ratios):.2f} (CPU time.process_time, one numba thread)")
+
+
+def _kernels() -> None:
+    """µs per call of each fast path and of the numpy version it replaced (kept as ``_*_numpy``
+    or, for code that was inline, written out in ``tests/test_los_speed_equivalence.py``), on a
+    72-beam scan in an office corridor (this process, this tree)."""
+    import math
+
+    import numpy as np
+
+    sys.path.insert(0, str(REPO / "tests"))
+    import test_los_speed_equivalence as eq
+
+    from teamnav.control.coop.los_help.goal_sharing import beam_near_reaches, point_visible
+    from teamnav.control.nav.local import base
+    from teamnav.control.nav.local.potential_field import PotentialFieldParams, _field_vector_numpy, field_vector
+    from teamnav.control.nav.local.visbug21 import VisBug21, VisBugParams, boundary_heading
+    from teamnav.control.types import RangeScan
+
+    angles = np.linspace(-math.pi, math.pi, 72, endpoint=False)
+    # a corridor 2 m wide along x, open ends beyond 8 m
+    with np.errstate(divide="ignore"):
+        r = np.minimum(np.abs(1.0 / np.sin(angles)), 8.0)
+    scan = RangeScan(r, angles, 8.0)
+    pose = np.array([0.3, 0.1, 0.2])
+    pts = base.scan_points(pose, scan)
+    xy = pose[:2].copy()
+    ends = xy + np.column_stack((np.linspace(0.5, 6, 60), np.linspace(-1, 1, 60)))
+    params = PotentialFieldParams()
+    nav_new = VisBug21(VisBugParams(), np.random.default_rng(0), 0.2, 0.2)
+    nav_old = VisBug21(VisBugParams(), np.random.default_rng(0), 0.2, 0.2)
+    a64 = np.ascontiguousarray(angles)
+    pairs = {
+        "point_visible (brain._sees)": (lambda: point_visible((3.0, 0.5), r, angles, 8.0, 0.0, 0.1),
+                                        lambda: eq._point_visible_numpy((3.0, 0.5), r, angles, 8.0, 0.0, 0.1)),
+        "keep view (brain._keeps)": (lambda: beam_near_reaches(r, a64, 3.0, 0.2, 0.13),
+                                     lambda: eq._keeps_numpy(scan, 3.0, 0.6, 0.087, 8.0)),
+        "corridor (brain._corridor_clear)": (lambda: base.corridor_clear(r, a64, 8.0, 0.2, 0.1, 3.0, 0.21),
+                                             lambda: eq._corridor_clear_numpy(scan, 0.2, 0.1, 3.0, 0.2)),
+        "scan_points": (lambda: base.scan_points(pose, scan), lambda: base._scan_points_numpy(pose, scan)),
+        "segment_clearance (60 segments)": (lambda: base.segment_clearance(pts, xy, ends),
+                                            lambda: base._segment_clearance_numpy(pts, xy, ends)),
+        "safe_heading (blocked ahead)": (lambda: base.safe_heading(1.5, xy, pts, 0.2, 0.9),
+                                         lambda: base._safe_heading_numpy(1.5, xy, pts, 0.2, 0.9)),
+        "field_vector": (lambda: field_vector(pose, np.array([5.0, 0.0]), pts, 72, params, 0.2),
+                         lambda: _field_vector_numpy(pose, np.array([5.0, 0.0]), pts, 72, params, 0.2)),
+        "VisBug _followed (+ ends)": (lambda: nav_new._followed(pose, scan), lambda: nav_old._followed_numpy(pose, scan)),
+        "VisBug boundary_heading": (lambda: boundary_heading(xy, pts, 0.33, 1, 1.5),
+                                    lambda: eq._boundary_heading_numpy(xy, pts, 0.33, 1, 1.5)),
+    }
+    pairs.update(_radio_pairs())
+    print(f"{'fast path':34s} {'new us':>8s} {'numpy us':>9s} {'ratio':>6s}")
+    for name, (new, old) in pairs.items():
+        new(), old()  # compiled / loaded
+        times = []
+        for f in (new, old):
+            n = 2000
+            t0 = time.process_time()
+            for _ in range(n):
+                f()
+            times.append(1e6 * (time.process_time() - t0) / n)
+        print(f"{name:34s} {times[0]:8.1f} {times[1]:9.1f} {times[1] / times[0]:6.1f}", flush=True)
+
+
+def _radio_pairs() -> dict:
+    """H7a-2: a los-help message's size (per-type sizers vs the generic walk) and one step of
+    a 4-robot line-of-sight radio (kernel vs numpy; send + collect vs the numpy version written
+    out in ``tests/test_radio_speed.py``)."""
+    import numpy as np
+
+    import test_radio_speed as rs
+
+    from teamnav.control.coop.los_help.messages import GoalShare, LosHelpMsg, Sighting, VisReport
+    from teamnav.control.types import Message, _payload_size_bytes_generic, payload_size_bytes
+    from teamnav.sim.config import RadioConfig
+    from teamnav.sim.radio import Radio
+
+    body = LosHelpMsg(812, tuple(Sighting(j, 0.1 * j, 2.0 + j) for j in range(3)),
+                      tuple(GoalShare(j, 40 * j, 1.5, -2.0) for j in range(4)),
+                      tuple(VisReport(j, 40 * j, 3.0, 1.0, 0.5, 2.0) for j in range(4)), False)
+    radio = Radio(RadioConfig(mode="line_of_sight", range_m=1e9), rs._grid(1), 4, np.random.default_rng(0))
+    ref = rs._Reference(radio, 4, 0.0, 0)
+    xs, ys = np.array([0.5, 1.0, 2.5, 4.0]), np.array([1.0, 3.0, 2.0, 1.5])
+    out = [(i, Message(i, 0.0, body, kind="los_help")) for i in range(4)]
+    senders = np.arange(4)
+
+    def new_radio():
+        radio.send(out, xs, ys)
+        radio.collect()
+
+    def old_radio():
+        ref.send(out, xs, ys)
+        ref.collect()
+
+    return {
+        "size_bytes (los-help message)": (lambda: payload_size_bytes(body), lambda: _payload_size_bytes_generic(body)),
+        "Radio._receivers_of (4 of 4)": (lambda: radio._receivers_of([0, 1, 2, 3], xs, ys),
+                                         lambda: radio._receivers_of_numpy(senders, xs, ys)),
+        "Radio send+collect (4 messages)": (new_radio, old_radio),
+    }
+
+
+def _tasks(base: Path, new: Path, args, repeats: int) -> None:
+    """CPU seconds of whole tasks (``--targets``), base and new alternating."""
+    print(f"{'configuration':26s} {'steps':>6s} {'reached':>7s} {'base CPU s':>10s} {'new CPU s':>10s} {'ratio':>6s}")
+    for key in ("/".join(k) for k in itertools.product(MAPS, CASES, TEAMS)):
+        if args.only and not any(s in key for s in args.only):
+            continue
+        b, n = [], []
+        for _ in range(repeats):
+            b.append(_measure(base, key, 0, args.targets))
+            n.append(_measure(new, key, 0, args.targets))
+        if (b[0]["steps"], b[0]["reached"]) != (n[0]["steps"], n[0]["reached"]):
+            print(f"{key}: runs differ: base {b[0]['steps']} steps {b[0]['reached']} reached, new "
+                  f"{n[0]['steps']} / {n[0]['reached']}", file=sys.stderr)
+        bt = statistics.median(r["cpu_s"] for r in b)
+        nt = statistics.median(r["cpu_s"] for r in n)
+        print(f"{key:26s} {n[0]['steps']:6d} {n[0]['reached']:7d} {bt:10.2f} {nt:10.2f} {bt / nt:6.2f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,140 @@
+"""Fingerprints of the line-of-sight help runs: a speed-up must not move a single bit.
+
+Runs ``los-help-simple`` and ``los-help-complex`` (Sgorbissa & Arkin §6) with each algorithm
+of Tables 1–2 (the cases of ``los-table1.yaml``: potential field with state + goal sharing,
+Avoid-Past and VisBug-21 with goal sharing), R1 alone and R1..R4, ``err_max`` 0 and 0.4 (every
+robot's detector, eqs. 1-2), for ``--steps`` steps each, recording every step, and prints one
+SHA-256 per run over
+
+- the true poses and the odometry of every robot at every step (bytes of the float64 arrays),
+- every brain's log at every step (modes, Tr/Pr/Nt, message and byte counts, targets reached),
+- the events, and per brain at the end: steps per target (``target_steps``), targets
+  reached, messages sent / received, bytes sent, moves.
+
+Usage::
+
+    python benchmarks/los_fingerprint.py                      # all 24 runs, ~1500 steps each
+    python benchmarks/los_fingerprint.py --save base.json     # record
+    python benchmarks/los_fingerprint.py --check base.json    # compare (exit 1 on a difference)
+    python benchmarks/los_fingerprint.py --steps 300 --only simple
+
+Recorded at the branch base f9d6cb5 in ``benchmarks/los_fingerprints.json`` (1500 steps).
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import itertools
+import json
+import sys
+import time
+
+#: case -> overrides (as los-table1.yaml's cases)
+CASES = {
+    "pot-field": {"robots.0.params.navigator": "potential_field", "robots.0.params.state_sharing": True},
+    "avoid-past": {"robots.0.params.navigator": "avoid_past", "robots.0.params.state_sharing": False},
+    "visbug21": {"robots.0.params.navigator": "visbug21", "robots.0.params.state_sharing": False},
+}
+MAPS = {"simple": "los-help-simple", "complex": "los-help-complex"}
+TEAMS = {"R1": 0, "R1-R4": 1}
+ERR_MAX = (0.0, 0.4)
+
+
+def _default(o):
+    import numpy as np
+
+    if isinstance(o, np.ndarray):
+        return {"nd": o.dtype.str, "shape": list(o.shape), "hex": hashlib.sha256(o.tobytes()).hexdigest()}
+    if isinstance(o, (np.floating,)):
+        return float(o).hex()
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, float):
+        return o.hex()
+    raise TypeError(type(o).__name__)
+
+
+def run_one(map_key: str, case: str, team: str, err_max: float, steps: int) -> tuple[str, dict]:
+    """(sha256, readable summary) of one run."""
+    import numpy as np
+
+    from teamnav import load_scenario
+    from teamnav.experiments.runner import run
+
+    ov = dict(CASES[case])
+    present = TEAMS[team]
+    for k in (1, 2, 3):
+        ov[f"robots.{k}.count"] = present
+    for k in (0, 1, 2, 3):
+        ov[f"robots.{k}.detector.err_max"] = err_max
+    ov["record_every"] = 1
+    scn = load_scenario(MAPS[map_key], overrides=ov, duration_s=steps * 0.1, seed=0)
+    res = run(scn, progress=False)
+    d = res.data
+    h = hashlib.sha256()
+    h.update(np.ascontiguousarray(d.true_pose, dtype=np.float64).tobytes())
+    h.update(np.ascontiguousarray(d.odom_pose, dtype=np.float64).tobytes())
+    h.update(np.ascontiguousarray(d.stalled).astype(np.uint8).tobytes())
+    h.update(json.dumps(d.logs, sort_keys=True, default=_default).encode())
+    h.update(json.dumps(d.event_log, sort_keys=True, default=_default).encode())
+    summary = {}
+    brains = [b for g in res.sim.brains for b in (g if isinstance(g, list) else [g])]
+    for i, b in enumerate(brains):
+        s = {
+            "target_steps": list(getattr(b, "target_steps", [])),
+            "targets_reached": int(getattr(b, "targets_reached", getattr(b, "waypoints_reached", 0))),
+            "msgs_sent": int(b.msgs_sent), "msgs_received": int(b.msgs_received),
+            "bytes_sent": int(b.bytes_sent), "moves": int(b.moves),
+        }
+        summary[f"robot{i}"] = s
+        h.update(json.dumps(s, sort_keys=True).encode())
+    summary["steps"] = int(res.sim.step_index)
+    h.update(str(summary["steps"]).encode())
+    return h.hexdigest(), summary
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--steps", type=int, default=1500)
+    ap.add_argument("--only", action="append", help="substring filter on the run key (repeatable: any)")
+    ap.add_argument("--save", help="write the fingerprints to this JSON file")
+    ap.add_argument("--check", help="compare with the fingerprints in this JSON file")
+    args = ap.parse_args(argv)
+    import teamnav
+
+    print(f"teamnav from {teamnav.__file__}", flush=True)
+    ref = {}
+    if args.check:
+        with open(args.check) as f:
+            ref = json.load(f)
+        if ref.get("steps") != args.steps:
+            print(f"reference has steps={ref.get('steps')}, running {args.steps}", file=sys.stderr)
+    out = {"steps": args.steps, "runs": {}}
+    bad = 0
+    t_all = time.process_time()
+    for map_key, case, team, err in itertools.product(MAPS, CASES, TEAMS, ERR_MAX):
+        key = f"{map_key}/{case}/{team}/err{err}"
+        if args.only and not any(s in key for s in args.only):
+            continue
+        t0 = time.process_time()
+        digest, summary = run_one(map_key, case, team, err, args.steps)
+        cpu = time.process_time() - t0
+        out["runs"][key] = {"sha256": digest, "summary": summary}
+        status = ""
+        if ref:
+            want = ref.get("runs", {}).get(key, {}).get("sha256")
+            status = "  (no reference)" if want is None else ("  OK" if want == digest else "  DIFFERS")
+            bad += want is not None and want != digest
+        r1 = summary["robot0"]
+        print(f"{key:36s} {digest[:16]} reached {r1['targets_reached']:3d} msgs {r1['msgs_sent']:5d} "
+              f"cpu {cpu:6.1f}s{status}", flush=True)
+    print(f"total CPU {time.process_time() - t_all:.1f} s; {len(out['runs'])} runs; {bad} differ")
+    if args.save:
+        with open(args.save, "w") as f:
+            json.dump(out, f, indent=1, sort_keys=True)
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
