@@ -134,3 +134,18 @@ def test_recover_reverse_tells_navigate_only_while_recovering(monkeypatch, flag,
     b.step(make_obs(0, 2, [4.0, 3.0, math.pi / 2]))  # off it up a branch: recovering
     assert b.nav.ignore_memory == [False, False, told]
     assert b.log()["recovering"] is True
+
+
+def test_give_way_never_fires_for_walls_alone_round_a_corner():
+    # An L-shaped corridor (east, then north): wall following round the corner brings walls into
+    # the front sector while the heading swings; no other robot, so no giving way.
+    walls = [(-5.0, -0.9, 2.7, -0.9), (2.7, -0.9, 2.7, 10.0), (-5.0, 0.9, 0.9, 0.9), (0.9, 0.9, 0.9, 10.0)]
+    n = nav(give_way_s=3.0)
+    fired = []
+    pose = np.array([-3.0, 0.0, 0.0])
+    for k in range(300):
+        v, w = n.step(observe(cast(walls, pose), pose, k), math.pi / 2 if pose[0] > 0.5 else 0.0)
+        fired.append(n._gw_active)
+        pose = pose + 0.1 * np.array([v * math.cos(pose[2]), v * math.sin(pose[2]), w])
+    assert pose[1] > 3.0  # round the corner and up the north leg
+    assert not any(fired)

@@ -71,6 +71,19 @@ the chosen heading for 1.5 m after an opening's turn (40.1 ± 0.6 %) or turning 
 to an opening's centre (46.7 ± 2.0 %, against 54.7 ± 4.1 %). An earlier measurement (6 m, seeds
 0-3, units delivered) saw no gain within its noise.
 
+Meeting flags (all off by default; Navigate's module docstring item 6 has the rules;
+``navigate={...}`` sets them): measured on ``try-to-see-it-my-way``, 4 robots, 30 min, seeds
+0-7, efficiency from ``place_interval_s`` (mean ± s.e.) against the default (no drift 58.2 ± 1.1 %,
+trips after the first source visit 119.1 ± 1.8 s, from 10 min on 117.5 ± 2.4 s; with the
+scenario's drift 53.5 ± 1.3 %, 128.6 ± 2.6 s): ``hint_skips_cooldown`` 57.4 ± 2.4 % (trips
+122.5 ± 3.6 s), ``face_hint_after_panic`` 56.6 ± 1.7 % (123.2 ± 2.5 s), ``recover_reverse``
+(below) 55.4 ± 1.0 % (127.9 ± 2.9 s), all without drift: none pays. ``give_way_s=3`` (with
+``give_way_jump_m`` 0.1 m, ``give_way_m`` 1 m, the defaults; 0.3 m fired once in 10 min) 60.4 ±
+2.3 % (trips 114.9 ± 3.9 s, from 10 min on 110.6 ± 3.2 s) without drift, 55.8 ± 2.6 % (126.9 ±
+7.1 s) with it: better, but not beyond the standard error; a candidate for more seeds.
+``recover_reverse`` (off by default): while recovering, Navigate's 180 deg rule ignores its
+reversal memory and distance cool-down (the robot is pushed up a branch by a meeting and the
+way back is where it last reversed).
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
 ``min_move_m`` since the previous temporary trail; radius 2 m (about a corridor's width);
 ``crumbs_for="every_place"`` is the §2.2 alternative the paper names for future work (one Crumb

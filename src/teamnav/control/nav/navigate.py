@@ -160,10 +160,10 @@ class NavigateParams(BaseModel):
     face_hint_after_panic: bool = False
     face_hint_min_deg: float = Field(45.0, ge=0.0, le=180.0)
     give_way_s: float = Field(0.0, ge=0.0, le=600.0)
-    give_way_m: float = Field(0.8, gt=0.0, le=20.0)
+    give_way_m: float = Field(1.0, gt=0.0, le=20.0)
     give_way_half_angle_deg: float = Field(30.0, gt=0.0, le=90.0)
     give_way_window_s: float = Field(1.0, gt=0.0, le=60.0)
-    give_way_jump_m: float = Field(0.3, ge=0.0, le=20.0)
+    give_way_jump_m: float = Field(0.1, ge=0.0, le=20.0)
 
     @model_validator(mode="after")
     def _ordered(self) -> "NavigateParams":
