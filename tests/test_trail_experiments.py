@@ -604,3 +604,29 @@ def test_try_section_needs_the_2000_team_to_collapse_not_just_slow_down(blazing_
     comps = [b for b in SECTION.build(_FakeCtx(table, quick=False)) if isinstance(b, Comparison)]
     assert _claim(comps, "collapses").holds is holds
     assert f"the 2000 team {100 * blazing_last_at_k4 / 9:.0f} %" in _claim(comps, "collapses").ours
+
+
+@pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
+def test_try_section_judges_the_drift_claim_where_the_2000_team_breaks_not_at_the_highest_k():
+    """EXPERIMENTS.md: "with drift that breaks the Blazing-a-trail system": at k = 6 the 2000 team
+    keeps a trickle (4 of 9) and the 2002 team degrades (4 of 9); at k = 4 the 2000 team
+    collapses (1 of 9) while the 2002 team keeps 6 of 9: the claim is judged at k = 4."""
+    from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
+
+    def table(key, kw):
+        if key == "try-drift" and kw.get("duration_s") == 10800.0:
+            return [_hours_row(0, [42, 42, 42])]
+        if key == "try-drift":
+            return [_row(9, 100.0, 0.0, {"units_per_10min_last": 9.0}),
+                    _row(9, 100.0, 4.0, {"units_per_10min_last": 6.0}),
+                    _row(9, 100.0, 6.0, {"units_per_10min_last": 4.0})]
+        if key == "blazing-drift":
+            return [_row(9, 100.0, 0.0, {"units_per_10min_last": 9.0}),
+                    _row(9, 100.0, 4.0, {"units_per_10min_last": 1.0}),
+                    _row(9, 100.0, 6.0, {"units_per_10min_last": 4.0})]
+        return [_row(9, 100.0)]
+
+    claim = _claim([b for b in SECTION.build(_FakeCtx(table, quick=False)) if isinstance(b, Comparison)],
+                   "collapses")
+    assert "at k = 4 the 2002 team keeps" in claim.ours and "the 2000 team 11 %" in claim.ours
+    assert claim.holds is True
