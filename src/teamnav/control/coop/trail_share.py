@@ -80,7 +80,10 @@ scenario's drift 53.5 ± 1.3 %, 128.6 ± 2.6 s): ``hint_skips_cooldown`` 57.4 ±
 (below) 55.4 ± 1.0 % (127.9 ± 2.9 s), all without drift: none pays. ``give_way_s=3`` (with
 ``give_way_jump_m`` 0.1 m, ``give_way_m`` 1 m, the defaults; 0.3 m fired once in 10 min) 60.4 ±
 2.3 % (trips 114.9 ± 3.9 s, from 10 min on 110.6 ± 3.2 s) without drift, 55.8 ± 2.6 % (126.9 ±
-7.1 s) with it: better, but not beyond the standard error; a candidate for more seeds.
+7.1 s) with it: better, but not beyond the standard error; on fresh seeds 8-11 (no drift)
+60.1 ± 1.9 % against 56.7 ± 2.3 % (paired gain 3.5 ± 1.4 points; trips 117.6 ± 1.8 s against
+122.5 ± 3.3 s); seeds 0-11 together 60.3 ± 1.6 % against 57.7 ± 1.0 %. A candidate to turn on
+after a drift check on more seeds and the 3-h runs.
 ``recover_reverse`` (off by default): while recovering, Navigate's 180 deg rule ignores its
 reversal memory and distance cool-down (the robot is pushed up a branch by a meeting and the
 way back is where it last reversed).
