@@ -44,13 +44,9 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-CASES = {
-    "pot-field": {"robots.0.params.navigator": "potential_field", "robots.0.params.state_sharing": True},
-    "avoid-past": {"robots.0.params.navigator": "avoid_past", "robots.0.params.state_sharing": False},
-    "visbug21": {"robots.0.params.navigator": "visbug21", "robots.0.params.state_sharing": False},
-}
-MAPS = {"simple": "los-help-simple", "complex": "los-help-complex"}
-TEAMS = {"R1": 0, "R1-R4": 1}
+sys.path.insert(0, str(HERE))
+from los_fingerprint import CASES, MAPS, TEAMS  # noqa: E402  (the same 12 configurations)
+
 BASE_COMMIT = "f9d6cb5"
 
 
