@@ -44,6 +44,24 @@ Quick mode (CI): the simple map only, the first target of task 1 with an 800-ste
 teams {R1, R1..R4}, err_max 0.4 (err_max 0 is the tables' R1..R4 run), no ablation: 9 short
 runs.
 
+The full tables, 5 tasks x 200 targets (`teamnav sweep los-table1 / los-table2 -j 2`, commit
+fc84d58, 2026-11-23; steps per target over finished tasks (std % of mean), tasks finished; for
+tasks not finished, the mean number of the 200 targets reached before R1 gave up)::
+
+    office_simple   R1                R1,2              R1..3             R1..4
+    VisBug-21       258 (6 %) 5/5     215 (4 %) 5/5     184 (6 %) 5/5     162 (5 %) 5/5
+    Avoid-Past      0/5 (10.6)        0/5 (24.8)        0/5 (36.8)        0/5 (79.2)
+    Pot. field      0/5 (0)           0/5 (19.8)        366 (1 %) 2/5     331 (9 %) 2/5
+    office_complex
+    VisBug-21       312 (10 %) 5/5    290 (7 %) 5/5     294 (7 %) 5/5     271 (4 %) 5/5
+    Avoid-Past      0/5 (19.2)        0/5 (30.0)        0/5 (44.2)        0/5 (53.8)
+    Pot. field      0/5 (0.8)         0/5 (19.6)        0/5 (19.6)        0/5 (28.2)
+
+VisBug-21 falls with every helper on office_simple; on office_complex 290 -> 294 is within the
+spread. Avoid-Past never finishes 200 targets: one target over its budget (1500 / 2500 steps)
+ends the task, although it finished 3-5 of 5 twenty-target tasks; the targets reached rise with
+every helper. The paper's Avoid-Past finished every task: its give-ups are the open defect.
+
 Measured (H7c, 2026-11-23; the 5 tasks' first 20 targets, the tables' budgets, workers=1;
 raw rows in the session's notes; "mean (std %) finished/run" as the tables print them)
 ----------------------------------------------------------------------------------------
@@ -199,16 +217,15 @@ def strictly_falling(means: Sequence[float]) -> bool:
 
 # ---------------------------------------------------------------------------- sweeps
 #: What the full reproduction costs on this machine (measured, see the note's numbers).
-FULL_CPU_NOTE = ("Cost of the full reproduction here (CPU time of `teamnav sweep` with one worker, measured on the "
-                 "5 tasks' first 20 targets on 2026-11-23 and scaled to 200: a finishing trial's CPU grows with its "
-                 "targets, a failing one ends at its first target over budget, so x10 is an upper bound): "
-                 "`los-table1` (3 algorithms x 4 nested teams x 5 tasks = 60 trials) 529 CPU-s for 20 targets, so "
-                 "at most about 1.5 CPU-hours for 200; `los-table2` (60 trials) 615 CPU-s, at most about 1.7 "
-                 "CPU-hours; `los-noise-simple` (75 trials, all helpers) 15 CPU-s per trial of 20 targets "
-                 "(Avoid-Past and VisBug at err_max 0.2 and 0.4), about 3 CPU-hours; `los-noise-complex` and "
-                 "`los-ablation` were not measured, about 3-4 and 2.5 CPU-hours by the same rates. The nested "
-                 "teams halved the table sweeps (a grid of every helper subset ran 120 trials each). Wall time is "
-                 "that over the number of workers (`-j`).")
+FULL_CPU_NOTE = ("Cost of the full reproduction here, measured: `NUMBA_NUM_THREADS=1 teamnav sweep los-table1 -j 2` "
+                 "(3 algorithms x 4 nested teams x 5 tasks of 200 targets = 60 trials) took 15 min wall and 20 "
+                 "CPU-min on this 2-core machine, `los-table2` 9 min wall and 17 CPU-min (2026-11-23, commit "
+                 "fc84d58, a test run sharing the cores; a failing trial ends at its first target over budget, "
+                 "which makes the Avoid-Past and potential-field trials short). Before the nested teams (120 "
+                 "trials) and the 2.45x faster brains and radio (benchmarks/bench_los_brains.py) the estimate was "
+                 "7 CPU-hours for los-table1. `los-noise-simple` (75 trials, all helpers) costs 15 CPU-s per "
+                 "trial of 20 targets at the old speed (not run at 200); `los-noise-complex` and `los-ablation` "
+                 "were not measured. Wall time is about the CPU time over the number of workers (`-j`).")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
 GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
