@@ -770,6 +770,20 @@ class VisBug21:
 
 
 @njit(cache=True)
+def _nearest_hit(pts, hit, x, y):
+    """Index of the returned beam (``hit``) whose point is nearest to (x, y), and that distance
+    (the first of equals; -1 and inf when no beam returned)."""
+    k = -1
+    best = np.inf
+    for i in range(pts.shape[0]):
+        if hit[i]:
+            d = math.hypot(pts[i, 0] - x, pts[i, 1] - y)
+            if k < 0 or d < best:
+                k, best = i, d
+    return k, best
+
+
+@njit(cache=True)
 def _follow_kernel(px, py, th, r, a, thr, has_ref, refx, refy, ref_lim, gap_per_m, want_ends):
     """:meth:`VisBug21._followed_numpy` and :meth:`VisBug21._sensed_ends` in one pass (numba),
     on beams sorted by angle. Returns (number of members, member indices, nearest member,
@@ -810,21 +824,9 @@ def _follow_kernel(px, py, th, r, a, thr, has_ref, refx, refy, ref_lim, gap_per_
         for i in range(n):
             if labels[i] == last:
                 labels[i] = labels[0]
-    choice = -1
-    best = np.inf
-    for i in range(n):
-        if hit[i]:
-            d = math.hypot(pts[i, 0] - px, pts[i, 1] - py)
-            if choice < 0 or d < best:
-                choice, best = i, d
+    choice, best = _nearest_hit(pts, hit, px, py)
     if has_ref:
-        k = -1
-        best = np.inf
-        for i in range(n):
-            if hit[i]:
-                d = math.hypot(pts[i, 0] - refx, pts[i, 1] - refy)
-                if k < 0 or d < best:
-                    k, best = i, d
+        k, best = _nearest_hit(pts, hit, refx, refy)
         if best <= ref_lim:
             choice = k
     m = 0
