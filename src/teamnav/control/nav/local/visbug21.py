@@ -106,7 +106,6 @@ import math
 from typing import Literal
 
 import numpy as np
-from numba import njit
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from teamnav.control.nav.local.base import (
@@ -119,7 +118,13 @@ from teamnav.control.nav.local.base import (
     scan_points,
     seen_free,
     segment_clear,
-    segment_clearance,
+)
+from teamnav.control.nav.local.visbug21_geometry import (
+    END_TOL_FRACTION,
+    END_TOL_M,
+    FOLLOW_GAP_M,
+    _follow_kernel,
+    boundary_heading,
 )
 from teamnav.control.types import RangeScan
 
@@ -128,17 +133,11 @@ __all__ = ["MODE_FOLLOW", "MODE_TO_GOAL", "MODE_UNREACHABLE", "VisBug21", "VisBu
 MODE_TO_GOAL = 0
 MODE_FOLLOW = 1
 MODE_UNREACHABLE = 2
-#: Two neighbouring beams' points closer than this [m] (or 2.5 beam gaps) lie on one obstacle.
-FOLLOW_GAP_M: float = 0.3
 #: Back from a temporary goal farther than this [m] from where it left the boundary walk,
 #: VisBug resumes with Step 1 (on the kept M-line and d_H), not the walk.
 RESUME_FOLLOW_M: float = 1.0
 #: Two ends' costs closer than this [m] are a tie for ``turn="nearer_end"``.
 NEARER_END_TIE_M: float = 0.05
-#: ``turn="nearer_end"``: a beam reading up to this much beyond the surface's line continues it [m] ...
-END_TOL_M: float = 0.1
-#: ... plus this fraction of the range.
-END_TOL_FRACTION: float = 0.1
 #: The leave test's run must be seen free this fraction of its half-width to either side.
 RUN_SEEN_FRACTION: float = 0.8
 
@@ -218,53 +217,6 @@ class VisBugParams(BaseModel):
                 f"leave_hysteresis_m must be < follow_margin_m ({self.follow_margin_m}), got {self.leave_hysteresis_m}"
             )
         return self
-
-
-def boundary_heading(xy: np.ndarray, points: np.ndarray, follow_distance_m: float, side: int,
-                     gain: float) -> float | None:
-    """Heading [rad] that follows the boundary through the nearest sensed point.
-
-    ``side = +1`` keeps the obstacle on the right, ``-1`` on the left. The heading is the
-    tangent at the nearest point, turned away from the obstacle by
-    ``gain · (follow_distance − d) / follow_distance`` (clipped to ±60°) when closer than
-    ``follow_distance_m`` and towards it when farther. None when nothing is sensed.
-
-    Examples
-    --------
-    >>> pts = np.array([[0.0, -0.5], [1.0, -0.5]])   # a wall 0.5 m to the right
-    >>> round(boundary_heading(np.zeros(2), pts, 0.5, +1, 1.5), 6)
-    0.0
-    """
-    if points.shape[0] == 0:
-        return None
-    pts = np.asarray(points, dtype=np.float64)
-    # speed (H7a): the nearest point in a kernel (same squared distances, first of equals)
-    i, d2 = _nearest_sq(pts[:, 0], pts[:, 1], float(xy[0]), float(xy[1]))
-    rx, ry = float(pts[i, 0] - xy[0]), float(pts[i, 1] - xy[1])
-    d = math.sqrt(d2)
-    err = max(-1.0, min(1.0, (follow_distance_m - d) / follow_distance_m))
-    corr = max(-math.pi / 3, min(math.pi / 3, gain * err))
-    return math.atan2(ry, rx) + side * (0.5 * math.pi + corr)
-
-
-@njit(cache=True)
-def _nearest_sq(px, py, x, y):
-    """(index, squared distance) of the point nearest (x, y): ``np.argmin`` of
-    ``einsum("ij,ij->i", rel, rel)`` with ``rel = points − xy``."""
-    best = 0
-    rx = px[0] - x
-    ry = py[0] - y
-    best_d2 = rx * rx + ry * ry
-    if best_d2 == best_d2:
-        for k in range(1, px.shape[0]):
-            rx = px[k] - x
-            ry = py[k] - y
-            d2 = rx * rx + ry * ry
-            if d2 != d2:
-                return k, d2
-            if d2 < best_d2:
-                best, best_d2 = k, d2
-    return best, best_d2
 
 
 class VisBug21:
@@ -767,116 +719,3 @@ class VisBug21:
         probe = np.concatenate((centres, centres + normal, centres - normal), axis=1)  # (K, 3(n+1), 2)
         seen = seen_free(pose, scan, probe.reshape(-1, 2)).reshape(probe.shape[:2])
         return seen.all(axis=1)
-
-
-@njit(cache=True)
-def _nearest_hit(pts, hit, x, y):
-    """Index of the returned beam (``hit``) whose point is nearest to (x, y), and that distance
-    (the first of equals; -1 and inf when no beam returned)."""
-    k = -1
-    best = np.inf
-    for i in range(pts.shape[0]):
-        if hit[i]:
-            d = math.hypot(pts[i, 0] - x, pts[i, 1] - y)
-            if k < 0 or d < best:
-                k, best = i, d
-    return k, best
-
-
-@njit(cache=True)
-def _follow_kernel(px, py, th, r, a, thr, has_ref, refx, refy, ref_lim, gap_per_m, want_ends):
-    """:meth:`VisBug21._followed_numpy` and :meth:`VisBug21._sensed_ends` in one pass (numba),
-    on beams sorted by angle. Returns (number of members, member indices, nearest member,
-    points (n, 2), ends found, ends (2, 2)); -1 members when no beam returned."""
-    n = r.shape[0]
-    pts = np.empty((n, 2))
-    dirs = np.empty((n, 2))
-    hit = np.empty(n, dtype=np.bool_)
-    any_hit = False
-    for i in range(n):
-        ang = th + a[i]
-        c = math.cos(ang)
-        s = math.sin(ang)
-        pts[i, 0] = px + r[i] * c
-        pts[i, 1] = py + r[i] * s
-        dirs[i, 0] = c
-        dirs[i, 1] = s
-        hit[i] = r[i] < thr
-        any_hit = any_hit or hit[i]
-    e = np.zeros((2, 2))
-    members = np.empty(n, dtype=np.int64)
-    if not any_hit:
-        return -1, members, -1, pts, False, e
-    joined = np.empty(n, dtype=np.bool_)
-    for i in range(n):
-        j = i + 1 if i + 1 < n else 0
-        gap = math.hypot(pts[j, 0] - pts[i, 0], pts[j, 1] - pts[i, 1])
-        allowed = gap_per_m * max(r[i], r[j])
-        if not allowed > FOLLOW_GAP_M:
-            allowed = FOLLOW_GAP_M if allowed == allowed else allowed
-        joined[i] = hit[i] and hit[j] and gap <= allowed
-    labels = np.empty(n, dtype=np.int64)
-    labels[0] = 0
-    for i in range(1, n):
-        labels[i] = labels[i - 1] + (0 if joined[i - 1] else 1)
-    if joined[n - 1]:
-        last = labels[n - 1]
-        for i in range(n):
-            if labels[i] == last:
-                labels[i] = labels[0]
-    choice, best = _nearest_hit(pts, hit, px, py)
-    if has_ref:
-        k, best = _nearest_hit(pts, hit, refx, refy)
-        if best <= ref_lim:
-            choice = k
-    m = 0
-    near = -1
-    best = np.inf
-    for i in range(n):
-        if hit[i] and labels[i] == labels[choice]:
-            members[m] = i
-            m += 1
-            d = math.hypot(pts[i, 0] - px, pts[i, 1] - py)
-            if near < 0 or d < best:
-                near, best = i, d
-    found = False
-    if want_ends:
-        found = True
-        for side in range(2):
-            step = 1 if side == 0 else -1
-            i = near
-            j = near
-            walked = 0
-            while walked < n:
-                k = (i + step) % n
-                close = joined[i] if step == 1 else joined[k]
-                if not (close and hit[k]) and not (j != i and _continues(pts, dirs, r, hit, px, py, i, j, k)):
-                    break
-                j = i
-                i = k
-                walked += 1
-            if walked >= n:
-                found = False
-                break
-            e[side, 0] = pts[i, 0]
-            e[side, 1] = pts[i, 1]
-    return m, members, near, pts, found, e
-
-
-@njit(cache=True)
-def _continues(pts, dirs, r, hit, px, py, i, j, k):
-    """Does beam k continue the surface through points j (older) and i (newest)?
-    (:meth:`VisBug21._sensed_ends`'s ``continues``, numba)."""
-    if not hit[k]:
-        return False
-    v0 = pts[i, 0] - pts[j, 0]
-    v1 = pts[i, 1] - pts[j, 1]
-    den = dirs[k, 0] * v1 - dirs[k, 1] * v0
-    w0 = pts[i, 0] - px
-    w1 = pts[i, 1] - py
-    if abs(den) <= 1e-12:
-        return False
-    r_line = (w0 * v1 - w1 * v0) / den
-    if not r_line > 0.0:
-        return False
-    return r[k] <= r_line + END_TOL_M + END_TOL_FRACTION * min(r[k], r_line)
