@@ -149,3 +149,50 @@ def test_give_way_never_fires_for_walls_alone_round_a_corner():
         pose = pose + 0.1 * np.array([v * math.cos(pose[2]), v * math.sin(pose[2]), w])
     assert pose[1] > 3.0  # round the corner and up the north leg
     assert not any(fired)
+
+
+# ------------------------------------------------------------------ meeting guard
+def _blocked_corridor(n, start_step, n_steps=200):
+    """A 1.4 m corridor along +x with a robot-sized obstacle 0.9 m ahead that leaves no room to
+    pass (the box is blocked); the trail's hint points on along +x. Closed loop with perfect
+    odometry; returns the headings [deg] and modes."""
+    walls = [(0.65, -0.35, 1.15, -0.35), (1.15, -0.35, 1.15, 0.15), (1.15, 0.15, 0.65, 0.15),
+             (0.65, 0.15, 0.65, -0.35), (-5.0, 0.7, 10.0, 0.7), (-5.0, -0.7, 10.0, -0.7)]
+    pose = np.array([0.0, 0.3, 0.0])
+    heads, modes = [], []
+    for j in range(n_steps):
+        v, w = n.step(observe(cast(walls, pose), pose, start_step + j), 0.0)
+        heads.append(math.degrees(pose[2]))
+        modes.append(n.mode)
+        pose = pose + 0.1 * np.array([v * math.cos(pose[2]), v * math.sin(pose[2]), w])
+    return np.abs(heads), modes
+
+
+@pytest.mark.parametrize("guard_deg", [0.0, 90.0])
+def test_meet_guard_keeps_a_blocked_robot_facing_along_the_trail_for_meet_guard_s(guard_deg):
+    # After a Panic the other robot still blocks the corridor: the left-wall follower turns on
+    # the spot and, unguarded, comes round and drives back the way it came. Guarded, the robot
+    # turns no further than ~guard_deg from the hint, until meet_guard_s (8 s) has passed.
+    n = nav(meet_guard_deg=guard_deg, meet_guard_s=8.0)
+    k = _panic_then_navigate(n)
+    heads, modes = _blocked_corridor(n, k)
+    if guard_deg == 0.0:
+        assert heads[:70].max() > 150.0
+    else:
+        assert heads[:78].max() < guard_deg + 5.0 and "turn" not in modes[:78]
+        assert heads.max() > 150.0  # released after 8 s: the rules above again
+
+
+def test_meet_guard_needs_a_meeting():
+    # The same corridor with no Panic and the obstacle in sight from the start (nothing appeared
+    # ahead): the guarded robot does exactly what the unguarded one does.
+    a, ma = _blocked_corridor(nav(meet_guard_deg=90.0), 0, 120)
+    b, mb = _blocked_corridor(nav(), 0, 120)
+    assert np.array_equal(a, b) and ma == mb and a.max() > 150.0
+
+
+def test_meet_guard_starts_when_an_obstacle_appears_ahead():
+    # A robot comes into view 0.6 m ahead at t = 1.5 s (no Panic): the guard window opens.
+    n = nav(meet_guard_deg=90.0)
+    _approach(n, _robot_ahead, n_after=2)
+    assert n._meet_until_s == pytest.approx(1.5 + 8.0) and n._meet_until_m == pytest.approx(n._odo_m + 3.0)

@@ -68,6 +68,17 @@ a wrong branch; see :mod:`teamnav.control.coop.trail_share` for their measuremen
    gone or ``give_way_s`` has passed, before Panic's emergency stop; once per metre driven.
    ``step(..., reverse_ignore_memory=True)`` lets the 180 deg rule ignore the reversal memory and
    distance cool-down for one step (the caller's recovery hint points back to its trail).
+   ``meet_guard_deg`` > 0 (the meeting guard): for ``meet_guard_m`` of odometry and at most
+   ``meet_guard_s`` after a meeting (a Panic ended, or an obstacle appeared ahead as for
+   ``give_way_s``), the wall follower may not turn the robot further than ``meet_guard_deg``
+   from the trail's hint nor hold a heading that far off: while it would, the robot turns
+   towards the hint instead, at ``min_speed_fraction`` of cruise (standing, when the box is
+   blocked). Why: in the traced head-on meetings (``try-to-see-it-my-way``, seeds 0-3) the
+   robot blocked by the other turned on the spot, its wall follower came round past 90 deg and
+   took it back the way it came, or down the wrong branch at the corner (the rules above then
+   keep it there: cool-downs, reversal memory). A 2002 robot can do this with its own sensing:
+   its odometry heading over a few seconds and the trail's hint. The time limit stops two
+   guarded robots from facing each other for ever (without it, 24 % efficiency on seed 0).
 
 Odometry is used only as the robot's own dead reckoning over short spans (how far it has turned,
 how far it has driven), never as a position in any shared frame.
@@ -117,7 +128,8 @@ class NavigateParams(BaseModel):
 
     Meeting flags (all off by default = the behaviour above; gap-fills for robots that meet at
     corners, module docstring item 6): ``hint_skips_cooldown``, ``face_hint_after_panic``
-    (``face_hint_min_deg``), ``give_way_s`` (``give_way_*``).
+    (``face_hint_min_deg``), ``give_way_s`` (``give_way_*``), ``meet_guard_deg``
+    (``meet_guard_m``, ``meet_guard_s``).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
@@ -164,6 +176,9 @@ class NavigateParams(BaseModel):
     give_way_half_angle_deg: float = Field(30.0, gt=0.0, le=90.0)
     give_way_window_s: float = Field(1.0, gt=0.0, le=60.0)
     give_way_jump_m: float = Field(0.1, ge=0.0, le=20.0)
+    meet_guard_deg: float = Field(0.0, ge=0.0, le=180.0)
+    meet_guard_m: float = Field(3.0, gt=0.0, le=100.0)
+    meet_guard_s: float = Field(8.0, gt=0.0, le=600.0)
 
     @model_validator(mode="after")
     def _ordered(self) -> "NavigateParams":
@@ -285,6 +300,9 @@ class Navigate:
         self._give_way_until_s = -math.inf
         self._give_way_after_m = -math.inf
         self._gw_active = False
+        self._meet_until_m = -math.inf  # meet_guard_deg: the guard holds until this odometry length
+        self._meet_until_s = -math.inf  # ... and this time
+        self.guarded = False  # the meeting guard overrode the wall follower this step
 
     def turn_around(self, leave_m: float = 0.0) -> None:
         """Start a sharp 180 deg right turn now (any manoeuvre or Panic is dropped), then wall
@@ -335,6 +353,12 @@ class Navigate:
         f0, o0, th0 = hist[0]
         return (abs(_wrap(th - th0)) < math.radians(15.0)
                 and f0 - front > (self._odo_m - o0) + p.give_way_jump_m)
+
+    def _meet(self, t_s: float) -> None:
+        """A meeting (a Panic ended, or an obstacle appeared ahead): the guard holds for the next
+        ``meet_guard_m`` of odometry and at most ``meet_guard_s``."""
+        self._meet_until_m = self._odo_m + self.params.meet_guard_m
+        self._meet_until_s = t_s + self.params.meet_guard_s
 
     def _start_turn(self, direction: float, amount_rad: float) -> None:
         self.mode = "turn"
@@ -433,6 +457,7 @@ class Navigate:
             self._turned_rad += _wrap(th - lth)
         self._last_pose = (x, y, th)
 
+        self.guarded = False
         # 1. Panic overrides Navigate (emergency stop running in parallel).
         if self.mode == "panic":
             v, w = self.panic.step(r)
@@ -440,11 +465,17 @@ class Navigate:
                 self.mode = "navigate"
                 self._cool(self.params.opening_cooldown_m)
                 self._face_hint = self.params.face_hint_after_panic
+                if self.params.meet_guard_deg > 0.0:
+                    self._meet(obs.time_s)
             return self._clip(v, w)
+        appeared = False
+        if self.params.give_way_s > 0.0 or self.params.meet_guard_deg > 0.0:
+            appeared = self._appeared_ahead(r, th) and self.mode in ("navigate", "advance")
+            if appeared and self.params.meet_guard_deg > 0.0 and self._odo_m >= self._meet_until_m:
+                self._meet(obs.time_s)
         # 1b. Give way (give_way_s > 0): an obstacle that has just appeared ahead (another
         # robot) stops the robot for up to give_way_s, until it is gone.
         if self.params.give_way_s > 0.0:
-            appeared = self._appeared_ahead(r, th) and self.mode in ("navigate", "advance")
             if (appeared and obs.time_s >= self._give_way_until_s and self._odo_m >= self._give_way_after_m
                     and not obs.stalled):
                 self._give_way_until_s = obs.time_s + self.params.give_way_s
@@ -542,5 +573,15 @@ class Navigate:
                     self._advance_to_m = self._odo_m + choice.advance_m
                     self._advance_steps = 0
                     self._advance_max_steps = int(round((choice.advance_m / self.cruise_mps + 3.0) / self.dt_s))
+        # 5b. Meeting guard (meet_guard_deg > 0): within meet_guard_m after a meeting, the wall
+        # follower may not turn the robot further from the trail's hint than meet_guard_deg
+        # (nor hold a heading that far off): it turns towards the hint instead, slowly.
+        if (self.params.meet_guard_deg > 0.0 and preferred_heading_rad is not None and self.mode == "navigate"
+                and self._odo_m < self._meet_until_m and obs.time_s < self._meet_until_s):
+            err = _wrap(preferred_heading_rad - th)
+            if abs(err) > math.radians(self.params.meet_guard_deg) and box.omega_radps * err <= 0.0:
+                self.guarded = True
+                w = math.copysign(min(self.turn_rate_radps, self.params.steer_gain_per_s * abs(err)), err)
+                return self._clip(min(box.v_mps, self.cruise_mps * self.params.min_speed_fraction), w)
         # 5. Wall following.
         return self._clip(box.v_mps, box.omega_radps)
