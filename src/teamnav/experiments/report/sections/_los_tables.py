@@ -1,0 +1,181 @@
+"""The ``los-help`` section's tables and figures: Tables 1-2 (Figs. 12, 14), Figs. 16-17, the
+ablation, §4.4 traffic and where R1's steps go (Sgorbissa & Arkin).
+
+Split from :mod:`.los_help` (no behaviour change).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from teamnav.experiments import los_tasks as L
+from teamnav.experiments.report.model import Plot, Series, Table
+from teamnav.experiments.report.sections._los_common import (
+    DELAYED_KEY, ERR_KEY, NAV_KEY, NAV_LABEL, PAPER_TABLES, STATE_KEY, TEAM_LABEL, _mean, _metric, _paper_cell, cell,
+    finished_of, group, stats, steps_of, targets_per_task,
+)
+
+
+def table_block(map_key: str, by_team: dict[int, list[dict]]) -> tuple[Table, dict[str, list[float]]]:
+    """Table 1 or 2 (ours beside the paper's) and our mean steps per algorithm and team size."""
+    teams = sorted(by_team)
+    rows: list[list[str]] = []
+    means: dict[str, list[float]] = {}
+    for nav in L.NAVIGATORS:
+        ours, mm = [], []
+        for h in range(4):
+            rs = group(by_team.get(h, []), NAV_KEY).get(nav, [])
+            st, fin = steps_of(rs), finished_of(rs)
+            ours.append(cell(st, fin) if h in by_team else "not run")
+            ok = fin > 0.5
+            mm.append(stats(st[ok])[0] if ok.any() else float("nan"))
+        means[nav] = mm
+        rows.append([NAV_LABEL[nav], "ours", *ours])
+        rows.append(["", "paper", *(_paper_cell(v) for v in PAPER_TABLES[map_key][nav])])
+    n = max((len(v) for v in by_team.values()), default=0)
+    title = (f"Table {1 if map_key == 'simple' else 2} ({L.MAPS[map_key]}): R1's motion steps per target, mean "
+             "(std as % of the mean) tasks finished / run")
+    n_t = targets_per_task(by_team)
+    note = (f"Ours: R1's motion steps per target (a task's steps over its targets; step {L.STEP_LENGTH_M} m), "
+            f"mean and std over the finished tasks of the {n // max(len(L.NAVIGATORS), 1)} run per cell, "
+            f"{n_t} targets per task; teams run: {', '.join(TEAM_LABEL[h] for h in teams)}. "
+            "The paper's numbers must be per "
+            "target too (a 200-target task cannot take 554 steps), but its step length and maps are not ours: "
+            "compare ratios along a row, not values.")
+    return Table(title, ["algorithm", "", *TEAM_LABEL.values()], rows, note), means
+
+def robots_plot(map_key: str, by_team: dict[int, list[dict]]) -> Plot:
+    series = []
+    for nav in L.NAVIGATORS:
+        xs, ys, lo, hi = [], [], [], []
+        for h in sorted(by_team):
+            rs = group(by_team[h], NAV_KEY).get(nav, [])
+            st, fin = steps_of(rs), finished_of(rs)
+            ok = fin > 0.5
+            if not ok.any() or not ok.all():
+                continue  # a failing cell is not plotted (the paper leaves PF alone out)
+            m = float(st.mean())
+            sd = float(st.std(ddof=1)) if st.size > 1 else 0.0
+            xs.append(h + 1)
+            ys.append(m)
+            lo.append(m - sd)
+            hi.append(m + sd)
+        series.append(Series(NAV_LABEL[nav], xs, ys, lo, hi, style="line+points"))
+    fig = 12 if map_key == "simple" else 14
+    return Plot(f"Fig. {fig} ({L.MAPS[map_key]}): R1's steps vs number of robots", "number of robots",
+                "R1's motion steps per target", series,
+                caption="Mean over tasks, band ± 1 std; the potential field alone does not finish and is not drawn.")
+
+def noise_plot(map_key: str, rows: list[dict], alone: dict[str, float]) -> tuple[Plot, dict[str, dict[float, float]]]:
+    by_nav = group(rows, NAV_KEY)
+    series, means = [], {}
+    unfinished: list[str] = []
+    for nav in L.NAVIGATORS:
+        per = group(by_nav.get(nav, []), ERR_KEY)
+        xs = sorted(float(e) for e in per)
+        ys, lo, hi = [], [], []
+        for e in xs:
+            st = steps_of(per[e])
+            fin = finished_of(per[e]) > 0.5
+            if not fin.all():
+                unfinished.append(f"{NAV_LABEL[nav]} at {e:g}: {int(fin.sum())}/{fin.size}")
+            st = st[fin]  # failures have no step count to average
+            m = float(np.nanmean(st)) if st.size else float("nan")
+            sd = float(np.nanstd(st, ddof=1)) if st.size > 1 else 0.0
+            ys.append(m)
+            lo.append(m - sd)
+            hi.append(m + sd)
+        means[nav] = dict(zip(xs, ys))
+        series.append(Series(NAV_LABEL[nav], xs, ys, lo, hi, style="line+points"))
+    hl = [(v, f"{NAV_LABEL[k]} alone") for k, v in alone.items() if np.isfinite(v)]
+    fig = 16 if map_key == "simple" else 17
+    return Plot(f"Fig. {fig} ({L.MAPS[map_key]}): R1's steps vs err_max, R2..R4 present", "err_max (eqs. 1-2)",
+                "R1's motion steps per target (finished tasks)", series, hlines=hl,
+                caption="Horizontal lines: R1 alone (Tables 1-2, noise has no effect without teammates; where R1 "
+                        "alone failed tasks, its steps per reached target with the abandoned target's budget, "
+                        "alone_levels); "
+                        "the potential field alone fails and has no line. Means over finished tasks only"
+                        + (" (finished: " + "; ".join(unfinished) + ")." if unfinished else "; every task finished.")), means
+
+def noise_table(map_key: str, rows: list[dict], alone_rows: list[dict]) -> Table:
+    """Figs. 16-17 as a table: R1's steps per target with R1..R4 per err_max, and R1 alone."""
+    by_nav = group(rows, NAV_KEY)
+    alone_by_nav = group(alone_rows, NAV_KEY)
+    errs = sorted({float(e) for r in rows if (e := (r.get("params") or {}).get(ERR_KEY)) is not None})
+    out = []
+    for nav in L.NAVIGATORS:
+        per = {float(k): v for k, v in group(by_nav.get(nav, []), ERR_KEY).items() if k is not None}
+        if not per:
+            continue
+        cells = [cell(steps_of(per.get(e, [])), finished_of(per.get(e, []))) for e in errs]
+        a = alone_by_nav.get(nav, [])
+        out.append([NAV_LABEL[nav], *cells, cell(steps_of(a), finished_of(a))])
+    fig = 16 if map_key == "simple" else 17
+    n_t = targets_per_task({0: rows})
+    return Table(f"Fig. {fig} ({L.MAPS[map_key]}) as a table: R1's steps per target with R2..R4 vs err_max, "
+                 "mean (std %) tasks finished / run",
+                 ["algorithm", *(f"err_max {e:g}" for e in errs), "R1 alone"], out,
+                 f"{n_t} targets per task; eqs. 1-2 noise on every robot's detector; 'R1 alone' is Table "
+                 f"{1 if map_key == 'simple' else 2}'s first column (no detector in use).")
+
+def ablation_block(rows: list[dict]) -> Table:
+    variants = [((False, False), "reflected visibility only (§3)"), ((True, False), "+ ghost robots (§4)"),
+                ((True, True), "+ state sharing (§5)"), ((False, True), "reflected + state sharing")]
+    table_rows = []
+    for nav in L.NAVIGATORS:
+        rs = group(rows, NAV_KEY).get(nav, [])
+        cells = []
+        for (dv, ss), _ in variants:
+            sel = [r for r in rs if (r["params"].get(DELAYED_KEY), r["params"].get(STATE_KEY)) == (dv, ss)]
+            cells.append(cell(steps_of(sel), finished_of(sel)))
+        table_rows.append([NAV_LABEL[nav], *cells])
+    return Table("Ablation (office_simple, R1..R4): what each rule buys — R1's steps, mean (std %)",
+                 ["algorithm", *(v[1] for v in variants)], table_rows,
+                 "Goal sharing on in every column; the tables use '+ state sharing' for the potential field and "
+                 "'+ ghost robots' for the others. The flags are R1's: the "
+                 "helpers keep their §4.3 bookkeeping in every column (one grid key cannot set four robots' flags).")
+
+def traffic_block(rows_by_map: dict[str, list[dict]]) -> Table:
+    out = []
+    for m, rows in rows_by_map.items():
+        for nav in L.NAVIGATORS:
+            rs = group(rows, NAV_KEY).get(nav, [])
+            if not rs:
+                continue
+            msgs = np.array([_metric(r, "los_msgs_per_robot") for r in rs])
+            nbytes = np.array([_metric(r, "los_bytes_per_robot") for r in rs])
+            steps = np.array([_metric(r, "los_steps") for r in rs], dtype=float)
+            out.append([L.MAPS[m], NAV_LABEL[nav], f"{np.nanmean(msgs):.0f}", f"{np.nanmean(nbytes) / 1024:.1f}",
+                        f"{np.nanmean(nbytes / np.maximum(steps, 1)):.1f}"])
+    return Table("§4.4 traffic with R1..R4 (per robot and task)", ["map", "algorithm", "messages", "KiB", "bytes per R1 step"],
+                 out, "Messages are sent only to teammates in line of sight; O(M) bytes per meeting (§4.4).")
+
+FRACTIONS = (("goal_seen", "goal in sight"), ("follow_teammate", "to a teammate"), ("ghost", "to a ghost"),
+             ("promised", "on a promise"), ("trouble_follow", "to a helper (in trouble)"))
+
+def where_steps_go_block(tables: dict[str, dict[int, list[dict]]]) -> Table:
+    """Where R1's steps went with helpers (§3-§5): share of its steps per temporary-goal kind,
+    the rest being the navigator towards its unseen goal; and how often the temporary goal
+    changed per target (oscillation between temporary goals would show there)."""
+    out = []
+    for m, by_team in tables.items():
+        for h in sorted(by_team):
+            if h == 0:
+                continue
+            for nav in L.NAVIGATORS:
+                rs = group(by_team[h], NAV_KEY).get(nav, [])
+                if not rs:
+                    continue
+                fr = [_mean([_metric(r, f"los_frac_{k}") for r in rs]) for k, _ in FRACTIONS]
+                if not np.isfinite(fr).any():
+                    continue  # runs without these logs
+                rest = 1.0 - float(np.nansum(fr))
+                sw = _mean([_metric(r, "los_temp_switches") / max(_metric(r, "los_targets_reached"), 1.0)
+                            for r in rs])
+                out.append([L.MAPS[m], TEAM_LABEL[h], NAV_LABEL[nav], *(f"{100 * f:.0f} %" for f in fr),
+                            f"{100 * rest:.0f} %", f"{sw:.1f}"])
+    return Table("Where R1's steps go with helpers (share of its steps, mean over tasks)",
+                 ["map", "team", "algorithm", *(t for _, t in FRACTIONS), "navigator to goal", "switches / target"],
+                 out, "'to a teammate': heading for a teammate in sight that offers the shortest D (§3); 'to a ghost': "
+                      "for where a teammate promised it (§4); 'on a promise': for its goal from a ghost where the "
+                      "teammate saw the goal itself; 'switches': changes of temporary goal per target reached.")

@@ -1,0 +1,182 @@
+"""The ``los-help`` section's verdicts: EXPERIMENTS.md's rows for Tables 1-2 and Figs. 16-17 as
+:class:`~teamnav.experiments.report.model.Comparison` blocks, paired by task (Sgorbissa & Arkin §6).
+
+Split from :mod:`.los_help` (no behaviour change).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Sequence
+
+import numpy as np
+
+from teamnav.experiments import los_tasks as L
+from teamnav.experiments.report.model import Comparison
+from teamnav.experiments.report.sections._los_common import (
+    ERR_KEY, NAV_KEY, NAV_LABEL, PAPER_TABLES, TARGETS_KEY, TEAM_LABEL, _metric, finished_of, group, stats, steps_of,
+    strictly_falling,
+)
+
+
+def paired_means(by_team: dict[int, list[dict]], nav: str, hs: Sequence[int]) -> tuple[list[float], int, int] | None:
+    """Mean steps per target per team size over the tasks finished with *every* team size in
+    ``hs`` (a task failed by one team would otherwise leave only the easy tasks in its mean);
+    (means, tasks kept, tasks run), or None when the rows do not name their tasks."""
+    per: dict[int, dict[str, float]] = {}
+    tasks: set[str] = set()
+    for h in hs:
+        per[h] = {}
+        for r in group(by_team.get(h, []), NAV_KEY).get(nav, []):
+            t = (r.get("params") or {}).get(TARGETS_KEY)
+            if t is None:
+                return None
+            key = json.dumps(t)
+            tasks.add(key)
+            if _metric(r, "los_finished") > 0.5:
+                per[h][key] = _metric(r, "los_steps_per_target")
+    common = set.intersection(*(set(v) for v in per.values())) if per else set()
+    if not tasks:
+        return None
+    ms = [float(np.mean([per[h][t] for t in common])) if common else float("nan") for h in hs]
+    return ms, len(common), len(tasks)
+
+def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict[int, list[dict]]) -> list[Comparison]:
+    tab = 1 if map_key == "simple" else 2
+    paper = PAPER_TABLES[map_key]
+    out: list[Comparison] = []
+    teams = sorted(by_team)
+    for nav in L.NAVIGATORS:
+        hs = [h for h in teams if not (nav == "potential_field" and h == 0)]
+        # a team that finished no task is worse than any that did: the trend holds through it
+        # when such teams come before (fewer helpers than) every team that finished tasks
+        fin = {h: finished_of(group(by_team.get(h, []), NAV_KEY).get(nav, [])) for h in hs}
+        failing = [h for h in hs if fin[h].size and not (fin[h] > 0.5).any()]
+        ok_hs = [h for h in hs if h not in failing]
+        ms = [means[nav][h] for h in ok_hs]
+        paired = paired_means(by_team, nav, ok_hs) if ok_hs else None
+        note = ""
+        if paired is not None:
+            ms, k, n = paired
+            note = f" (paired: the {k} of {n} tasks finished with every team that finished one)"
+        p = [paper[nav][h][0] for h in hs if paper[nav][h] is not None]
+        fails_first = not failing or not ok_hs or max(failing) < min(ok_hs)
+        if len(ms) < 2:
+            # one team size with results: a trend only if teams with fewer helpers failed outright
+            holds = (fails_first and bool(ok_hs)) if failing else None
+        else:
+            trend = strictly_falling(ms) if all(np.isfinite(ms)) else (False if any(np.isfinite(ms)) else None)
+            holds = None if trend is None else bool(trend and fails_first)
+        ours = " → ".join([f"fails ({int(fin[h].sum())}/{fin[h].size})" for h in failing if h < min(ok_hs, default=9)]
+                          + ["n/a" if not np.isfinite(m) else f"{m:.0f}" for m in ms]
+                          + [f"fails ({int(fin[h].sum())}/{fin[h].size})" for h in failing if h > min(ok_hs, default=9)])
+        ratio = (f"; last/first {ms[-1] / ms[0]:.2f} (paper {p[-1] / p[0]:.2f})"
+                 if len(ms) >= 2 and np.isfinite(ms[0]) and np.isfinite(ms[-1]) and ms[0] > 0 and not failing else "")
+        out.append(Comparison(
+            f"Table {tab}: {NAV_LABEL[nav]} steps fall as helpers are added ({', '.join(TEAM_LABEL[h] for h in hs)})",
+            " → ".join(f"{v:.1f}" for v in p), ours + ratio + note, holds,
+            "" if holds or holds is None else "not strictly falling at every added helper in our runs (see the table)"))
+    pf = group(by_team.get(0, []), NAV_KEY).get("potential_field", [])
+    pf_help = [r for h in teams if h > 0 for r in group(by_team[h], NAV_KEY).get("potential_field", [])]
+    alone_fin, help_fin = finished_of(pf), finished_of(pf_help)
+    if alone_fin.size and help_fin.size:
+        holds = bool(np.all(alone_fin < 0.5) and np.all(help_fin > 0.5))
+        per_team = ", ".join(f"{TEAM_LABEL[h]} {int(f.sum())}/{f.size}" for h in teams if h > 0
+                             and (f := finished_of(group(by_team[h], NAV_KEY).get("potential_field", []))).size)
+        ours = (f"alone: {int(alone_fin.sum())}/{alone_fin.size} finished; with helpers: "
+                f"{int(help_fin.sum())}/{help_fin.size} finished ({per_team})")
+    else:
+        holds, ours = None, "not run"
+    out.append(Comparison(f"Table {tab}: the potential field alone fails, and finishes with helpers (state + goal sharing)",
+                          "no result alone; " + " → ".join(f"{v[0]:.1f}" for v in paper["potential_field"][1:]),
+                          ours, holds, "" if holds or holds is None else
+                          "some potential-field runs did the opposite of the paper (see the table)"))
+    if map_key == "complex" and 3 in by_team:
+        m3 = {nav: means[nav][3] for nav in L.NAVIGATORS if np.isfinite(means[nav][3])}
+        if len(m3) >= 2:
+            spread = max(m3.values()) / min(m3.values()) - 1.0
+            holds = spread > 0.10
+            ours = ", ".join(f"{NAV_LABEL[k]} {v:.0f}" for k, v in m3.items()) + f" (best to worst +{100 * spread:.0f} %)"
+        else:
+            holds, ours = None, "not measured"
+        out.append(Comparison("Table 2: with 3 helpers the algorithm still matters (best and worst differ by > 10 %)",
+                              "Av. Past 682.6, VisBug 373.4, Pot. Fields 913.6 (+145 %)", ours, holds,
+                              "" if holds or holds is None else "with 3 helpers our algorithms end up close"))
+    return out
+
+def alone_levels(rows: list[dict]) -> dict[str, float]:
+    """R1 alone's steps per target per algorithm, the reference line of Figs. 16-17: the mean
+    over its tasks when every task finished; otherwise the mean steps per *reached* target over
+    every task, the abandoned target's budget included (a failed task has no finished mean, and
+    a mean over the finished tasks only would keep the easy ones); NaN when none reached any."""
+    out: dict[str, float] = {}
+    for nav in L.NAVIGATORS:
+        rs = group(rows, NAV_KEY).get(nav, [])
+        st, fin = steps_of(rs), finished_of(rs)
+        if not rs:
+            out[nav] = float("nan")
+        elif (fin > 0.5).all():
+            out[nav] = stats(st)[0]
+        else:
+            reached = np.array([_metric(r, "los_targets_reached") for r in rs])
+            ok = reached > 0
+            out[nav] = float(np.mean(st[ok])) if ok.any() and nav != "potential_field" else float("nan")
+    return out
+
+def paired_noise(rows: list[dict], nav: str, errs: Sequence[float]) -> tuple[list[float], int] | None:
+    """Mean steps per target of ``nav`` at each err_max of ``errs`` over the tasks finished at
+    every one of them (a task failed at one noise level would leave only the easy ones), and
+    how many tasks that is; None when the rows do not name their tasks."""
+    per: dict[float, dict[str, float]] = {float(e): {} for e in errs}
+    for r in group(rows, NAV_KEY).get(nav, []):
+        p = r.get("params") or {}
+        e, t = p.get(ERR_KEY), p.get(TARGETS_KEY)
+        if t is None:
+            return None
+        if e is not None and float(e) in per and _metric(r, "los_finished") > 0.5:
+            per[float(e)][json.dumps(t)] = _metric(r, "los_steps_per_target")
+    common = set.intersection(*(set(v) for v in per.values()))
+    return [float(np.mean([per[float(e)][t] for t in common])) if common else float("nan") for e in errs], len(common)
+
+def noise_comparisons(map_key: str, means: dict[str, dict[float, float]], alone: dict[str, float],
+                      rows: list[dict] | None = None) -> list[Comparison]:
+    """Figs. 16-17's claims; with ``rows`` the err_max 0 vs 0.4 comparison is paired by task
+    (:func:`paired_noise`)."""
+    out: list[Comparison] = []
+    fig = 16 if map_key == "simple" else 17
+    grow, text = [], []
+    for nav, per in means.items():
+        if 0.0 in per and 0.4 in per and np.isfinite(per[0.0]) and np.isfinite(per[0.4]):
+            pn = paired_noise(rows, nav, (0.0, 0.4)) if rows else None
+            if pn is not None and pn[1] > 0:
+                (a, b), k = pn
+                grow.append(b > a)
+                text.append(f"{NAV_LABEL[nav]} {a:.0f} → {b:.0f} (paired, {k} tasks)")
+            else:
+                grow.append(per[0.4] > per[0.0])
+                text.append(f"{NAV_LABEL[nav]} {per[0.0]:.0f} → {per[0.4]:.0f}")
+    out.append(Comparison(f"Fig. {fig}: steps grow with err_max (0 → 0.4), R2..R4 present",
+                          "performance decreases for every algorithm as err_max grows",
+                          "; ".join(text) or "not run", all(grow) if grow else None,
+                          "" if (not grow or all(grow)) else "some algorithms did not get slower with noise"))
+    navs = [n for n in means if n in alone and np.isfinite(alone[n]) and 0.4 in means[n]]
+    if map_key == "simple":
+        below = [means[n][0.4] < alone[n] for n in navs]
+        ours = "; ".join(f"{NAV_LABEL[n]} {means[n][0.4]:.0f} vs alone {alone[n]:.0f}" for n in navs)
+        out.append(Comparison("Fig. 16: at err_max = 0.4 the steps stay below R1 alone",
+                              "still lower than with no supporting robot (every algorithm)", ours or "not run",
+                              all(below) if below else None,
+                              "" if (not below or all(below)) else "help is gone at err_max = 0.4 for some algorithm"))
+    else:
+        fade = []
+        for n in navs:
+            if 0.0 in means[n]:
+                gain0, gain4 = alone[n] - means[n][0.0], alone[n] - means[n][0.4]
+                fade.append((n, gain0, gain4))
+        holds = [g4 < 0.5 * g0 for _, g0, g4 in fade if g0 > 0]
+        ours = "; ".join(f"{NAV_LABEL[n]} gain over alone {g0:.0f} → {g4:.0f} steps" for n, g0, g4 in fade)
+        out.append(Comparison("Fig. 17: on the complex map help fades quickly with noise (gain at 0.4 < half the gain at 0)",
+                              "support robots become almost useless; VisBug worse than R1 alone", ours or "not run",
+                              all(holds) if holds else None,
+                              "" if (not holds or all(holds)) else "our helpers keep more of their gain under noise"))
+    return out
