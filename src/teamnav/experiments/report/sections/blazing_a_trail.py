@@ -32,49 +32,12 @@ by time t per k (Kaplan–Meier), units over time per k and last-10-minute units
 each robot announced in its own frame (Fig. 6) and all of them in a fixed frame of the places.
 
 Quick mode: 450 s runs (drift sweep 300 s), 2 seeds (1 for each one-robot baseline), drift
-k = 0 and 4 only, no explorer or no-communication baselines (≈ 30 s wall idle; 83 s under a load
-of 6.6 on 2 cores, 50 CPU s for both trail sections). Full: the paper's 30 min, 10 seeds; drift
+k = 0 and 4 only, no explorer or no-communication baselines. Full: the paper's 30 min, 10 seeds; drift
 k = 0, 1, 2, 3, 4, 6 for 1 h, 10 seeds (the sweep's k = 0.5 case is there for ``teamnav sweep``;
 the drift sweep is shared with the try-to-see-it-my-way section).
 
-Cost of the full mode (measured on one core: 4 robots x 1 simulated hour = 26–30 CPU s for
-blazing-trail-v1, 37 CPU s for trail-share-v1): this section 5 (paper) + 5 (paper rules) + ≈ 1
-(one robot, optimal and exploring) + 5 (no communication) + 60 (drift sweep) team-hours ≈ 36 CPU
-min (the drift sweep's 30 new runs at k = 2, 3, 6 took 772 CPU s, 26 per team-hour, under a load
-of 6–7); with the try-to-see-it-my-way section (≈ 85 CPU min more) ≈ 2 CPU-hours for both.
-blazing-trail-v1's cost per simulated hour grows with its global crumb list (the 2000 paper has
-no expiry): a 2-hour profiled run at k = 1 (commit bec19bc, shared machine under a load of ~13)
-took 28, 42, 42, 50 CPU s per simulated hour in its four half-hours while the largest list grew
-4,464 → 7,946 → 10,584 → 12,058 crumbs (the try section's profile table).
-
-Drift sweep of blazing-trail-v1, final (k = 0, 1, 4 on commit 8ce20af, k = 2, 3, 6 on f31560f:
-blazing_trail.py and the simulator unchanged between them; 1 h, 10 seeds per point, mean ± std):
-
-=====  ==========================  =============  ==========================================
-k      units in the last 10 min    units in 1 h   broke down (at, min)
-=====  ==========================  =============  ==========================================
-0      10.5 ± 2.0                  57.9 ± 3.1     0/10
-1       7.3 ± 1.3                  51.8 ± 2.0     0/10
-2       3.4 ± 0.8                  37.3 ± 1.9     3/10 (56, 57, 57)
-3       3.2 ± 1.9                  28.5 ± 3.7     3/10 (54, 54, 55)
-4       1.0 ± 1.3                  24.2 ± 4.3     8/10 (38, 44, 46, 46, 48, 49, 53, 54)
-6       2.1 ± 1.4                  18.4 ± 2.6     4/10 (38, 48, 56, 56)
-=====  ==========================  =============  ==========================================
-
-Units in the hour fall at every step (58 → 18); breakdown time falls on the whole (rank
-correlation with k −0.50 over the 60 runs; last-10-min units −0.83) but not at every step: at
-k = 6 fewer runs break down than at k = 4 (4 vs 8 of 10) and the last 10 minutes hold 2.1 units,
-a trickle the drifted trail no longer steers (the robots explore). A breakdown is 180 s without a
-delivery at the run's end, so a team delivering ~3 units per 10 min (k = 2, 3) shows one by
-chance in some runs. Claim 3 holds. The 2002 team's side of the sweep: the try section.
-Paper conditions (commit 5d4a607, 30 min, 10 seeds): 27.9 ± 1.7 units (paper 28), no breakdown
-within 30 min, first source visit 2.2 ± 0.8 min, median trip after it 94 ± 3 s; one robot on the
-optimal route 11 units (3 seeds, trip 78 s): 2.5x.
-One blazing-trail-v1 robot alone, team params, no drift (trail-solo-blazing, commit 6ec1f6d + this
-sweep, 30 min, 10 seeds): median trip after its own first trail 88.6 ± 0.3 s (a 2.95 min round
-trip: the paper's "approximately 3 minutes"), so 1800 / 177 = 10.2 units at that rate and the
-team's 27.9 is 2.75x by the paper's method (the paper: 2.8x); measured, the robot delivered
-8.6 ± 1.0 units (first source visit at 4.5 ± 2.4 min; 42 CPU s for the 10 runs).
+What the section measured (the final drift sweep, the paper's conditions, one robot alone,
+the full mode's cost, with commits): ``docs/report/blazing-a-trail.md``.
 """
 
 from __future__ import annotations
