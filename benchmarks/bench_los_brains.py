@@ -45,6 +45,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 sys.path.insert(0, str(HERE))
+from _common import timed_run  # noqa: E402  (benchmarks/_common.py)
 from los_fingerprint import CASES, MAPS, TEAMS  # noqa: E402  (the same 12 configurations)
 
 BASE_COMMIT = "f9d6cb5"
@@ -68,47 +69,19 @@ def _worker(map_key: str, case: str, team: str, steps: int, targets: int = 0) ->
     """(in the measuring process) CPU of one warm run: total and inside the brains."""
     from teamnav import load_scenario
     from teamnav.experiments.runner import run
-    from teamnav.sim import engine
-
-    brain_s = [0.0]
-    clock = time.process_time
-    orig_init = engine.Simulation.__init__
-
-    def init(self, *args, **kwargs):
-        orig_init(self, *args, **kwargs)
-        for group in self.brains:
-            for brain in group if isinstance(group, list) else [group]:
-                for meth in ("step", "log"):
-                    f = getattr(brain, meth, None)
-                    if not callable(f):
-                        continue
-
-                    def timed(*args, f=f):
-                        t = clock()
-                        out = f(*args)
-                        brain_s[0] += clock() - t
-                        return out
-
-                    setattr(brain, meth, timed)
 
     ov = _overrides(case, team, map_key, targets)
     run(load_scenario(MAPS[map_key], overrides=ov, duration_s=40.0, seed=0), progress=False)  # warm-up: kernels loaded
-    engine.Simulation.__init__ = init
-    try:
-        if targets:
-            scn = load_scenario(MAPS[map_key], overrides=ov, seed=0)  # its own duration: stops when R1 is done
-        else:
-            scn = load_scenario(MAPS[map_key], overrides=ov, duration_s=steps * 0.1, seed=0)
-        t0 = clock()
-        res = run(scn, progress=False)
-        total = clock() - t0
-    finally:
-        engine.Simulation.__init__ = orig_init
+    if targets:
+        scn = load_scenario(MAPS[map_key], overrides=ov, seed=0)  # its own duration: stops when R1 is done
+    else:
+        scn = load_scenario(MAPS[map_key], overrides=ov, duration_s=steps * 0.1, seed=0)
+    total, brain_s, res = timed_run(scn, ("step", "log"))
     import teamnav
 
     brain = res.sim.brains[0]
     brain = brain[0] if isinstance(brain, list) else brain
-    return {"cpu_s": total, "brain_s": brain_s[0], "steps": int(res.sim.step_index), "tree": teamnav.__file__,
+    return {"cpu_s": total, "brain_s": brain_s, "steps": int(res.sim.step_index), "tree": teamnav.__file__,
             "reached": int(getattr(brain, "targets_reached", -1))}
 
 

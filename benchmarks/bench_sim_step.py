@@ -28,7 +28,11 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import timed_run  # noqa: E402  (benchmarks/_common.py)
 
 #: scenario -> simulated seconds per timed run (full mode)
 SCENARIOS = {
@@ -42,39 +46,10 @@ SCENARIOS = {
 def _timed_run(name: str, duration_s: float, seed: int) -> tuple[float, float, int]:
     """(total CPU [s], CPU inside brain steps [s], steps) of one run."""
     from teamnav import load_scenario
-    from teamnav.experiments.runner import run
-    from teamnav.sim import engine
 
-    brain_s = [0.0]
-    clock = time.process_time
-    orig_init = engine.Simulation.__init__
-
-    def init(self, *args, **kwargs):
-        orig_init(self, *args, **kwargs)
-        for group in self.brains:
-            for brain in group if isinstance(group, list) else [group]:
-                for meth in ("step", "step_batch", "log"):
-                    f = getattr(brain, meth, None)
-                    if not callable(f):
-                        continue
-
-                    def timed(*args, f=f):
-                        t = clock()
-                        out = f(*args)
-                        brain_s[0] += clock() - t
-                        return out
-
-                    setattr(brain, meth, timed)
-
-    engine.Simulation.__init__ = init
-    try:
-        scn = load_scenario(name, duration_s=duration_s, seed=seed)
-        t0 = clock()
-        result = run(scn, progress=False)
-        total = clock() - t0
-    finally:
-        engine.Simulation.__init__ = orig_init
-    return total, brain_s[0], int(result.sim.step_index)
+    total, brain_s, result = timed_run(load_scenario(name, duration_s=duration_s, seed=seed),
+                                       ("step", "step_batch", "log"))
+    return total, brain_s, int(result.sim.step_index)
 
 
 def main(argv: list[str] | None = None) -> None:
