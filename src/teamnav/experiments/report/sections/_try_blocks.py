@@ -29,6 +29,13 @@ def _broke(rows: list) -> str:
     return f"{int((c == 0).sum())}/{c.size}" if c.size else "n/a"
 
 
+def drift_curves(d_share: list, d_blaze: list) -> tuple:
+    """Per drift scale k, both algorithms (:func:`_trails.per_drift`): breakdown time of the 2002
+    team, of the 2000 team, then last-10-min units (mean) of the 2002 team, of the 2000 team."""
+    return (T.per_drift(d_share, "breakdown_s"), T.per_drift(d_blaze, "breakdown_s"),
+            T.per_drift(d_share, "units_per_10min_last", np.mean), T.per_drift(d_blaze, "units_per_10min_last", np.mean))
+
+
 def drift_table(d_share: list, d_blaze: list, drift_dur: float, quick: bool) -> list:
     """The drift sweep as numbers: mean ± std (n) per drift scale, both algorithms."""
     blocks: list = []
@@ -116,10 +123,8 @@ def figure_blocks(share: list, long_blaze: list, same_share: list, plain: list, 
     """The figures: units over time, Fig. 2 top (arrivals) and bottom (trips), breakdown and last-10-min
     units vs drift, survival per k, and the crumb views (Figs. 3-4)."""
     blocks: list = []
-    xs_s, bd_s, lo_s, hi_s = T.per_drift(d_share, "breakdown_s")
-    xs_b, bd_b, lo_b, hi_b = T.per_drift(d_blaze, "breakdown_s")
-    _, last_s, llo_s, lhi_s = T.per_drift(d_share, "units_per_10min_last", np.mean)
-    _, last_b, llo_b, lhi_b = T.per_drift(d_blaze, "units_per_10min_last", np.mean)
+    (xs_s, bd_s, lo_s, hi_s), (xs_b, bd_b, lo_b, hi_b), (_, last_s, llo_s, lhi_s), (_, last_b, llo_b, lhi_b) = \
+        drift_curves(d_share, d_blaze)
     gs, gb = T.by_scale(d_share), T.by_scale(d_blaze)
     # figures: units over time, Fig. 2 top (arrivals), breakdown vs drift
     t = T.time_grid(dur)

@@ -56,7 +56,7 @@ from teamnav.experiments.report.sections import _trails as T
 
 # the section's parts, importable from here as before the split
 from teamnav.experiments.report.sections._try_blocks import (  # noqa: F401
-    OUR_ROBOTS, PAPER_TABLE1, _broke, drift_table, figure_blocks, odometry_table, table1_block,
+    OUR_ROBOTS, PAPER_TABLE1, _broke, drift_curves, drift_table, figure_blocks, odometry_table, table1_block,
 )
 from teamnav.experiments.report.sections._try_long_runs import (  # noqa: F401
     HOURS_S, HOURS_SCALE, HOURS_SEEDS, PROFILE_BLAZE_HOURS, PROFILE_BLAZE_SCALE, PROFILE_CRUMB_FACTOR, PROFILE_HOURS,
@@ -201,10 +201,8 @@ def build(ctx) -> list:
         "pure heading drift (no wheel noise)"))
 
     # 3. drift sweep, both algorithms
-    xs_s, bd_s, lo_s, hi_s = T.per_drift(d_share, "breakdown_s")
-    xs_b, bd_b, lo_b, hi_b = T.per_drift(d_blaze, "breakdown_s")
-    _, last_s, llo_s, lhi_s = T.per_drift(d_share, "units_per_10min_last", np.mean)
-    _, last_b, llo_b, lhi_b = T.per_drift(d_blaze, "units_per_10min_last", np.mean)
+    (xs_s, bd_s, lo_s, hi_s), (xs_b, bd_b, lo_b, hi_b), (_, last_s, llo_s, lhi_s), (_, last_b, llo_b, lhi_b) = \
+        drift_curves(d_share, d_blaze)
     # judged at the drift that breaks the 2000 algorithm (EXPERIMENTS.md: "with drift that breaks the
     # Blazing-a-trail system"): the k > 0 both ran where the 2000 team's last-10-min throughput is
     # lowest, each team against its own k = 0
