@@ -261,6 +261,9 @@ class _LosBrain(abc.ABC):
         self.trouble = TroubleState(int(params.trouble_cr))
         self._history: dict[int, tuple[np.ndarray, dict[int, tuple[float, float]]]] = {}
         self._teammate_tr: dict[int, bool | None] = {}
+        #: where each teammate whose Tr bit arrived this step stood (own frame) when it sent it,
+        #: from my own sighting of it at the sending step (None: I did not see it then)
+        self._teammate_tr_xy: dict[int, XY] = {}
         self._seen_now: dict[int, tuple[float, float]] = {}
         self._prev_xy: XY | None = None
         self._last_target: tuple[str, Any, float] | None = None
@@ -401,6 +404,7 @@ class _LosBrain(abc.ABC):
     def _receive(self, obs: Observation) -> None:
         """Read the inbox: frames from mutual bearings, Id rule, D arbitration, Tr bits."""
         self._teammate_tr = {}
+        self._teammate_tr_xy = {}
         for msg in obs.inbox:
             body = msg.body
             if not isinstance(body, LosHelpMsg) or msg.sender == self.me:
@@ -409,6 +413,10 @@ class _LosBrain(abc.ABC):
             s = int(msg.sender)
             if body.trouble is not None:
                 self._teammate_tr[s] = bool(body.trouble)
+                sent = self._history.get(int(body.step))
+                if sent is not None and s in sent[1]:
+                    rng_s, b_s = sent[1][s]
+                    self._teammate_tr_xy[s] = self._body_to_odom(sent[0], rng_s * math.cos(b_s), rng_s * math.sin(b_s))
             if not self.params.goal_sharing:
                 continue
             hist = self._history.get(int(body.step))

@@ -115,6 +115,29 @@ class LosExplorerParams(_CommonParams):
         178 (4/5, 85/100) -> 190 (5/5, 100/100), R1..4 168 -> 169 (5/5 both); on the tasks
         finished both ways unchanged (R1+R2 identical, R1..3 178 -> 176); R1 alone
         unaffected (253, 5/5). None: VisBug's one-direction walk (the paper's A).
+    trouble_sighting_at_send : bool
+        §5 rule 3 counts a teammate R_j in sight that is not in trouble; its Tr bit, sent at step
+        k, arrives at k + 1 (the radio's one-step delay), when a teammate seen for one step only
+        is out of sight again, so it was never a candidate. True: a teammate whose Tr bit (false)
+        arrived and which R1 saw at the sending step is a candidate at the position R1 saw it
+        at (kept with ``keep_trouble_helper``). Defect against §5 fixed (R_j was in V(R_i) when
+        it shared its state): traced, office_complex, potential field, R1..R4, task 1, target
+        room 5 from room 6: R1 trapped in room 7's south-east corner (26.6, 14.0) saw a
+        helper through room 7's door for one step every ~100 steps, 2500 steps long, and never
+        headed to it. False: only teammates in sight at the step the bit arrives.
+    trouble_return : bool
+        In trouble with no teammate in sight to head to (§5 rule 3 needs one), head back to the
+        position where R1 last saw a teammate not in trouble (own frame; with
+        ``trouble_helper_towards_goal`` not one walking away from R1's goal), and wait there
+        (not counted as progress: Pr stays) until a teammate comes in sight or
+        ``trouble_wait_steps`` have passed (then A drives again and the point is forgotten).
+        Gap filled: §5 does not say what a robot in trouble does while nobody is in sight;
+        helpers patrol the corridors, and R1 trapped in a room corner (office_complex
+        (28.0, 18.6) behind room 8's U, (16.0, 5.4) against room 2's east wall) is out of every
+        helper's sight (traced: helper in sight 17 of 2500 steps). R1 alone never saw a
+        teammate and stays trapped (§6). False: A drives as if not in trouble.
+    trouble_wait_steps : int
+        Steps R1 waits at the point of ``trouble_return`` for a teammate before A drives again.
     """
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
@@ -126,6 +149,9 @@ class LosExplorerParams(_CommonParams):
     trouble_heading_steps: int = Field(5, ge=1, le=1000)
     trouble_recede_m: float = Field(2.0, ge=0.0, le=100.0)
     visbug_reverse_walk_factor: float | None = Field(3.0, gt=0.0, le=1000.0)
+    trouble_sighting_at_send: bool = False
+    trouble_return: bool = False
+    trouble_wait_steps: int = Field(600, ge=1, le=10_000_000)
 
 
 
@@ -178,6 +204,9 @@ class LosExplorer(_LosBrain):
         #: teammates' recent straight distances to R1's goal, (step, d) (trouble_helper_towards_goal)
         self._mate_goal_d: dict[int, list[tuple[int, float]]] = {}
         self._tt_best_d = math.inf
+        #: where a teammate not in trouble was last seen (``trouble_return``), and since when R1 waits there
+        self._last_helper_xy: XY | None = None
+        self._return_since: int | None = None
         self._set_goal()
 
     def _set_goal(self) -> None:
@@ -289,6 +318,8 @@ class LosExplorer(_LosBrain):
             self._trouble_target = None
         if p.state_sharing and p.trouble_helper_towards_goal:
             self._track_mates(goal)
+        if p.state_sharing and p.trouble_return:
+            self._remember_helper()
         me_xy = self._me_xy()
         goal_d = math.hypot(goal[0] - me_xy[0], goal[1] - me_xy[1])
         if action is None and p.state_sharing and self.trouble.tr:
@@ -297,7 +328,12 @@ class LosExplorer(_LosBrain):
             # (at its last seen position) when it goes out of sight (gap filled; the paper
             # names only these two ends)
             near = 2.0 * self.radius_m + self.step_m
-            cands = [(rid, xy[0], xy[1], self._teammate_tr.get(rid)) for rid, xy in self._seen_now.items()]
+            seen = self._seen_now
+            if p.trouble_sighting_at_send:
+                # a teammate whose Tr bit arrived, seen when it sent it though not now (see
+                # ``trouble_sighting_at_send``): a candidate at the position it was seen at
+                seen = {**{rid: xy for rid, xy in self._teammate_tr_xy.items() if rid not in seen}, **seen}
+            cands = [(rid, xy[0], xy[1], self._teammate_tr.get(rid)) for rid, xy in seen.items()]
             if p.trouble_helper_towards_goal:
                 # not a teammate walking away from R1's goal (see ``trouble_helper_towards_goal``)
                 cands = [(rid, x, y, None if self._mate_recedes(rid) else tr) for rid, x, y, tr in cands]
@@ -311,9 +347,11 @@ class LosExplorer(_LosBrain):
                 tt = self._trouble_target = (tt[0], self._seen_now[tt[0]])
             elif tt is None or math.hypot(tt[1][0] - self._pose[0], tt[1][1] - self._pose[1]) <= near:
                 helper = choose_helper(True, self._me_xy(), cands)
-                tt = self._trouble_target = None if helper is None else (helper, self._seen_now[helper])
+                tt = self._trouble_target = None if helper is None else (helper, seen[helper])
                 if helper is not None and p.trouble_helper_towards_goal:
-                    self._tt_best_d = self._mate_goal_d[helper][-1][1]
+                    hist = self._mate_goal_d.get(helper)
+                    self._tt_best_d = hist[-1][1] if hist else math.hypot(seen[helper][0] - goal[0],
+                                                                          seen[helper][1] - goal[1])
             if tt is not None and (tt[0] in self._seen_now or p.keep_trouble_helper):
                 self.mode = "trouble_follow"
                 action, towards = self._head_to(tt[1], ("helper", tt[0]), stop_within_m=near, end_margin_m=near)
@@ -329,6 +367,21 @@ class LosExplorer(_LosBrain):
                     # from it keeps R1 in trouble (and following), so it is led along the
                     # patrol until it sees its goal or the teammate takes it nearer
                     progressing = goal_d < self._prev_goal_d - p.progress_min_fraction * self.step_m
+                self._return_since = None
+            elif p.trouble_return and self._last_helper_xy is not None:
+                # in trouble, no teammate in sight: back to where one was last seen, and wait
+                # there (see ``trouble_return``); not progress towards the goal (Pr stays)
+                self.mode = "trouble_return"
+                point = self._last_helper_xy
+                if math.hypot(point[0] - me_xy[0], point[1] - me_xy[1]) > near:
+                    action, _ = self._head_to(point, ("return", point), stop_within_m=near, end_margin_m=near)
+                else:
+                    if self._return_since is None:
+                        self._return_since = self._step
+                    action = Action()
+                    if self._step - self._return_since >= p.trouble_wait_steps:
+                        self._last_helper_xy = self._return_since = None  # nobody came: A again
+                progressing = False
         if action is None and self._promised == self.target_index and not self.trouble.tr:
             self.mode = "own_goal"
             self.promised_steps += 1
@@ -340,6 +393,18 @@ class LosExplorer(_LosBrain):
         self.trouble.update(progressing)
         self._prev_goal_d = goal_d
         return action
+
+    def _remember_helper(self) -> None:
+        """Keep where a teammate not in trouble was last seen (own frame; ``trouble_return``):
+        the nearest one seen now, else one seen when it sent the Tr bit that arrived now."""
+        me = self._me_xy()
+        for source in (self._seen_now, self._teammate_tr_xy):
+            ok = [xy for rid, xy in source.items() if self._teammate_tr.get(rid) is False
+                  and not (self.params.trouble_helper_towards_goal and self._mate_recedes(rid))]
+            if ok:
+                self._last_helper_xy = min(ok, key=lambda xy: math.hypot(xy[0] - me[0], xy[1] - me[1]))
+                self._return_since = None
+                return
 
     def _track_mates(self, goal: XY) -> None:
         """Keep each teammate's straight distance to R1's goal over the last

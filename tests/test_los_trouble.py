@@ -1,0 +1,87 @@
+"""State sharing gaps filled for the potential field (Sgorbissa & Arkin §5 rule 3): a teammate seen
+only at the step it sent its Tr bit, and R1 in trouble with no teammate in sight."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from teamnav.control.coop.los_help import LosExplorer
+from teamnav.control.coop.los_help import brain as brain_mod
+
+from test_los_help import StraightNav, info, msg, obs
+
+WALL = [(0.0, 0.1, 0.5)]  # a wall 0.5 m ahead (+x), where the goal is
+
+
+def _trapped(monkeypatch, cr=3, **params):
+    """R1 whose navigator never progresses, in trouble after ``cr`` steps with nobody in sight."""
+    stuck = StraightNav(stuck=True)
+    monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=cr, goal_sharing=False,
+                                        trouble_helper_towards_goal=False, **params),
+                     np.random.default_rng(0), info(0, 2))
+    return r1
+
+
+@pytest.mark.parametrize("at_send", [False, True])
+def test_teammate_seen_only_when_it_sent_its_state_is_headed_for(monkeypatch, at_send):
+    """§5 rule 3 with a one-step sighting: the Tr bit sent at step k arrives at k + 1, when the
+    teammate is out of sight again; ``trouble_sighting_at_send`` pairs it with the sighting at k."""
+    r1 = _trapped(monkeypatch, trouble_sighting_at_send=at_send)
+    for k in range(3):
+        r1.step(obs(k, walls=WALL))
+    assert r1.trouble.tr
+    # step 3: R2 seen 3 m to the left (+y) for this step only; its message of step 3 arrives at 4
+    r1.step(obs(3, walls=WALL, seen=[(1, 3.0, math.pi / 2)]))
+    assert r1.mode == "own_goal"  # no Tr bit yet
+    a, _ = r1.step(obs(4, walls=WALL, inbox=[msg(1, 3, trouble=False)]))
+    if at_send:
+        assert r1.mode == "trouble_follow" and a.direction_rad == pytest.approx(math.pi / 2)
+        a, _ = r1.step(obs(5, pose=(0.0, 0.2, 0.0), walls=WALL))  # kept at its last seen position
+        assert r1.mode == "trouble_follow" and a.direction_rad == pytest.approx(math.pi / 2)
+    else:
+        assert r1.mode == "own_goal"
+    # a teammate that sent "in trouble" is no candidate either way
+    r2 = _trapped(monkeypatch, trouble_sighting_at_send=at_send)
+    for k in range(3):
+        r2.step(obs(k, walls=WALL))
+    r2.step(obs(3, walls=WALL, seen=[(1, 3.0, math.pi / 2)]))
+    r2.step(obs(4, walls=WALL, inbox=[msg(1, 3, trouble=True)]))
+    assert r2.mode == "own_goal"
+
+
+def test_in_trouble_with_nobody_in_sight_returns_to_the_last_helper_and_waits(monkeypatch):
+    """``trouble_return``: R1 saw R2 (not in trouble) 2 m behind it; trapped later with nobody in
+    sight, it walks back there (Pr stays at its bound), waits ``trouble_wait_steps``, then drives
+    with A again."""
+    r1 = _trapped(monkeypatch, cr=50, trouble_return=True, trouble_wait_steps=5)
+    # step 0-1: R2 seen at (-2, 0) (behind), its Tr bit (false) arrives at step 1
+    r1.step(obs(0, walls=WALL, seen=[(1, 2.0, math.pi)]))
+    r1.step(obs(1, walls=WALL, seen=[(1, 2.0, math.pi)], inbox=[msg(1, 0, trouble=False)]))
+    assert r1.mode == "own_goal" and not r1.trouble.tr
+    k = 2
+    while not r1.trouble.tr:
+        r1.step(obs(k, walls=WALL))
+        k += 1
+    pr = r1.trouble.pr
+    a, _ = r1.step(obs(k, walls=WALL))
+    assert r1.mode == "trouble_return" and a.direction_rad == pytest.approx(math.pi)
+    assert r1.trouble.tr and r1.trouble.pr == pr
+    # there (within 2 radii + a step): it stays, then after 5 steps A takes over
+    waits = []
+    for j in range(1, 8):
+        a, _ = r1.step(obs(k + j, pose=(-1.5, 0.0, 0.0), walls=WALL))
+        waits.append((r1.mode, a.direction_rad))
+    assert waits[:5] == [("trouble_return", None)] * 5
+    assert waits[-1][0] == "own_goal" and waits[-1][1] == pytest.approx(math.atan2(0.0, 7.5))
+
+
+def test_alone_r1_never_returns_anywhere(monkeypatch):
+    """The potential field alone stays trapped (§6): with no teammate ever seen there is no point
+    to return to, so R1 in trouble keeps driving with A."""
+    r1 = _trapped(monkeypatch, trouble_return=True, trouble_sighting_at_send=True)
+    for k in range(20):
+        a, _ = r1.step(obs(k, walls=WALL))
+    assert r1.trouble.tr and r1.mode == "own_goal" and a.direction_rad == pytest.approx(0.0)
