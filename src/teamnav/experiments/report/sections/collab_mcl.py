@@ -20,17 +20,24 @@ Quick mode (CI) runs few robots and particles, 1-2 seeds and 40-90 s runs (8 tri
 leaves the belief pictures and the §7.2 variants to the full report: its numbers show that the
 pipeline works, not the paper's result. The full report runs 16 hallway runs of 600 s (8 robots, about 30 CPU s each),
 16 hexagon runs of 300 s, 20 + 50 two-robot runs of 150 s and one pictured run.
+
+Files: the row helpers (error curves with 95 % bands) in :mod:`._collab_common`, the §7.2 variants
+in :mod:`._collab_beyond`; the paper's experiments here.
 """
 
 from __future__ import annotations
 
-import json
 import math
-from typing import Any
 
 import numpy as np
 
-from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, SectionSpec, Series, Table, Text
+from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, SectionSpec, Table, Text
+
+# the row helpers and the §7.2 part, importable from here as before the split
+from teamnav.experiments.report.sections._collab_beyond import _ANON, _FILTER, _FP, _beyond  # noqa: F401
+from teamnav.experiments.report.sections._collab_common import (  # noqa: F401
+    _band, _metric, _ms, _ok, _param, _series,
+)
 
 PAPER = "fox-burgard-kruppa-thrun-collaborative-multi-robot-localization.txt"
 
@@ -40,61 +47,6 @@ QUICK_HEXAGON = {"robots.0.count": 2, "robots.1.count": 2, "robots.0.params.max_
                  "robots.1.params.max_particles": 1000, "robots.0.params.min_particles": 200,
                  "robots.1.params.min_particles": 200}
 QUICK_DETECTION = {"robots.1.params.max_particles": 3000}
-
-
-def _ok(result) -> list[dict[str, Any]]:
-    return [r for r in result.rows() if r.get("status") == "ok" and r.get("metrics")]
-
-
-def _param(row: dict, key: str, default=None):
-    return row["params"].get(key, default)
-
-
-def _ms(values) -> str:
-    v = np.asarray([x for x in values if x is not None and math.isfinite(x)], dtype=float)
-    if v.size == 0:
-        return "n/a"
-    sd = float(v.std(ddof=1)) if v.size > 1 else 0.0
-    return f"{v.mean():.1f} ± {sd:.1f}"
-
-
-def _band(rows: list[dict], pick) -> tuple[list[float], list[float], list[float], list[float]] | None:
-    """Mean and 95 % confidence band over runs of a per-run error series on a common time grid."""
-    curves = []
-    for r in rows:
-        s = r["metrics"].get("loc_error_series")
-        if not s:
-            continue
-        d = json.loads(s)
-        y = pick(d)
-        if y is None:
-            continue
-        t = np.asarray(d["t_s"], dtype=float)
-        y = np.asarray([np.nan if v is None else v for v in y], dtype=float)
-        curves.append((t, y))
-    if not curves:
-        return None
-    t_end = min(c[0][-1] for c in curves)
-    grid = np.linspace(0.0, t_end, min(120, max(2, len(curves[0][0]))))
-    ys = np.array([np.interp(grid, t, y) for t, y in curves])
-    n = ys.shape[0]
-    mean = np.nanmean(ys, axis=0)
-    if n > 1:
-        from scipy.stats import t as student
-
-        half = student.ppf(0.975, n - 1) * np.nanstd(ys, axis=0, ddof=1) / math.sqrt(n)
-    else:
-        half = np.zeros_like(mean)
-    return grid.tolist(), mean.tolist(), (mean - half).tolist(), (mean + half).tolist()
-
-
-def _series(label: str, rows: list[dict], pick) -> list[Series]:
-    b = _band(rows, pick)
-    return [] if b is None else [Series(label, b[0], b[1], lo=b[2], hi=b[3])]
-
-
-def _metric(rows: list[dict], key: str) -> list[float]:
-    return [r["metrics"][key] for r in rows if isinstance(r["metrics"].get(key), (int, float))]
 
 
 # ---------------------------------------------------------------------------- §5.2.1
@@ -277,59 +229,6 @@ def _detection(ctx) -> list:
     if ctx.quick:
         return blocks + [Missing("belief before/after the detection (Fig. 10)", "drawn in the full report only")]
     return blocks + _belief_views(ctx)
-
-
-# ---------------------------------------------------------------------------- beyond the paper
-_FP = {"robots.0.detector.p_false_positive": 0.035}
-_FILTER = {"robots.0.params.false_positive_filter": True, "robots.1.params.false_positive_filter": True}
-_ANON = {"robots.0.detector.report_identity": False}
-
-
-def _beyond(ctx) -> list:
-    if ctx.quick:
-        return [Missing("false positives and withheld identities (§7.2)", "measured in the full report only "
-                        "(5 variants x 10 runs)")]
-    kw = {"seeds": 10, "duration_s": 150}
-    base: dict = {}
-    variants = [
-        ("no false positives, identities (paper §5)", "collab-mcl-detection-paper", {}),
-        ("3.5 % false positives, paper's method", "collab-mcl-fp-paper", _FP),
-        ("3.5 % false positives, with the filter", "collab-mcl-fp-filter", {**_FP, **_FILTER}),
-        ("identity withheld, paper's method (ignored)", "collab-mcl-anon-paper",
-         {**_ANON, "robots.0.params.anonymous": "ignore"}),
-        ("identity withheld, associated by belief", "collab-mcl-anon-assoc", _ANON),
-    ]
-    table, res = [], {}
-    for label, name, over in variants:
-        rows = _ok(ctx.sweep("collab-mcl-detection", name=name, set={**base, **over,
-                                                                     "robots.1.params.collaborate": True}, **kw))
-        e = _metric(rows, "loc_final_error_m_g_robin")
-        ok = [v < 1.5 for v in e]
-        res[name] = float(np.mean(ok)) if ok else float("nan")
-        table.append([label, len(rows), _ms(e), f"{res[name]:.0%}" if ok else "n/a",
-                      _ms(_metric(rows, "loc_time_to_localize_s_g_robin"))])
-    blocks = [Table("Beyond the paper (§7.2), on the §5.1 setting: Robin localized at the end",
-                    ["setting", "runs", "Robin's final error [m]", "runs localized", "time to localize [s]"], table,
-                    note="Filter: an observer uses a robot only when it was seen on the previous frame at a "
-                         "consistent place and the detected position is free space under its belief; the detected "
-                         "robot drops trees its belief makes more likely phantom than real. Association: the "
-                         "observer broadcasts its tree, every robot answers with the tree's density under its "
-                         "belief, the clear winner gets the update.")]
-    blocks.append(Comparison("§7.2: 3.5 % false positives break the method when sights are rare; a filter survives",
-                             "stated, not measured (\"not robust to such high failure-rates\")",
-                             f"Robin localized in {res['collab-mcl-fp-paper']:.0%} of runs with phantoms vs "
-                             f"{res['collab-mcl-fp-filter']:.0%} with the filter "
-                             f"({res['collab-mcl-detection-paper']:.0%} without phantoms)",
-                             bool(res["collab-mcl-fp-filter"] > res["collab-mcl-fp-paper"]),
-                             "Marian stands still, so the 2.5 m rule lets it use Robin once: a phantom that comes "
-                             "first spends that use."))
-    blocks.append(Comparison("§7.2: detections without identity",
-                             "the factorial method cannot use them",
-                             f"Robin localized in {res['collab-mcl-anon-paper']:.0%} of runs ignoring them vs "
-                             f"{res['collab-mcl-anon-assoc']:.0%} associating by belief",
-                             bool(res["collab-mcl-anon-assoc"] > res["collab-mcl-anon-paper"]),
-                             "With two robots the association is easy; in a team, ambiguous sights are dropped."))
-    return blocks
 
 
 def build(ctx) -> list:
