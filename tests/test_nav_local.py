@@ -255,8 +255,8 @@ def test_avoid_past_escapes_the_u(seed, x0):
     assert max(p[1] for p in loop.path) > 7.3  # it went round the cup, not through it
 
 
-def test_avoid_past_memory_survives_a_new_goal():
-    nav = nav_of("avoid_past")
+def test_avoid_past_robot_memory_survives_a_new_goal():
+    nav = nav_of("avoid_past", {"memory_scope": "robot"})
     assert isinstance(nav, AvoidPast)
     loop = Loop(u_trap(), nav, U_START, U_GOAL)
     for _ in range(200):

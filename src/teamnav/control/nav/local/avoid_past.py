@@ -4,39 +4,67 @@ Sgorbissa & Arkin §6 run "a potential field algorithm to which the Avoid Past s
 been added" (Balch & Arkin 1993, "Avoiding the past: a simple but effective strategy for
 reactive navigation", ICRA, pp. 678-685). Balch & Arkin add "a local spatial memory [that]
 allows a robot to avoid areas that have already been visited", implemented "within a
-schema-based motor control model", as a solution to box canyons (their abstract). We did not
-have the full paper at hand: the grid of visit counts and the repulsion law below are our
-reading of that description, with our own choices marked.
+schema-based motor control model", as a solution to box canyons (their abstract, the only
+part of the paper the reference search found, session 6: no MissionLab or TeamBots source of
+an avoid-past schema was found either). The grid of visit counts, the repulsion law, its
+saturation and the memory's lifetime below are therefore our reading of that description,
+with our own choices marked.
 
 Here:
 
 - memory: a grid of square cells of side ``cell_m`` in the robot's **own odometry frame**
   (a dict keyed by cell index, so it grows with the explored area); every :meth:`direction`
   call adds the step length to the cell under the robot (a visit weighs the path it stands
-  for, so the law below does not change with the step length). The memory belongs to the robot, not to a
-  goal: a new goal keeps it (it is a memory of places, not of a task);
+  for, so the law below does not change with the step length);
+- lifetime (``memory_scope``, our choice, a gap in the abstract): ``"goal"`` (default) forgets
+  the visits when the robot is given a new goal of its own (not a temporary one: an
+  excursion to a teammate or a ghost, Sgorbissa & Arkin §3-§5, keeps the memory, and so does
+  the way back to the same goal), so that the robot avoids *this* trip's past; ``"robot"``
+  keeps one memory for the robot's whole life. Why (issue 7, traced): with ``"robot"`` the
+  counts of the corridors grow with every target of a 200-target task and the vector below
+  is linear in the counts, so after a few targets any asymmetry of the well-trodden corridor
+  saturates the push (office_simple, task 1: the unsaturated magnitude's median 1.4 over the
+  first 300 steps, 2.2 over the last 1500, saturated in 54 % of those steps with 1153 m of
+  path in memory) and the memory, not the goal, steers: R1 was pushed from the corridor
+  into rooms N4/N5/S5 for 1500 steps without entering S4's door 1.5 m from where it stood.
+  With ``"goal"``: 28 % saturated, 12 m of path in memory over the same task's last 1500
+  steps;
 - avoid-past vector: ``avoid_gain_per_m · Σ_c n_c · (1 − d_c / memory_radius_m) · (x − c) / d_c``
   over the cells ``c`` whose centre is within ``memory_radius_m`` of the robot (``n_c`` metres
-  of path in the cell,
-  ``d_c`` distance from the cell centre to the robot ``x``): a discrete, distance-weighted
-  estimate of minus the gradient of the visit density, so that a box canyon fills up with
-  visits until the robot is pushed out of it (the linear distance weighting is our
-  choice). The vector grows with the counts until its magnitude reaches ``avoid_max`` (our choice, default twice the
-  move-to-goal gain): enough to outweigh move-to-goal so that the trap is left given time,
-  never so much that it pins the robot against a wall (unbounded, it would outgrow
-  avoid-static-obstacle, which we measured trapping the robot on the cup's inner wall);
+  of path in the cell, ``d_c`` distance from the cell centre to the robot ``x``): a discrete,
+  distance-weighted estimate of minus the gradient of the visit density, so that a box canyon
+  fills up with visits until the robot is pushed out of it (the linear distance weighting is
+  our choice). The vector grows with the counts until its magnitude reaches ``avoid_max``
+  (our choice, default twice the move-to-goal gain): enough to outweigh move-to-goal so that
+  the trap is left given time, never so much that it pins the robot against a wall
+  (unbounded, it would outgrow avoid-static-obstacle, which we measured trapping the robot on
+  the cup's inner wall; Balch's own TeamBots ``v_Avoid_va`` bounds avoid-obstacle the same
+  way, returning the largest term's magnitude in 0..1 instead of the sum, because a wall of
+  many returns was too repulsive);
 - the rest (move-to-goal, avoid-static-obstacle, collision guard, progress estimate) is the
   potential field of :mod:`teamnav.control.nav.local.potential_field` with the same parameters.
+
+Defaults, measured (R1 alone, ``los-help-*`` scenarios, per-target budgets 1500 / 2500 steps,
+tasks finished and mean steps per target): ``"robot"``, 2 m (the old default): 40-target
+prefixes 0/5 on office_simple (4 to 14 targets reached) and 0/5 on office_complex (11 to 23);
+``"robot"``, 3 m: 0/5 simple. ``"goal"``, 2 m: 5/5 simple, 2/5 complex (R1 pinned on room 1's
+east wall 5 m from the door, the push reaching 2 m into a room 8 m wide); ``"goal"``, 3 m
+(the default): 5/5 and 5/5 (steps per target 171-221 simple, 278-386 complex);
+3 m with ``avoid_max`` 1.5: 4/5 simple; 4 m: 3/5 simple with ``avoid_max`` 2, 4/5 on both maps
+with 1.5 (40-target prefixes; ``avoid_max`` 3 or 5 lost tasks on office_complex with 2-4 m).
+Full 200-target tasks with the default: see :class:`AvoidPastParams`.
 """
 
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 from numba import njit
 from pydantic import Field
 
+from teamnav.control.nav.local.base import GOAL_SAME_TOL_M
 from teamnav.control.nav.local.potential_field import PotentialField, PotentialFieldParams
 
 __all__ = ["AvoidPast", "AvoidPastParams", "avoid_past_vector"]
@@ -49,19 +77,24 @@ class AvoidPastParams(PotentialFieldParams):
     ----------
     cell_m : float, default 0.3
         Side of a memory cell [m].
-    memory_radius_m : float, default 2.0
-        Cells within this distance of the robot push it [m].
+    memory_radius_m : float, default 3.0
+        Cells within this distance of the robot push it [m] (was 2.0: see the module
+        docstring's measurements).
     avoid_gain_per_m : float, default 1.0
         Avoid-past magnitude per metre of path in a cell next to the robot (1.0 is 0.1 per
         visit with 0.1 m steps).
     avoid_max : float, default 2.0
         Largest avoid-past magnitude (saturation; see the module docstring).
+    memory_scope : {"goal", "robot"}, default "goal"
+        Lifetime of the memory: forgotten at each new goal of the robot's own (temporary goals
+        keep it), or kept for the robot's life (the old default; see the module docstring).
     """
 
     cell_m: float = Field(0.3, gt=0.0, le=10.0)
-    memory_radius_m: float = Field(2.0, gt=0.0, le=50.0)
+    memory_radius_m: float = Field(3.0, gt=0.0, le=50.0)
     avoid_gain_per_m: float = Field(1.0, ge=0.0, le=1000.0)
     avoid_max: float = Field(2.0, ge=0.0, le=1000.0)
+    memory_scope: Literal["goal", "robot"] = "goal"
 
 
 def avoid_past_vector(xy: np.ndarray, visits: dict[tuple[int, int], float], cell_m: float,
@@ -132,7 +165,9 @@ class AvoidPast(PotentialField):
     """Potential field with the avoid-past schema (Sgorbissa & Arkin §6, algorithm 2).
 
     Same constructor and protocol as :class:`~teamnav.control.nav.local.potential_field.PotentialField`;
-    ``visits`` is the robot's memory (cell index in the own frame -> metres of path in the cell).
+    ``visits`` is the robot's memory (cell index in the own frame -> metres of path in the cell);
+    with ``memory_scope="goal"`` a new goal of the robot's own (``temporary=False``, farther than
+    ``GOAL_SAME_TOL_M`` from the last one) starts an empty memory.
 
     Examples
     --------
@@ -154,6 +189,20 @@ class AvoidPast(PotentialField):
         self._grid = _VisitGrid()
         self._grid_of: dict | None = None
         self._grid_len = 0
+        self._own_goal: np.ndarray | None = None
+
+    def _new_goal(self) -> None:
+        """Restart the progress estimate; with ``memory_scope="goal"`` forget the visits when the
+        robot's own goal changed (an excursion to a temporary goal and back keeps them)."""
+        super()._new_goal()
+        p: AvoidPastParams = self.params  # type: ignore[assignment]
+        if self.temporary:
+            return
+        g = self.goal_xy
+        if (p.memory_scope == "goal" and self._own_goal is not None
+                and math.hypot(g[0] - self._own_goal[0], g[1] - self._own_goal[1]) > GOAL_SAME_TOL_M):
+            self.visits = {}
+        self._own_goal = g.copy()
 
     def _vector(self, pose: np.ndarray, points: np.ndarray, n_beams: int) -> np.ndarray:
         p: AvoidPastParams = self.params  # type: ignore[assignment]

@@ -1,0 +1,106 @@
+"""Avoid-Past (Sgorbissa & Arkin §6 algorithm 2; Balch & Arkin 1993): the memory's lifetime
+(``memory_scope``) and the escapes it buys on the paper's office maps.
+
+Driven in :mod:`test_nav_local`'s closed loop (no ``teamnav.sim``): ranges at the true pose, the
+robot's own frame shifted and rotated from the world's.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_nav_local import STEP_M, U_GOAL, U_START, Loop, nav_of, u_trap
+
+from teamnav.control.nav.local import AvoidPast, AvoidPastParams
+from teamnav.world import builtin_map
+
+
+def _visited(nav: AvoidPast, steps: int) -> Loop:
+    loop = Loop(u_trap(), nav, U_START, U_GOAL)
+    for _ in range(steps):
+        loop.step()
+    return loop
+
+
+def test_default_memory_is_the_trips():
+    assert AvoidPastParams().memory_scope == "goal" and AvoidPastParams().memory_radius_m == 3.0
+    with pytest.raises(ValueError):
+        AvoidPastParams(memory_scope="task")
+
+
+def test_a_new_own_goal_forgets_the_visits_a_temporary_one_does_not():
+    nav = nav_of("avoid_past")
+    loop = _visited(nav, 100)
+    visits = dict(nav.visits)
+    assert sum(visits.values()) == pytest.approx(100 * STEP_M)
+    own = loop.to_own(np.asarray(U_GOAL))
+    # an excursion (a teammate, a ghost: temporary) and the way back to the same goal keep them
+    nav.set_goal(loop.to_own(np.array([1.0, 1.0])), temporary=True)
+    assert nav.visits == visits
+    loop.step()
+    nav.set_goal(own + 1e-8)  # the same goal (within GOAL_SAME_TOL_M)
+    assert sum(nav.visits.values()) == pytest.approx(101 * STEP_M)
+    # a new goal of the robot's own starts an empty memory, and the push with it
+    nav.set_goal(loop.to_own(np.array([1.0, 1.0])))
+    assert nav.visits == {} and nav.progressing
+    loop.step()
+    assert sum(nav.visits.values()) == pytest.approx(STEP_M)
+
+
+def test_robot_scope_keeps_one_memory():
+    nav = nav_of("avoid_past", {"memory_scope": "robot"})
+    loop = _visited(nav, 50)
+    nav.set_goal(loop.to_own(np.array([1.0, 1.0])))
+    assert sum(nav.visits.values()) == pytest.approx(50 * STEP_M)
+
+
+def test_reset_memory_pushes_like_a_fresh_navigator():
+    """After the reset the vector is the one of a navigator that never saw the old goal (the
+    dense mirror of the visits is rebuilt, not left stale)."""
+    a = nav_of("avoid_past")
+    loop = _visited(a, 150)
+    a.set_goal(loop.to_own(np.array([1.0, 1.0])))
+    b = nav_of("avoid_past")
+    b.set_goal(loop.to_own(np.array([1.0, 1.0])))
+    pts = np.array([[0.0, 0.0]])
+    for k in range(30):
+        pose = np.array([0.05 * k, 0.02 * k, 0.0])
+        assert np.array_equal(a._vector(pose, pts, 72), b._vector(pose, pts, 72))
+
+
+@pytest.mark.parametrize("room,start,door_x", [("room_N2", (9.0, 7.0), (10.0, 11.2)),
+                                               ("room_S4", (21.2, 6.5), (18.6, 19.8))])
+def test_avoid_past_finds_the_door_the_potential_field_misses(room, start, door_x):
+    """office_simple: the goal is a room's centre behind the corridor wall, its door 1.1-2.3 m
+    to the side. The potential field sits on the wall (§6: trapped); Avoid-Past fills the spot
+    with visits and is pushed along the wall to the door and in."""
+    em = builtin_map("office_simple")
+    goal = em.places[room]
+    ap = Loop(em.grid, nav_of("avoid_past"), start, goal)
+    steps = ap.run(1500)
+    assert steps is not None and ap.stalls == 0
+    inside = [p for p in ap.path if abs(p[1] - 7.0) > 1.4]  # out of the corridor, in the room
+    assert door_x[0] < inside[0][0] < door_x[1]  # it entered through the door
+    pf = Loop(em.grid, nav_of("potential_field"), start, goal)
+    assert pf.run(1500) is None
+
+
+def test_trip_memory_reaches_a_sequence_the_robot_memory_does_not():
+    """Issue 7, R1 alone on office_simple (``los-help-simple``, task 1's first 12 targets, budget
+    1500 steps each). With one memory for the robot's life (the old default) the trodden
+    corridor's visits saturate the push and R1 gives up on the 11th target (S4 from S5); with
+    the trip's memory (the default) it reaches all 12."""
+    from teamnav import load_scenario, run
+    from teamnav.experiments.los_tasks import task_targets_xy
+
+    def reached(navigator_params) -> tuple[int, bool]:
+        ov = {"robots.0.params.navigator": "avoid_past", "robots.0.params.state_sharing": False,
+              "robots.0.params.navigator_params": navigator_params,
+              "robots.0.params.targets_xy": task_targets_xy("simple", 1, 12),
+              "robots.1.count": 0, "robots.2.count": 0, "robots.3.count": 0}
+        m = run(load_scenario("los-help-simple", overrides=ov, duration_s=0.1 * 1500 * 12), progress=False).metrics
+        return int(m["los_targets_reached"]), bool(m["los_finished"])
+
+    assert reached({}) == (12, True)
+    n, finished = reached({"memory_scope": "robot", "memory_radius_m": 2.0})
+    assert n < 12 and not finished
