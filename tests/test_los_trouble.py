@@ -85,3 +85,26 @@ def test_alone_r1_never_returns_anywhere(monkeypatch):
     for k in range(20):
         a, _ = r1.step(obs(k, walls=WALL))
     assert r1.trouble.tr and r1.mode == "own_goal" and a.direction_rad == pytest.approx(0.0)
+
+
+def test_return_without_waiting_hands_back_to_a_and_can_count_as_progress(monkeypatch):
+    """``trouble_wait_steps=0``: at the point, nobody in sight, A drives again at once;
+    ``trouble_return_progress``: closing in on the point lowers Pr (§5: progress towards G_icurr)."""
+    r1 = _trapped(monkeypatch, cr=50, trouble_return=True, trouble_wait_steps=0, trouble_return_progress=True)
+    r1.step(obs(0, walls=WALL, seen=[(1, 4.0, math.pi)]))
+    r1.step(obs(1, walls=WALL, seen=[(1, 4.0, math.pi)], inbox=[msg(1, 0, trouble=False)]))
+    k = 2
+    while not r1.trouble.tr:
+        r1.step(obs(k, walls=WALL))
+        k += 1
+    pr = r1.trouble.pr
+    x = 0.0
+    for j in range(5):
+        a, _ = r1.step(obs(k + j, pose=(x, 0.0, 0.0), walls=WALL))
+        assert r1.mode == "trouble_return" and a.direction_rad == pytest.approx(math.pi)
+        x -= 0.2
+    assert r1.trouble.tr and r1.trouble.pr < pr
+    a, _ = r1.step(obs(k + 5, pose=(-3.6, 0.0, 0.0), walls=WALL))  # there: A again, the point forgotten
+    assert r1.mode == "own_goal" and a.direction_rad == pytest.approx(0.0)
+    a, _ = r1.step(obs(k + 6, pose=(-3.4, 0.0, 0.0), walls=WALL))
+    assert r1.mode == "own_goal"

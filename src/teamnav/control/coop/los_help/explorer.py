@@ -137,7 +137,11 @@ class LosExplorerParams(_CommonParams):
         helper's sight (traced: helper in sight 17 of 2500 steps). R1 alone never saw a
         teammate and stays trapped (§6). False: A drives as if not in trouble.
     trouble_wait_steps : int
-        Steps R1 waits at the point of ``trouble_return`` for a teammate before A drives again.
+        Steps R1 waits at the point of ``trouble_return`` for a teammate before A drives again
+        (0: no wait, A drives as soon as R1 is there).
+    trouble_return_progress : bool
+        With ``trouble_return``: closing in on the point counts as progress (Pr falls, as when
+        heading to a teammate, §5 Fig. 10); False: Pr stays at its bound while returning.
     """
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
@@ -151,7 +155,8 @@ class LosExplorerParams(_CommonParams):
     visbug_reverse_walk_factor: float | None = Field(3.0, gt=0.0, le=1000.0)
     trouble_sighting_at_send: bool = False
     trouble_return: bool = False
-    trouble_wait_steps: int = Field(600, ge=1, le=10_000_000)
+    trouble_wait_steps: int = Field(600, ge=0, le=10_000_000)
+    trouble_return_progress: bool = False
 
 
 
@@ -373,15 +378,19 @@ class LosExplorer(_LosBrain):
                 # there (see ``trouble_return``); not progress towards the goal (Pr stays)
                 self.mode = "trouble_return"
                 point = self._last_helper_xy
+                progressing = False
                 if math.hypot(point[0] - me_xy[0], point[1] - me_xy[1]) > near:
-                    action, _ = self._head_to(point, ("return", point), stop_within_m=near, end_margin_m=near)
+                    action, towards = self._head_to(point, ("return", point), stop_within_m=near, end_margin_m=near)
+                    progressing = towards and p.trouble_return_progress
+                elif p.trouble_wait_steps == 0:
+                    self._last_helper_xy = None  # there, nobody in sight: A again
+                    self.mode = "own_goal"
                 else:
                     if self._return_since is None:
                         self._return_since = self._step
                     action = Action()
                     if self._step - self._return_since >= p.trouble_wait_steps:
                         self._last_helper_xy = self._return_since = None  # nobody came: A again
-                progressing = False
         if action is None and self._promised == self.target_index and not self.trouble.tr:
             self.mode = "own_goal"
             self.promised_steps += 1
@@ -432,7 +441,8 @@ class LosExplorer(_LosBrain):
 
         ``target_index`` (0-based current target), ``targets_reached``, ``moves`` (motion
         steps commanded so far), ``mode`` (``"own_goal"`` | ``"follow_teammate"`` |
-        ``"ghost"`` | ``"trouble_follow"`` | ``"done"`` | ``"gave_up"``), ``tr``, ``pr``, ``nt`` (§5),
+        ``"ghost"`` | ``"trouble_follow"`` | ``"trouble_return"`` (``trouble_return``) | ``"done"`` |
+        ``"gave_up"``), ``tr``, ``pr``, ``nt`` (§5),
         ``msgs_sent``, ``bytes_sent``, ``msgs_received`` (§4.4 traffic, cumulative),
         ``nav_restarts`` (times A gave up and was started afresh),
         ``known_goals`` and ``ghosts`` (memory, §4.4), ``own_d_m`` (D to its own goal, -1
