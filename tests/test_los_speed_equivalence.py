@@ -193,8 +193,9 @@ def test_field_vector_equals_numpy(seed, gx, gy, th, k):
 @given(seeds, st.sampled_from([0.1, 0.2]))
 @settings(max_examples=15, deadline=None)
 def test_avoid_past_visit_grid_gives_the_dictionary_walks_vector(seed, step):
-    """A random walk (with jumps, so the grid grows in every direction): each step's vector
-    equals the potential field's plus avoid_past_vector over the visits dictionary."""
+    """A random walk (with jumps, so the grid grows in every direction, and goal changes that
+    reset the memory): each step's vector equals the potential field's plus avoid_past_vector
+    over the visits dictionary."""
     rng = np.random.default_rng(seed)
     p = AvoidPastParams()
     nav = AvoidPast(p, np.random.default_rng(0), step, 0.2)
@@ -204,6 +205,14 @@ def test_avoid_past_visit_grid_gives_the_dictionary_walks_vector(seed, step):
         pose = pose + np.array([*rng.normal(0, step, 2), 0.0])
         if i % 40 == 39:
             pose[:2] += rng.uniform(-30, 30, 2)
+        if i % 50 == 49:  # a new own goal (memory_scope="goal"): a fresh memory, the mirror rebuilt
+            nav.set_goal(np.array([5.0, 5.0 + i]))
+            assert nav.visits == {}
+        elif i % 50 == 25:  # an excursion and back keep the memory
+            n_visited = len(nav.visits)
+            nav.set_goal(np.array([-3.0, 1.0]), temporary=True)
+            nav.set_goal(np.array([5.0, 5.0 + 49 * (i // 50)]) if i > 50 else np.array([5.0, 5.0]))
+            assert len(nav.visits) == n_visited > 0
         pts = pose[:2] + rng.uniform(-2, 2, (5, 2))
         got = nav._vector(pose, pts, 72)
         want = field_vector(pose, nav.goal_xy, pts, 72, p, 0.2) + avoid_past_vector(

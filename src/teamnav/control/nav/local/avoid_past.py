@@ -52,7 +52,12 @@ east wall 5 m from the door, the push reaching 2 m into a room 8 m wide); ``"goa
 (the default): 5/5 and 5/5 (steps per target 171-221 simple, 278-386 complex);
 3 m with ``avoid_max`` 1.5: 4/5 simple; 4 m: 3/5 simple with ``avoid_max`` 2, 4/5 on both maps
 with 1.5 (40-target prefixes; ``avoid_max`` 3 or 5 lost tasks on office_complex with 2-4 m).
-Full 200-target tasks with the default: see :class:`AvoidPastParams`.
+Full 200-target tasks with the default, R1 alone: office_simple 5/5, 210 / 231 / 208 / 224 / 222
+steps per target (Table 1: 554.2); office_complex 4/5, 333 / 338 / 281 / 301 on the four
+finished (Table 2: 1132.2); task 4 gives up on its 174th target (room 1 -> room 3: ~1800 steps
+to leave room 1, whose door is 5 m west of the wall facing the goal, then pushed from the
+vertical corridor back into room 2 by its own visits). Paired on that task, ``avoid_gain_per_m``
+2, ``memory_radius_m`` 3.5 or ``cell_m`` 0.2 give up sooner (targets 128, 27, 46).
 """
 
 from __future__ import annotations
