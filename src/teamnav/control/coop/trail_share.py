@@ -87,6 +87,33 @@ after a drift check on more seeds and the 3-h runs.
 ``recover_reverse`` (off by default): while recovering, Navigate's 180 deg rule ignores its
 reversal memory and distance cool-down (the robot is pushed up a branch by a meeting and the
 way back is where it last reversed).
+``navigate={"meet_guard_deg": ...}`` (Navigate's meeting guard, off by default; Navigate's
+module docstring item 6): session 6, against the default on the same seeds (paired, mean ±
+s.e.; ``eff`` from ``place_interval_s``, ``eff_trips`` = 31.5 m / mean trip after the first
+source visit / cruise, the fairer figure in 30-min runs where the first exploration weighs):
+guard 90 deg at 0.4 m/s, no drift, seeds 0-7: eff 56.6 ± 1.7 % against 58.2 ± 1.1 % (paired
+-1.6 ± 1.8 points), eff_trips 65.3 ± 1.7 % against 66.2 ± 1.0 % (-0.9 ± 1.9); guard 60 deg at
+0.25 m/s, no drift, seeds 0-7: eff_trips 70.4 ± 2.2 % against 71.3 ± 3.3 % (-0.9 ± 3.0). No
+gain: it stays off. (Without its 8-s limit two guarded robots faced each other for good: 24 %
+on seed 0.)
+
+Cruise speed: the ``try-to-see-it-my-way`` scenario drives at 0.4 m/s, not the paper's
+0.25 m/s (§3.6, the default here). No reason was recorded when the trail scenarios were written
+(422d896 gave every trail scenario 0.4, as blazing-a-trail, whose paper gives no speed). Measured
+in session 6 (30-min runs, 4 robots, seeds 0-7 paired, efficiency is relative to each run's
+cruise so the two compare): without drift 0.25 m/s is not worse (eff 56.2 ± 3.7 % against
+58.2 ± 1.1 %, paired -2.0 ± 3.8 points; eff_trips 71.3 ± 3.3 % against 66.2 ± 1.0 %, paired
++5.1 ± 3.4: Panic, sharp turns and turns on the spot take the same time at either speed), but
+under the scenario's drift (the paper's per-robot rates) it is clearly worse: eff 41.5 ± 2.7 %
+against 53.5 ± 1.3 % (paired -12.0 ± 2.3 points), eff_trips 57.2 ± 3.2 % against 61.4 ± 1.2 %
+(-4.2 ± 2.6); over the scenario's 3 h (seed 0) 44.5 % against 54.2 %. Heading drift is per
+minute, so at 0.25 m/s a trip is 1.6x as long in time and frames diverge 1.6x as much per metre
+of trail, and the 4-min crumb expiry keeps 60 m of each robot's trail instead of 96 m. So the
+scenario keeps 0.4 m/s; the report's efficiency divides by the scenario's cruise either way.
+0.25 m/s also delivers 45 % fewer units in 30 min (13.3 ± 1.3 against 24.0 ± 0.4, no drift):
+the drift verdicts' units per 10 min, the lone-robot trip times (88.6 s at 0.4) and the report's
+durations would all have had to be re-measured.
+
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
 ``min_move_m`` since the previous temporary trail; radius 2 m (about a corridor's width);
 ``crumbs_for="every_place"`` is the §2.2 alternative the paper names for future work (one Crumb
