@@ -124,7 +124,13 @@ class LosExplorerParams(_CommonParams):
         it shared its state): traced, office_complex, potential field, R1..R4, task 1, target
         room 5 from room 6: R1 trapped in room 7's south-east corner (26.6, 14.0) saw a
         helper through room 7's door for one step every ~100 steps, 2500 steps long, and never
-        headed to it. False: only teammates in sight at the step the bit arrives.
+        headed to it. Measured (H7pf), potential field, 40-target prefixes of tasks, paired,
+        False -> True, tasks finished and targets reached: office_complex (tasks 1-10) R1+R2
+        0/10 (178/400) -> 4/10 (245/400), R1..3 1/10 (167/400) -> 4/10 (244/400), R1..4
+        3/8 (216/320) -> 4/8 (204/320); office_simple (tasks 1-5) R1+R2 1/5 (77/200) -> 0/5
+        (72/200), R1..3 4/5 (187/200) -> 4/5 (167/200), R1..4 5/5 -> 5/5, 323 -> 305 steps per
+        target. The default since H7pf. False: only teammates in sight at the step the bit
+        arrives (the earlier behaviour).
     trouble_return : bool
         In trouble with no teammate in sight to head to (§5 rule 3 needs one), head back to the
         position where R1 last saw a teammate not in trouble (own frame; with
@@ -135,7 +141,13 @@ class LosExplorerParams(_CommonParams):
         helpers patrol the corridors, and R1 trapped in a room corner (office_complex
         (28.0, 18.6) behind room 8's U, (16.0, 5.4) against room 2's east wall) is out of every
         helper's sight (traced: helper in sight 17 of 2500 steps). R1 alone never saw a
-        teammate and stays trapped (§6). False: A drives as if not in trouble.
+        teammate and stays trapped (§6). Measured (H7pf), office_complex, R1+R2, tasks 1-5 x
+        40 targets, with ``trouble_sighting_at_send``, targets reached (tasks finished): off
+        116/200 (2/5); on, waiting 600 steps 42/200 (0/5); ``trouble_wait_steps=0`` with
+        ``trouble_return_progress`` 26/200; 150 steps with it 27/200 (0/5): R1 kept in
+        trouble walks the helper's trail and spends each target's budget (traced: Pr at its
+        bound for 2000 steps, never back on its own goal). Off by default. False: A drives as
+        if not in trouble.
     trouble_wait_steps : int
         Steps R1 waits at the point of ``trouble_return`` for a teammate before A drives again
         (0: no wait, A drives as soon as R1 is there).
@@ -153,7 +165,7 @@ class LosExplorerParams(_CommonParams):
     trouble_heading_steps: int = Field(5, ge=1, le=1000)
     trouble_recede_m: float = Field(2.0, ge=0.0, le=100.0)
     visbug_reverse_walk_factor: float | None = Field(3.0, gt=0.0, le=1000.0)
-    trouble_sighting_at_send: bool = False
+    trouble_sighting_at_send: bool = True
     trouble_return: bool = False
     trouble_wait_steps: int = Field(600, ge=0, le=10_000_000)
     trouble_return_progress: bool = False
