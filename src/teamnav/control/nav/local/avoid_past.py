@@ -58,6 +58,13 @@ finished (Table 2: 1132.2); task 4 gives up on its 174th target (room 1 -> room 
 to leave room 1, whose door is 5 m west of the wall facing the goal, then pushed from the
 vertical corridor back into room 2 by its own visits). Paired on that task, ``avoid_gain_per_m``
 2, ``memory_radius_m`` 3.5 or ``cell_m`` 0.2 give up sooner (targets 128, 27, 46).
+With helpers (goal sharing, the nested teams of ``los_tasks.team_routes``, 5 tasks x 40
+targets, mean steps per target over the finished tasks): office_simple R1 200 (5/5), R1+R2 234
+(5/5), R1..3 227 (5/5), R1..4 190 (5/5); office_complex 310 (5/5), 321 (5/5), 316 (5/5), 309
+(4/5). The helpers barely help here, unlike Tables 1-2 (554 -> 257, 1132 -> 683): R1 alone
+already needs fewer steps than the paper's R1..R4. Forgetting the memory at every goal change
+(excursions included) or at a ghost reached without the goal in sight (§4.2 "start again")
+gave R1+R2 on office_simple 225 and 239 (paired, within the task-to-task spread): not kept.
 """
 
 from __future__ import annotations
