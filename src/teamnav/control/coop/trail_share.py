@@ -82,8 +82,15 @@ scenario's drift 53.5 ± 1.3 %, 128.6 ± 2.6 s): ``hint_skips_cooldown`` 57.4 ±
 2.3 % (trips 114.9 ± 3.9 s, from 10 min on 110.6 ± 3.2 s) without drift, 55.8 ± 2.6 % (126.9 ±
 7.1 s) with it: better, but not beyond the standard error; on fresh seeds 8-11 (no drift)
 60.1 ± 1.9 % against 56.7 ± 2.3 % (paired gain 3.5 ± 1.4 points; trips 117.6 ± 1.8 s against
-122.5 ± 3.3 s); seeds 0-11 together 60.3 ± 1.6 % against 57.7 ± 1.0 %. A candidate to turn on
-after a drift check on more seeds and the 3-h runs.
+122.5 ± 3.3 s); seeds 0-11 together 60.3 ± 1.6 % against 57.7 ± 1.0 % (paired +2.6 ± 1.6
+points). Drift check (session 6, at 0.4 m/s, paired against the default on the same seeds):
+the scenario's drift, 30 min, seeds 0-23: 54.1 ± 1.3 % against 52.3 ± 1.4 % (paired +1.9 ± 1.9
+points, better on 13 of 24 seeds; seeds 8-15 +1.5 ± 3.5, fresh seeds 16-23 +1.9 ± 3.8; fewer
+bad runs: worst seed 47 % against 29 %); the scenario's 3 h, seeds 0-1: 58.0 and 60.5 % against
+54.2 and 57.0 % (165 and 173 units against 147 and 154); 4x the drift, 1 h, seeds 0-2: 34, 33,
+25 units against 16, 39, 34 (last 10 min 6, 4, 4 against 4, 6, 6). Every comparison leans the
+same way but none is beyond the noise under drift, so it stays off (the rule for defaults);
+the first thing to try with more seeds.
 ``recover_reverse`` (off by default): while recovering, Navigate's 180 deg rule ignores its
 reversal memory and distance cool-down (the robot is pushed up a branch by a meeting and the
 way back is where it last reversed).
