@@ -124,13 +124,14 @@ class LosExplorerParams(_CommonParams):
         it shared its state): traced, office_complex, potential field, R1..R4, task 1, target
         room 5 from room 6: R1 trapped in room 7's south-east corner (26.6, 14.0) saw a
         helper through room 7's door for one step every ~100 steps, 2500 steps long, and never
-        headed to it. Measured (H7pf), potential field, 40-target prefixes of tasks, paired,
-        False -> True, tasks finished and targets reached: office_complex (tasks 1-10) R1+R2
-        0/10 (178/400) -> 4/10 (245/400), R1..3 1/10 (167/400) -> 4/10 (244/400), R1..4
-        3/8 (216/320) -> 4/8 (204/320); office_simple (tasks 1-5) R1+R2 1/5 (77/200) -> 0/5
-        (72/200), R1..3 4/5 (187/200) -> 4/5 (167/200), R1..4 5/5 -> 5/5, 323 -> 305 steps per
-        target. The default since H7pf. False: only teammates in sight at the step the bit
-        arrives (the earlier behaviour).
+        headed to it. Measured (H7pf), potential field, 40-target prefixes of tasks 1-10,
+        paired, False -> True, tasks finished (targets reached): office_complex R1+R2 0/10
+        (178/400) -> 4/10 (245/400), R1..3 1/10 (167/400) -> 4/10 (244/400), R1..4 4/10
+        (279/400) -> 5/10 (271/400); office_simple R1+R2 2/10 (161/400) -> 2/10 (205/400),
+        R1..3 9/10 (387/400) -> 9/10 (367/400), 349 -> 330 steps per target on the 8 tasks
+        both finished, R1..4 10/10 both, 299 -> 290. R1 alone is unaffected (no teammate).
+        The default since H7pf. False: only teammates in sight at the step the bit arrives
+        (the earlier behaviour).
     trouble_return : bool
         In trouble with no teammate in sight to head to (§5 rule 3 needs one), head back to the
         position where R1 last saw a teammate not in trouble (own frame; with
