@@ -119,7 +119,10 @@ of trail, and the 4-min crumb expiry keeps 60 m of each robot's trail instead of
 scenario keeps 0.4 m/s; the report's efficiency divides by the scenario's cruise either way.
 0.25 m/s also delivers 45 % fewer units in 30 min (13.3 ± 1.3 against 24.0 ± 0.4, no drift):
 the drift verdicts' units per 10 min, the lone-robot trip times (88.6 s at 0.4) and the report's
-durations would all have had to be re-measured.
+durations would all have had to be re-measured. At 0.25 m/s, ``give_way_s=3`` against the
+default: no drift, seeds 0-7, eff 57.0 ± 2.5 % against 56.2 ± 3.7 % (paired +0.8 ± 4.5), eff_trips
+65.5 ± 2.8 % against 71.3 ± 3.3 % (-5.7 ± 3.1); with the drift, seeds 0-5 (run cut short), eff
++8.6 ± 1.7 points (better on 6 of 6).
 
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
 ``min_move_m`` since the previous temporary trail; radius 2 m (about a corridor's width);
