@@ -105,7 +105,12 @@ GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on t
                   "3 / 2 / 3 (office_simple unchanged within the spread). At a reached ghost R1 goes on to the via "
                   "point only while it sees it (via_in_sight; a via point behind a wall had pulled R1 into a room "
                   "corner): office_simple Avoid-Past task 5 R1..3, 20 targets, 7/20 -> 20/20; VisBug R1..4 tasks "
-                  "2 and 3, 15/20 and 16/20 -> 20/20.")
+                  "2 and 3, 15/20 and 16/20 -> 20/20. A teammate seen at the step it sent its Tr bit is a §5 "
+                  "candidate at the spot R1 saw it (trouble_sighting_at_send; the radio's one-step delay had hidden "
+                  "teammates seen through a door for one step): potential field, 40-target prefixes of tasks 1-10, "
+                  "office_complex tasks finished R1,2 / R1..3 / R1..4 from 0 / 1 / 4 to 4 / 4 / 5 of 10. "
+                  "Avoid-Past's memory lives for one own goal (AvoidPastParams.memory_scope; a lifelong memory "
+                  "saturated the push after a few targets and R1 alone finished no 40-target task, 5/5 now).")
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
 QUICK_BUDGET_STEPS_PER_TARGET = 800
