@@ -65,6 +65,15 @@ targets, mean steps per target over the finished tasks): office_simple R1 200 (5
 already needs fewer steps than the paper's R1..R4. Forgetting the memory at every goal change
 (excursions included) or at a ghost reached without the goal in sight (§4.2 "start again")
 gave R1+R2 on office_simple 225 and 239 (paired, within the task-to-task spread): not kept.
+Where the R1+R2 steps come from (issue 7, H7ap2, office_simple, 5 tasks x 40 targets, seed 0,
+per target paired with R1 alone): the 136 targets without an excursion cost the same (180 vs
+178 steps); the 64 with one (R1 followed a teammate or a ghost) cost 245 alone and 354 with R2,
+but 276 of those 354 are spent *before* the first excursion (the helper reports only once R1
+has wandered long enough for it to see the goal: a selection, not the excursion's cost);
+excursions are 27 steps per target, own-goal steps after the first one 50, R1 within 0.8 m of R2 in 1 %
+of the steps. The whole gap is the seed: R1 alone seeds 0 / 1 / 2 give 200 / 215 / 233 steps
+per target, R1+R2 234 / 220 / 228 (means 216 vs 228; per-task spread across seeds up to 50
+steps). Not recording visits during excursions (R1+R2, seed 0): 234 -> 234: not kept.
 """
 
 from __future__ import annotations
