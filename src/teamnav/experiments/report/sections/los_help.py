@@ -76,11 +76,12 @@ NOISE_SWEEP = {"simple": "los-noise-simple", "complex": "los-noise-complex"}
 
 # ---------------------------------------------------------------------------- sweeps
 #: What the full reproduction costs on this machine (measured, see the note's numbers).
-FULL_CPU_NOTE = ("Cost of the full reproduction here, measured: `NUMBA_NUM_THREADS=1 teamnav sweep los-table1 -j 2` "
-                 "(3 algorithms x 4 nested teams x 5 tasks of 200 targets = 60 trials) took 15 min wall and 20 "
-                 "CPU-min on this 2-core machine, `los-table2` 9 min wall and 17 CPU-min (2026-11-23, commit "
-                 "fc84d58, a test run sharing the cores; a failing trial ends at its first target over budget, "
-                 "which makes the Avoid-Past and potential-field trials short). Before the nested teams (120 "
+FULL_CPU_NOTE = ("Cost of the full reproduction here, measured: `NUMBA_NUM_THREADS=1 teamnav sweep los-table1` "
+                 "(3 algorithms x 4 nested teams x 5 tasks of 200 targets = 60 trials) took 20 CPU-min on this "
+                 "2-core machine (20.5 min wall on one worker), `los-table2` 24 CPU-min (2026-11-23, commit "
+                 "041ed99, Avoid-Past now finishing its tasks; about the CPU time over the workers with "
+                 "`-j 2`; a failing trial ends at its first target over budget, which makes the "
+                 "potential-field trials short). Before the nested teams (120 "
                  "trials) and the 2.45x faster brains and radio (benchmarks/bench_los_brains.py) the estimate was "
                  "7 CPU-hours for los-table1. `los-noise-simple` (75 trials, all helpers) costs 15 CPU-s per "
                  "trial of 20 targets at the old speed (not run at 200); `los-noise-complex` and `los-ablation` "
