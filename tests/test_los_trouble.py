@@ -108,3 +108,39 @@ def test_return_without_waiting_hands_back_to_a_and_can_count_as_progress(monkey
     assert r1.mode == "own_goal" and a.direction_rad == pytest.approx(0.0)
     a, _ = r1.step(obs(k + 6, pose=(-3.4, 0.0, 0.0), walls=WALL))
     assert r1.mode == "own_goal"
+
+
+@pytest.mark.parametrize("release", [False, True])
+def test_released_by_a_helper_walking_away_goes_on_to_where_it_was_seen(monkeypatch, release):
+    """``trouble_release_to_helper``: R1 (goal 6 m ahead, behind a wall) follows R2, which then
+    walks away from R1's goal (6.7 m -> 9.5 m, beyond ``trouble_recede_m``) and is let go
+    (``trouble_helper_towards_goal``); with the flag R1 heads on to R2's last seen position
+    (-3, 3) until it is there, then A drives; without it A drives at once."""
+    stuck = StraightNav(stuck=True)
+    monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=3, goal_sharing=False,
+                                        trouble_release_to_helper=release),
+                     np.random.default_rng(0), info(0, 2))
+    for k in range(3):
+        r1.step(obs(k, walls=WALL))
+    assert r1.trouble.tr
+    r1.step(obs(3, walls=WALL, seen=[(1, 3.0, math.pi / 2)]))
+    a, _ = r1.step(obs(4, walls=WALL, seen=[(1, 3.0, math.pi / 2)], inbox=[msg(1, 3, trouble=False)]))
+    assert r1.mode == "trouble_follow" and a.direction_rad == pytest.approx(math.pi / 2)
+    # R2 walks away from the goal to (-3, 3): let go
+    a, _ = r1.step(obs(5, walls=WALL, seen=[(1, 3.0 * math.sqrt(2), 3 * math.pi / 4)],
+                       inbox=[msg(1, 4, trouble=False)]))
+    seq = [(r1.mode, a.direction_rad)]
+    for k, x in ((6, -0.2), (7, -0.4)):  # R2 out of sight
+        a, _ = r1.step(obs(k, pose=(x, 0.2 * (k - 5), 0.0), walls=WALL))
+        seq.append((r1.mode, a.direction_rad))
+    if release:
+        assert [m for m, _ in seq] == ["trouble_follow"] * 3
+        assert seq[0][1] == pytest.approx(3 * math.pi / 4)
+        assert seq[2][1] == pytest.approx(math.atan2(3.0 - 0.4, -3.0 + 0.4))
+        # there: the point is forgotten and A drives again
+        a, _ = r1.step(obs(8, pose=(-2.8, 2.8, 0.0), walls=WALL))
+        assert r1.mode == "own_goal" and r1._release_xy is None
+    else:
+        assert [m for m, _ in seq] == ["own_goal"] * 3
+        assert seq[0][1] == pytest.approx(0.0)

@@ -155,6 +155,17 @@ class LosExplorerParams(_CommonParams):
     trouble_return_progress : bool
         With ``trouble_return``: closing in on the point counts as progress (Pr falls, as when
         heading to a teammate, §5 Fig. 10); False: Pr stays at its bound while returning.
+    trouble_release_to_helper : bool
+        With ``trouble_helper_towards_goal``: when a followed teammate is let go because it
+        walks away from R1's goal, R1 first goes on to the position where it last saw it (own
+        frame; progress as towards a teammate, §5 Fig. 10) before A drives again; the point is
+        dropped when reached, after ``trouble_cr`` steps without progress towards it, when R1
+        sees its goal or follows another teammate, or at the next target. Gap filled: §5 does
+        not say where a robot released by its helper resumes A; R1 follows a helper at the
+        helper's own speed, never gains on it, so Pr does not reach 0 and, once the helper
+        turns away, A walked R1 back from the doorway into the trap it had been led out of
+        (traced (H7pf), office_complex, potential field: room 7's SE corner (26.6, 14.0)).
+        Off by default (measurement below). False: A drives at once (the earlier behaviour).
     """
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
@@ -170,6 +181,7 @@ class LosExplorerParams(_CommonParams):
     trouble_return: bool = False
     trouble_wait_steps: int = Field(600, ge=0, le=10_000_000)
     trouble_return_progress: bool = False
+    trouble_release_to_helper: bool = False
 
 
 
@@ -225,6 +237,9 @@ class LosExplorer(_LosBrain):
         #: where a teammate not in trouble was last seen (``trouble_return``), and since when R1 waits there
         self._last_helper_xy: XY | None = None
         self._return_since: int | None = None
+        #: where a followed teammate let go for walking away was last seen (``trouble_release_to_helper``)
+        self._release_xy: XY | None = None
+        self._release_stall = 0
         self._set_goal()
 
     def _set_goal(self) -> None:
@@ -252,6 +267,7 @@ class LosExplorer(_LosBrain):
             self.target_index += 1
             self.targets_reached += 1
             self._mate_goal_d = {}
+            self._release_xy = None
             self.finished = self.target_index >= len(self.targets)
             self._set_goal()
             self._last_target = None
@@ -360,6 +376,9 @@ class LosExplorer(_LosBrain):
                 d_mate = self._mate_goal_d[tt[0]][-1][1]
                 self._tt_best_d = min(self._tt_best_d, d_mate)
                 if d_mate > self._tt_best_d + p.trouble_recede_m:
+                    if p.trouble_release_to_helper:
+                        # on to where it was last seen first (see ``trouble_release_to_helper``)
+                        self._release_xy, self._release_stall = self._seen_now[tt[0]], 0
                     tt = self._trouble_target = None  # it turned away from the goal: let it go
             if tt is not None and tt[0] in self._seen_now:
                 tt = self._trouble_target = (tt[0], self._seen_now[tt[0]])
@@ -386,6 +405,7 @@ class LosExplorer(_LosBrain):
                     # patrol until it sees its goal or the teammate takes it nearer
                     progressing = goal_d < self._prev_goal_d - p.progress_min_fraction * self.step_m
                 self._return_since = None
+                self._release_xy = None
             elif p.trouble_return and self._last_helper_xy is not None:
                 # in trouble, no teammate in sight: back to where one was last seen, and wait
                 # there (see ``trouble_return``); not progress towards the goal (Pr stays)
@@ -404,6 +424,22 @@ class LosExplorer(_LosBrain):
                     action = Action()
                     if self._step - self._return_since >= p.trouble_wait_steps:
                         self._last_helper_xy = self._return_since = None  # nobody came: A again
+        if action is not None and self.mode == "own_goal":
+            self._release_xy = None  # it sees its goal (§2 point 4)
+        if action is None and self._release_xy is not None:
+            # released by a helper walking away: on to its last seen position before A drives
+            # (see ``trouble_release_to_helper``)
+            near = 2.0 * self.radius_m + self.step_m
+            point = self._release_xy
+            if math.hypot(point[0] - me_xy[0], point[1] - me_xy[1]) > near:
+                self.mode = "trouble_follow"
+                action, progressing = self._head_to(point, ("release", point), stop_within_m=near,
+                                                    end_margin_m=near)
+                self._release_stall = 0 if progressing else self._release_stall + 1
+                if self._release_stall >= p.trouble_cr:
+                    self._release_xy = None
+            else:
+                self._release_xy = None
         if action is None and self._promised == self.target_index and not self.trouble.tr:
             self.mode = "own_goal"
             self.promised_steps += 1
