@@ -144,3 +144,33 @@ def test_released_by_a_helper_walking_away_goes_on_to_where_it_was_seen(monkeypa
     else:
         assert [m for m, _ in seq] == ["own_goal"] * 3
         assert seq[0][1] == pytest.approx(0.0)
+
+
+@pytest.mark.parametrize("near_m", [None, 1.5])
+def test_close_behind_a_helper_at_its_own_speed_counts_as_progress(monkeypatch, near_m):
+    """``trouble_near_helper_m``: R1 in trouble follows R2, which walks 1 m ahead of it at R1's
+    own speed; by the paper's rule (distance to G_icurr = R2 falling) Pr never falls, with the
+    gap fill it does."""
+    stuck = StraightNav(stuck=True)
+    monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=3, goal_sharing=False,
+                                        trouble_near_helper_m=near_m),
+                     np.random.default_rng(0), info(0, 2))
+    for k in range(3):
+        r1.step(obs(k, walls=WALL))
+    assert r1.trouble.tr
+    r1.step(obs(3, walls=WALL, seen=[(1, 1.0, math.pi / 2)]))
+    r1.step(obs(4, walls=WALL, seen=[(1, 1.0, math.pi / 2)], inbox=[msg(1, 3, trouble=False)]))
+    assert r1.mode == "trouble_follow"
+    pr = r1.trouble.pr
+    modes = []
+    for k in range(5, 10):
+        y = 0.2 * (k - 4)
+        r1.step(obs(k, pose=(0.0, y, 0.0), walls=WALL, seen=[(1, 1.0, math.pi / 2)],
+                    inbox=[msg(1, k - 1, trouble=False)]))
+        modes.append(r1.mode)
+    if near_m is None:
+        assert modes == ["trouble_follow"] * 5 and r1.trouble.tr and r1.trouble.pr >= pr
+    else:
+        # Pr falls to 0: out of trouble, A drives again (§5 rule 1; trapped again later)
+        assert modes[0] == "trouble_follow" and "own_goal" in modes

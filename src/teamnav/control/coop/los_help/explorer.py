@@ -165,7 +165,19 @@ class LosExplorerParams(_CommonParams):
         helper's own speed, never gains on it, so Pr does not reach 0 and, once the helper
         turns away, A walked R1 back from the doorway into the trap it had been led out of
         (traced (H7pf), office_complex, potential field: room 7's SE corner (26.6, 14.0)).
-        Off by default (measurement below). False: A drives at once (the earlier behaviour).
+        Measured (H7pf2), office_complex, potential field, 40-target prefixes of tasks 1-5,
+        paired, False -> True, tasks finished (targets reached): R1+R2 2/5 (116/200) -> 1/5
+        (115/200), R1..R4 2/5 (105/200) -> 0/5 (55/200): worse, off by default. False: A
+        drives at once (the earlier behaviour).
+    trouble_near_helper_m : float or None
+        While following a teammate in trouble (§5 rule 3), a step taken from within this many
+        metres [m] of the teammate, in sight, counts as progress (Pr falls) whatever
+        ``trouble_progress`` says. Gap filled: following at the teammate's own speed R1 never
+        gains on it, so with the paper's rule Pr stays up and Nt grows; close behind its
+        helper R1 is "progressing" in the sense of Fig. 10. Measured (H7pf2), same protocol as
+        ``trouble_release_to_helper``, None -> 1.5 m: R1+R2 2/5 (116/200) -> 1/5 (131/200),
+        R1..R4 2/5 (105/200) -> 1/5 (94/200): no clear gain, off by default.
+        None: ``trouble_progress`` alone (the earlier behaviour).
     """
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
@@ -182,6 +194,7 @@ class LosExplorerParams(_CommonParams):
     trouble_wait_steps: int = Field(600, ge=0, le=10_000_000)
     trouble_return_progress: bool = False
     trouble_release_to_helper: bool = False
+    trouble_near_helper_m: float | None = Field(None, gt=0.0, le=100.0)
 
 
 
@@ -404,6 +417,9 @@ class LosExplorer(_LosBrain):
                     # from it keeps R1 in trouble (and following), so it is led along the
                     # patrol until it sees its goal or the teammate takes it nearer
                     progressing = goal_d < self._prev_goal_d - p.progress_min_fraction * self.step_m
+                if (p.trouble_near_helper_m is not None and tt[0] in self._seen_now
+                        and math.hypot(tt[1][0] - me_xy[0], tt[1][1] - me_xy[1]) <= p.trouble_near_helper_m):
+                    progressing = True  # close behind its helper (see ``trouble_near_helper_m``)
                 self._return_since = None
                 self._release_xy = None
             elif p.trouble_return and self._last_helper_xy is not None:
