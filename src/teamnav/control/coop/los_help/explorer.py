@@ -176,7 +176,8 @@ class LosExplorerParams(_CommonParams):
         gains on it, so with the paper's rule Pr stays up and Nt grows; close behind its
         helper R1 is "progressing" in the sense of Fig. 10. Measured (H7pf2), same protocol as
         ``trouble_release_to_helper``, None -> 1.5 m: R1+R2 2/5 (116/200) -> 1/5 (131/200),
-        R1..R4 2/5 (105/200) -> 1/5 (94/200): no clear gain, off by default.
+        R1..R4 2/5 (105/200) -> 1/5 (94/200); 3 m: 2/5 (131/200), 1/5 (67/200): no clear
+        gain (R1..R4 worse), off by default.
         None: ``trouble_progress`` alone (the earlier behaviour).
     """
 
