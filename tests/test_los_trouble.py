@@ -110,20 +110,25 @@ def test_return_without_waiting_hands_back_to_a_and_can_count_as_progress(monkey
     assert r1.mode == "own_goal"
 
 
+def _r1_in_trouble_behind_a_wall(monkeypatch, **params):
+    """R1 (goal 6 m ahead, behind ``WALL``, its navigator stuck) after 3 steps: in trouble."""
+    stuck = StraightNav(stuck=True)
+    monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=3, goal_sharing=False, **params),
+                     np.random.default_rng(0), info(0, 2))
+    for k in range(3):
+        r1.step(obs(k, walls=WALL))
+    assert r1.trouble.tr
+    return r1
+
+
 @pytest.mark.parametrize("release", [False, True])
 def test_released_by_a_helper_walking_away_goes_on_to_where_it_was_seen(monkeypatch, release):
     """``trouble_release_to_helper``: R1 (goal 6 m ahead, behind a wall) follows R2, which then
     walks away from R1's goal (6.7 m -> 9.5 m, beyond ``trouble_recede_m``) and is let go
     (``trouble_helper_towards_goal``); with the flag R1 heads on to R2's last seen position
     (-3, 3) until it is there, then A drives; without it A drives at once."""
-    stuck = StraightNav(stuck=True)
-    monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
-    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=3, goal_sharing=False,
-                                        trouble_release_to_helper=release),
-                     np.random.default_rng(0), info(0, 2))
-    for k in range(3):
-        r1.step(obs(k, walls=WALL))
-    assert r1.trouble.tr
+    r1 = _r1_in_trouble_behind_a_wall(monkeypatch, trouble_release_to_helper=release)
     r1.step(obs(3, walls=WALL, seen=[(1, 3.0, math.pi / 2)]))
     a, _ = r1.step(obs(4, walls=WALL, seen=[(1, 3.0, math.pi / 2)], inbox=[msg(1, 3, trouble=False)]))
     assert r1.mode == "trouble_follow" and a.direction_rad == pytest.approx(math.pi / 2)
@@ -151,14 +156,7 @@ def test_close_behind_a_helper_at_its_own_speed_counts_as_progress(monkeypatch, 
     """``trouble_near_helper_m``: R1 in trouble follows R2, which walks 1 m ahead of it at R1's
     own speed; by the paper's rule (distance to G_icurr = R2 falling) Pr never falls, with the
     gap fill it does."""
-    stuck = StraightNav(stuck=True)
-    monkeypatch.setattr(brain_mod, "make_navigator", lambda *a, **k: stuck)
-    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(6.0, 0.0)], trouble_cr=3, goal_sharing=False,
-                                        trouble_near_helper_m=near_m),
-                     np.random.default_rng(0), info(0, 2))
-    for k in range(3):
-        r1.step(obs(k, walls=WALL))
-    assert r1.trouble.tr
+    r1 = _r1_in_trouble_behind_a_wall(monkeypatch, trouble_near_helper_m=near_m)
     r1.step(obs(3, walls=WALL, seen=[(1, 1.0, math.pi / 2)]))
     r1.step(obs(4, walls=WALL, seen=[(1, 1.0, math.pi / 2)], inbox=[msg(1, 3, trouble=False)]))
     assert r1.mode == "trouble_follow"
