@@ -1,4 +1,4 @@
-"""Meeting flags of Navigate / trail-share-v1 (all off by default): gap-fills for robots that
+"""Meeting flags of Navigate / trail-share-v1 (off by default but give_way_s in trail-share-v1): gap-fills for robots that
 meet at corners (trail_share module docstring). Hand-made situations: synthetic scans and
 odometry poses fed step by step, the fake Navigate for the brain-level flag."""
 
@@ -10,6 +10,9 @@ import numpy as np
 import pytest
 
 from _trail_brain_fakes import make_brains, make_obs
+from teamnav.control.check import synthetic_infos
+from teamnav.control.coop.blazing_trail import BlazingTrail
+from teamnav.control.coop.trail_share import TrailShare
 from test_nav_navigate import MAX_R, cast, nav, observe, t_junction
 
 CLEAR = np.full(181, MAX_R)
@@ -196,3 +199,14 @@ def test_meet_guard_starts_when_an_obstacle_appears_ahead():
     n = nav(meet_guard_deg=90.0)
     _approach(n, _robot_ahead, n_after=2)
     assert n._meet_until_s == pytest.approx(1.5 + 8.0) and n._meet_until_m == pytest.approx(n._odo_m + 3.0)
+
+
+@pytest.mark.parametrize(("navigate", "expected_s"), [({}, 3.0), ({"give_way_s": 0.0}, 0.0)])
+def test_trail_share_gives_way_by_default_and_blazing_trail_does_not(navigate, expected_s):
+    # Session 7 turned give_way_s = 3 on for trail-share-v1 only (TRAIL_SHARE_NAVIGATE, measured
+    # on the try-paper condition); the 2000 brain keeps Navigate's default (its drift curve).
+    info = synthetic_infos(1)[0]
+    share = TrailShare(TrailShare.Params(navigate=navigate), np.random.default_rng(0), info)
+    assert share.nav.params.give_way_s == expected_s
+    blaze = BlazingTrail(BlazingTrail.Params(), np.random.default_rng(0), info)
+    assert blaze.nav.params.give_way_s == 0.0
