@@ -434,6 +434,21 @@ def test_try_section_says_it_does_not_hold_when_the_2002_team_breaks_down():
     assert quick[0].holds is None and _claim(quick, "collapses").holds is None
 
 
+def test_try_efficiency_is_split_into_detours_and_time_moving():
+    # efficiency = route / (lifetime / trips) / cruise = (route / m per trip) x (m / lifetime / cruise):
+    # 40 trips of 45 m in 100 min at 0.4 m/s cruise -> 45.0 m per trip, 75 % of cruise moving
+    from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
+
+    def table(key, kw):
+        extra = {"trips_total": 40, "distance_m_total": 1800.0, "lifetime_min_total": 100.0,
+                 "place_speed_mps": 31.5 * 40 / 6000.0}  # 150 s between places: 0.21 m/s, 52.5 % of cruise
+        return [_row(20, 100.0, d, extra) for d in (0.0, 2.0)]
+
+    ours = [b for b in SECTION.build(_FakeCtx(table, quick=False)) if isinstance(b, Comparison)][0].ours
+    assert "efficiency 52 ± 0 % (n = 2) = route 31.5 m / 45.0 ± 0.0 m (n = 2) driven per trip" in ours
+    assert "x 75 ± 0 % (n = 2) of cruise on average" in ours
+
+
 @pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
 def test_try_section_draws_fig2_trips_and_the_crumb_figures():
     from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION

@@ -52,6 +52,7 @@ from __future__ import annotations
 import numpy as np
 
 from teamnav.experiments.report.model import Comparison, Missing, SectionSpec, Table, Text
+from teamnav.experiments.metric_sets.trails import ROUTE_LENGTH_M
 from teamnav.experiments.report.sections import _trails as T
 
 # the section's parts, importable from here as before the split
@@ -75,6 +76,8 @@ SLIP_SEEDS = {"blazing-drift": 10, "try-drift": 5}
 #: (SHARE_DRIFT_SEEDS seeds); its k = 1 point is the first hour of the try-paper runs (the paper's
 #: drift) and its k = HOURS_SCALE point the first hour of the hours runs (_trails.first_part)
 SHARE_RUN_SCALES, SHARE_DRIFT_SEEDS = (0.0, 2.0, 6.0), 8
+#: the home-source route of trail_office (the efficiency's numerator)
+ROUTE_M = ROUTE_LENGTH_M[frozenset({"home", "source"})]
 
 
 def _last_quarter_units(rows, dur_s: float) -> np.ndarray:
@@ -157,6 +160,12 @@ def build(ctx) -> list:
     interval = T.values(share, "place_interval_s")
     speed = T.values(share, "place_speed_mps")
     eff = speed / cruise
+    # the efficiency's two factors: metres driven per trip against the route (detours), and the
+    # mean speed over the lifetime against cruise (stops, turns on the spot, Panic)
+    full = [r for r in share if T.values([r], "distance_m_total").size and T.values([r], "lifetime_min_total").size
+            and T.values([r], "trips_total").size and r["trips_total"] > 0 and r["lifetime_min_total"] > 0]
+    per_trip = T.values(full, "distance_m_total") / T.values(full, "trips_total")
+    moving = T.values(full, "distance_m_total") / (T.values(full, "lifetime_min_total") * 60.0) / cruise
     b_rows, b_dur = (long_blaze, dur) if long_blaze else (same_blaze, drift_dur)
     b_cens = T.values(b_rows, "breakdown_censored")
     b_bd = T.values(b_rows, "breakdown_s")
@@ -170,13 +179,14 @@ def build(ctx) -> list:
         "= 0.23 m/s over 31 m, of 0.25 m/s cruise (92 %)",
         f"{dur / 60:g} min: {T.msd(trips, '{:.0f}')} trips, {T.msd(dist_km, '{:.2f}', 'km')}; "
         f"{T.msd(interval, '{:.0f}', 's')} between places = {T.msd(speed, '{:.2f}', 'm/s')}: efficiency "
-        f"{T.msd(eff * 100, '{:.0f}', '%')}; no breakdown in {int(cens.sum())} of {cens.size} runs, units in the last "
+        f"{T.msd(eff * 100, '{:.0f}', '%')} = route {ROUTE_M:g} m / {T.msd(per_trip, '{:.1f}', 'm')} driven per trip "
+        f"x {T.msd(moving * 100, '{:.0f}', '%')} of cruise on average over the lifetime; no breakdown in {int(cens.sum())} of {cens.size} runs, units in the last "
         f"quarter {T.msd(late_long)} (2000 algorithm, same drift, {b_dur / 60:g} min: no breakdown in "
         f"{int(b_cens.sum()) if b_cens.size else 0} of {b_cens.size}, breakdown at {T.msd(b_bd / 60, '{:.0f}', 'min')}"
         + (f", units in the last quarter {T.msd(late_long_b)}" if late_long_b.size else "") + ")",
         holds1,
         f"our robots never fail, so every lifetime is about the whole run (the paper's ran out of power or lost "
-        f"odometry); route 31.5 m, cruise {cruise:g} m/s (paper 31 m, 0.25 m/s)"))
+        f"odometry); route {ROUTE_M:g} m, cruise {cruise:g} m/s (paper 31 m, 0.25 m/s)"))
 
     # 1b. hours at the drift that breaks the 2000 team (the long-run claim, several seeds)
     blocks += hours_blocks(hours, T.by_scale(d_blaze).get(HOURS_SCALE, []), T.by_scale(d_blaze).get(0.0, []),
