@@ -83,8 +83,8 @@ FULL_CPU_NOTE = ("Cost of the full reproduction here, measured: `NUMBA_NUM_THREA
                  "`-j 2`; a failing trial ends at its first target over budget, which makes the "
                  "potential-field trials short). Before the nested teams (120 "
                  "trials) and the 2.45x faster brains and radio (benchmarks/bench_los_brains.py) the estimate was "
-                 "7 CPU-hours for los-table1. `los-noise-simple` (75 trials, all helpers) costs 15 CPU-s per "
-                 "trial of 20 targets at the old speed (not run at 200); `los-noise-complex` and `los-ablation` "
+                 "7 CPU-hours for los-table1. `los-noise-simple` (75 trials of 200 targets, all helpers) took "
+                 "39 min on one worker (2026-11-23, commit 3f4f3b7); `los-noise-complex` and `los-ablation` "
                  "were not measured. Wall time is about the CPU time over the number of workers (`-j`).")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
