@@ -399,7 +399,7 @@ def _u_obstacle(b: "MapBuilder", xmin: float, ymin: float, xmax: float, ymax: fl
     b.clear_rect(*gap)
 
 
-def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
+def office_complex(resolution_m: float = 0.1, alleys: bool = True) -> EnvironmentMap:
     """Sgorbissa & Arkin §6, Fig. 13: the complex office, built to trap local methods.
 
     A 36 m x 24 m building with a cross of 2.4 m corridors (east-west ``H`` at
@@ -431,6 +431,20 @@ def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
       circled a U standing 1 m from a wall).
 
     Where we fill a gap: the paper gives Fig. 13 as a picture only (no sizes or coordinates).
+
+    ``alleys=False`` (builtin ``office_complex_closed``, session 7, H7trap; not used by any
+    scenario yet): the 1.6 m alleys between the backs of the U walls of rooms 1, 2 and 8 and the
+    room's wall are filled, so the U's back is flush with the wall. Why: Table 2's potential
+    field with helpers finishes every task, so no trap of the paper's map was out of every
+    helper's sight; on ``office_complex`` a potential field leaving the room's centre for the
+    next room drives round the U into the alley and stops there, out of sight of every patrol
+    route and of the doorway (tests/test_los_complex_traps.py); on the closed variant it stops
+    inside the U instead, in sight of the doorway, as Fig. 13 draws it. Measured (40-target
+    prefixes of tasks 1-5, default brains, office_complex -> closed; tasks finished, targets
+    reached): potential field alone 0/5 (4/200) -> 0/5 (4/200), R1+R2 2/5 (116/200) -> 4/5
+    (168/200), R1..R4 (tasks 1-4) 1/4 (65/160) -> 3/4 (121/160); VisBug-21 alone 350 -> 321 steps
+    per target, R1..R4 286 -> 283; Avoid-Past alone 309 -> 345, R1..R4 -> 337. Switching
+    ``los-help-complex`` to it changes every Table 2 / Fig. 17 number: not done yet.
 
     Places: ``room_1``..``room_8`` (targets), ``door_<k>`` (H doorways; ``door_6w`` room 6's
     west one) and ``door_<k>v`` (V doorways, 0.3 m into the room), ``base`` at the west end of H
@@ -468,6 +482,8 @@ def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
     _u_obstacle(b, 13.6, 3.4, 15.0, 7.4, "W")  # room 2: east of the centre (12.5, 5.4)
     _u_obstacle(b, 24.8, 3.6, 26.0, 7.2, "E")  # room 4: a bay in its west wall, west of the centre (27.5, 5.4)
     _u_obstacle(b, 29.2, 16.2, 30.6, 21.0, "E")  # room 8: west of the centre (31.7, 18.6)
+    if not alleys:  # the U's back flush with the room's wall (builtin office_complex_closed)
+        b.rect(6.6, 3.4, 8.2, 7.4).rect(15.0, 3.4, 16.6, 7.4).rect(27.6, 16.2, 29.2, 21.0)
     b.disc(5.0, 20.6, 0.4).disc(12.0, 20.6, 0.4)  # room 6: pillars north of its centre
     b.disc(22.4, 21.4, 0.4).disc(25.4, 16.0, 0.4)  # room 7: pillars off the door-centre line
     places: dict[str, tuple[float, float]] = {}
@@ -492,7 +508,8 @@ def office_complex(resolution_m: float = 0.1) -> EnvironmentMap:
         "suites of joined rooms; targets at room centres, each in sight from its doorway."
     )
     regions = {"corridor_H": (0.2, 10.8, 35.8, 13.2), "corridor_V": (16.8, 0.2, 19.2, 23.8)}
-    return EnvironmentMap(b.build("builtin:office_complex"), places, notes, regions)
+    name = "builtin:office_complex" if alleys else "builtin:office_complex_closed"
+    return EnvironmentMap(b.build(name), places, notes, regions)
 
 
 # ---------------------------------------------------------------------------- Fox et al.
@@ -719,6 +736,7 @@ def trail_office(resolution_m: float = 0.1, *, doors: bool = True) -> Environmen
 BUILTIN_MAPS: dict[str, Callable[[], EnvironmentMap]] = {
     "office_simple": office_simple,
     "office_complex": office_complex,
+    "office_complex_closed": functools.partial(office_complex, alleys=False),
     "symmetric_hallway": symmetric_hallway,
     "hexagon": hexagon,
     "lab_and_corridor": lab_and_corridor,
