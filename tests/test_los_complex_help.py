@@ -34,7 +34,7 @@ def _route_samples(start, route, step_m=0.25):
 
 
 def test_h_corridor_helpers_step_into_every_door_and_see_every_target():
-    env = builtin_map("office_complex")
+    env = builtin_map(L.MAPS["complex"])
     occ, res = np.asarray(env.grid.occupied()), env.grid.resolution_m
     doors_h = {k: env.places[f"door_{k}"] for k in range(1, 9)}
     targets = {k: env.places[f"room_{k}"] for k in range(1, 9)}
@@ -57,7 +57,7 @@ def test_h_corridor_helpers_step_into_every_door_and_see_every_target():
 
 def _leg(navigator: str, a: str, b: str, helpers: int, budget_steps: int):
     """R1 from room ``a``'s centre (heading 90 deg) to room ``b``'s, alone or with helpers."""
-    env = builtin_map("office_complex")
+    env = builtin_map(L.MAPS["complex"])
     start = (*env.places[a], 90.0)
     target = L.world_to_frame(start, [env.places[b]])[0]
     over = {

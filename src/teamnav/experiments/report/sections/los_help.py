@@ -29,7 +29,7 @@ los_tasks.CASES`), which tie a navigator to its sharing flag; the ablation shows
 sharing does to the others.
 
 Budget: R1 abandons its task when a target is not reached within
-:data:`~teamnav.experiments.los_tasks.BUDGET_STEPS_PER_TARGET` steps (1500 simple, 2500
+:data:`~teamnav.experiments.los_tasks.BUDGET_STEPS_PER_TARGET` steps (6000 simple, 12000
 complex); the run then ends and counts as failed (not in the means). A trapped run so ends
 at its first trap instead of burning a whole task's budget.
 
