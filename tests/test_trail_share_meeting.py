@@ -13,7 +13,8 @@ from _trail_brain_fakes import make_brains, make_obs
 from teamnav.control.check import synthetic_infos
 from teamnav.control.coop.blazing_trail import BlazingTrail
 from teamnav.control.coop.trail_share import TrailShare
-from test_nav_navigate import MAX_R, cast, nav, observe, t_junction
+from teamnav.control.nav.navigate import Navigate
+from test_nav_navigate import INFO, MAX_R, cast, nav, observe, t_junction
 
 CLEAR = np.full(181, MAX_R)
 
@@ -210,3 +211,55 @@ def test_trail_share_gives_way_by_default_and_blazing_trail_does_not(navigate, e
     assert share.nav.params.give_way_s == expected_s
     blaze = BlazingTrail(BlazingTrail.Params(), np.random.default_rng(0), info)
     assert blaze.nav.params.give_way_s == 0.0
+
+
+# ------------------------------------------------------------------ asymmetric give-way
+def _approach_bold(n, bold, n_clear=15, n_after=50):
+    """``_approach`` with ``_robot_ahead``, telling Navigate ``bold`` at every step."""
+    x, cmds = 0.0, []
+    for k in range(n_clear + n_after):
+        walls = _robot_ahead(x) if k >= n_clear else []
+        r = cast(walls, (x, 0.0, 0.0)) if walls else CLEAR
+        v, w = n.step(observe(r, (x, 0.0, 0.0), k), bold=bold)
+        if k >= n_clear:
+            cmds.append((v, w))
+        x += 0.04 if k < n_clear else 0.0
+    return cmds
+
+
+@pytest.mark.parametrize(("bold_s", "bold", "n_stopped"), [(None, True, 30), (0.5, True, 5), (0.5, False, 30),
+                                                           (0.0, True, 1)])
+def test_give_way_bold_waits_briefly_only_for_the_bold_robot(bold_s, bold, n_stopped):
+    # Vaughan et al. SAB 2000 / ICAR 2005 (gap-fill): the robot with the higher investment (told
+    # bold) waits only give_way_bold_s, the other the full give_way_s; off (None): both 3 s.
+    cmds = _approach_bold(nav(give_way_s=3.0, give_way_bold_s=bold_s), bold)
+    stopped = [c == (0.0, 0.0) for c in cmds]
+    assert all(stopped[: n_stopped - 1]) and not stopped[n_stopped]
+
+
+def test_give_way_bold_is_off_without_give_way():
+    cmds = _approach_bold(nav(give_way_s=0.0, give_way_bold_s=0.5), True)
+    assert cmds[0] != (0.0, 0.0)
+
+
+@pytest.mark.parametrize(("bold_s", "told"), [(None, []), (0.5, [False, True])])
+def test_trail_share_tells_navigate_bold_when_loaded(bold_s, told):
+    # trail-share-v1 passes bold = loaded (seeking round[0], home) only when the param is set.
+    calls = []
+
+    class Spy(Navigate):
+        def step(self, obs, preferred_heading_rad=None, **kw):
+            calls.append(kw.get("bold"))
+            return super().step(obs, preferred_heading_rad, **kw)
+
+    nav_kw = {} if bold_s is None else {"give_way_bold_s": bold_s}
+    b = TrailShare(TrailShare.Params(round=["home", "source"], navigate=nav_kw), np.random.default_rng(0), INFO)
+    b.nav.__class__ = Spy
+    b.step(make_obs(0, 0, [0.0, 0.0, 0.0]))
+    assert b.round.index == 1  # seeking the source: unloaded
+    b.step(make_obs(0, 1, [0.1, 0.0, 0.0], ["source"]))
+    assert b.round.index == 0  # at the source: loaded, heading home
+    if bold_s is None:
+        assert calls == [None, None]
+    else:
+        assert calls == told

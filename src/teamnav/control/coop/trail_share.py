@@ -270,6 +270,9 @@ class TrailShare:
         self.info = info
         nav_params = navigate_params({**TRAIL_SHARE_NAVIGATE, **params.navigate}, params.cruise_speed_mps)
         self.nav = Navigate(nav_params, rng, info, laser=params.sensor)
+        # Navigate's give_way_bold_s (asymmetric give-way, SAB 2000 / ICAR 2005 local investment,
+        # a gap-fill): the loaded robot (seeking round[0], home) is the bold one.
+        self._tell_bold = nav_params.give_way_bold_s is not None
         self.round = PlaceRound(params.round, start_index=0)
         self.trail = Trail()
         self.visits_s: dict[str, float] = {}
@@ -351,10 +354,11 @@ class TrailShare:
             if near is not None and (near[0] - x) ** 2 + (near[1] - y) ** 2 > 1e-12:
                 heading = math.atan2(near[1] - y, near[0] - x)
                 self._recovering = True
+        kw: dict[str, Any] = {"bold": self.round.index == 0} if self._tell_bold else {}
         if self._recovering and p.recover_reverse:
-            v, w = self.nav.step(obs, preferred_heading_rad=heading, reverse_ignore_memory=True)
+            v, w = self.nav.step(obs, preferred_heading_rad=heading, reverse_ignore_memory=True, **kw)
         else:
-            v, w = self.nav.step(obs, preferred_heading_rad=heading)
+            v, w = self.nav.step(obs, preferred_heading_rad=heading, **kw)
         return Action(float(v), float(w)), outbox
 
     def log(self) -> dict[str, Any]:

@@ -80,6 +80,19 @@ a wrong branch; see :mod:`teamnav.control.coop.trail_share` for their measuremen
    its odometry heading over a few seconds and the trail's hint. The time limit stops two
    guarded robots from facing each other for ever (without it, 24 % efficiency on seed 0).
    Measured (trail_share's docstring): no gain at 90 or 60 deg, so it stays off.
+   ``give_way_bold_s`` (None = off: both robots wait ``give_way_s``, a symmetric rule): an
+   asymmetric give-way after Vaughan, Støy, Sukhatme & Matarić, "Go ahead, make my day: robot
+   conflict resolution by aggressive competition" (SAB 2000) and the "local investment"
+   aggression of their ICAR 2005 follow-up: when two robots block each other one yields and the
+   other proceeds, and the robot that has invested more wins. Gap-fill: those robots displayed
+   and compared aggression; ours see each other only in the laser, so each decides from its own
+   state alone: the caller passes ``step(..., bold=True)`` for the robot with the higher
+   investment (trail-share-v1: loaded, heading home), which then waits only
+   ``give_way_bold_s`` and drives on (its wall follower takes it round the other robot); a
+   ``bold=False`` robot waits the full ``give_way_s`` while the obstacle stays ahead. A head-on
+   meeting on the route (one robot out, one back) is thus resolved without a contest.
+   Measured on ``try-to-see-it-my-way`` (30 min, seeds 0-11, paired against give_way_s = 3):
+   measurement under way (session 8); it stays off.
 
 Odometry is used only as the robot's own dead reckoning over short spans (how far it has turned,
 how far it has driven), never as a position in any shared frame.
@@ -177,6 +190,7 @@ class NavigateParams(BaseModel):
     give_way_half_angle_deg: float = Field(30.0, gt=0.0, le=90.0)
     give_way_window_s: float = Field(1.0, gt=0.0, le=60.0)
     give_way_jump_m: float = Field(0.1, ge=0.0, le=20.0)
+    give_way_bold_s: float | None = Field(None, ge=0.0, le=600.0)
     meet_guard_deg: float = Field(0.0, ge=0.0, le=180.0)
     meet_guard_m: float = Field(3.0, gt=0.0, le=100.0)
     meet_guard_s: float = Field(8.0, gt=0.0, le=600.0)
@@ -418,7 +432,8 @@ class Navigate:
 
     # ------------------------------------------------------------------ step
     def step(self, obs: Observation, preferred_heading_rad: float | None = None, *,
-             allow_reverse: bool = True, reverse_ignore_memory: bool = False) -> tuple[float, float]:
+             allow_reverse: bool = True, reverse_ignore_memory: bool = False,
+             bold: bool = False) -> tuple[float, float]:
         """The command ``(v_mps, omega_radps)`` for this step.
 
         Parameters
@@ -434,6 +449,9 @@ class Navigate:
         reverse_ignore_memory : bool, default False
             True: a reversal this step ignores ``reverse_memory_m`` and ``reverse_cooldown_m``
             (the time cooldown still holds), e.g. for a hint back to a trail the robot left.
+        bold : bool, default False
+            The robot's investment is the higher one (e.g. loaded): with ``give_way_bold_s``
+            set, a give-way lasts only ``give_way_bold_s`` (module docstring item 6).
 
         Returns
         -------
@@ -479,7 +497,10 @@ class Navigate:
         if self.params.give_way_s > 0.0:
             if (appeared and obs.time_s >= self._give_way_until_s and self._odo_m >= self._give_way_after_m
                     and not obs.stalled):
-                self._give_way_until_s = obs.time_s + self.params.give_way_s
+                wait_s = self.params.give_way_s
+                if bold and self.params.give_way_bold_s is not None:  # SAB 2000 / ICAR 2005 (gap-fill)
+                    wait_s = min(wait_s, self.params.give_way_bold_s)
+                self._give_way_until_s = obs.time_s + wait_s
                 self._give_way_after_m = self._odo_m + 1.0  # drive 1 m before giving way again
                 self._gw_active = True
             if self._gw_active:
