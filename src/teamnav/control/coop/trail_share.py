@@ -107,6 +107,14 @@ guard 90 deg at 0.4 m/s, no drift, seeds 0-7: eff 56.6 ± 1.7 % against 58.2 ± 
 0.25 m/s, no drift, seeds 0-7: eff_trips 70.4 ± 2.2 % against 71.3 ± 3.3 % (-0.9 ± 3.0). No
 gain: it stays off. (Without its 8-s limit two guarded robots faced each other for good: 24 %
 on seed 0.)
+``navigate={"give_way_bold_s": ...}`` (Navigate's asymmetric give-way, off by default; Navigate's
+module docstring item 6, after Vaughan et al.'s aggressive competition with local investment,
+SAB 2000 / ICAR 2005, a gap-fill): this brain tells Navigate ``bold`` = loaded (seeking
+``round[0]``, home), so in a head-on meeting on the route the loaded robot drives on after
+``give_way_bold_s`` while the unloaded one waits ``give_way_s``. Session 8, scenario's drift,
+30 min, seeds 0-11, paired against give_way_s = 3: bold 0.5 s: eff +0.2 ± 2.8 points, trip
+after 10 min -9.1 ± 8.0 s (7/12 seeds better); bold 0 s with give_way_s = 6: eff -0.05 ± 2.1,
+trip -8.9 ± 6.2 s (6/12). No gain beyond the noise: it stays off.
 
 Cruise speed: the ``try-to-see-it-my-way`` scenario drives at 0.4 m/s, not the paper's
 0.25 m/s (§3.6, the default here). No reason was recorded when the trail scenarios were written

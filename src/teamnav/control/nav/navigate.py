@@ -91,8 +91,12 @@ a wrong branch; see :mod:`teamnav.control.coop.trail_share` for their measuremen
    ``give_way_bold_s`` and drives on (its wall follower takes it round the other robot); a
    ``bold=False`` robot waits the full ``give_way_s`` while the obstacle stays ahead. A head-on
    meeting on the route (one robot out, one back) is thus resolved without a contest.
-   Measured on ``try-to-see-it-my-way`` (30 min, seeds 0-11, paired against give_way_s = 3):
-   measurement under way (session 8); it stays off.
+   Measured (session 8) on ``try-to-see-it-my-way`` with its drift, 30 min, seeds 0-11, paired
+   against trail-share-v1's default (give_way_s = 3, symmetric), eff = ``place_speed_mps`` / 0.4,
+   trip = ``trip_time_s_after_10min_mean``: bold 0.5 s (yielder 3 s): eff 54.8 % against 54.5 %
+   (paired +0.2 ± 2.8 points, 7/12 seeds better), trip 120.4 s against 129.6 s (-9.1 ± 8.0 s,
+   7/12); bold 0 s with the yielder at give_way_s = 6: eff -0.05 ± 2.1 points (6/12), trip
+   -8.9 ± 6.2 s (6/12). Within the noise either way: it stays off (no 3-h runs).
 
 Odometry is used only as the robot's own dead reckoning over short spans (how far it has turned,
 how far it has driven), never as a position in any shared frame.
