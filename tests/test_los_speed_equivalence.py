@@ -260,10 +260,29 @@ def test_visbug_followed_equals_numpy(seed, x, y, th, with_ref, turn):
         assert a == b
 
 
+def _libm():
+    """The C maths library's hypot, atan2 and atan (what numba's math.* calls compile to)."""
+    import ctypes
+    import ctypes.util
+    import types
+
+    lib = ctypes.CDLL(ctypes.util.find_library("m"))
+    fns = {}
+    for name, nargs in (("hypot", 2), ("atan2", 2), ("atan", 1)):
+        f = getattr(lib, name)
+        f.restype, f.argtypes = ctypes.c_double, [ctypes.c_double] * nargs
+        fns[name] = f
+    return types.SimpleNamespace(**fns)
+
+
+_LIBM = _libm()
+
+
 @given(seeds, st.integers(0, 12), st.sampled_from([0.0, 0.1, 0.4]))
 @FAST
-def test_detector_range_bearing_and_occlusion_noise_equal_numpy(seed, m, err_max):
-    """The detector's kernels (Sgorbissa & Arkin eqs. 1-2) against the numpy lines they replace."""
+def test_detector_range_bearing_and_occlusion_noise_equal_libm(seed, m, err_max):
+    """The detector's kernels (Sgorbissa & Arkin eqs. 1-2) against the numpy lines they replaced,
+    with libm's scalar functions where NumPy now has its own."""
     from teamnav.sim.sensors.detector import _occlusion_noise, _range_bearing, _wrap
 
     rng = np.random.default_rng(seed)
@@ -275,14 +294,17 @@ def test_detector_range_bearing_and_occlusion_noise_equal_numpy(seed, m, err_max
     b = (a + rng.integers(1, n, m)) % n
     b[: m // 3] = a[: m // 3]  # a zero range (d_r = 0: the half angle is pi/2)
     dx, dy = xs[b] - xs[a], ys[b] - ys[a]
-    want_r = np.hypot(dx, dy)
-    want_b = _wrap(np.arctan2(dy, dx) - thetas[a]) if m else np.empty(0)
+    # libm's hypot/atan2/atan element by element, as the kernels call them: NumPy >= 2.4 has
+    # its own SIMD versions and Python's math.hypot its own algorithm, either may differ from
+    # libm in the last bit
+    want_r = np.array([_LIBM.hypot(p, q) for p, q in zip(dx, dy)])
+    want_b = _wrap(np.array([_LIBM.atan2(q, p) for p, q in zip(dx, dy)]) - thetas[a]) if m else np.empty(0)
     got_r, got_b = _range_bearing(xs, ys, thetas, a, b)
     assert np.array_equal(_bits(got_r), _bits(want_r)) and np.array_equal(_bits(got_b), _bits(want_b))
     u = rng.random((2, m))
     size = np.full(m, 0.4)
     with np.errstate(divide="ignore"):
-        half = np.arctan(size / (2.0 * want_r))
+        half = np.array([_LIBM.atan(t) for t in size / (2.0 * want_r)])
     want_d = want_r + want_r * (err_max * (2.0 * u[0] - 1.0))
     want_a = want_b + half * (2.0 * u[1] - 1.0)
     want_a = _wrap(want_a) if m else want_a

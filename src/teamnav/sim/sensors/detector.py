@@ -181,10 +181,13 @@ class RobotDetector:
         b = np.concatenate([j, i])
         keep = row_of[a] >= 0
         a, b = a[keep], b[keep]
-        dx = xs[b] - xs[a]
-        dy = ys[b] - ys[a]
-        rng_m = np.hypot(dx, dy)
-        bearing = wrap_angle(np.arctan2(dy, dx) - thetas[a]) if a.size else np.empty(0)
+        # the same kernel as the small-team path (libm's hypot and atan2, element by element):
+        # NumPy >= 2.4 has its own SIMD hypot/arctan2 that can differ from libm in the last bit,
+        # and the two paths must return the same detections bit for bit
+        if a.size:
+            rng_m, bearing = _range_bearing(xs, ys, thetas, a.astype(np.int64), b.astype(np.int64))
+        else:
+            rng_m, bearing = np.empty(0), np.empty(0)
         if not self.full_circle and a.size:
             keep = np.abs(bearing) <= self.fov_rad / 2
             a, b, rng_m, bearing = a[keep], b[keep], rng_m[keep], bearing[keep]
@@ -201,8 +204,8 @@ class RobotDetector:
 
     def _visible_brute(self, xs, ys, thetas, obs):
         """:meth:`_visible` for a small team: one kernel finds the pairs in range and in line
-        of sight (already ordered by row, then target); NumPy computes range and bearing,
-        as the hashed path does, so both agree to the last bit."""
+        of sight (already ordered by row, then target); range and bearing come from the kernel
+        the hashed path uses too, so both agree to the last bit."""
         n_all = xs.shape[0]
         cap = obs.shape[0] * max(n_all - 1, 0)
         out = np.empty((3, cap), dtype=np.int64)
@@ -212,8 +215,8 @@ class RobotDetector:
         if not m:
             empty = np.empty(0)
             return row, a, b, empty, empty
-        # speed (H7a): hypot, arctan2 and the wrap of the lines below in one kernel
-        # (_range_bearing; the same libm calls and operations, element by element)
+        # speed (H7a): hypot, atan2 and the wrap in one kernel (_range_bearing: libm's calls,
+        # element by element)
         rng_m, bearing = _range_bearing(xs, ys, thetas, a, b)
         if not self.full_circle and m:
             keep = np.abs(bearing) <= self.fov_rad / 2
