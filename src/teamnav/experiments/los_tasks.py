@@ -130,15 +130,25 @@ BUDGET_STEPS_PER_TARGET: dict[str, int] = {"simple": 6000, "complex": 12000}
 #: A helper passes over a waypoint it has not reached within this many steps (``los-helper-v1``
 #: ``waypoint_timeout_steps``; ours). On office_complex R2 and R4 step into the same doorways
 #: from opposite sides and, both driven by a potential field, blocked each other in room 5's
-#: door for 2000 steps; the longest leg of a route there is under 60 steps.
-HELPER_WAYPOINT_TIMEOUT_STEPS: dict[str, int] = {"complex": 150}
+#: door for 2000 steps; the longest leg of a route there is under 60 steps. On office_simple
+#: (session 9) R1, in trouble, followed R2 into room N3's doorway and stood in its way back for
+#: 4400 steps (potential field with R2, task 4, target 50, 200-target tasks): 300 steps there,
+#: twice its longest leg (R4's 28 m corridor, 140 steps).
+HELPER_WAYPOINT_TIMEOUT_STEPS: dict[str, int] = {"simple": 300, "complex": 150}
 #: The helpers' own navigator A (§6 does not say which one the helpers use). On office_complex a
 #: helper pushed off its route (by R1 in a doorway) into a room was trapped there by its own
 #: potential field, and R1, in trouble, followed it into the trap and stood by it for 2000 steps
 #: (PF with R2+R3, task 3); VisBug-21 always walks back out. Measured with R1 on the potential
 #: field, tasks 1-3 of 10 targets: targets reached 7/3/2 (R1+R2), 3/5/6 (R1..R3), 10/9/10 (R1..R4)
-#: with VisBug helpers against 0/1/2, 2/3/2, 7/4/6 with potential-field helpers.
-HELPER_NAVIGATOR: dict[str, str] = {"simple": "potential_field", "complex": "visbug21"}
+#: with VisBug helpers against 0/1/2, 2/3/2, 7/4/6 with potential-field helpers. The same
+#: deadlock on office_simple, seen once tasks ran their 200 targets (session 9, after the
+#: budgets above stopped cutting them short): potential field with R2, task 4, target 50 (room
+#: N5 from S2): R1 followed R2 into room N3's door; R2, its potential field blocked by R1, and R1,
+#: its own trapped against N3's east wall, stood 0.45 m apart for 4400 steps and R1 gave up.
+#: With VisBug-21 helpers and the 300-step waypoint timeout the same 50 targets took 575 steps
+#: each (775 up to the give-up with potential-field helpers). So the helpers walk VisBug-21 on
+#: both maps.
+HELPER_NAVIGATOR: dict[str, str] = {"simple": "visbug21", "complex": "visbug21"}
 
 
 @dataclass(frozen=True)
