@@ -70,6 +70,22 @@ def test_patrol_routes_and_starts_lie_in_the_corridors_with_clearance(m):
         assert any(x0 <= x <= x1 and y0 - 0.4 <= y <= y1 + 0.4 for x0, y0, x1, y1 in corridors), (x, y)
 
 
+@pytest.mark.parametrize("m", list(L.MAPS))
+def test_helpers_give_up_a_waypoint_only_well_after_the_longest_leg_of_any_route(m):
+    # the waypoint timeout ends deadlocks in doorways (a helper blocked by R1 for thousands of
+    # steps, los_tasks.HELPER_WAYPOINT_TIMEOUT_STEPS); it must never cut a free leg short, even
+    # with a detour of the leg's own length around a teammate
+    timeout = L.HELPER_WAYPOINT_TIMEOUT_STEPS[m]
+    assert L.HELPER_NAVIGATOR[m] == "visbug21"  # walks back out of a room it was pushed into
+    legs = []
+    for team in L.TEAMS:
+        for (start, _), route in zip(L.LAYOUTS[m].helpers, L.team_routes(m, team)):
+            pts = [start[:2], *route]
+            legs += [math.dist(a, b) / L.STEP_LENGTH_M for a, b in zip(pts, pts[1:])]
+    assert 2.0 * max(legs) <= timeout, (max(legs), timeout)
+    assert timeout <= 0.1 * L.BUDGET_STEPS_PER_TARGET[m]  # and a deadlock ends long before R1 gives up
+
+
 @pytest.mark.parametrize("both", [False, True])
 def test_simple_r2_route_steps_into_the_south_doors_or_every_door(both):
     # R2 alone steps into the north doorways too (where R1 trapped in N4/N5 sees it)
