@@ -172,3 +172,30 @@ def test_close_behind_a_helper_at_its_own_speed_counts_as_progress(monkeypatch, 
     else:
         # Pr falls to 0: out of trouble, A drives again (§5 rule 1; trapped again later)
         assert modes[0] == "trouble_follow" and "own_goal" in modes
+
+
+@pytest.mark.parametrize("drop", [False, True])
+def test_a_kept_helper_position_r1_cannot_close_in_on_is_dropped_after_cr_steps(monkeypatch, drop):
+    """``trouble_drop_stalled_helper``: R1 in trouble follows R2 seen 3 m to its left; R2 goes out of
+    sight and R1, pinned (its pose never changes), makes no progress towards R2's last seen
+    position: after ``trouble_cr`` such steps the position is dropped and A drives again.
+    Without the gap fill the point is kept for as long as R1 is in trouble (§5's two ends only)."""
+    r1 = _trapped(monkeypatch, cr=5, trouble_drop_stalled_helper=drop)
+    k = 0
+    while not r1.trouble.tr:
+        r1.step(obs(k, walls=WALL))
+        k += 1
+    r1.step(obs(k, walls=WALL, seen=[(1, 3.0, math.pi / 2)]))
+    a, _ = r1.step(obs(k + 1, walls=WALL, seen=[(1, 3.0, math.pi / 2)], inbox=[msg(1, k, trouble=False)]))
+    assert r1.mode == "trouble_follow" and a.direction_rad == pytest.approx(math.pi / 2)
+    modes = []
+    for j in range(2, 14):  # R2 out of sight from now on, R1 does not move
+        a, _ = r1.step(obs(k + j, walls=WALL))
+        modes.append(r1.mode)
+    assert r1.trouble.tr  # still in trouble: §5's own end never came
+    if drop:
+        first = modes.index("own_goal")
+        assert 4 <= first <= 6 and set(modes[first:]) == {"own_goal"}
+        assert r1.trouble_helpers_dropped == 1 and a.direction_rad == pytest.approx(0.0)
+    else:
+        assert set(modes) == {"trouble_follow"} and r1.trouble_helpers_dropped == 0

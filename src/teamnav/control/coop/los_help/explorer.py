@@ -179,6 +179,21 @@ class LosExplorerParams(_CommonParams):
         R1..R4 2/5 (105/200) -> 1/5 (94/200); 3 m: 2/5 (131/200), 1/5 (67/200): no clear
         gain (R1..R4 worse), off by default.
         None: ``trouble_progress`` alone (the earlier behaviour).
+    trouble_drop_stalled_helper : bool
+        With ``keep_trouble_helper``: the last seen position of a followed teammate now out of
+        sight is dropped after ``trouble_cr`` steps without progress towards it (as a ghost
+        is, ``temp_dropped``), so that A, or another teammate in sight, takes over. Gap filled:
+        §5 ends the following only when R1 is no longer in trouble or sees its goal, and a
+        point behind a wall pinned R1 for good: traced (session 9), office_simple, potential
+        field, R1..R3, task 5, target 59 (room N2 from room S5): R1 saw R3 through S5's door,
+        kept heading for R3's last seen position in the corridor (28.8, 7.8) and stood against
+        S5's north wall below it, Tr set and the same robot never in sight again, for 5800 steps
+        until it gave up. Measured on the three 200-target give-ups of the potential field with
+        helpers in session 9's Tables 1-2 (VisBug helpers): each went past the target it had
+        given up on (office_simple R1..R3 task 5: 59/59 targets, 369 steps per target; task 3:
+        155/155, 353; office_complex R1+R2 task 2: 141/141, 822). The default since session 9
+        (the tables' numbers: ``docs/report/los-help.md``). False: kept until Tr clears or the
+        goal is seen (the earlier behaviour).
     """
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
@@ -196,6 +211,7 @@ class LosExplorerParams(_CommonParams):
     trouble_return_progress: bool = False
     trouble_release_to_helper: bool = False
     trouble_near_helper_m: float | None = Field(None, gt=0.0, le=100.0)
+    trouble_drop_stalled_helper: bool = True
 
 
 
@@ -254,6 +270,8 @@ class LosExplorer(_LosBrain):
         #: where a followed teammate let go for walking away was last seen (``trouble_release_to_helper``)
         self._release_xy: XY | None = None
         self._release_stall = 0
+        self._tt_stall = 0
+        self.trouble_helpers_dropped = 0
         self._set_goal()
 
     def _set_goal(self) -> None:
@@ -399,6 +417,7 @@ class LosExplorer(_LosBrain):
             elif tt is None or math.hypot(tt[1][0] - self._pose[0], tt[1][1] - self._pose[1]) <= near:
                 helper = choose_helper(True, self._me_xy(), cands)
                 tt = self._trouble_target = None if helper is None else (helper, seen[helper])
+                self._tt_stall = 0
                 if helper is not None and p.trouble_helper_towards_goal:
                     hist = self._mate_goal_d.get(helper)
                     self._tt_best_d = hist[-1][1] if hist else math.hypot(seen[helper][0] - goal[0],
@@ -406,6 +425,14 @@ class LosExplorer(_LosBrain):
             if tt is not None and (tt[0] in self._seen_now or p.keep_trouble_helper):
                 self.mode = "trouble_follow"
                 action, towards = self._head_to(tt[1], ("helper", tt[0]), stop_within_m=near, end_margin_m=near)
+                if p.trouble_drop_stalled_helper:
+                    # a kept position out of sight that R1 does not close in on is given up
+                    # (see ``trouble_drop_stalled_helper``)
+                    self._tt_stall = 0 if (towards or tt[0] in self._seen_now) else self._tt_stall + 1
+                    if self._tt_stall >= p.trouble_cr:
+                        self._tt_stall = 0
+                        self.trouble_helpers_dropped += 1
+                        self._trouble_target = None
                 if p.trouble_progress == "helper":
                     # Sgorbissa & Arkin §5, Fig. 10: progress towards G_icurr = R_j
                     progressing = towards
@@ -518,7 +545,8 @@ class LosExplorer(_LosBrain):
         teammate's direct promise, ``trust_direct_promise``), ``slide_steps`` (heading to
         a seen point along a side direction), ``temp_switches`` (changes of the teammate, ghost
         or trouble helper headed for), ``temp_dropped`` (teammate or ghost points given up after
-        ``trouble_cr`` steps without progress towards them), ``vias_taken`` (times R1 went on from
+        ``trouble_cr`` steps without progress towards them), ``trouble_helpers_dropped`` (last seen
+        helper positions given up, ``trouble_drop_stalled_helper``), ``vias_taken`` (times R1 went on from
         a teammate's reached point to the point its D led through, ``share_via``); and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
         the odometry frame (when ``log_layers``).
         """
@@ -526,7 +554,8 @@ class LosExplorer(_LosBrain):
         out.update(target_index=int(self.target_index), targets_reached=int(self.targets_reached),
                    finished=bool(self.finished), gave_up=bool(self.gave_up),
                    goal_seen_steps=int(self.goal_seen_steps), promised_steps=int(self.promised_steps),
-                   temp_dropped=int(self.temp_dropped), vias_taken=int(self.vias_taken))
+                   temp_dropped=int(self.temp_dropped), vias_taken=int(self.vias_taken),
+                   trouble_helpers_dropped=int(self.trouble_helpers_dropped))
         layers = self._layers()
         if layers:
             out["layers"] = layers
