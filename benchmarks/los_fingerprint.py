@@ -21,7 +21,11 @@ Usage::
 Recorded in ``benchmarks/los_fingerprints.json`` (1500 steps) at 4641d4c, the brains of
 session 5 (trouble_helper_towards_goal, via_in_sight, visbug_reverse_walk_factor); the
 speed-ups merged after it (56777c6) reproduce every hash. The speed branch itself was checked
-against its base f9d6cb5 after every commit.
+against its base f9d6cb5 after every commit. Re-recorded in session 9 with NumPy 2.4.6 and numba
+0.68.1 (the file now names them; ``--check`` warns when they differ): the session-8 commit
+f9f4cf8 run with NumPy 2.4.6 already differed in 21 of 24 runs, the complex ones by session 8's
+map and budget, the simple potential-field and Avoid-Past ones by NumPy (2.4's own hypot and
+arctan2 differ from libm in the last bit; VisBug-21 alone, all in numba kernels, held).
 """
 
 from __future__ import annotations
@@ -97,6 +101,14 @@ def run_one(map_key: str, case: str, team: str, err_max: float, steps: int) -> t
     return h.hexdigest(), summary
 
 
+def _versions() -> dict[str, str]:
+    """The numeric libraries a run's last bits depend on."""
+    import numba
+    import numpy
+
+    return {"numpy": numpy.__version__, "numba": numba.__version__}
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--steps", type=int, default=1500)
@@ -113,7 +125,13 @@ def main(argv: list[str] | None = None) -> int:
             ref = json.load(f)
         if ref.get("steps") != args.steps:
             print(f"reference has steps={ref.get('steps')}, running {args.steps}", file=sys.stderr)
-    out = {"steps": args.steps, "runs": {}}
+        for lib, have in _versions().items():
+            want = ref.get("versions", {}).get(lib)
+            if want != have:
+                print(f"reference recorded with {lib} {want or '(not recorded)'}, running {have}: hashes may "
+                      "differ without any change of ours (NumPy 2.4's hypot/arctan2 differ from libm's in the "
+                      "last bit, and the potential field's and Avoid-Past's numpy lines use them)", file=sys.stderr)
+    out = {"steps": args.steps, "versions": _versions(), "runs": {}}
     bad = 0
     t_all = time.process_time()
     for map_key, case, team, err in itertools.product(MAPS, CASES, TEAMS, ERR_MAX):
