@@ -178,9 +178,9 @@ def test_close_behind_a_helper_at_its_own_speed_counts_as_progress(monkeypatch, 
 def test_a_kept_helper_position_r1_cannot_close_in_on_is_dropped_after_cr_steps(monkeypatch, drop):
     """``trouble_drop_stalled_helper``: R1 in trouble follows R2 seen 3 m to its left; R2 goes out of
     sight and R1, pinned (its pose never changes), makes no progress towards R2's last seen
-    position: after ``trouble_cr`` such steps the position is dropped and A drives again.
+    position: after ``trouble_drop_after_steps`` such steps the position is dropped and A drives again.
     Without the gap fill the point is kept for as long as R1 is in trouble (§5's two ends only)."""
-    r1 = _trapped(monkeypatch, cr=5, trouble_drop_stalled_helper=drop)
+    r1 = _trapped(monkeypatch, cr=5, trouble_drop_stalled_helper=drop, trouble_drop_after_steps=5)
     k = 0
     while not r1.trouble.tr:
         r1.step(obs(k, walls=WALL))
