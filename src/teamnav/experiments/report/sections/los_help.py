@@ -77,15 +77,14 @@ NOISE_SWEEP = {"simple": "los-noise-simple", "complex": "los-noise-complex"}
 # ---------------------------------------------------------------------------- sweeps
 #: What the full reproduction costs on this machine (measured, see the note's numbers).
 FULL_CPU_NOTE = ("Cost of the full reproduction here, measured: `NUMBA_NUM_THREADS=1 teamnav sweep los-table1` "
-                 "(3 algorithms x 4 nested teams x 5 tasks of 200 targets = 60 trials) took 20 CPU-min on this "
-                 "2-core machine (20.5 min wall on one worker), `los-table2` 24 CPU-min (2026-11-23, commit "
-                 "041ed99, Avoid-Past now finishing its tasks; about the CPU time over the workers with "
-                 "`-j 2`; a failing trial ends at its first target over budget, which makes the "
-                 "potential-field trials short). Before the nested teams (120 "
-                 "trials) and the 2.45x faster brains and radio (benchmarks/bench_los_brains.py) the estimate was "
-                 "7 CPU-hours for los-table1. `los-noise-simple` (75 trials of 200 targets, all helpers) took "
-                 "39 min on one worker (2026-11-23, commit 3f4f3b7); `los-noise-complex` and `los-ablation` "
-                 "were not measured. Wall time is about the CPU time over the number of workers (`-j`).")
+                 "(3 algorithms x 4 nested teams x 5 tasks of 200 targets = 60 trials) took 23 CPU-min on this "
+                 "2-core machine and `los-table2` 30 CPU-min (2026-11-26, session 9: budgets of 6000 / 12000 steps "
+                 "per target, office_complex_closed, VisBug-21 helpers on both maps; one worker per sweep, the two "
+                 "sweeps side by side; a failing trial ends at its first target over budget). `los-noise-simple` "
+                 "(75 trials of 200 targets, all helpers) took 39 min on one worker in session 7, before the "
+                 "larger budgets let the potential field finish its noisy tasks (its 25 trials alone took 23 CPU-min "
+                 "in session 9); `los-noise-complex` and `los-ablation` were not measured at full size. Wall time "
+                 "is about the CPU time over the number of workers (`-j`).")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
 GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
@@ -111,7 +110,11 @@ GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on t
                   "teammates seen through a door for one step): potential field, 40-target prefixes of tasks 1-10, "
                   "office_complex tasks finished R1,2 / R1..3 / R1..4 from 0 / 1 / 4 to 4 / 4 / 5 of 10. "
                   "Avoid-Past's memory lives for one own goal (AvoidPastParams.memory_scope; a lifelong memory "
-                  "saturated the push after a few targets and R1 alone finished no 40-target task, 5/5 now).")
+                  "saturated the push after a few targets and R1 alone finished no 40-target task, 5/5 now). "
+                  "In trouble, the last seen position of a helper now out of sight is given up after 500 steps "
+                  "without getting closer (trouble_drop_stalled_helper; R1 had stood 5800 steps against a wall "
+                  "below it): office_simple, potential field, 200-target tasks finished with R1..3 3/5 -> 5/5, "
+                  "office_complex_closed unchanged.")
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
 QUICK_BUDGET_STEPS_PER_TARGET = 800
