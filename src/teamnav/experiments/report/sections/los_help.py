@@ -82,9 +82,8 @@ FULL_CPU_NOTE = ("Cost of the full reproduction here, measured: `NUMBA_NUM_THREA
                  "per target, office_complex_closed, VisBug-21 helpers on both maps; one worker per sweep, the two "
                  "sweeps side by side; a failing trial ends at its first target over budget). `los-noise-simple` "
                  "(75 trials of 200 targets, all helpers) took 52 CPU-min and `los-ablation` (60 trials) 33 CPU-min "
-                 "(same session and code); `los-noise-complex` (75 trials on the complex map) was not measured at "
-                 "full size (about 70 CPU-min by Table 2's R1..4 trials, 160 CPU-s per task and err_max). Wall "
-                 "time is about the CPU time over the number of workers (`-j`).")
+                 "(same session and code), `los-noise-complex` (75 trials on the complex map) 58 CPU-min (28 min "
+                 "wall with `-j 2`). Wall time is about the CPU time over the number of workers (`-j`).")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
 GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
