@@ -185,7 +185,7 @@ class RobotDetector:
         # NumPy >= 2.4 has its own SIMD hypot/arctan2 that can differ from libm in the last bit,
         # and the two paths must return the same detections bit for bit
         if a.size:
-            rng_m, bearing = _range_bearing(xs, ys, thetas, a.astype(np.int64), b.astype(np.int64))
+            rng_m, bearing = _range_bearing(xs, ys, thetas, a, b)  # int64 from pairs_within
         else:
             rng_m, bearing = np.empty(0), np.empty(0)
         if not self.full_circle and a.size:
