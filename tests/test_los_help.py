@@ -23,6 +23,7 @@ from teamnav.control.coop.los_help.goal_sharing import (
     hops,
     point_visible,
     relayed_id,
+    see_past_teammates,
     sender_frame,
 )
 from teamnav.control.coop.los_help.messages import (
@@ -813,3 +814,60 @@ def test_at_a_ghost_visbug_starts_again_with_the_explorers_reverse_walk_factor(m
     r1.step(obs(2, pose=(0.0, 1.0, 0.0), walls=wall))
     r1.step(obs(3, pose=(0.0, 2.95, 0.0), walls=[(math.atan2(-2.95, 6.0), 0.2, 1.0)]))
     assert r1.sharing.path(0).reached and made[0].restarts == [want]
+
+
+@pytest.mark.parametrize("see_past", [True, False])
+def test_a_teammate_between_r1_and_its_goal_does_not_hide_the_goal(straight_nav, see_past):
+    """R2 stands 2 m ahead of R1 on the line to R1's goal 5 m ahead; R1's laser reads R2's body
+    (0.2 m radius) there. With ``see_past_teammates`` R1 sees its goal past the teammate it
+    detects (the paper's V(R) is bounded by the environment, §2); without it R2 hides it."""
+    goal = (5.0, 0.0)
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[goal], see_past_teammates=see_past), np.random.default_rng(0),
+                     info(0, 2))
+    body = [(0.0, math.atan(0.2 / 1.8), 1.8)]
+    r1.step(obs(0, walls=body, seen=[(1, 2.0, 0.0)]))
+    path = r1.sharing.path(0)
+    assert (path is not None and path.kind == "direct") is see_past
+    # an undetected body (no identity, or out of the detector's sight) still occludes
+    r1b = LosExplorer(LosExplorer.Params(targets_xy=[goal], see_past_teammates=True), np.random.default_rng(0),
+                      info(0, 2))
+    r1b.step(obs(0, walls=body))
+    assert r1b.sharing.path(0) is None
+    # beside the body, inside the widened sector (bearing and range noise), a beam that passes
+    # the teammate and ends on a far wall keeps its reading (reach 1.7 d + 2 radius): a goal
+    # 0.2 rad off R2's bearing, 7.8 m away behind a wall at 7.5 m, stays hidden
+    off = (7.8 * math.cos(0.2), 7.8 * math.sin(0.2))
+    r1c = LosExplorer(LosExplorer.Params(targets_xy=[off], see_past_teammates=True), np.random.default_rng(0),
+                      info(0, 2))
+    wall = [(0.0, 0.5, 7.5)]
+    r1c.step(obs(0, walls=wall + body, seen=[(1, 2.0, 0.0)]))
+    assert r1c.sharing.path(0) is None
+    r1c.step(obs(1, walls=body, seen=[(1, 2.0, 0.0)]))  # without the wall it is seen
+    assert r1c.sharing.path(0) is not None and r1c.sharing.path(0).kind == "direct"
+    # straight behind the body the laser knows nothing: the body's beams read what its flanks
+    # read, so the wall seen past both flanks hides a goal right behind R2 too
+    r1d = LosExplorer(LosExplorer.Params(targets_xy=[(7.8, 0.0)], see_past_teammates=True), np.random.default_rng(0),
+                      info(0, 2))
+    r1d.step(obs(0, walls=wall + body, seen=[(1, 2.0, 0.0)]))
+    assert r1d.sharing.path(0) is None
+
+
+@settings(max_examples=200, deadline=None)
+@given(d=st.floats(0.5, 7.0), b=st.floats(-math.pi, math.pi), err=st.floats(-0.4, 0.4), berr=st.floats(-1.0, 1.0))
+def test_see_past_teammates_frees_every_beam_on_the_body_under_eq_1_2_noise(d, b, err, berr):
+    """Whatever the detector's eq. 1-2 noise (range error up to 0.4 d_r, bearing error up to
+    atan(radius / d_r)), every beam that the true body (radius 0.2 m at range d, bearing b)
+    blocks reads what the beams beside it read (a room 6 m deep here), and beams far outside
+    the body's sector keep their reading."""
+    radius = 0.2
+    half_true = math.asin(min(1.0, radius / d))
+    r = np.full(N_BEAMS, 6.0)
+    on_body = np.abs(wrap_angle(ANGLES - b)) <= half_true
+    r[on_body] = d - radius
+    d_p = d + d * err
+    b_p = float(wrap_angle(b + math.atan(radius / d) * berr))
+    out = see_past_teammates(r, ANGLES, MAX_RANGE, np.array([d_p]), np.array([b_p]), radius)
+    assert np.all(out[on_body] == 6.0)
+    far = np.abs(wrap_angle(ANGLES - b)) > 2.0 * math.atan(1.5 * radius / d_p) + 2.0 * math.atan(radius / d) + 1e-9
+    assert np.all(out[far] == r[far])
+    assert np.all(r[~on_body] == 6.0)  # the input is not modified

@@ -68,6 +68,7 @@ __all__ = [
     "beam_near_reaches",
     "nearest_beam_visible",
     "goal_in_own_frame",
+    "see_past_teammates",
     "sender_frame",
     "sender_pose_in_own_frame",
     "can_relay",
@@ -261,6 +262,60 @@ def beam_near_reaches(ranges_m, angles_rad, d_m, bearing_rad, max_diff_rad):
         if diff <= max_diff_rad and ranges_m[i] >= d_m:
             return True
     return False
+
+
+@njit(cache=True)
+def see_past_teammates(ranges_m, angles_rad, max_range_m, ranges_det_m, bearings_det_rad, radius_m):
+    """A copy of ``ranges_m`` in which the beams that end on a detected teammate read what the
+    beams beside its body read (numba): the scan the brains' visibility tests use with
+    ``see_past_teammates``.
+
+    A beam is taken to end on the teammate detected at (``ranges_det_m[j]``,
+    ``bearings_det_rad[j]``, body frame) when its bearing is within ``2 atan(1.5 radius / d)``
+    of the detected bearing and its reading is at most ``1.7 d + 2 radius``. Why these bounds:
+    the teammate subtends ``atan(radius / d_r)`` each side, eq. 2's bearing error adds up to
+    as much again, and eq. 1's range error is at most ``err_max d_r`` with the paper's largest
+    ``err_max = 0.4`` (``d_r <= d / 0.6``); the detector reports a teammate only in line of
+    sight, so no wall stands between (§2). Teammates share the observer's radius (the paper's
+    robots are identical). What lies behind the body is unknown to the laser: such a beam
+    reads the smaller of the two nearest unmasked beams on either side (the body's flanks),
+    so a wall seen past both flanks stays a wall; with every beam masked it keeps its reading.
+    ``angles_rad`` must be sorted (a scan's beam order).
+    """
+    n = angles_rad.shape[0]
+    out = ranges_m.copy()
+    masked = np.zeros(n, dtype=np.bool_)
+    any_masked = False
+    for j in range(ranges_det_m.shape[0]):
+        d = max(ranges_det_m[j], 1e-6)
+        half = 2.0 * math.atan(1.5 * radius_m / d)
+        reach = 1.7 * d + 2.0 * radius_m
+        for i in range(n):
+            diff = abs(pymod(angles_rad[i] - bearings_det_rad[j] + math.pi, _TWO_PI) - math.pi)
+            if diff <= half and ranges_m[i] <= reach:
+                masked[i] = True
+                any_masked = True
+    if not any_masked:
+        return out
+    for i in range(n):
+        if not masked[i]:
+            continue
+        left = -1.0
+        for k in range(1, n):
+            m = (i - k) % n
+            if not masked[m]:
+                left = ranges_m[m]
+                break
+        if left < 0.0:
+            continue  # every beam is masked
+        right = left
+        for k in range(1, n):
+            m = (i + k) % n
+            if not masked[m]:
+                right = ranges_m[m]
+                break
+        out[i] = min(max_range_m, left, right)
+    return out
 
 
 def max_beam_gap(angles: np.ndarray) -> float:
