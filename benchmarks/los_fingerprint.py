@@ -26,6 +26,9 @@ against its base f9d6cb5 after every commit. Re-recorded in session 9 with NumPy
 f9f4cf8 run with NumPy 2.4.6 already differed in 21 of 24 runs, the complex ones by session 8's
 map and budget, the simple potential-field and Avoid-Past ones by NumPy (2.4's own hypot and
 arctan2 differ from libm in the last bit; VisBug-21 alone, all in numba kernels, held).
+Re-recorded in session 10 after ``see_past_teammates`` (fc95e88): the 12 runs of R1 alone
+reproduced session 9's hashes (the rule acts only on steps with a teammate in sight), the 12
+team runs moved, as they must; a re-check reproduces the new file.
 """
 
 from __future__ import annotations
