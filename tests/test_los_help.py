@@ -871,3 +871,28 @@ def test_see_past_teammates_frees_every_beam_on_the_body_under_eq_1_2_noise(d, b
     far = np.abs(wrap_angle(ANGLES - b)) > 2.0 * math.atan(1.5 * radius / d_p) + 2.0 * math.atan(radius / d) + 1e-9
     assert np.all(out[far] == r[far])
     assert np.all(r[~on_body] == 6.0)  # the input is not modified
+
+
+@pytest.mark.parametrize("beyond, dist, read_past", [(None, 3.0, False), (1.0, 3.0, True), (1.0, 0.8, False)])
+def test_navigator_scan_reads_past_teammates_beyond_the_set_distance(straight_nav, monkeypatch, beyond, dist,
+                                                                     read_past):
+    """``navigate_past_teammates_beyond_m``: A's scan reads past a teammate detected farther than
+    the distance (its body's beams read what the beams beside it read); a nearer one, or any with
+    the default None, stays an obstacle in A's scan."""
+    r1 = LosExplorer(LosExplorer.Params(targets_xy=[(0.0, 6.0)], navigate_past_teammates_beyond_m=beyond,
+                                        straight_when_visible=False),
+                     np.random.default_rng(0), info(0, 2))
+    seen_scans = []
+    real = StraightNav.direction
+
+    def spy(self, pose, scan):
+        seen_scans.append(scan)
+        return real(self, pose, scan)
+
+    monkeypatch.setattr(StraightNav, "direction", spy)
+    body = [(0.0, math.atan(0.2 / (dist - 0.2)), dist - 0.2)]
+    r1.step(obs(0, walls=body, seen=[(1, dist, 0.0)]))
+    assert seen_scans, "the navigator was not asked for a heading"
+    ahead = seen_scans[-1].ranges_m[np.argmin(np.abs(ANGLES))]
+    assert bool(ahead == MAX_RANGE) is read_past
+    assert read_past or ahead == pytest.approx(dist - 0.2)
