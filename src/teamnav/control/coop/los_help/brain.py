@@ -216,9 +216,10 @@ class _CommonParams(BaseModel):
         A distance d: A's scan reads past the teammates this robot detects farther than d
         (the beams on their bodies read what the beams beside them read, as for
         ``see_past_teammates``); nearer ones stay obstacles, and the engine's contact rule keeps
-        bodies apart whatever A does. Gap-fill candidate (session 10, measured in
-        docs/report/los-help.md): a patrolling teammate in Avoid-Past's scan pushes R1 away as a
-        wall would (office_simple, R1+R2 silent: 236 steps per target against 214 alone).
+        bodies apart whatever A does. Measured (session 10, office_simple, Avoid-Past, R1+R2,
+        5 tasks x 200 targets): silent R2 236 steps per target against 214 alone; helping R2
+        225 with None and 226 with 1.0 on R1: the teammate's cost is not its body seen from afar
+        (docs/report/los-help.md). Kept off; kept for the next trace.
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
