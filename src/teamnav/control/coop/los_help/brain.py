@@ -202,15 +202,17 @@ class _CommonParams(BaseModel):
         found (measured: R1 saw N3's centre for one step from the corridor and VisBug then
         resumed a boundary 8 m west, 129 steps). False: one test, every step.
     see_past_teammates : bool
-        The visibility tests (V(R) of a goal, a via point, a ghost: ``_sees``, ``_keeps``) read
-        the beams that end on a teammate this robot detects this step as free up to the
-        beams beside its body (:func:`~.goal_sharing.see_past_teammates`); navigation and the straight
-        corridor test still see the teammate's body. Gap filled: the paper's V(R) is bounded by
-        the environment (§2), and its robots do not hide goals from each other; ours have
-        bodies that the laser sees. Measured (session 9, office_simple, Avoid-Past, R1+R2,
+        The visibility tests (V(R) of a goal, a via point, a ghost: ``_sees``, ``_keeps``) give
+        the beams that end on a teammate this robot detects this step the reading of the beams
+        beside its body (:func:`~.goal_sharing.see_past_teammates`); navigation and the
+        straight-corridor test still see the teammate's body. Gap filled: the paper's V(R) is
+        bounded by the environment (§2), and its robots do not hide goals from each other; ours
+        have bodies that the laser sees. Why (session 9, office_simple, Avoid-Past, R1+R2,
         5 tasks x 200 targets, steps per target): R1 alone 214, R2 patrolling silent 236,
         silent R2 with R1's laser blind to robots 221: R2's body hid goals that R1 would have
-        driven straight to. False: a teammate occludes like a wall.
+        driven straight to. Measured (session 10, same tasks, R1..R3, paired against False):
+        227 -> 210; the full tables with it: docs/report/los-help.md. False: a teammate
+        occludes like a wall.
     navigate_past_teammates_beyond_m : float or None
         None (the default): the navigator A sees teammates as obstacles, as the laser does.
         A distance d: A's scan reads past the teammates this robot detects farther than d
