@@ -166,6 +166,28 @@ def test_closed_loop_keeps_left_in_a_wide_corridor_and_centred_in_a_narrow_one()
     assert clearance(narrow, poses) > RADIUS and poses[-1, 0] > 5.0
 
 
+def test_trail_brains_cross_back_to_their_lane_from_the_oncoming_one():
+    """A robot that turned 180 deg on the spot at a place sits in the oncoming lane of a 1.8 m
+    corridor, 0.45 m from its right wall and 1.35 m from its left one (traced at the source of
+    ``try-to-see-it-my-way``). With Navigate's default reach (1.2 m) the first box is free and
+    the robot drives straight on in that lane ("big open space", Blazing §4.2); the trail
+    brains' ``box_reach_m = 2.0`` spans the corridor, so it crosses to its own (left) lane."""
+    from teamnav.control.coop.blazing_trail import NAVIGATE_DEFAULTS, navigate_params
+
+    assert NAVIGATE_DEFAULTS["box_reach_m"] >= 1.8  # the trail office's corridor width
+    wide = [(-5, 0.9, 60, 0.9), (-5, -0.9, 60, -0.9)]
+    start = (0.0, -0.45, 0.0)
+    trail = Navigate(navigate_params({}, 0.4), np.random.default_rng(0), INFO)
+    poses, _, _ = drive(trail, wide, start, 250, preferred=0.0)  # a trail hint along the corridor
+    in_lane = np.flatnonzero(np.abs(0.9 - poses[:, 1] - WIDTH / 2) < 0.1)
+    assert in_lane.size and poses[in_lane[0], 0] < 2.5  # in its lane within 2.5 m
+    assert np.all(np.abs(0.9 - poses[-50:, 1] - WIDTH / 2) < 0.1)
+    assert clearance(wide, poses) > RADIUS
+    short = Navigate(navigate_params({"box_reach_m": 1.2}, 0.4), np.random.default_rng(0), INFO)
+    poses, _, _ = drive(short, wide, start, 250, preferred=0.0)
+    assert poses[-1, 0] > 8.0 and np.all(poses[:, 1] < 0.0)  # 8 m on, still in the oncoming lane
+
+
 # ------------------------------------------------------------------------ openings
 def side_corridor(width_m, wall_m=0.45, edge_x_m=0.05, depth_m=5.0, side=1):
     """Corridor walls at +-wall_m / -1.35 m; a side corridor of width_m opens on ``side`` at edge_x_m."""

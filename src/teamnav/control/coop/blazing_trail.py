@@ -85,7 +85,29 @@ __all__ = ["NAVIGATE_DEFAULTS", "BlazingTrail", "BlazingTrailParams", "navigate_
 #: §5.1: "When the robot detects an opening it turns into the opening if the average heading of
 #: the crumbs points to the side where the opening is detected" (Navigate's ``trail_rule="side"``;
 #: with "closest" the averaged heading lags at corners and robots overshoot into the next door).
-NAVIGATE_DEFAULTS: dict[str, Any] = {"trail_rule": "side"}
+#:
+#: ``box_reach_m = 2.0`` (Navigate's default 1.2; a gap-fill, session 11): the sliding box's first
+#: position reaches across the trail office's 1.8 m corridors, so a robot always finds its left
+#: wall and keeps to the left lane (Blazing §4.2 / Try §3.3: the robots pass each other in the
+#: corridors). With 1.2 m, a robot more than 1.2 m from its left wall finds the first box free and
+#: drives straight on ("big open space", Blazing §4.2): after its 180 deg turn at home or at the
+#: source (made on the spot, in the lane it arrived in) and after swerving round another robot,
+#: it stayed in the *oncoming* lane until a passing place or a corner pulled it across, and met
+#: the next robots head-on. Traced (session 11, true trajectories, ``try-to-see-it-my-way``,
+#: seeds 0-3, 30 min, trips from 10 min on): robots left the source at y 16.35 in C3's north
+#: half heading west, the north half being the eastbound lane; the share of time in the robot's
+#: own lane on the three corridors' straight stretches rose from 80 / 82 / 78 % to 97 / 96 / 91 %
+#: with 2.0 m, and the time lost against driving the route at cruise fell from 35 to 17 % of
+#: trip time (within 1.5 m of another robot: 1800 -> 550 s; dead-end branches: ~1060 -> ~150 s).
+#: Measured, 30 min, paired against 1.2 (efficiency =
+#: ``place_speed_mps`` / cruise, mean ± s.e.): trail-share-v1 with the scenario's drift, seeds 0-7:
+#: 55.8 -> 67.7 % (+11.9 ± 2.8 points, better on 8/8; 1.45 m +6.8, 1.6 m +10.2, 2.5 m +10.0,
+#: 3.0 m +9.2: a plateau once the reach spans the corridor), fresh seeds 8-15: 53.7 -> 62.4 %
+#: (+8.7 ± 4.1, 6/8 more units); blazing-trail-v1 at the paper's conditions (no drift), seeds
+#: 0-7: 27.3 -> 32.8 units in 30 min (+5.5 ± 0.6, 8/8). At 4x the drift (blazing-trail-v1, 1 h,
+#: seeds 0-3) the 2000 team still breaks down (3 of 4; 1.75 units in the last 10 min against
+#: 0.5). Both trail brains share it, so the 2000 and 2002 systems drive alike.
+NAVIGATE_DEFAULTS: dict[str, Any] = {"trail_rule": "side", "box_reach_m": 2.0}
 
 
 def navigate_params(navigate: dict[str, Any], cruise_speed_mps: float) -> NavigateParams:
@@ -144,7 +166,7 @@ class BlazingTrailParams(BaseModel):
         Draw the global crumbs in the replay at most once per this many steps.
     navigate : dict
         Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields, over
-        ``NAVIGATE_DEFAULTS`` (``trail_rule="side"``, Blazing §5.1).
+        ``NAVIGATE_DEFAULTS`` (``trail_rule="side"``, Blazing §5.1; ``box_reach_m=2.0``, lanes).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)

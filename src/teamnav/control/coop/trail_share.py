@@ -222,7 +222,7 @@ class TrailShareParams(BaseModel):
     navigate : dict
         Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields, over
         :data:`TRAIL_SHARE_NAVIGATE` (``give_way_s=3``) over ``NAVIGATE_DEFAULTS``
-        (``trail_rule="side"``, Blazing §5.1).
+        (``trail_rule="side"``, Blazing §5.1; ``box_reach_m=2.0``, lanes).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
