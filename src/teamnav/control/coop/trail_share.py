@@ -37,6 +37,12 @@ heads for crumbs with s below that bound, so it never turns back up a trail, and
 minimum it explores instead of dithering. The bound is reset when the goal changes.
 ``descend_only=False`` is the paper's rule as written.
 
+Lanes: the trail brains' Navigate reaches 2.0 m for its wall (``box_reach_m`` in
+:data:`~teamnav.control.coop.blazing_trail.NAVIGATE_DEFAULTS`, session 11), so robots keep to the
+left lane of the 1.8 m corridors and pass each other; that comment has the trace and the paired
+measurements (the scenario's drift, 30 min: 55.8 -> 67.7 % of cruise). Every measurement below
+this paragraph was made before it, with the 1.2 m reach.
+
 Efficiency gap-fills (one flag away from the paper's rules): ``turn_at_place`` (a sharp 180 deg
 turn on reaching the sought place, then ``leave_place_m`` of wall following, as in
 :mod:`~teamnav.control.coop.blazing_trail`) and ``lookahead_m`` (the best crumb is searched
