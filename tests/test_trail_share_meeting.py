@@ -1,4 +1,4 @@
-"""Meeting flags of Navigate / trail-share-v1 (off by default but give_way_s in trail-share-v1): gap-fills for robots that
+"""Meeting flags of Navigate / trail-share-v1 (all off by default since session 11): gap-fills for robots that
 meet at corners (trail_share module docstring). Hand-made situations: synthetic scans and
 odometry poses fed step by step, the fake Navigate for the brain-level flag."""
 
@@ -202,10 +202,10 @@ def test_meet_guard_starts_when_an_obstacle_appears_ahead():
     assert n._meet_until_s == pytest.approx(1.5 + 8.0) and n._meet_until_m == pytest.approx(n._odo_m + 3.0)
 
 
-@pytest.mark.parametrize(("navigate", "expected_s"), [({}, 3.0), ({"give_way_s": 0.0}, 0.0)])
-def test_trail_share_gives_way_by_default_and_blazing_trail_does_not(navigate, expected_s):
-    # Session 7 turned give_way_s = 3 on for trail-share-v1 only (TRAIL_SHARE_NAVIGATE, measured
-    # on the try-paper condition); the 2000 brain keeps Navigate's default (its drift curve).
+@pytest.mark.parametrize(("navigate", "expected_s"), [({}, 0.0), ({"give_way_s": 3.0}, 3.0)])
+def test_both_trail_brains_drive_without_give_way_by_default(navigate, expected_s):
+    # Sessions 7-10 turned give_way_s = 3 on for trail-share-v1 only; session 11's lane fix
+    # (box_reach_m = 2.0) made it cost, so both brains drive with the same Navigate again.
     info = synthetic_infos(1)[0]
     share = TrailShare(TrailShare.Params(navigate=navigate), np.random.default_rng(0), info)
     assert share.nav.params.give_way_s == expected_s

@@ -99,8 +99,8 @@ same way but none is beyond the noise under drift, so it stays off (the rule for
 the first thing to try with more seeds. The try-paper sweep itself (the scenario's drift, 3 h,
 seeds 0-9, session 6, against the stored default runs of the same seeds): 57.3 % against
 54.6 % (paired +2.7 ± 0.9 points, better on 9 of 10): beyond the noise on the paper's own
-condition. On by default since session 7 (:data:`TRAIL_SHARE_NAVIGATE`); the 2002 runs of the report
-were re-run with it (``docs/report/try-to-see-it-my-way.md``).
+condition. On by default in sessions 7-10 (:data:`TRAIL_SHARE_NAVIGATE`); off again since session 11, when
+the lane fix made it cost (+3.9 points without it over 24 paired seeds; that constant's comment).
 ``recover_reverse`` (off by default): while recovering, Navigate's 180 deg rule ignores its
 reversal memory and distance cool-down (the robot is pushed up a branch by a meeting and the
 way back is where it last reversed).
@@ -167,12 +167,16 @@ from teamnav.control.types import Action, Message, Observation
 __all__ = ["TRAIL_SHARE_NAVIGATE", "TrailShare", "TrailShareParams"]
 
 #: Navigate settings of ``trail-share-v1`` over the trail brains' shared ``NAVIGATE_DEFAULTS``
-#: (its ``navigate`` dict overrides them; ``{"give_way_s": 0}`` gives the behaviour before
-#: session 7). ``give_way_s = 3`` (Navigate's module docstring item 6, a gap-fill): measured on
-#: the try-paper condition itself (the scenario's drift, 3 h, seeds 0-9, paired): 57.3 % against
-#: 54.6 %, +2.7 ± 0.9 points, better on 9 of 10 seeds (the module docstring has the other
-#: comparisons). Blazing-trail-v1 keeps 0: its drift curve was recorded without it.
-TRAIL_SHARE_NAVIGATE: dict[str, Any] = {"give_way_s": 3.0}
+#: (its ``navigate`` dict overrides them). Empty since session 11: both trail brains drive with the
+#: same Navigate. Sessions 7-10 set ``give_way_s = 3`` here (Navigate's module docstring item 6, a
+#: gap-fill; measured then with the 1.2 m box reach on the try-paper condition: 57.3 % against
+#: 54.6 %, +2.7 ± 0.9 points). Once the robots keep their lanes (``box_reach_m = 2.0`` in
+#: ``NAVIGATE_DEFAULTS``) the stops cost more than they save. Measured (session 11, the scenario's
+#: drift, 30 min, paired, efficiency = ``place_speed_mps`` / cruise): give_way_s = 0 against 3,
+#: seeds 0-11 67.4 -> 70.4 % (+3.0 ± 1.3 points, 9/12 better; trips after 10 min -4.4 ± 1.4 s),
+#: fresh seeds 12-23 63.8 -> 68.5 % (+4.7 ± 2.5, 8/12; +2.2 ± 1.1 units in 30 min).
+#: ``{"give_way_s": 3}`` restores the old setting.
+TRAIL_SHARE_NAVIGATE: dict[str, Any] = {}
 
 
 class TrailShareParams(BaseModel):
@@ -227,7 +231,7 @@ class TrailShareParams(BaseModel):
         Draw the trail in the replay at most once per this many steps.
     navigate : dict
         Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields, over
-        :data:`TRAIL_SHARE_NAVIGATE` (``give_way_s=3``) over ``NAVIGATE_DEFAULTS``
+        :data:`TRAIL_SHARE_NAVIGATE` (empty since session 11) over ``NAVIGATE_DEFAULTS``
         (``trail_rule="side"``, Blazing §5.1; ``box_reach_m=2.0``, lanes).
     """
 
