@@ -143,7 +143,18 @@ default: no drift, seeds 0-7, eff 57.0 ± 2.5 % against 56.2 ± 3.7 % (paired +0
 +8.6 ± 1.7 points (better on 6 of 6).
 
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
-``min_move_m`` since the previous temporary trail; radius 2 m (about a corridor's width);
+``min_move_m`` since the previous temporary trail; radius 3 m (``radius_m``; 2 m, about a
+corridor's width, until session 11). Why 3: once robots keep their lanes (``box_reach_m`` in
+:data:`~teamnav.control.coop.blazing_trail.NAVIGATE_DEFAULTS`), the crumbs a robot follows were
+dropped by robots coming the other way, about 1 m across the corridor from it. Traced
+(``try-to-see-it-my-way``, seed 0): an eastbound robot following its wall into C3's passing place
+put its look-ahead point 2 m from the westbound lane's crumbs, found none within 2 m, recovered
+towards the nearest crumb behind it and the 180 deg rule sent it back 3 m (25 s lost, on many
+outbound trips). Measured (session 11, 30 min, paired against 2 m, the scenario's drift,
+efficiency = ``place_speed_mps`` / cruise): 2.5 m +4.4 ± 1.3 points, **3 m +7.9 ± 1.4 (seeds
+0-11, 11/12 better; trips after 10 min 102.1 -> 93.5 s, 12/12 faster)**, 4 m +7.6 ± 1.0; fresh seeds
+12-23 at 3 m +6.4 ± 1.1 (12/12). Under 4x the drift (1 h, seeds 0-5) 38.2 -> 51.2 units (+13.0 ±
+2.4), under 6x 28.0 -> 39.5 (none of 6 broke down, 1 of 6 before).
 ``crumbs_for="every_place"`` is the §2.2 alternative the paper names for future work (one Crumb
 per Place the robot has visited, each with the time since that visit), useful for rounds of
 N > 2 places where the next place is never the previous one.
@@ -241,7 +252,7 @@ class TrailShareParams(BaseModel):
                              max_length=100)
     communicate: bool = True
     broadcast_interval_s: float = Field(2.0, gt=0.0, le=600.0)
-    radius_m: float = Field(2.0, gt=0.0, le=100.0)
+    radius_m: float = Field(3.0, gt=0.0, le=100.0)
     cruise_speed_mps: float = Field(0.25, gt=0.0, le=10.0)
     policy: Literal["pessimistic", "optimistic"] = "pessimistic"
     crumb_max_age_s: float = Field(240.0, gt=0.0, le=1e7)
