@@ -40,8 +40,11 @@ minimum it explores instead of dithering. The bound is reset when the goal chang
 Lanes: the trail brains' Navigate reaches 2.0 m for its wall (``box_reach_m`` in
 :data:`~teamnav.control.coop.blazing_trail.NAVIGATE_DEFAULTS`, session 11), so robots keep to the
 left lane of the 1.8 m corridors and pass each other; that comment has the trace and the paired
-measurements (the scenario's drift, 30 min: 55.8 -> 67.7 % of cruise). Every measurement below
-this paragraph was made before it, with the 1.2 m reach.
+measurements (the scenario's drift, 30 min: 55.8 -> 67.7 % of cruise). In lanes the crumbs a
+robot follows lie in the other lane, so the crumb neighbourhood is 3 m (``radius_m``, "Choices
+where the paper is silent" below: +7.9 points more) and give-way is off again
+(:data:`TRAIL_SHARE_NAVIGATE`: +3.0). Every measurement between this paragraph and that one was
+made before session 11, with the 1.2 m reach and the 2 m neighbourhood.
 
 Efficiency gap-fills (one flag away from the paper's rules): ``turn_at_place`` (a sharp 180 deg
 turn on reaching the sought place, then ``leave_place_m`` of wall following, as in
