@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from teamnav.control import registry as controllers
 from teamnav.experiments import los_tasks as L
-from teamnav.experiments.metric_sets.los_help import los_help
+from teamnav.experiments.metric_sets.los_help import los_help, los_legs
 from teamnav.experiments.metrics import RunData
 from teamnav.experiments.report.model import Comparison, Missing, Plot, Table
 from teamnav.experiments.report.sections import los_help as S
@@ -296,6 +296,30 @@ def test_metrics_read_r1s_last_log_and_add_the_unrecorded_tail_of_a_finished_run
 
 def test_metrics_are_empty_without_an_explorer_log():
     assert los_help(_data([_log(0, 1, targets_reached=3, moves=2)], finished=False, n_steps=5)) == {}
+
+
+def test_legs_split_r1s_steps_into_leaving_corridor_wrong_rooms_and_entering():
+    """Two legs on office_simple sampled every 10 steps: base -> room S1, then S1 -> S2 by way of a
+    wrong room (N2); each interval's steps go to the leg it started in, placed where R1 ends it."""
+    xy = [(1, 7), (2, 7), (1.4, 5.0), (3, 3),                      # leg 0: corridor, door, S1
+          (2, 4), (1.4, 6.5), (8.9, 10), (8, 7), (7.2, 5), (8.9, 3)]  # leg 1: S1, corridor, N2, corridor, S2
+    ti = [0, 0, 0, 1, 1, 1, 1, 1, 1, 2]
+    pose = np.zeros((len(xy), 1, 3))
+    pose[:, 0, :2] = xy
+    logs = [_log(10 * k, 0, target_index=t, moves=10 * k, targets_reached=t, finished=k == len(xy) - 1)
+            for k, t in enumerate(ti)]
+    data = RunData(t_s=np.arange(len(xy), dtype=float), true_pose=pose, odom_pose=pose,
+                   stalled=np.zeros((len(xy), 1), bool), radius_m=np.full(1, 0.2),
+                   grid=builtin_map("office_simple").grid, n_steps=90, logs=logs, finished=True)
+    m = los_legs(data)
+    assert m == {"los_leg_leave": 5.0, "los_leg_corridor": 15.0, "los_leg_other_rooms": 5.0, "los_leg_enter": 20.0}
+    assert sum(m.values()) == 90 / 2  # every step of a reached target, once
+    # a map without corridors (not a built-in office) has no legs
+    from teamnav.world import OccupancyGrid
+
+    plain = RunData(t_s=data.t_s, true_pose=pose, odom_pose=pose, stalled=data.stalled, radius_m=data.radius_m,
+                    grid=OccupancyGrid(np.zeros((10, 10), np.uint8), 0.1), n_steps=90, logs=logs, finished=True)
+    assert los_legs(plain) == {}
 
 
 # ---------------------------------------------------------------------------- section verdicts

@@ -49,6 +49,7 @@ sweeps ``sweeps/los-{table1,table2,noise-simple,noise-complex}.yaml`` (the algor
 from __future__ import annotations
 
 import copy
+import functools
 import hashlib
 import math
 from dataclasses import dataclass
@@ -76,6 +77,8 @@ __all__ = [
     "patrol_xy",
     "room_centres",
     "scenario_data",
+    "shortest_steps_for_targets",
+    "shortest_steps_per_target",
     "simple_r2_route",
     "table_cases",
     "team_overrides",
@@ -393,6 +396,67 @@ def team_overrides(map_key: str, team: int) -> dict[str, Any]:
     return out
 
 
+@functools.lru_cache(maxsize=None)
+def _room_paths(map_key: str) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
+    """Room names, shortest path lengths [m] between room centres, and from R1's start to each
+    (:class:`teamnav.world.shortest_path.GridPaths`, clearance = the body radius)."""
+    from teamnav.world.shortest_path import GridPaths
+
+    rooms = room_centres(map_key)
+    names = tuple(rooms)
+    pts = np.array([rooms[n] for n in names], dtype=float)
+    paths = GridPaths(_env(map_key).grid, RADIUS_M)
+    between = paths.lengths(pts, pts)
+    from_start = paths.lengths([LAYOUTS[map_key].r1_start[:2]], pts)[0]
+    return names, between, from_start
+
+
+def shortest_steps_per_target(map_key: str, task: int, n_targets: int = N_TARGETS) -> float:
+    """The floor of R1's steps per target on task ``task``: the shortest path through its targets.
+
+    Each leg is the shortest collision-free path between room centres for R1's body (grid
+    estimate, within 2.7 % plus about a cell, :mod:`teamnav.world.shortest_path`), less the
+    tolerance ε at both ends (R1 stops on entering ε of a target and leaves from there; the
+    first leg starts at R1's start, so only its end is shortened), over the step length and the
+    number of targets. Ours, not the paper's: §6 counts steps "directly proportional to the
+    length of the path" but gives no optimum; this says how far each algorithm and team is
+    from it.
+
+    Examples
+    --------
+    >>> 80 < shortest_steps_per_target("simple", 1) < 95
+    True
+    """
+    return shortest_steps_for_targets(map_key, task_targets_world(map_key, task, n_targets))
+
+
+def shortest_steps_for_targets(map_key: str, targets_world) -> float:
+    """:func:`shortest_steps_per_target` for any sequence of room centres (world [m], shape (n, 2)).
+
+    Raises
+    ------
+    ValueError
+        A target that is not a room centre of the map (within 1 cm), or no target.
+    """
+    names, between, from_start = _room_paths(map_key)
+    rooms = room_centres(map_key)
+    centres = np.array([rooms[n] for n in names], dtype=float)
+    pts = np.asarray(targets_world, dtype=float).reshape(-1, 2)
+    if not len(pts):
+        raise ValueError("targets_world: expected at least one target, got none")
+    d = np.hypot(*(pts[:, None, :] - centres[None, :, :]).transpose(2, 0, 1))
+    idx = d.argmin(axis=1)
+    bad = np.flatnonzero(d[np.arange(len(pts)), idx] > 0.01)
+    if bad.size:
+        k = int(bad[0])
+        raise ValueError(f"targets_world[{k}] = ({pts[k, 0]:g}, {pts[k, 1]:g}) m is not a room centre of "
+                         f"{MAPS[map_key]} (expected one of {dict(zip(names, centres.round(2).tolist()))})")
+    eps = GOAL_TOLERANCE_M
+    total = max(float(from_start[idx[0]]) - eps, 0.0)
+    total += sum(max(float(between[a, b]) - 2.0 * eps, 0.0) for a, b in zip(idx, idx[1:]))
+    return total / STEP_LENGTH_M / len(idx)
+
+
 # ---------------------------------------------------------------------------- scenarios
 def _detector(err_max: float) -> dict[str, Any]:
     return {
@@ -480,7 +544,7 @@ def scenario_data(map_key: str, *, name: str | None = None, task: int = 1, n_tar
         "seed": 0,
         "record_every": RECORD_EVERY,
         "stop_when_finished": True,
-        "metrics": ["los_help", "steps", "path_length", "messages", "collisions"],
+        "metrics": ["los_help", "los_legs", "steps", "path_length", "messages", "collisions"],
         "robots": groups,
         "radio": {"mode": "line_of_sight", "range_m": VISIBILITY_M},
     }

@@ -38,6 +38,15 @@ Keys
     The same, averaged over every robot that logs ``msgs_sent`` (R1 and the helpers).
 ``los_trouble_frac``
     Fraction of R1's kept samples in which it was "in trouble" (``tr``, §5).
+``los_leg_<part>``
+    Where R1's path goes, in motion steps per target reached, from its true positions (ours:
+    §6 reports only the total): ``leave`` (from the last target until R1 first stands in a
+    corridor: leaving the room it reached it in), ``corridor`` (in the corridors),
+    ``other_rooms`` (off the corridors between its first and last corridor sample of the leg:
+    rooms entered by mistake), ``enter`` (from its last corridor sample to the target). A leg
+    that never reaches a corridor counts whole as ``leave``. Kept samples (``record_every``)
+    resolve it, so each part is off by up to a sample per change. Only for maps whose
+    ``regions`` name corridors (``corridor*``: the built-in office maps); otherwise absent.
 """
 
 from __future__ import annotations
@@ -105,6 +114,67 @@ def los_help(data: RunData) -> dict[str, float | int]:
     }
 
 
+def _corridors(data: RunData) -> list[tuple[float, float, float, float]]:
+    """The corridor rectangles of a built-in map (its ``regions`` named ``corridor*``), else []."""
+    name = str(getattr(data.grid, "name", ""))
+    if not name.startswith("builtin:"):
+        return []
+    from teamnav.world import BUILTIN_MAPS, builtin_map
+
+    key = name.split(":", 1)[1]
+    if key not in BUILTIN_MAPS:
+        return []
+    return [r for k, r in builtin_map(key).regions.items() if k.startswith("corridor")]
+
+
+def los_legs(data: RunData) -> dict[str, float]:
+    """R1's steps per target by part of its legs (``los_leg_<part>``, see the module docstring)."""
+    rects = _corridors(data)
+    last = _last_by_robot(data)
+    r1 = _explorer(last)
+    if not rects or r1 is None:
+        return {}
+    entries = sorted(((int(e.get("step", 0)), float(e.get("t_s", 0.0)), e.get("values") or {})
+                      for e in data.logs if int(e.get("robot", -1)) == r1), key=lambda e: e[0])
+    if len(entries) < 2:
+        return {}
+    t = np.array([e[1] for e in entries])
+    k = np.clip(np.searchsorted(data.t_s, t - 1e-9), 0, data.true_pose.shape[0] - 1)
+    xy = data.true_pose[k, r1, :2]
+    inside = np.zeros(len(entries), dtype=bool)
+    for x0, y0, x1, y1 in rects:
+        inside |= (xy[:, 0] >= x0) & (xy[:, 0] <= x1) & (xy[:, 1] >= y0) & (xy[:, 1] <= y1)
+    target = np.array([int(e[2].get("target_index", 0)) for e in entries])
+    moves = np.array([int(e[2].get("moves", 0)) for e in entries])
+    # the steps made between two samples belong to the leg of the earlier sample's target and are
+    # placed where R1 stands at the later one
+    dm = np.diff(moves, prepend=moves[0])
+    leg_of = np.concatenate([[-1], target[:-1]])
+    parts = {"leave": 0.0, "corridor": 0.0, "other_rooms": 0.0, "enter": 0.0}
+    reached = 0
+    for leg in range(int(target.max())):  # legs whose target was reached
+        sel = np.flatnonzero(leg_of == leg)
+        if sel.size == 0:
+            continue
+        steps, cor = dm[sel], inside[sel]
+        reached += 1
+        if not cor.any():
+            parts["leave"] += float(steps.sum())
+            continue
+        first, lastc = int(np.argmax(cor)), int(len(cor) - 1 - np.argmax(cor[::-1]))
+        parts["leave"] += float(steps[:first].sum())
+        parts["enter"] += float(steps[lastc + 1:].sum())
+        mid_steps, mid_cor = steps[first:lastc + 1], cor[first:lastc + 1]
+        parts["corridor"] += float(mid_steps[mid_cor].sum())
+        parts["other_rooms"] += float(mid_steps[~mid_cor].sum())
+    if not reached:
+        return {}
+    return {f"los_leg_{p}": v / reached for p, v in parts.items()}
+
+
 register("los_help", los_help,
          "Sgorbissa & Arkin §6: R1's motion steps to finish its targets, whether it gave up, targets reached, "
          "messages/bytes, where its steps went")
+register("los_legs", los_legs,
+         "Sgorbissa & Arkin §6 (ours): R1's steps per target leaving the room it was in, in the corridors, in "
+         "rooms entered by mistake and entering the target's room")

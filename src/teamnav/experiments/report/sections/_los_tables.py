@@ -11,7 +11,8 @@ import numpy as np
 from teamnav.experiments import los_tasks as L
 from teamnav.experiments.report.model import Plot, Series, Table
 from teamnav.experiments.report.sections._los_common import (
-    DELAYED_KEY, ERR_KEY, NAV_KEY, NAV_LABEL, PAPER_TABLES, STATE_KEY, TEAM_LABEL, _mean, _metric, _paper_cell, cell,
+    DELAYED_KEY, ERR_KEY, NAV_KEY, NAV_LABEL, PAPER_TABLES, STATE_KEY, TARGETS_KEY, TEAM_LABEL, _mean, _metric,
+    _paper_cell, cell,
     finished_of, group, stats, steps_of, targets_per_task,
 )
 
@@ -179,3 +180,50 @@ def where_steps_go_block(tables: dict[str, dict[int, list[dict]]]) -> Table:
                  out, "'to a teammate': heading for a teammate in sight that offers the shortest D (§3); 'to a ghost': "
                       "for where a teammate promised it (§4); 'on a promise': for its goal from a ghost where the "
                       "teammate saw the goal itself; 'switches': changes of temporary goal per target reached.")
+
+LEGS = (("leave", "leaving its room"), ("corridor", "corridors"), ("other_rooms", "wrong rooms"),
+        ("enter", "entering the target's room"))
+
+
+def _floor_of(map_key: str, rows: list[dict]) -> float:
+    """Mean shortest-path steps per target over the tasks of ``rows`` (:func:`los_tasks.shortest_steps_for_targets`)."""
+    floors = []
+    for r in rows:
+        t = (r.get("params") or {}).get(TARGETS_KEY)
+        if t:
+            try:
+                floors.append(L.shortest_steps_for_targets(map_key, L.frame_to_world(L.LAYOUTS[map_key].r1_start, t)))
+            except ValueError:
+                return float("nan")  # targets that are not the map's room centres: no floor
+    return float(np.mean(floors)) if floors else float("nan")
+
+
+def legs_block(tables: dict[str, dict[int, list[dict]]]) -> Table:
+    """Where R1's path goes, per target (metric ``los_legs``), against the shortest path.
+
+    Ours, not the paper's (§6 reports the total only): it shows which part of R1's path the
+    helpers shorten. They stand in the corridors, so they can shorten the corridor legs and the
+    wrong rooms; a room R1 must leave it leaves on its navigator's own until a helper that knows
+    its new goal's way comes into its sight."""
+    out = []
+    for m, by_team in tables.items():
+        for nav in L.NAVIGATORS:
+            for h in sorted(by_team):
+                rs = group(by_team[h], NAV_KEY).get(nav, [])
+                parts = [_mean([_metric(r, f"los_leg_{k}") for r in rs]) for k, _ in LEGS]
+                if not rs or not np.isfinite(parts).any():
+                    continue  # runs without the metric
+                fin = finished_of(rs)
+                floor = _floor_of(m, rs)
+                total = float(np.nansum(parts))
+                out.append([L.MAPS[m], NAV_LABEL[nav], TEAM_LABEL[h], *(f"{p:.0f}" for p in parts), f"{total:.0f}",
+                            f"{floor:.0f}", f"{total / floor:.2f}" if floor > 0 else "n/a",
+                            f"{int((fin > 0.5).sum())}/{fin.size}"])
+    return Table("Where R1's path goes, motion steps per target reached (mean over tasks), against the shortest path",
+                 ["map", "algorithm", "team", *(t for _, t in LEGS), "total", "shortest path", "total / shortest",
+                  "finished"],
+                 out, "From R1's true positions at the kept samples: 'leaving its room' runs from the last target until "
+                      "R1 first stands in a corridor, 'entering' from its last corridor sample to the target, 'wrong "
+                      "rooms' are the rooms it stepped into in between. 'Shortest path': the shortest collision-free "
+                      "path through the task's targets for R1's body, less ε at each end of a leg (grid estimate within "
+                      "3 %; teamnav.world.shortest_path). Totals cover the targets reached, finished tasks or not.")

@@ -63,7 +63,8 @@ from teamnav.experiments.report.sections._los_common import (  # noqa: F401
     _metric, _paper_cell, cell, finished_of, group, ok_rows, stats, steps_of, strictly_falling, targets_per_task,
 )
 from teamnav.experiments.report.sections._los_tables import (  # noqa: F401
-    FRACTIONS, ablation_block, noise_plot, noise_table, robots_plot, table_block, traffic_block, where_steps_go_block,
+    FRACTIONS, ablation_block, legs_block, noise_plot, noise_table, robots_plot, table_block, traffic_block,
+    where_steps_go_block,
 )
 from teamnav.experiments.report.sections._los_verdicts import (  # noqa: F401
     alone_levels, noise_comparisons, paired_means, paired_noise, table_comparisons,
@@ -246,6 +247,7 @@ def build(ctx) -> list:
     else:
         blocks.append(ablation_block(ok_rows(ctx.sweep("los-ablation"))))
     blocks.append(where_steps_go_block(tables))
+    blocks.append(legs_block(tables))
     blocks.append(traffic_block({m: tables[m].get(3, []) for m in maps}))
     if quick:
         note = "quick mode: one target per cell, not 5 tasks of 200; the verdict is indicative only"
