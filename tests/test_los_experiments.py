@@ -508,3 +508,17 @@ def test_steps_fall_verdict_pairs_tasks_so_a_failed_hard_task_cannot_fake_a_fall
     tab, m = S.table_block("simple", by_team)
     comp = [c for c in S.table_comparisons("simple", m, by_team) if "Av. Past" in c.claim][0]
     assert comp.holds is False and "paired: the 1 of 2 tasks" in comp.ours
+
+
+def test_a_failed_falling_verdict_says_how_large_each_rise_is_against_the_task_noise():
+    from teamnav.experiments.report.sections._los_verdicts import paired_rises
+
+    steps = {0: [100.0, 110.0, 120.0], 1: [110.0, 115.0, 118.0], 2: [90.0, 95.0, 99.0]}
+    by_team = {h: [_row("avoid_past", s, **{S.TARGETS_KEY: [[float(task), 0.0]] * 20})
+                   for task, s in enumerate(v)] for h, v in steps.items()}
+    # R1 -> R1,2 rose by 10, 5, -2: +4.3 ± 3.5 (s.e.); R1,2 -> R1,2,3 fell: not listed
+    assert paired_rises(by_team, "avoid_past", [0, 1, 2]) == ["R1 → R1,2: +4 ± 3 (s.e. over 3 tasks; 2 of 3 worse)"]
+    comps = S.table_comparisons("simple", {"avoid_past": [110.0, 114.3, 94.7], "visbug21": [float("nan")] * 4,
+                                           "potential_field": [float("nan")] * 4}, by_team)
+    ap = next(c for c in comps if "Av. Past" in c.claim)
+    assert ap.holds is False and "R1 → R1,2: +4 ± 3 (s.e. over 3 tasks; 2 of 3 worse)" in ap.differs

@@ -19,10 +19,11 @@ from teamnav.experiments.report.sections._los_common import (
 )
 
 
-def paired_means(by_team: dict[int, list[dict]], nav: str, hs: Sequence[int]) -> tuple[list[float], int, int] | None:
-    """Mean steps per target per team size over the tasks finished with *every* team size in
-    ``hs`` (a task failed by one team would otherwise leave only the easy tasks in its mean);
-    (means, tasks kept, tasks run), or None when the rows do not name their tasks."""
+def _paired_per_task(by_team: dict[int, list[dict]], nav: str,
+                     hs: Sequence[int]) -> tuple[dict[int, dict[str, float]], list[str], int] | None:
+    """Steps per target by team size and task over the tasks finished with *every* team size in
+    ``hs``: ({team: {task: steps}}, the common tasks (sorted), tasks run), or None when the rows do
+    not name their tasks."""
     per: dict[int, dict[str, float]] = {}
     tasks: set[str] = set()
     for h in hs:
@@ -35,11 +36,43 @@ def paired_means(by_team: dict[int, list[dict]], nav: str, hs: Sequence[int]) ->
             tasks.add(key)
             if _metric(r, "los_finished") > 0.5:
                 per[h][key] = _metric(r, "los_steps_per_target")
-    common = set.intersection(*(set(v) for v in per.values())) if per else set()
     if not tasks:
         return None
+    common = sorted(set.intersection(*(set(v) for v in per.values()))) if per else []
+    return per, common, len(tasks)
+
+
+def paired_means(by_team: dict[int, list[dict]], nav: str, hs: Sequence[int]) -> tuple[list[float], int, int] | None:
+    """Mean steps per target per team size over the tasks finished with *every* team size in
+    ``hs`` (a task failed by one team would otherwise leave only the easy tasks in its mean);
+    (means, tasks kept, tasks run), or None when the rows do not name their tasks."""
+    got = _paired_per_task(by_team, nav, hs)
+    if got is None:
+        return None
+    per, common, n = got
     ms = [float(np.mean([per[h][t] for t in common])) if common else float("nan") for h in hs]
-    return ms, len(common), len(tasks)
+    return ms, len(common), n
+
+
+def paired_rises(by_team: dict[int, list[dict]], nav: str, hs: Sequence[int]) -> list[str]:
+    """Each added helper that *raised* the paired mean, with its size against the task-to-task
+    noise: "R1 → R1,2: +11 ± 4 (s.e. over 5 tasks; 5 of 5 worse)". A verdict that fails on a
+    rise within its standard error fails on noise; one several s.e. out fails for real."""
+    got = _paired_per_task(by_team, nav, hs)
+    if got is None:
+        return []
+    per, common, _n = got
+    out = []
+    for a, b in zip(hs, hs[1:]):
+        if not common:
+            break
+        d = np.array([per[b][t] - per[a][t] for t in common])
+        if d.mean() <= 0:
+            continue
+        se = float(d.std(ddof=1) / np.sqrt(d.size)) if d.size > 1 else float("nan")
+        out.append(f"{TEAM_LABEL[a]} → {TEAM_LABEL[b]}: +{d.mean():.0f} ± {se:.0f} (s.e. over {d.size} tasks; "
+                   f"{int((d > 0).sum())} of {d.size} worse)")
+    return out
 
 def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict[int, list[dict]]) -> list[Comparison]:
     tab = 1 if map_key == "simple" else 2
@@ -75,7 +108,9 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         out.append(Comparison(
             f"Table {tab}: {NAV_LABEL[nav]} steps fall as helpers are added ({', '.join(TEAM_LABEL[h] for h in hs)})",
             " → ".join(f"{v:.1f}" for v in p), ours + ratio + note, holds,
-            "" if holds or holds is None else "not strictly falling at every added helper in our runs (see the table)"))
+            "" if holds or holds is None else "not strictly falling at every added helper in our runs"
+            + (f" (each rise paired by task, {'; '.join(rises)})" if (rises := paired_rises(by_team, nav, ok_hs))
+               else " (see the table)")))
     pf = group(by_team.get(0, []), NAV_KEY).get("potential_field", [])
     pf_help = [r for h in teams if h > 0 for r in group(by_team[h], NAV_KEY).get("potential_field", [])]
     alone_fin, help_fin = finished_of(pf), finished_of(pf_help)
