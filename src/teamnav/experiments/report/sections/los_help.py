@@ -15,9 +15,15 @@ What it runs (sweeps ``los-table1``, ``los-table2``, ``los-noise-simple``,
   the "R1 alone" level of the tables.
 - An ablation the paper implies (simple map, all helpers): reflected visibility only (§3),
   + delayed visibility / ghost robots (§4), + state sharing (§5).
+- Where R1's path goes (ours; §6 reports only totals): the tables' runs split into leaving
+  R1's room, the corridors, wrong rooms and entering the target's room (metric ``los_legs``),
+  beside the shortest path through the task's targets
+  (:func:`~teamnav.experiments.los_tasks.shortest_steps_for_targets`), so that a reader sees
+  which part of the path the helpers shorten for each algorithm.
 
 EXPERIMENTS.md rows become :class:`Comparison` blocks: steps fall monotonically as helpers are
-added, for every algorithm (Tables 1-2); the potential field alone never finishes and
+added, for every algorithm (Tables 1-2; a verdict that fails names each rise with its paired
+mean ± s.e. over the tasks, so that a rise within the noise reads as such); the potential field alone never finishes and
 finishes with helpers; with 3 helpers the algorithm still matters on the complex map (the
 best and worst mean differ by > 10 %); steps grow with err_max; at err_max = 0.4 the simple
 map's steps stay below R1 alone; on the complex map help fades (at 0.4 it keeps less than
