@@ -26,6 +26,7 @@ def _box(h=60, w=80, wall=False):
 
 
 _EMPTY = GridPaths(_box(), 0.0)
+_WALL = GridPaths(_box(wall=True), 0.2)
 _pt = st.tuples(st.floats(0.35, 7.6), st.floats(0.35, 5.6))
 
 
@@ -115,3 +116,15 @@ def test_no_navigator_beats_the_floor_on_a_short_task():
     assert m["los_finished"] == 1
     floor = L.shortest_steps_per_target("simple", 1, n)
     assert floor < m["los_steps_per_target"] < 6 * floor
+
+
+@settings(max_examples=40, deadline=None)
+@given(_pt, _pt, _pt)
+def test_lengths_obey_the_triangle_inequality_round_a_wall(a, b, c):
+    try:
+        d = _WALL.lengths([a, b], [b, c])
+        ac = _WALL.lengths([a], [c])[0, 0]
+    except ValueError:
+        return  # a point on the wall or within its clearance: not a free point
+    assert ac <= d[0, 0] + d[1, 1] + 1e-9
+
