@@ -522,3 +522,24 @@ def test_a_failed_falling_verdict_says_how_large_each_rise_is_against_the_task_n
                                            "potential_field": [float("nan")] * 4}, by_team)
     ap = next(c for c in comps if "Av. Past" in c.claim)
     assert ap.holds is False and "R1 → R1,2: +4 ± 3 (s.e. over 3 tasks; 2 of 3 worse)" in ap.differs
+
+
+def test_legs_table_sets_the_finished_tasks_against_their_shortest_path():
+    from teamnav.experiments.report.sections._los_tables import legs_block
+
+    t = L.task_targets_xy("simple", 1, 3)
+    legs = {"los_leg_leave": 100.0, "los_leg_corridor": 60.0, "los_leg_other_rooms": 10.0, "los_leg_enter": 20.0}
+
+    def row(nav, finished, scale=1.0):
+        return {"status": "ok", "params": {S.NAV_KEY: nav, S.TARGETS_KEY: t},
+                "metrics": {"los_finished": finished, **{k: v * scale for k, v in legs.items()}}}
+
+    by_team = {0: [row("avoid_past", 1), row("avoid_past", 0, scale=3.0), row("potential_field", 0)]}
+    tab = legs_block({"simple": by_team})
+    ap = next(r for r in tab.rows if r[1] == "Av. Past")
+    floor = L.shortest_steps_per_target("simple", 1, 3)
+    # the finished task only (the unfinished one, three times as long, is left out as in Tables 1-2)
+    assert ap[3:8] == ["100", "60", "10", "20", "190"] and ap[8] == f"{floor:.0f}"
+    assert ap[9] == f"{190 / floor:.2f}" and ap[10] == "1/2"
+    pf = next(r for r in tab.rows if r[1] == "Pot. Fields")
+    assert pf[9] == "n/a (no task finished)" and pf[10] == "0/1"

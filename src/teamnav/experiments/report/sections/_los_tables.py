@@ -210,15 +210,19 @@ def legs_block(tables: dict[str, dict[int, list[dict]]]) -> Table:
         for nav in L.NAVIGATORS:
             for h in sorted(by_team):
                 rs = group(by_team[h], NAV_KEY).get(nav, [])
-                parts = [_mean([_metric(r, f"los_leg_{k}") for r in rs]) for k, _ in LEGS]
+                fin = finished_of(rs)
+                done = [r for r, f in zip(rs, fin) if f > 0.5]
+                # the finished tasks, as in Tables 1-2; a cell that finished none shows the targets it
+                # reached, with no ratio (its floor would be the whole task's)
+                use = done or rs
+                parts = [_mean([_metric(r, f"los_leg_{k}") for r in use]) for k, _ in LEGS]
                 if not rs or not np.isfinite(parts).any():
                     continue  # runs without the metric
-                fin = finished_of(rs)
-                floor = _floor_of(m, rs)
+                floor = _floor_of(m, use)
                 total = float(np.nansum(parts))
+                ratio = f"{total / floor:.2f}" if done and floor > 0 else "n/a (no task finished)" if not done else "n/a"
                 out.append([L.MAPS[m], NAV_LABEL[nav], TEAM_LABEL[h], *(f"{p:.0f}" for p in parts), f"{total:.0f}",
-                            f"{floor:.0f}", f"{total / floor:.2f}" if floor > 0 else "n/a",
-                            f"{int((fin > 0.5).sum())}/{fin.size}"])
+                            f"{floor:.0f}", ratio, f"{int((fin > 0.5).sum())}/{fin.size}"])
     return Table("Where R1's path goes, motion steps per target reached (mean over tasks), against the shortest path",
                  ["map", "algorithm", "team", *(t for _, t in LEGS), "total", "shortest path", "total / shortest",
                   "finished"],
@@ -226,4 +230,5 @@ def legs_block(tables: dict[str, dict[int, list[dict]]]) -> Table:
                       "R1 first stands in a corridor, 'entering' from its last corridor sample to the target, 'wrong "
                       "rooms' are the rooms it stepped into in between. 'Shortest path': the shortest collision-free "
                       "path through the task's targets for R1's body, less ε at each end of a leg (grid estimate within "
-                      "3 %; teamnav.world.shortest_path). Totals cover the targets reached, finished tasks or not.")
+                      "3 %; teamnav.world.shortest_path). Means over the finished tasks, as in Tables 1-2; a cell that "
+                      "finished none shows the legs of the targets it reached.")

@@ -83,15 +83,14 @@ NOISE_SWEEP = {"simple": "los-noise-simple", "complex": "los-noise-complex"}
 
 # ---------------------------------------------------------------------------- sweeps
 #: What the full reproduction costs on this machine (measured, see the note's numbers).
-FULL_CPU_NOTE = ("Cost of the full reproduction here, measured: `NUMBA_NUM_THREADS=1 teamnav sweep los-table1` "
-                 "(3 algorithms x 4 nested teams x 5 tasks of 200 targets = 60 trials) took 21 CPU-min on this "
-                 "2-core machine and `los-table2` 27 CPU-min (2026-11-26, session 10: see_past_teammates, budgets "
-                 "of 6000 / 12000 steps per target, office_complex_closed, VisBug-21 helpers on both maps; one "
-                 "worker per sweep, the two sweeps side by side; a failing trial ends at its first target over "
-                 "budget). `los-noise-simple` and `los-noise-complex` (75 trials of 200 targets each, all helpers) "
-                 "took 52 and 58 CPU-min on idle cores (session 9; 62 and 70 min of trial wall time in session 10 "
-                 "on cores shared with other work), `los-ablation` (60 trials) 33-37 CPU-min. All five: about "
-                 "3.3 CPU-hours. Wall time is about the CPU time over the number of workers (`-j`).")
+FULL_CPU_NOTE = ("Cost of the full reproduction here, measured (2026-11-26, session 12, this 2-core machine): "
+                 "`teamnav sweep los-table1` (3 algorithms x 4 nested teams x 5 tasks of 200 targets = 60 trials) "
+                 "took 996 s and `los-table2` 1245 s of wall time, one worker each, the two side by side (session 10: "
+                 "21 and 27 min); then `teamnav report los-help -j 2` ran `los-noise-simple` (75 trials) in 1788 s, "
+                 "`los-noise-complex` (75) in 1305 s and `los-ablation` (60) in 686 s on 2 workers (the first shared "
+                 "its cores with other work for a while). All five: about 84 min of wall time on 2 cores, about 2.7 "
+                 "CPU-hours. A failing trial ends at its first target over budget; wall time is about the CPU time "
+                 "over the number of workers (`-j`).")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
 GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
