@@ -397,9 +397,10 @@ def team_overrides(map_key: str, team: int) -> dict[str, Any]:
 
 
 @functools.lru_cache(maxsize=None)
-def _room_paths(map_key: str) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
-    """Room names, shortest path lengths [m] between room centres, and from R1's start to each
-    (:class:`teamnav.world.shortest_path.GridPaths`, clearance = the body radius)."""
+def _room_paths(map_key: str) -> tuple[tuple[str, ...], np.ndarray, np.ndarray, np.ndarray]:
+    """Room names, their centres (world [m]), shortest path lengths [m] between room centres, and
+    from R1's start to each (:class:`teamnav.world.shortest_path.GridPaths`, clearance = the body
+    radius); built once per map."""
     from teamnav.world.shortest_path import GridPaths
 
     rooms = room_centres(map_key)
@@ -408,7 +409,7 @@ def _room_paths(map_key: str) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
     paths = GridPaths(_env(map_key).grid, RADIUS_M)
     between = paths.lengths(pts, pts)
     from_start = paths.lengths([LAYOUTS[map_key].r1_start[:2]], pts)[0]
-    return names, between, from_start
+    return names, pts, between, from_start
 
 
 def shortest_steps_per_target(map_key: str, task: int, n_targets: int = N_TARGETS) -> float:
@@ -438,9 +439,7 @@ def shortest_steps_for_targets(map_key: str, targets_world) -> float:
     ValueError
         A target that is not a room centre of the map (within 1 cm), or no target.
     """
-    names, between, from_start = _room_paths(map_key)
-    rooms = room_centres(map_key)
-    centres = np.array([rooms[n] for n in names], dtype=float)
+    names, centres, between, from_start = _room_paths(map_key)
     pts = np.asarray(targets_world, dtype=float).reshape(-1, 2)
     if not len(pts):
         raise ValueError("targets_world: expected at least one target, got none")

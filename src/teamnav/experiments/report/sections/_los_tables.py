@@ -12,8 +12,7 @@ from teamnav.experiments import los_tasks as L
 from teamnav.experiments.report.model import Plot, Series, Table
 from teamnav.experiments.report.sections._los_common import (
     DELAYED_KEY, ERR_KEY, NAV_KEY, NAV_LABEL, PAPER_TABLES, STATE_KEY, TARGETS_KEY, TEAM_LABEL, _mean, _metric,
-    _paper_cell, cell,
-    finished_of, group, stats, steps_of, targets_per_task,
+    _paper_cell, cell, finished_of, group, stats, steps_of, targets_per_task,
 )
 
 
