@@ -38,7 +38,20 @@ import numpy as np
 
 from teamnav.experiments.metrics import RunData, register
 
-__all__ = ["LOCALIZED_M", "error_matrix"]
+__all__ = ["HEADLINE", "LOCALIZED_M", "error_matrix"]
+
+#: what ``teamnav run`` prints of these metrics (see :mod:`teamnav.experiments.metric_sets`)
+HEADLINE: dict[str, tuple[tuple[str, str], ...]] = {
+    "localization": (
+        ("loc_time_to_localize_s", "s"),
+        ("loc_censored", "robots"),
+        ("loc_localized_fraction", "fraction"),
+        ("loc_final_localized_fraction", "fraction"),
+        ("loc_final_error_m", "m"),
+        ("loc_mean_error_m", "m"),
+        ("loc_syncs", "updates"),
+    ),
+}
 
 #: Fox et al. §5.2.1: a robot is localized once its error is below this [m].
 LOCALIZED_M: float = 1.5

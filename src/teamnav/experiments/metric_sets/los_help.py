@@ -57,6 +57,26 @@ import numpy as np
 
 from teamnav.experiments.metrics import RunData, register
 
+#: what ``teamnav run`` prints of these metrics (see :mod:`teamnav.experiments.metric_sets`)
+HEADLINE: dict[str, tuple[tuple[str, str], ...]] = {
+    "los_help": (
+        ("los_finished", "0/1"),
+        ("los_gave_up", "0/1"),
+        ("los_steps", "steps"),
+        ("los_targets_reached", "targets"),
+        ("los_steps_per_target", "steps/target"),
+        ("los_msgs_r1", "messages"),
+        ("los_bytes_r1", "bytes"),
+        ("los_trouble_frac", "fraction"),
+    ),
+    "los_legs": (
+        ("los_leg_leave", "steps/target"),
+        ("los_leg_corridor", "steps/target"),
+        ("los_leg_other_rooms", "steps/target"),
+        ("los_leg_enter", "steps/target"),
+    ),
+}
+
 
 def _last_by_robot(data: RunData) -> dict[int, dict[str, Any]]:
     """Each robot's last logged values (with the step they were kept at under ``"_step"``)."""

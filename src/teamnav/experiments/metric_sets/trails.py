@@ -62,6 +62,7 @@ from teamnav.experiments.metrics import RunData, register
 __all__ = [
     "BREAKDOWN_GAP_S",
     "CRUMB_EVERY_S",
+    "HEADLINE",
     "HOME_EVENT",
     "ROUTE_LENGTH_M",
     "SOURCE_EVENT",
@@ -84,6 +85,24 @@ CRUMB_EVERY_S = 10.0
 WINDOW_S = 600.0
 #: driven route length between pairs of places [m] (trail_office; see module docstring)
 ROUTE_LENGTH_M: dict[frozenset, float] = {frozenset({"home", "source"}): 31.5}
+
+#: what ``teamnav run`` prints of these metrics (see :mod:`teamnav.experiments.metric_sets`);
+#: the series are for the report's figures only
+HEADLINE: dict[str, tuple[tuple[str, str], ...]] = {
+    "trails": (
+        ("units_total", "units"),
+        ("trips_total", "trips"),
+        ("first_trail_s", "s"),
+        ("trip_time_s_before_mean", "s"),
+        ("trip_time_s_after_mean", "s"),
+        ("units_per_10min_peak", "units/10 min"),
+        ("breakdown_s", "s"),
+        ("place_speed_mps", "m/s"),
+        ("crumbs_max", "crumbs"),
+    ),
+    "trails_series": (),
+    "trails_crumbs": (),
+}
 
 
 def _is_trail_run(data: RunData) -> bool:
