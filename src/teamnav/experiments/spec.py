@@ -47,11 +47,18 @@ from pydantic import Field, PrivateAttr, ValidationError, field_validator, model
 from teamnav.control import registry as controllers
 from teamnav.experiments import metrics as metric_registry
 from teamnav.experiments import registry as scenarios
-from teamnav.experiments.errors import Problem, ScenarioError, from_validation_error, from_yaml_error, show_value
+from teamnav.experiments.errors import (
+    Problem,
+    ScenarioError,
+    YamlLimitError,
+    from_validation_error,
+    from_yaml_error,
+    show_value,
+)
 from teamnav.sim.config import Model, SimConfig
 from teamnav.world.generators import BUILTIN_MAPS, MapBuilder
 from teamnav.world.grid import OccupancyGrid
-from teamnav.world.mapio import MapError, load_map
+from teamnav.world.mapio import MapError, load_map, read_map_yaml
 
 __all__ = [
     "ArenaSpec",
@@ -71,10 +78,150 @@ PACKAGE_MAP_DIR: Path = Path(str(resources.files("teamnav.world"))) / "maps"
 
 _MAP_SUFFIXES = (".yaml", ".yml", ".png", ".pgm")
 
+#: Most memory [bytes] a scenario's map may need (2 GiB); bigger maps and arenas are refused
+#: before anything is allocated, naming the estimate and this limit.
+MAX_MAP_BYTES = 2 * 1024**3
+#: Bytes a run needs per map cell: the cells and blocking masks (uint8), the float64 distance
+#: field and scipy's Euclidean distance transform's working arrays (measured peak: ~36 B/cell).
+MAP_BYTES_PER_CELL = 40
+
+
+def map_memory_problem(n_cells: float, what: str) -> str | None:
+    """Why a map of ``n_cells`` cells is refused (None when it fits :data:`MAX_MAP_BYTES`).
+
+    Examples
+    --------
+    >>> map_memory_problem(1200 * 1200, "map") is None
+    True
+    >>> print(map_memory_problem(20_000 * 20_000, "arena 10000 x 10000 m at 0.5 m"))
+    arena 10000 x 10000 m at 0.5 m has 400,000,000 cells, which needs about 14.9 GiB of memory (40 bytes per cell for the grid and its distance transform); expected at most 2.0 GiB (teamnav.experiments.spec.MAX_MAP_BYTES): use a coarser resolution_m or a smaller map
+    """
+    need = float(n_cells) * MAP_BYTES_PER_CELL
+    if need <= MAX_MAP_BYTES:
+        return None
+    return (
+        f"{what} has {int(n_cells):,} cells, which needs about {need / 1024**3:.1f} GiB of memory ({MAP_BYTES_PER_CELL} bytes "
+        f"per cell for the grid and its distance transform); expected at most {MAX_MAP_BYTES / 1024**3:.1f} GiB "
+        "(teamnav.experiments.spec.MAX_MAP_BYTES): use a coarser resolution_m or a smaller map"
+    )
+
+
+def map_file_problem(path: str | os.PathLike) -> str | None:
+    """Why the map file ``path`` (map YAML or image) is refused for its size, read from the
+    image header only (None when it fits or cannot be read: :func:`load_map` then reports).
+
+    Raises
+    ------
+    MapError
+        The map YAML itself is invalid.
+    """
+    from PIL import Image
+
+    path = Path(path)
+    image = read_map_yaml(path).image if path.suffix.lower() in (".yaml", ".yml") else path
+    try:
+        with Image.open(image) as im:
+            w, h = im.size
+    except Image.DecompressionBombError as exc:
+        return f"map image {image} is too large to open ({exc})"
+    except Exception:  # noqa: BLE001 - unreadable images are load_map's to report, with its own message
+        return None
+    return map_memory_problem(w * h, f"map image {image} ({w} x {h} pixels)")
+
+
+def _builtin_problem(name: str, resolution_m: float | None) -> str | None:
+    """Why built-in map ``name`` at ``resolution_m`` is refused for its size (scaled from the
+    cached default-resolution build, so nothing big is allocated)."""
+    if resolution_m is None or name not in BUILTIN_MAPS:
+        return None
+    base = _builtin_env(name, None).grid
+    cells = base.cells.size * (base.resolution_m / float(resolution_m)) ** 2
+    return map_memory_problem(cells, f"built-in map {name!r} at resolution_m {resolution_m:g}")
+
+
+#: Deepest nesting of mappings and lists a scenario, sweep or ``--set`` YAML may have (a
+#: scenario needs about 6; deeper documents are refused before Python's recursion limit).
+YAML_MAX_DEPTH = 100
+#: Most values (scalars, lists, mappings) a YAML document may hold once every alias
+#: (``*name``) is expanded: refuses a "billion laughs" before anything walks it.
+YAML_MAX_NODES = 1_000_000
+_MERGE_TAG = "tag:yaml.org,2002:merge"
+
 
 class _YamlLoader(yaml.SafeLoader):
     """PyYAML's safe loader with YAML 1.2 booleans: only true/false, so ``on: enter`` (a
-    PlaceConfig field) stays the key ``"on"`` instead of YAML 1.1's ``True``."""
+    PlaceConfig field) stays the key ``"on"`` instead of YAML 1.1's ``True``.
+
+    It also refuses, with a :class:`~teamnav.experiments.errors.YamlLimitError` naming the
+    field and the line: a key given twice in one mapping (plain YAML keeps the last one
+    silently), nesting deeper than :data:`YAML_MAX_DEPTH`, more than :data:`YAML_MAX_NODES`
+    values once aliases are expanded, and an alias inside the node it refers to.
+    """
+
+    def __init__(self, stream) -> None:
+        super().__init__(stream)
+        self._path: list[str] = []
+        self._size: dict[int, int] = {}  # id(node) -> values under it, aliases expanded
+
+    def _field(self, extra: str = "") -> str:
+        text = "".join(self._path) + extra
+        text = text[1:] if text.startswith(".") else text
+        return text if len(text) <= 80 else text[:60] + "..." + text[-17:]
+
+    def compose_node(self, parent, index):  # noqa: D102 - PyYAML hook
+        event = self.peek_event()
+        if isinstance(index, yaml.ScalarNode):
+            seg = f".{index.value}"
+        elif isinstance(index, int):
+            seg = f"[{index}]"
+        else:
+            seg = ""  # the document, or a mapping key
+        if len(self._path) >= YAML_MAX_DEPTH:
+            raise YamlLimitError(
+                self._field(),
+                f"nested more than {YAML_MAX_DEPTH} levels deep; expected at most {YAML_MAX_DEPTH} levels of mappings and lists",
+                event.start_mark,
+            )
+        self._path.append(seg)
+        try:
+            node = super().compose_node(parent, index)
+        finally:
+            self._path.pop()
+        size = self._size.get(id(node))
+        if size is None:
+            if isinstance(event, yaml.AliasEvent):
+                raise YamlLimitError(
+                    self._field(seg),
+                    f"alias *{event.anchor} is used inside the node it names (a self-referencing structure); "
+                    "expected aliases to refer to complete nodes",
+                    event.start_mark,
+                )
+            if isinstance(node, yaml.MappingNode):
+                seen: dict[tuple[str, str], Any] = {}
+                for key, _ in node.value:
+                    if isinstance(key, yaml.ScalarNode) and key.tag != _MERGE_TAG:
+                        first = seen.setdefault((key.tag, key.value), key)
+                        if first is not key:
+                            raise YamlLimitError(
+                                self._field(seg + f".{key.value}"),
+                                f"duplicate key {key.value!r} (first given at line {first.start_mark.line + 1}); "
+                                "expected each key once in a mapping",
+                                key.start_mark,
+                            )
+                size = 1 + sum(self._size[id(k)] + self._size[id(v)] for k, v in node.value)
+            elif isinstance(node, yaml.SequenceNode):
+                size = 1 + sum(self._size[id(v)] for v in node.value)
+            else:
+                size = 1
+            self._size[id(node)] = size
+        if size > YAML_MAX_NODES:
+            raise YamlLimitError(
+                self._field(seg),
+                f"expands to more than {YAML_MAX_NODES:,} values through aliases (*name) or sheer size; "
+                f"expected at most {YAML_MAX_NODES:,} (teamnav.experiments.spec.YAML_MAX_NODES)",
+                event.start_mark,
+            )
+        return node
 
 
 _YamlLoader.yaml_implicit_resolvers = {
@@ -121,6 +268,10 @@ class ArenaSpec(Model):
                 f"arena would need more than 20000 cells per side ({self.width_m} x {self.height_m} m "
                 f"at {self.resolution_m} m); use a coarser resolution_m"
             )
+        cells = round(self.width_m / self.resolution_m) * round(self.height_m / self.resolution_m)
+        problem = map_memory_problem(cells, f"arena {self.width_m:g} x {self.height_m:g} m at {self.resolution_m:g} m")
+        if problem:
+            raise ValueError(problem)
         return self
 
 
@@ -155,6 +306,10 @@ class MapSpec(Model):
             raise ValueError(
                 f"map.builtin: unknown built-in map {self.builtin!r}{hint} (known: {', '.join(sorted(BUILTIN_MAPS))})"
             )
+        if self.builtin is not None:
+            problem = _builtin_problem(self.builtin, self.resolution_m)
+            if problem:
+                raise ValueError(f"map.resolution_m: {problem}")
         if self.package is not None:
             known = package_maps()
             target = PACKAGE_MAP_DIR / self.package
@@ -236,7 +391,11 @@ class Scenario(SimConfig):
                 f"map, got map {show_value(spec)}"
             )
         res = spec.get("resolution_m")
-        named = _builtin_env(builtin, res if isinstance(res, (int, float)) else None).places
+        res = res if isinstance(res, (int, float)) and not isinstance(res, bool) and 0 < res <= 10 else None
+        problem = _builtin_problem(builtin, res)
+        if problem:
+            raise ValueError(f"map.resolution_m: {problem}")
+        named = _builtin_env(builtin, res).places
         data = copy.deepcopy(data)
 
         def where(field: str, ref: Any) -> tuple[float, float]:
@@ -319,6 +478,11 @@ def _file_grid(path: str, mtime_ns: int, resolution_m: float | None) -> Occupanc
     return load_map(path, resolution_m=resolution_m)
 
 
+@functools.lru_cache(maxsize=16)
+def _file_problem(path: str, mtime_ns: int) -> str | None:
+    return map_file_problem(path)
+
+
 @functools.lru_cache(maxsize=8)
 def _arena_grid(arena: ArenaSpec) -> OccupancyGrid:
     b = MapBuilder(arena.width_m, arena.height_m, arena.resolution_m)
@@ -347,6 +511,9 @@ def build_grid(scenario: Scenario) -> OccupancyGrid:
             mtime = path.stat().st_mtime_ns
         except OSError:
             raise ScenarioError.one(scenario.source, field, "expected an existing map file", f"{path} (no such file)", raw=True)
+        problem = _file_problem(str(path), mtime)
+        if problem:
+            raise ScenarioError(scenario.source, [Problem(field, problem)])
         return _file_grid(str(path), mtime, spec.resolution_m)
     except MapError as exc:
         field = "map.file" if spec.file is not None else "map.package"
@@ -355,6 +522,45 @@ def build_grid(scenario: Scenario) -> OccupancyGrid:
         if isinstance(exc, ScenarioError):
             raise
         raise ScenarioError(scenario.source, [Problem("map.resolution_m", str(exc))]) from None
+
+
+# ---------------------------------------------------------------------------- booleans as numbers
+def bool_number_problems(model: Any, raw: Any, prefix: str = "") -> list[Problem]:
+    """Fields where the file gave ``true``/``false`` but the model made a number of it.
+
+    pydantic's lax mode reads ``count: true`` as 1; a count, a seed or a length given as a
+    boolean is a mistake, so every such field is reported (walking the validated ``model``
+    beside the ``raw`` data it came from, nested models and lists included).
+    """
+    from pydantic import BaseModel
+
+    problems: list[Problem] = []
+
+    def check(value: Any, given: Any, path: str) -> None:
+        if isinstance(given, bool) and isinstance(value, (int, float)) and not isinstance(value, bool):
+            kind = "an integer" if isinstance(value, int) else "a number"
+            problems.append(Problem(path, f"expected {kind}, not a boolean", show_value(given).lower()))
+        elif isinstance(value, BaseModel) and isinstance(given, dict):
+            for name, info in type(value).model_fields.items():
+                key = info.alias or name
+                if key in given:
+                    check(getattr(value, name), given[key], f"{path}.{key}" if path else key)
+        elif isinstance(value, (list, tuple)) and isinstance(given, (list, tuple)) and len(value) == len(given):
+            for i, (v, g) in enumerate(zip(value, given)):
+                check(v, g, f"{path}[{i}]")
+        elif isinstance(value, dict) and isinstance(given, dict):
+            for k, v in value.items():
+                if k in given:
+                    check(v, given[k], f"{path}.{k}" if path else str(k))
+
+    check(model, raw, prefix)
+    return problems
+
+
+def _note_for(field: str, notes: Mapping[str, str]) -> str | None:
+    """The override note (``from --set ...``) of ``field`` or of the nearest field above it."""
+    keys = [key for key in notes if field == key or field.startswith((key + ".", key + "["))]
+    return notes[max(keys, key=len)] if keys else None
 
 
 # ---------------------------------------------------------------------------- controllers
@@ -375,10 +581,12 @@ def check_controllers(scenario: Scenario) -> list[Problem]:
         if params_model is None:
             continue
         try:
-            params_model.model_validate(group.params)
+            params = params_model.model_validate(group.params)
         except ValidationError as exc:
             err = from_validation_error(exc, scenario.source, group.params, model=params_model, prefix=f"robots[{i}].params")
             problems.extend(err.problems)
+        else:
+            problems.extend(bool_number_problems(params, group.params, f"robots[{i}].params"))
     return problems
 
 
@@ -483,6 +691,8 @@ def _looks_like_path(s: str) -> bool:
 
 def _read_yaml(path: Path) -> dict:
     file = str(path)
+    if path.is_dir():
+        raise ScenarioError.one(file, "", "expected a scenario YAML file", "a directory", raw=True)
     if not path.is_file():
         raise ScenarioError.one(file, "", "expected an existing scenario file", "no such file", raw=True)
     try:
@@ -493,6 +703,8 @@ def _read_yaml(path: Path) -> dict:
         data = read_yaml(text)
     except yaml.YAMLError as exc:
         raise from_yaml_error(exc, file) from None
+    except RecursionError:  # the loader bounds nesting; this is a last guard
+        raise ScenarioError.one(file, "", f"expected at most {YAML_MAX_DEPTH} levels of nesting", "a document nested too deeply", raw=True) from None
     if data is None:
         raise ScenarioError.one(file, "", "expected a mapping of scenario fields, the file is empty")
     if not isinstance(data, dict):
@@ -574,8 +786,11 @@ def load_scenario(
         scn = Scenario.model_validate(data)
     except ValidationError as exc:
         raise from_validation_error(exc, file, data, model=Scenario, notes=notes) from None
+    except RecursionError:  # a Python dict nested past the interpreter's limit (files are bounded by the loader)
+        raise ScenarioError.one(file, "", "expected a scenario nested at most a few levels deep", "a structure nested too deeply", raw=True) from None
     scn._source = file
-    problems = check_controllers(scn)
+    problems = [Problem(p.field, p.message, p.received, _note_for(p.field, notes)) for p in bool_number_problems(scn, data)]
+    problems += check_controllers(scn)
     if problems:
         raise ScenarioError(file, problems)
     build_grid(scn)
