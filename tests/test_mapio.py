@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import logging
+import math
 from pathlib import Path
 
 import numpy as np
@@ -82,24 +84,40 @@ def test_yaml_overrides(tmp_path):
 
 # ---------------------------------------------------------------------------- pixel rule
 def _reference(px: np.ndarray, negate: bool, occ_th: float, free_th: float, mode: str) -> np.ndarray:
-    """Direct reimplementation of map_server + amcl's reading, per pixel, in Python loops."""
+    """nav2's loadMapFromFile + amcl's reading, per pixel, in Python loops (map_io.cpp).
+
+    Magick gives red, green and blue quantums (a grey pixel's grey value three times); in
+    trinary mode an image with alpha adds the alpha as a fourth channel.
+    """
+    full = 65535.0 if px.dtype == np.uint16 else 255.0
     h, w = px.shape[:2]
     out = np.empty((h, w), np.uint8)
     for i in range(h):
         for j in range(w):
-            p = px[i, j] if px.ndim == 3 else np.array([px[i, j]])
-            n = len(p)
-            has_alpha = n in (2, 4)
-            k = n if (mode == "trinary" or not has_alpha) else n - 1
-            c = sum(int(v) for v in p[:k]) / k
-            if negate:
-                c = 255.0 - c
-            if mode == "raw":
-                v = int(c)
-                out[i, j] = FREE if v == 0 else WALL if v == 100 else UNKNOWN
-                continue
-            occ = (255.0 - c) / 255.0
-            out[i, j] = WALL if occ > occ_th else FREE if occ < free_th else UNKNOWN
+            p = [int(v) for v in (px[i, j] if px.ndim == 3 else [px[i, j]])]
+            has_alpha = len(p) in (2, 4)
+            colour = p[:-1] if has_alpha else p
+            channels = colour * 3 if len(colour) == 1 else colour
+            alpha = p[-1] if has_alpha else int(full)
+            if mode == "trinary" and has_alpha:
+                channels = channels + [alpha]
+            shade = (sum(channels) / len(channels)) / full
+            occ = shade if negate else 1.0 - shade
+            if mode == "trinary":
+                v = 100 if occ_th < occ else 0 if occ < free_th else -1
+            elif mode == "scale":
+                if alpha != full:
+                    v = -1
+                elif occ_th < occ:
+                    v = 100
+                elif occ < free_th:
+                    v = 0
+                else:
+                    v = int(np.rint((occ - free_th) / (occ_th - free_th) * 100.0))
+            else:
+                r = math.floor(shade * 255 + 0.5)
+                v = r if 0 <= r <= 100 else -1
+            out[i, j] = FREE if v == 0 else WALL if v == 100 else UNKNOWN
     return out[::-1]
 
 
@@ -112,20 +130,28 @@ thresholds = st.tuples(st.floats(0.0, 1.0), st.floats(0.0, 1.0)).filter(lambda t
     th=thresholds,
     negate=st.booleans(),
     mode=st.sampled_from(["trinary", "scale", "raw"]),
-    fmt=st.sampled_from([("pgm", "L"), ("png", "L"), ("png", "LA"), ("png", "RGB"), ("png", "RGBA")]),
+    fmt=st.sampled_from([("pgm", "L"), ("png", "L"), ("bmp", "L"), ("png", "LA"), ("png", "RGB"), ("bmp", "RGB"),
+                         ("png", "RGBA"), ("png", "I;16"), ("pgm", "I;16")]),
 )
 def test_loader_matches_map_server_rule(tmp_path, data, th, negate, mode, fmt):
     occ_th, free_th = th
     suffix, pil_mode = fmt
     h = data.draw(st.integers(1, 6))
     w = data.draw(st.integers(1, 6))
-    channels = {"L": 1, "LA": 2, "RGB": 3, "RGBA": 4}[pil_mode]
-    # favour the values maps use, plus anything
-    value = st.one_of(st.sampled_from([0, 100, 155, 205, 254, 255]), st.integers(0, 255))
+    channels = {"L": 1, "LA": 2, "RGB": 3, "RGBA": 4, "I;16": 1}[pil_mode]
+    if pil_mode == "I;16":  # 16-bit greyscale: nav2 keeps the precision
+        value = st.one_of(st.sampled_from([0, 100 * 257, 205 * 257, 254 * 257, 65535]), st.integers(0, 65535))
+        dtype = np.uint16
+    else:  # favour the values maps use, plus anything
+        value = st.one_of(st.sampled_from([0, 100, 155, 205, 254, 255]), st.integers(0, 255))
+        dtype = np.uint8
     flat = data.draw(st.lists(value, min_size=h * w * channels, max_size=h * w * channels))
-    px = np.array(flat, np.uint8).reshape((h, w, channels) if channels > 1 else (h, w))
+    px = np.array(flat, dtype).reshape((h, w, channels) if channels > 1 else (h, w))
     img = tmp_path / f"m.{suffix}"
-    Image.fromarray(px, mode=pil_mode).save(img)
+    if suffix == "pgm" and dtype == np.uint16:  # a 16-bit binary PGM (maxval 65535), written by hand
+        img.write_bytes(f"P5\n{w} {h}\n65535\n".encode() + px.astype(">u2").tobytes())
+    else:
+        Image.fromarray(px, mode=None if dtype == np.uint16 else pil_mode).save(img)
     doc = {
         "image": img.name,
         "resolution": 0.05,
@@ -141,27 +167,32 @@ def test_loader_matches_map_server_rule(tmp_path, data, th, negate, mode, fmt):
 
 
 def test_scale_mode_grades_between_thresholds_and_trinary_does_not():
-    px = np.array([[128]], np.uint8)  # p = 0.498, between 0.196 and 0.65
+    px = np.array([[128]], np.uint8)  # occ = 0.498, between 0.196 and 0.65
     assert occupancy_values(px, mode="trinary").item() == -1
     graded = occupancy_values(px, mode="scale").item()
-    assert graded == int(1 + 98 * ((127 / 255 - 0.196) / (0.65 - 0.196)))
+    assert graded == round((1 - 128 / 255 - 0.196) / (0.65 - 0.196) * 100) == 67  # nav2: rint(ratio * 100)
     transparent = np.array([[[128, 0]]], np.uint8)  # grey + alpha 0
     assert occupancy_values(transparent, mode="scale").item() == -1
 
 
-def test_raw_mode_stores_pixel_value_as_int8():
-    px = np.array([[0, 100, 37, 255]], np.uint8)
-    assert occupancy_values(px, mode="raw").tolist() == [[0, 100, 37, -1]]
-    assert occupancy_values(px, negate=True, mode="raw").tolist() == [[-1, -101, -38, 0]]
+def test_raw_mode_keeps_0_to_100_and_ignores_negate_like_nav2():
+    px = np.array([[0, 100, 37, 101, 255]], np.uint8)
+    assert occupancy_values(px, mode="raw").tolist() == [[0, 100, 37, -1, -1]]
+    # nav2 applies negate to occ, which raw mode never reads
+    assert occupancy_values(px, negate=True, mode="raw").tolist() == [[0, 100, 37, -1, -1]]
+    # RGB: the mean of the three channels, rounded half away from zero (std::round)
+    assert occupancy_values(np.array([[[1, 1, 2], [0, 0, 1]]], np.uint8), mode="raw").tolist() == [[1, 0]]
 
 
-def test_trinary_averages_alpha_in_like_map_server():
-    # black, fully transparent: (0 + 0) / 2 = 0 -> occupied; in scale mode alpha is left out
+def test_trinary_averages_alpha_in_like_nav2():
+    # grey + alpha: red, green, blue and alpha -> (3 * 0 + 0) / 4 = 0 -> occupied
     assert occupancy_values(np.array([[[0, 0]]], np.uint8), mode="trinary").item() == 100
-    # white, transparent: (255 + 0)/2 = 127.5 -> p = 0.5 -> unknown in trinary, free in scale
+    # white, transparent: (3 * 255 + 0) / 4 -> occ = 0.25 -> unknown between 0.196 and 0.65
     px = np.array([[[255, 0]]], np.uint8)
     assert occupancy_values(px, mode="trinary").item() == -1
-    assert occupancy_values(px, mode="scale").item() == 0
+    # scale mode: any pixel that is not opaque is unknown
+    assert occupancy_values(px, mode="scale").item() == -1
+    assert occupancy_values(np.array([[[255, 255]]], np.uint8), mode="scale").item() == 0
 
 
 # ---------------------------------------------------------------------------- round trips and materials
@@ -238,16 +269,16 @@ _DELETE = object()
         ({"image": _DELETE}, "image", "required"),
         ({"image": 3}, "image", "image file name"),
         ({"image": "missing.pgm"}, "image", "existing image"),
-        ({"origin": [0.0, 0.0, 0.5]}, "origin", "yaw"),
+        ({"origin": [0.0, 0.0, float("inf")]}, "origin", "three finite numbers"),
         ({"origin": [0.0, 0.0]}, "origin", "three finite numbers"),
         ({"origin": "0 0 0"}, "origin", "three finite numbers"),
-        ({"negate": 2}, "negate", "0, 1"),
+        ({"negate": "yes"}, "negate", "0, 1"),
         ({"occupied_thresh": 1.5}, "occupied_thresh", r"\[0, 1\]"),
         ({"free_thresh": -0.1}, "free_thresh", r"\[0, 1\]"),
         ({"occupied_thresh": 0.1, "free_thresh": 0.2}, "occupied_thresh", "greater than free_thresh"),
         ({"occupied_thresh": 0.2, "free_thresh": 0.2}, "occupied_thresh", "greater than free_thresh"),
         ({"mode": "ternary"}, "mode", "trinary"),
-        ({"negat": 1}, "negat", "did you mean 'negate'"),
+        ({"resolutoin": 0.05, "resolution": _DELETE}, "resolution", "'resolutoin' a misspelling"),
         ({"materials": "ok.pgm"}, "material_values", "mapping"),
         ({"materials": "ok.pgm", "material_values": {300: "glass"}}, "material_values", "0..255"),
         ({"materials": "ok.pgm", "material_values": {3: 4}}, "material_values[3]", "material name"),
@@ -274,7 +305,7 @@ def test_missing_file_and_bad_suffix(tmp_path):
 def test_unreadable_image_and_bad_yaml_syntax(tmp_path):
     (tmp_path / "junk.pgm").write_bytes(b"not an image at all")
     p = _write_map(tmp_path, image="junk.pgm")
-    with pytest.raises(MapError, match=r"bad\.yaml -> .*junk\.pgm: field 'image': expected a readable PNG or PGM"):
+    with pytest.raises(MapError, match=r"bad\.yaml -> .*junk\.pgm: field 'image': expected a readable PNG, PGM or BMP"):
         load_map(p)
     (tmp_path / "s.yaml").write_text("image: [unclosed\n")
     with pytest.raises(MapError, match=r"s\.yaml: field '<yaml>': expected valid YAML"):
@@ -300,9 +331,13 @@ def test_bad_override_arguments(tmp_path):
 
 
 def test_sixteen_bit_image_and_palette_image(tmp_path):
-    Image.fromarray(np.full((2, 2), 1000, np.uint16)).save(tmp_path / "deep.png")
-    with pytest.raises(MapError, match=r"deep\.png: field 'image': expected an 8-bit greyscale.*found image mode 'I;16'"):
-        load_map(tmp_path / "deep.png", resolution_m=0.1)
+    # 16-bit greyscale keeps its precision: 1000/65535 is black (occupied), 65000/65535 white
+    Image.fromarray(np.array([[1000, 65000]], np.uint16)).save(tmp_path / "deep.png")
+    assert load_map(tmp_path / "deep.png", resolution_m=0.1).cells.tolist() == [[WALL, FREE]]
+    Image.fromarray(np.zeros((2, 2), np.float32), mode="F").save(tmp_path / "float.tiff")
+    (tmp_path / "f.yaml").write_text("image: float.tiff\nresolution: 0.1\norigin: [0, 0, 0]\n")
+    with pytest.raises(MapError, match=r"float\.tiff: field 'image': expected an 8- or 16-bit greyscale.*found image mode 'F'"):
+        load_map(tmp_path / "f.yaml")
     pal = Image.fromarray(np.array([[0, 1]], np.uint8), mode="P")
     pal.putpalette([0, 0, 0, 255, 255, 255] + [0] * 762)  # index 0 black, 1 white
     pal.save(tmp_path / "pal.png")

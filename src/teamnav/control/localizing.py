@@ -473,8 +473,7 @@ class MCLWander:
         """Weight of the observer's belief that puts the detected robot in free space (gate 1)."""
         pos = self.model.sample_positions(self.mcl.particles, det.range_m, det.bearing_rad, self.rng)
         g = self.info.known_map
-        ix = np.floor((pos[:, 0] - g.origin_xy_m[0]) / g.resolution_m).astype(np.int64)
-        iy = np.floor((pos[:, 1] - g.origin_xy_m[1]) / g.resolution_m).astype(np.int64)
+        iy, ix = np.moveaxis(g.world_to_cell(pos[:, :2]), -1, 0)  # the map's own transform (any yaw)
         h, w = self._free.shape
         inside = (ix >= 0) & (ix < w) & (iy >= 0) & (iy < h)
         ok = np.zeros(pos.shape[0], dtype=bool)

@@ -415,8 +415,11 @@ class MCL:
         res = self.map.resolution_m
         u = self.rng.random((n, 3))
         out = np.empty((n, 3))
-        out[:, 0] = self.map.origin_xy_m[0] + (cells[:, 1] + u[:, 0]) * res
-        out[:, 1] = self.map.origin_xy_m[1] + (cells[:, 0] + u[:, 1]) * res
+        if not self.map.rotated:
+            out[:, 0] = self.map.origin_xy_m[0] + (cells[:, 1] + u[:, 0]) * res
+            out[:, 1] = self.map.origin_xy_m[1] + (cells[:, 0] + u[:, 1]) * res
+        else:
+            out[:, :2] = self.map.cell_to_world(cells[:, 0] + u[:, 1], cells[:, 1] + u[:, 0])
         out[:, 2] = wrap_angle(-math.pi + 2.0 * math.pi * u[:, 2])
         return out
 
@@ -512,8 +515,12 @@ class MCL:
             zz = z[keep]
             g = self.map
             kernel = lf_loglik_kernel if self._threads(n * zz.shape[0]) else lf_loglik_kernel_serial
-            kernel(self._particles, np.ascontiguousarray(zz * np.cos(a)), np.ascontiguousarray(zz * np.sin(a)),
-                             self._lf_table, self._lf_free, g.origin_xy_m[0], g.origin_xy_m[1], 1.0 / g.resolution_m,
+            parts, ox, oy = self._particles, g.origin_xy_m[0], g.origin_xy_m[1]
+            if g.rotated:  # the field is read in the grid's local frame
+                lx, ly, ox, oy = g.kernel_frame(parts[:, 0], parts[:, 1])
+                parts = np.ascontiguousarray(np.stack([lx, ly, g.kernel_theta(parts[:, 2])], axis=1))
+            kernel(parts, np.ascontiguousarray(zz * np.cos(a)), np.ascontiguousarray(zz * np.sin(a)),
+                             self._lf_table, self._lf_free, ox, oy, 1.0 / g.resolution_m,
                              self._lf_outside, self._lf_worst, exponent, self._ll)
         return self._ll
 

@@ -48,8 +48,20 @@ _SQRT2 = math.sqrt(2.0)
 
 
 @njit(cache=True)
-def _disc_hits_wall(blocking, clear_m, ox, oy, res, px, py, r):
-    """True when the disc (px, py, r) overlaps a blocking cell or leaves the map."""
+def _disc_hits_wall(blocking, clear_m, ox, oy, res, cs, sn, px, py, r):
+    """True when the disc (px, py, r) overlaps a blocking cell or leaves the map.
+
+    ``cs, sn`` are the cosine and sine of the map's yaw: a rotated map's disc centre is taken
+    into the grid's local frame first (a disc is round, so only its centre moves); with
+    ``cs == 1, sn == 0`` nothing is computed and the test is the axis-aligned one, bit for bit.
+    """
+    if sn != 0.0 or cs != 1.0:
+        dx = px - ox
+        dy = py - oy
+        px = cs * dx + sn * dy
+        py = -sn * dx + cs * dy
+        ox = 0.0
+        oy = 0.0
     h = blocking.shape[0]
     w = blocking.shape[1]
     if px - r < ox or py - r < oy or px + r > ox + w * res or py + r > oy + h * res:
@@ -78,9 +90,9 @@ def _disc_hits_wall(blocking, clear_m, ox, oy, res, px, py, r):
 
 
 @njit(cache=True)
-def _discs_hit_walls(blocking, clear_m, ox, oy, res, xs, ys, rs, out):
+def _discs_hit_walls(blocking, clear_m, ox, oy, res, cs, sn, xs, ys, rs, out):
     for i in range(xs.shape[0]):
-        out[i] = _disc_hits_wall(blocking, clear_m, ox, oy, res, xs[i], ys[i], rs[i])
+        out[i] = _disc_hits_wall(blocking, clear_m, ox, oy, res, cs, sn, xs[i], ys[i], rs[i])
 
 
 @njit(cache=True, inline="always")
@@ -104,8 +116,9 @@ def move_discs(x, y, th, radius, pre_turn, arc, turn, blocking, clear_m, geo, co
         1 where a cell blocks motion.
     clear_m : (H, W) float64
         Distance field of ``blocking`` [m] (:func:`teamnav.world.distance.distance_field`).
-    geo : (3,) float64
-        ``origin_x_m, origin_y_m, resolution_m``.
+    geo : (5,) float64
+        ``origin_x_m, origin_y_m, resolution_m, cos(yaw), sin(yaw)``
+        (:attr:`teamnav.world.grid.OccupancyGrid.geo`).
     collide : bool
         Whether robots collide with each other.
     stalled : (N,) bool
@@ -115,6 +128,8 @@ def move_discs(x, y, th, radius, pre_turn, arc, turn, blocking, clear_m, geo, co
     ox = geo[0]
     oy = geo[1]
     res = geo[2]
+    cs = geo[3] if geo.shape[0] > 4 else 1.0  # a 3-element geo: an unrotated map
+    sn = geo[4] if geo.shape[0] > 4 else 0.0
     use_hash = collide and n > 1
     # ---- spatial hash of start-of-step positions (counting sort into buckets)
     size = 1
@@ -156,7 +171,7 @@ def move_discs(x, y, th, radius, pre_turn, arc, turn, blocking, clear_m, geo, co
             by = y[i]
             for k in range(1, nsub + 1):
                 px, py, _ = arc_point(x[i], y[i], th0, a, turn[i], k / nsub)
-                hit = _disc_hits_wall(blocking, clear_m, ox, oy, res, px, py, ri)
+                hit = _disc_hits_wall(blocking, clear_m, ox, oy, res, cs, sn, px, py, ri)
                 if not hit and use_hash:
                     for dxk in range(-1, 2):
                         for dyk in range(-1, 2):
@@ -192,8 +207,9 @@ def discs_hit_walls(blocking, clear_m, geo, xs, ys, rs) -> np.ndarray:
     blocking : ndarray of shape (H, W), uint8
     clear_m : ndarray of shape (H, W), float64
         Distance field of ``blocking`` [m].
-    geo : sequence of 3 floats
-        ``origin_x_m, origin_y_m, resolution_m``.
+    geo : sequence of 3 or 5 floats
+        ``origin_x_m, origin_y_m, resolution_m`` and, for a rotated map, ``cos(yaw), sin(yaw)``
+        (:attr:`teamnav.world.grid.OccupancyGrid.geo`).
     xs, ys, rs : ndarray of shape (n,)
         Disc centres and radii [m].
 
@@ -215,6 +231,7 @@ def discs_hit_walls(blocking, clear_m, geo, xs, ys, rs) -> np.ndarray:
     out = np.empty(xs.shape[0], dtype=np.bool_)
     _discs_hit_walls(
         np.ascontiguousarray(blocking, dtype=np.uint8), np.ascontiguousarray(clear_m, dtype=np.float64),
-        float(geo[0]), float(geo[1]), float(geo[2]), xs, ys, rs, out,
+        float(geo[0]), float(geo[1]), float(geo[2]), float(geo[3]) if len(geo) > 3 else 1.0,
+        float(geo[4]) if len(geo) > 4 else 0.0, xs, ys, rs, out,
     )
     return out

@@ -177,7 +177,7 @@ class Simulation:
         # ---- truth
         self._blocking = grid.blocking(None)
         self._clear_m = distance_field(self._blocking, grid.resolution_m)
-        self._geo = np.array([grid.origin_xy_m[0], grid.origin_xy_m[1], grid.resolution_m])
+        self._geo = grid.geo  # origin, resolution, cos and sin of the map's yaw
         poses = start_poses(grid, groups, np.random.default_rng(start_ss), self._clear_m)
         counts = [g.count for g in groups]
         group_idx = np.repeat(np.arange(len(groups)), counts)

@@ -100,10 +100,13 @@ class Radio:
         self.n = int(n_robots)
         self.rng = rng
         self._blocking = grid.blocking(cfg.sees) if cfg.mode == "line_of_sight" else None
+        self._grid = grid
         self._geo = (grid.origin_xy_m[0], grid.origin_xy_m[1], grid.resolution_m)
         if self._blocking is not None:
             self._blocking = _check_blocking(self._blocking)
-        self._geo_inv = (float(self._geo[0]), float(self._geo[1]), 1.0 / float(self._geo[2]))
+        # a rotated map: positions go to the kernels in the grid's local frame, origin (0, 0)
+        ox, oy = (0.0, 0.0) if grid.rotated else (float(self._geo[0]), float(self._geo[1]))
+        self._geo_inv = (ox, oy, 1.0 / float(self._geo[2]))
         # per-robot counts as Python ints (a numpy scalar update costs more than the rest of a
         # delivery); read as int64 arrays through the properties below
         self._sent_messages = [0] * self.n
@@ -148,6 +151,8 @@ class Radio:
         """
         mode = self.cfg.mode
         sidx = np.asarray(senders, dtype=np.int64)
+        if mode == "line_of_sight" and self._grid.rotated:
+            xs, ys = self._grid.kernel_frame(xs, ys)[:2]  # distances do not change
         if sidx.shape[0] * self.n <= _KERNEL_MAX_PAIRS:
             ok = np.empty((sidx.shape[0], self.n), dtype=np.bool_)
             blocking = self._blocking if self._blocking is not None else _NO_MAP

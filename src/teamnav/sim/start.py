@@ -98,7 +98,7 @@ def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator,
         clear_m = distance_field(blocking, grid.resolution_m)
     res = grid.resolution_m
     ox, oy = grid.origin_xy_m
-    geo = (ox, oy, res)
+    geo = grid.geo
     counts = [g.count for g in groups]
     offsets = np.concatenate([[0], np.cumsum(counts)]).astype(int)
     n = int(offsets[-1])
@@ -143,11 +143,22 @@ def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator,
             continue
         r = g.radius_m
         xmin, xmax, ymin, ymax = g.start.region if g.start.region is not None else grid.bounds_m
-        cx0 = ox + cols * res
-        cy0 = oy + rows * res
         ok = (clear_m >= r + math.sqrt(2.0) * res) & (blocking == 0)
-        ok &= (cx0 - r >= ox) & (cx0 + res + r <= ox + w * res) & (cy0 - r >= oy) & (cy0 + res + r <= oy + h * res)
-        ok &= (cx0 + res > xmin) & (cx0 < xmax) & (cy0 + res > ymin) & (cy0 < ymax)
+        if not grid.rotated:
+            cx0 = ox + cols * res
+            cy0 = oy + rows * res
+            ok &= (cx0 - r >= ox) & (cx0 + res + r <= ox + w * res) & (cy0 - r >= oy) & (cy0 + res + r <= oy + h * res)
+            ok &= (cx0 + res > xmin) & (cx0 < xmax) & (cy0 + res > ymin) & (cy0 < ymax)
+        else:
+            # the map edge in the grid's own axes; the (world-frame) region against the cell's
+            # centre, widened by half the cell's diagonal (each drawn point is checked exactly below)
+            lx0 = cols * res
+            ly0 = rows * res
+            ok &= (lx0 - r >= 0) & (lx0 + res + r <= w * res) & (ly0 - r >= 0) & (ly0 + res + r <= h * res)
+            centre = grid.cell_centers(rows, cols)
+            half = res / math.sqrt(2.0)
+            ok &= (centre[..., 0] + half > xmin) & (centre[..., 0] - half < xmax)
+            ok &= (centre[..., 1] + half > ymin) & (centre[..., 1] - half < ymax)
         cand = np.flatnonzero(ok)
         if cand.size == 0:
             where = f"region {list(g.start.region)}" if g.start.region is not None else "the map"
@@ -166,8 +177,12 @@ def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator,
                     )
                 cells = cand[rng.integers(0, cand.size, size=_BATCH)]
                 u = rng.random((_BATCH, 2))
-                xs = ox + (cells % w + u[:, 0]) * res
-                ys = oy + (cells // w + u[:, 1]) * res
+                if not grid.rotated:
+                    xs = ox + (cells % w + u[:, 0]) * res
+                    ys = oy + (cells // w + u[:, 1]) * res
+                else:
+                    world = grid.cell_to_world(cells // w + u[:, 1], cells % w + u[:, 0])
+                    xs, ys = world[:, 0], world[:, 1]
                 for x, y in zip(xs.tolist(), ys.tolist()):
                     tries += 1
                     if not (xmin <= x <= xmax and ymin <= y <= ymax):
@@ -181,6 +196,9 @@ def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator,
                     break
             if g.start.theta_deg is not None:
                 poses[idx, 2] = float(wrap_angle(math.radians(g.start.theta_deg)))
-            else:
+            elif not grid.rotated:
                 poses[idx, 2] = float(wrap_angle(rng.uniform(-math.pi, math.pi)))
+            else:
+                # uniform either way; turned with the map so a rotated map's run is its twin's, turned
+                poses[idx, 2] = float(wrap_angle(rng.uniform(-math.pi, math.pi) + grid.yaw_rad))
     return poses

@@ -174,7 +174,7 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
                     occ[grid.cells == grid.materials.index("unknown")] = 255
                 h, w = occ.shape
                 log(ch, Grid(timestamp=stamp(int(t_ns[0])), frame_id="world",
-                             pose=_pose(grid.origin_xy_m[0], grid.origin_xy_m[1], 0.0), column_count=int(w),
+                             pose=_pose(grid.origin_xy_m[0], grid.origin_xy_m[1], grid.yaw_rad), column_count=int(w),
                              cell_size=Vector2(x=grid.resolution_m, y=grid.resolution_m), row_stride=int(w), cell_stride=1,
                              fields=[PackedElementField(name="occupancy", offset=0, type=PackedElementFieldNumericType.Uint8)],
                              data=occ.tobytes()), t_ns[0])

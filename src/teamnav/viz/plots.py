@@ -23,6 +23,7 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection, PatchCollection  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
+from matplotlib.transforms import Affine2D  # noqa: E402
 
 from teamnav.world.grid import OccupancyGrid  # noqa: E402
 from teamnav.world.mapio import load_map  # noqa: E402
@@ -81,7 +82,10 @@ def _view_box(grid: OccupancyGrid, xy: np.ndarray, margin_m: float = 1.0) -> tup
     xmin, xmax, ymin, ymax = grid.bounds_m
     known = grid.cells != grid.materials.index("unknown") if "unknown" in grid.materials else np.ones(grid.shape, bool)
     rows, cols = np.nonzero(known)
-    if rows.size:
+    if rows.size and grid.rotated:
+        x0, x1, y0, y1 = grid.block_bounds_m(rows.min(), rows.max(), cols.min(), cols.max())
+        bx, by = [x0, x1], [y0, y1]
+    elif rows.size:
         lo = grid.cell_centers(rows.min(), cols.min())
         hi = grid.cell_centers(rows.max(), cols.max())
         bx = [lo[0], hi[0]]
@@ -95,16 +99,23 @@ def _view_box(grid: OccupancyGrid, xy: np.ndarray, margin_m: float = 1.0) -> tup
 
 
 def _draw_map(ax, grid: OccupancyGrid) -> None:
-    xmin, xmax, ymin, ymax = grid.bounds_m
-    ax.imshow(
+    """The map's cells; a rotated map is drawn turned about its origin by its yaw."""
+    ox, oy = grid.origin_xy_m
+    w, h = grid.size_m
+    image = ax.imshow(
         grid.cells,
         cmap=_map_cmap(grid),
         vmin=-0.5,
         vmax=len(grid.materials) - 0.5,
         origin="lower",
-        extent=(xmin, xmax, ymin, ymax),
+        extent=(ox, ox + w, oy, oy + h),
         interpolation="nearest",
     )
+    if grid.rotated:
+        image.set_transform(Affine2D().rotate_around(ox, oy, grid.yaw_rad) + ax.transData)
+        xmin, xmax, ymin, ymax = grid.bounds_m
+        ax.set_xlim(xmin, xmax)
+        ax.set_ylim(ymin, ymax)
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")

@@ -230,7 +230,9 @@ def _bounds(grid: OccupancyGrid | None, xy: np.ndarray) -> tuple[float, float, f
         x0, x1, y0, y1 = grid.bounds_m
         if "unknown" in grid.materials:  # frame the explored part of a SLAM map, not its grey margin
             rows, cols = np.nonzero(grid.cells != grid.materials.index("unknown"))
-            if rows.size:
+            if rows.size and grid.rotated:
+                x0, x1, y0, y1 = grid.block_bounds_m(rows.min(), rows.max(), cols.min(), cols.max())
+            elif rows.size:
                 (x0, y0), (x1, y1) = grid.cell_centers(rows.min(), cols.min()), grid.cell_centers(rows.max(), cols.max())
     else:
         x0, x1, y0, y1 = float(pts[:, 0].min()), float(pts[:, 0].max()), float(pts[:, 1].min()), float(pts[:, 1].max())
@@ -420,8 +422,10 @@ def build_replay(
     map_meta = None
     if grid is not None:
         uri, f = _map_png(grid)
-        gx0, gx1, gy0, gy1 = grid.bounds_m
-        map_meta = {"png": uri, "x0": gx0, "y0": gy0, "x1": gx1, "y1": gy1, "downsample": f, "name": grid.name}
+        # the image's own rectangle (origin + size) and the yaw it is turned by about its origin
+        (gx0, gy0), (gw, gh) = grid.origin_xy_m, grid.size_m
+        map_meta = {"png": uri, "x0": gx0, "y0": gy0, "x1": gx0 + gw, "y1": gy0 + gh, "yaw": grid.yaw_rad,
+                    "downsample": f, "name": grid.name}
 
     scenario_name = ""
     if (run_dir / "scenario.yaml").is_file():

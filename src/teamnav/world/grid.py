@@ -10,12 +10,23 @@ Conventions (ROS REP 103 and map_server):
 
 - ``cells[row, col]``: row 0 is the *lowest* y (the bottom of the map image), so the array
   is the image flipped vertically.
-- cell ``(row, col)`` covers ``[ox + col*res, ox + (col+1)*res) x [oy + row*res, oy + (row+1)*res)``
-  where ``(ox, oy) = origin_xy_m``.
+- cell ``(row, col)`` covers ``[col*res, (col+1)*res) x [row*res, (row+1)*res)`` in the grid's
+  *local* frame, whose origin is the lower-left corner of cell (0, 0) and whose x axis runs
+  along the rows. The local frame sits at ``origin_xy_m`` in the world, turned by ``yaw_rad``
+  (map_server's ``origin: [x, y, yaw]``, the pose of the lower-left pixel in the map frame):
+  ``world = origin + R(yaw) @ local``. With ``yaw_rad == 0`` (every generated map and most
+  map files) the cell covers ``[ox + col*res, ox + (col+1)*res) x [oy + row*res, oy + (row+1)*res)``.
+
+Kernels (ray casting, line of sight, collisions, likelihood fields) work on the axis-aligned
+cell array. For a rotated grid their callers pass positions in the local frame and headings
+less ``yaw_rad`` (:meth:`OccupancyGrid.kernel_frame`, :meth:`OccupancyGrid.kernel_theta`);
+for an unrotated grid nothing is transformed, so results are the same bit for bit as before
+rotation was supported. Ranges, distances and clearances do not depend on the frame.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Iterable
 
@@ -30,6 +41,37 @@ WALL: int = 1
 UNKNOWN: int = 2
 GLASS: int = 3  # invisible to a laser, echoes sonar
 FOAM: int = 4  # absorbs sonar, seen by a laser
+
+#: Largest map teamnav builds, in cells. A grid costs about :data:`BYTES_PER_CELL` bytes a
+#: cell once the simulator has its blocking masks, distance field, ray-casting clearance maps
+#: and a localizer's likelihood field, so this bounds a run's map memory near 2 GB on the
+#: 24 GB machines teamnav is tested on. Map files and arenas larger than this are refused
+#: before anything is allocated (:func:`check_map_size`).
+MAX_MAP_CELLS: int = 50_000_000
+#: Bytes a cell costs in a run (measured order of magnitude: cells 1, blocking masks 1 each,
+#: distance field 8, clearance maps 4 each, EDT work arrays ~16, likelihood field 8).
+BYTES_PER_CELL: int = 40
+
+
+def check_map_size(width_cells: int, height_cells: int, what: str) -> None:
+    """Raise ValueError naming ``what`` when a ``width x height`` grid is over :data:`MAX_MAP_CELLS`.
+
+    Examples
+    --------
+    >>> check_map_size(100, 100, "m.png")
+    >>> check_map_size(100_000, 100_000, "m.png")
+    Traceback (most recent call last):
+    ...
+    ValueError: m.png: a map of 100000 x 100000 cells (10000000000 cells) would need about 400.0 GB; teamnav's limit is 50000000 cells (about 2.0 GB)
+    """
+    n = int(width_cells) * int(height_cells)
+    if n > MAX_MAP_CELLS:
+        raise ValueError(
+            f"{what}: a map of {int(width_cells)} x {int(height_cells)} cells ({n} cells) would need about "
+            f"{n * BYTES_PER_CELL / 1e9:.1f} GB; teamnav's limit is {MAX_MAP_CELLS} cells "
+            f"(about {MAX_MAP_CELLS * BYTES_PER_CELL / 1e9:.1f} GB)"
+        )
+
 
 #: What each built-in sensor kind sees by default.
 DEFAULT_SEES: dict[str, tuple[str, ...]] = {
@@ -56,6 +98,9 @@ class OccupancyGrid:
         ``materials[k]`` names material id ``k``; ``materials[0] == "free"``.
     name : str
         Where the map came from (file path or generator), for messages.
+    yaw_rad : float, default 0
+        Rotation of the grid's axes in the world [rad], about ``origin_xy_m`` (map_server's
+        origin yaw), kept as given (a map file's yaw is written back as it was read).
 
     Examples
     --------
@@ -69,6 +114,7 @@ class OccupancyGrid:
     origin_xy_m: tuple[float, float] = (0.0, 0.0)
     materials: tuple[str, ...] = DEFAULT_MATERIALS
     name: str = "<code>"
+    yaw_rad: float = 0.0
     _masks: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -85,6 +131,9 @@ class OccupancyGrid:
             raise ValueError(
                 f"map {self.name}: cell material id {int(cells.max())} has no name (known: {self.materials})"
             )
+        if not np.isfinite(self.yaw_rad):
+            raise ValueError(f"map {self.name}: yaw must be a finite angle in radians, got {self.yaw_rad!r}")
+        object.__setattr__(self, "yaw_rad", float(self.yaw_rad) + 0.0)  # -0.0 -> 0.0
         cells.setflags(write=False)
         object.__setattr__(self, "cells", cells)
         object.__setattr__(self, "origin_xy_m", (float(self.origin_xy_m[0]), float(self.origin_xy_m[1])))
@@ -100,7 +149,11 @@ class OccupancyGrid:
 
     def with_cells(self, cells: np.ndarray) -> "OccupancyGrid":
         """A copy with new cells and the same geometry and materials."""
-        return OccupancyGrid(cells, self.resolution_m, self.origin_xy_m, self.materials, self.name)
+        return OccupancyGrid(cells, self.resolution_m, self.origin_xy_m, self.materials, self.name, self.yaw_rad)
+
+    def with_pose(self, origin_xy_m: tuple[float, float], yaw_rad: float = 0.0) -> "OccupancyGrid":
+        """A copy with the same cells and materials placed at another origin and yaw."""
+        return OccupancyGrid(self.cells, self.resolution_m, origin_xy_m, self.materials, self.name, yaw_rad)
 
     # ------------------------------------------------------------------ geometry
     @property
@@ -113,21 +166,106 @@ class OccupancyGrid:
         return (self.cells.shape[1] * self.resolution_m, self.cells.shape[0] * self.resolution_m)
 
     @property
+    def rotated(self) -> bool:
+        """True when the grid's axes are turned in the world (``yaw_rad != 0``)."""
+        return self.yaw_rad != 0.0
+
+    @property
+    def corners_m(self) -> np.ndarray:
+        """World (x, y) of the map's four corners, shape (4, 2): lower-left, lower-right,
+        upper-right, upper-left (in the grid's own axes)."""
+        w, h = self.size_m
+        return self.local_to_world(np.array([[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]]))
+
+    @property
     def bounds_m(self) -> tuple[float, float, float, float]:
-        """(xmin, xmax, ymin, ymax) [m]."""
+        """(xmin, xmax, ymin, ymax) [m] of the map in the world: for a rotated grid, the
+        axis-aligned box around its four corners."""
         ox, oy = self.origin_xy_m
         w, h = self.size_m
-        return (ox, ox + w, oy, oy + h)
+        if not self.rotated:
+            return (ox, ox + w, oy, oy + h)
+        c = self.corners_m
+        return (float(c[:, 0].min()), float(c[:, 0].max()), float(c[:, 1].min()), float(c[:, 1].max()))
+
+    def block_bounds_m(self, row0: int, row1: int, col0: int, col1: int) -> tuple[float, float, float, float]:
+        """(xmin, xmax, ymin, ymax) [m] in the world of the cells ``row0..row1 x col0..col1``
+        (inclusive): the axis-aligned box around the block's four outer corners."""
+        rows = np.array([row0, row0, row1 + 1, row1 + 1], dtype=float)
+        cols = np.array([col0, col1 + 1, col0, col1 + 1], dtype=float)
+        c = self.cell_to_world(rows, cols)
+        return (float(c[:, 0].min()), float(c[:, 0].max()), float(c[:, 1].min()), float(c[:, 1].max()))
+
+    def world_to_local(self, xy: np.ndarray) -> np.ndarray:
+        """Local-frame (x, y) [m] of world points ``xy`` (..., 2): ``R(-yaw) @ (xy - origin)``."""
+        xy = np.asarray(xy, dtype=float)
+        dx = xy[..., 0] - self.origin_xy_m[0]
+        dy = xy[..., 1] - self.origin_xy_m[1]
+        if not self.rotated:
+            return np.stack([dx, dy], axis=-1)
+        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
+        return np.stack([c * dx + s * dy, -s * dx + c * dy], axis=-1)
+
+    def local_to_world(self, xy: np.ndarray) -> np.ndarray:
+        """World (x, y) [m] of local-frame points ``xy`` (..., 2): ``origin + R(yaw) @ xy``."""
+        xy = np.asarray(xy, dtype=float)
+        lx, ly = xy[..., 0], xy[..., 1]
+        if not self.rotated:
+            return np.stack([self.origin_xy_m[0] + lx, self.origin_xy_m[1] + ly], axis=-1)
+        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
+        return np.stack([self.origin_xy_m[0] + c * lx - s * ly, self.origin_xy_m[1] + s * lx + c * ly], axis=-1)
+
+    def kernel_frame(self, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """Positions and origin to hand a kernel that reads the cell array axis-aligned.
+
+        Returns ``(xs, ys, ox, oy)``: for an unrotated grid the arrays as given and the
+        grid's origin (nothing is computed, so kernels give the same bits as ever); for a
+        rotated grid contiguous float64 local-frame positions and origin ``(0, 0)``.
+        """
+        if not self.rotated:
+            return xs, ys, self.origin_xy_m[0], self.origin_xy_m[1]
+        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
+        dx = np.asarray(xs, dtype=np.float64) - self.origin_xy_m[0]
+        dy = np.asarray(ys, dtype=np.float64) - self.origin_xy_m[1]
+        return (np.ascontiguousarray(c * dx + s * dy), np.ascontiguousarray(-s * dx + c * dy), 0.0, 0.0)
+
+    def kernel_theta(self, thetas: np.ndarray) -> np.ndarray:
+        """Headings [rad] in the grid's local frame (``thetas - yaw_rad``; unchanged, not
+        copied, for an unrotated grid). Not wrapped: kernels take their cos and sin."""
+        if not self.rotated:
+            return thetas
+        return np.ascontiguousarray(np.asarray(thetas, dtype=np.float64) - self.yaw_rad)
+
+    @property
+    def geo(self) -> np.ndarray:
+        """``[ox, oy, res, cos(yaw), sin(yaw)]``: the world-to-cell transform for the motion
+        kernels (:func:`teamnav.sim.collisions.move_discs`)."""
+        return np.array([self.origin_xy_m[0], self.origin_xy_m[1], self.resolution_m,
+                         math.cos(self.yaw_rad), math.sin(self.yaw_rad)])
 
     def world_to_cell(self, xy: np.ndarray) -> np.ndarray:
         """Integer (row, col) of world points ``xy`` of shape (..., 2); may be out of range."""
         xy = np.asarray(xy, dtype=float)
+        if self.rotated:
+            local = self.world_to_local(xy)
+            col = np.floor(local[..., 0] / self.resolution_m).astype(np.int64)
+            row = np.floor(local[..., 1] / self.resolution_m).astype(np.int64)
+            return np.stack([row, col], axis=-1)
         col = np.floor((xy[..., 0] - self.origin_xy_m[0]) / self.resolution_m).astype(np.int64)
         row = np.floor((xy[..., 1] - self.origin_xy_m[1]) / self.resolution_m).astype(np.int64)
         return np.stack([row, col], axis=-1)
 
+    def cell_to_world(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """World (x, y) of fractional cell coordinates, shape (..., 2): ``(rows, cols) = (0, 0)``
+        is the lower-left corner of cell (0, 0), ``(0.5, 0.5)`` its centre."""
+        lx = np.asarray(cols, dtype=float) * self.resolution_m
+        ly = np.asarray(rows, dtype=float) * self.resolution_m
+        return self.local_to_world(np.stack([lx, ly], axis=-1))
+
     def cell_centers(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """World (x, y) of cell centres, shape (..., 2)."""
+        if self.rotated:
+            return self.cell_to_world(np.asarray(rows) + 0.5, np.asarray(cols) + 0.5)
         x = self.origin_xy_m[0] + (np.asarray(cols) + 0.5) * self.resolution_m
         y = self.origin_xy_m[1] + (np.asarray(rows) + 0.5) * self.resolution_m
         return np.stack([x, y], axis=-1)

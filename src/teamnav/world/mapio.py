@@ -1,16 +1,25 @@
-"""Map files: ROS map_server YAML + image, plain PNG/PGM images, and a material layer.
+"""Map files: ROS map_server YAML + image, plain PNG/PGM/BMP images, and a material layer.
 
-teamnav reads and writes maps in the format of ROS ``map_server`` (ROS 1
-``map_server/src/image_loader.cpp``; ROS 2 ``nav2_map_server/src/map_io.cpp`` follows the
-same rules). A map is a YAML file next to an image::
+teamnav reads and writes maps in the format of ROS 2's ``nav2_map_server``
+(``nav2_map_server/src/map_io.cpp``, ``loadMapYaml`` and ``loadMapFromFile``): every map that
+nav2's map_server loads, teamnav loads the same way, cell for cell (``tests/test_mapio.py``
+holds nav2's own loader test cases). A map is a YAML file next to an image::
 
     image: depot.pgm          # relative to the YAML file's folder (or absolute)
     resolution: 0.05          # metres per pixel, positive
-    origin: [0.0, 0.0, 0.0]   # x [m], y [m], yaw [rad] of the lower-left pixel; yaw must be 0
-    negate: 0                 # 0/1 or false/true                (default 0)
+    origin: [0.0, 0.0, 0.0]   # x [m], y [m], yaw [rad] of the lower-left pixel (any yaw)
+    negate: 0                 # 0/1 (any integer: non-zero is true) or false/true (default 0)
     occupied_thresh: 0.65     # in [0, 1]                        (default 0.65)
     free_thresh: 0.196        # in [0, 1], below occupied_thresh (default 0.196)
     mode: trinary             # trinary | scale | raw            (default trinary)
+
+Keys the loader does not know (``map_type: occupancy``, written by common map tools) are
+ignored, as map_server ignores them, with one warning line naming the file and the keys.
+nav2 requires the two thresholds; teamnav takes map_saver's values when they are missing.
+
+A yaw turns the map about its origin: the grid keeps its cells axis-aligned in its own local
+frame and every consumer (ray casting, collisions, spawning, plots, replay, MCAP) goes
+through :class:`~teamnav.world.grid.OccupancyGrid`'s world <-> cell transform.
 
 teamnav extension (ignored by ROS, which skips unknown keys)::
 
@@ -23,43 +32,54 @@ are appended to the grid's materials in increasing pixel value order; ``free`` c
 space). Pixels with unlisted values (conventionally 0) keep what the occupancy image says.
 The layer is applied after the occupancy image is thresholded.
 
-Pixel rule (map_server, per pixel)
-----------------------------------
-1. ``c`` = mean of the colour channels. Like map_server, *trinary* mode averages the alpha
-   channel in with the colours (map_server's "preserve existing behaviour" quirk); *scale*
-   and *raw* modes leave alpha out. Palette images are expanded to RGB(A) first and 1-bit
-   images to 0/255 greyscale.
-2. If ``negate``: ``c = 255 - c``.
-3. *trinary* and *scale*: ``p = (255 - c) / 255``; occupied (100) if ``p > occupied_thresh``,
-   free (0) if ``p < free_thresh``; otherwise unknown (-1) in trinary mode and, in scale
-   mode, a value in 1..99 (or -1 for a fully transparent pixel).
-4. *raw*: the occupancy value is ``c`` itself, truncated to an integer (map_server stores it
-   unchanged in the int8 ``OccupancyGrid.data``; 255 reads back as -1).
+Pixel rule (nav2 ``loadMapFromFile``, per pixel)
+------------------------------------------------
+1. The channels averaged are red, green and blue (a greyscale pixel is its grey value three
+   times); in *trinary* mode an image with an alpha channel averages the alpha in as a fourth
+   channel (nav2's "preserve existing behaviour" quirk; for grey + alpha that is
+   ``(3 grey + alpha) / 4``). ``shade = average / max`` where ``max`` is 255 for 8-bit images
+   and 65535 for 16-bit ones (16-bit greyscale PNG and PGM keep their precision; a PGM with
+   another ``maxval`` is scaled to 8 or 16 bits on reading). Palette images are expanded to
+   RGB(A), 1-bit images to 0/255 greyscale.
+2. ``occ = shade`` if ``negate`` else ``1 - shade``.
+3. *trinary*: occupied (100) if ``occupied_thresh < occ``, free (0) if ``occ < free_thresh``,
+   unknown (-1) otherwise.
+   *scale*: unknown (-1) where alpha is not opaque; else occupied / free as in trinary, and in
+   between ``rint((occ - free_thresh) / (occupied_thresh - free_thresh) * 100)``.
+4. *raw*: ``v = round(shade * 255)`` (``negate`` is not applied); ``v`` if ``0 <= v <= 100``,
+   else unknown (-1).
+
+ROS 1's ``map_server`` (``image_loader.cpp``) differs from nav2 only in modes scale and raw:
+its scale band is ``1 + 99 * ratio`` truncated (never 0 or 100), and raw takes the negated
+average truncated. teamnav follows nav2.
 
 teamnav's grid has no graded occupancy, so the occupancy value is reduced to materials the
 way ``amcl`` reads a map (``amcl_node.cpp``, ``convertMap``): exactly 0 is ``free``, exactly
 100 is ``wall`` and every other value (-1 and the graded 1..99) is ``unknown``. In trinary
 mode this is exactly the three-way threshold rule above; in scale mode the graded band
-between the two thresholds becomes ``unknown``; in raw mode only pixel values 0 and 100 are
-free and wall.
+between the two thresholds becomes ``unknown`` (except where nav2's rounding gives 0 or 100);
+in raw mode only pixel values 0 and 100 are free and wall.
 
 The image's top row is the map's highest y, so the pixel array is flipped vertically
 (row 0 of :attr:`OccupancyGrid.cells` is the bottom of the image).
 
-A plain ``.png``/``.pgm`` file (no YAML) is read with map_server's default thresholds
+A plain ``.png``/``.pgm``/``.bmp`` file (no YAML) is read with map_saver's thresholds
 (``occupied_thresh=0.65``, ``free_thresh=0.196``, ``negate=0``, trinary) and needs
 ``resolution_m``.
 
 Every malformed input raises :class:`MapError`, whose message names the file, the field,
-what was expected and what was found.
+what was expected and what was found. An image larger than :data:`MAX_MAP_CELLS` pixels is
+refused from its header, before any pixel is decoded, with the memory it would need.
 """
 
 from __future__ import annotations
 
 import difflib
+import logging
 import math
 import os
 import tempfile
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -68,7 +88,9 @@ import numpy as np
 import yaml
 from PIL import Image, UnidentifiedImageError
 
-from teamnav.world.grid import DEFAULT_MATERIALS, OccupancyGrid
+from teamnav.world.grid import DEFAULT_MATERIALS, MAX_MAP_CELLS, OccupancyGrid, check_map_size
+
+_log = logging.getLogger(__name__)
 
 __all__ = [
     "MapError",
@@ -89,7 +111,7 @@ DEFAULT_OCCUPIED_THRESH: float = 0.65
 DEFAULT_FREE_THRESH: float = 0.196
 MODES: tuple[str, ...] = ("trinary", "scale", "raw")
 YAML_SUFFIXES: tuple[str, ...] = (".yaml", ".yml")
-IMAGE_SUFFIXES: tuple[str, ...] = (".png", ".pgm")
+IMAGE_SUFFIXES: tuple[str, ...] = (".png", ".pgm", ".bmp")
 YAML_FIELDS: tuple[str, ...] = (
     "image",
     "resolution",
@@ -158,6 +180,8 @@ class MapMetadata:
         Cell side [m], positive and finite.
     origin_xy_m : tuple of float
         World (x, y) [m] of the lower-left corner of the lower-left pixel.
+    yaw_rad : float
+        Rotation of the image's axes in the world [rad] (``origin[2]``).
     negate : bool
         Swap the meaning of black and white.
     occupied_thresh, free_thresh : float
@@ -179,6 +203,9 @@ class MapMetadata:
     mode: str = "trinary"
     materials_image: Path | None = None
     material_values: dict[int, str] | None = None
+    yaw_rad: float = 0.0
+    #: keys of the YAML file that map_server and teamnav ignore (warned about once)
+    ignored_keys: tuple[str, ...] = ()
 
 
 # ---------------------------------------------------------------------------- public API
@@ -221,6 +248,8 @@ def load_map(
     """
     path = Path(path)
     suffix = path.suffix.lower()
+    if path.is_dir():
+        raise MapError(path, "<file>", "a map file", _Described("a directory"))
     if suffix not in YAML_SUFFIXES + IMAGE_SUFFIXES:
         raise MapError(path, "<file>", f"a file ending in one of {YAML_SUFFIXES + IMAGE_SUFFIXES}", _Described(repr(path.suffix)))
     if not path.is_file():
@@ -237,16 +266,10 @@ def load_map(
     else:
         meta = read_map_yaml(path)
         if resolution_m is not None or origin_xy_m is not None:
-            meta = MapMetadata(
-                image=meta.image,
+            meta = dataclasses.replace(
+                meta,
                 resolution_m=meta.resolution_m if resolution_m is None else resolution_m,
                 origin_xy_m=meta.origin_xy_m if origin_xy_m is None else origin_xy_m,
-                negate=meta.negate,
-                occupied_thresh=meta.occupied_thresh,
-                free_thresh=meta.free_thresh,
-                mode=meta.mode,
-                materials_image=meta.materials_image,
-                material_values=meta.material_values,
             )
 
     pixels = _read_image(meta.image, "image", source=path)
@@ -257,7 +280,7 @@ def load_map(
         cells, materials = _apply_material_layer(path, meta, cells)
     # image row 0 is the top (highest y); grid row 0 is the bottom
     cells = np.ascontiguousarray(cells[::-1])
-    return OccupancyGrid(cells, meta.resolution_m, meta.origin_xy_m, materials, str(path))
+    return OccupancyGrid(cells, meta.resolution_m, meta.origin_xy_m, materials, str(path), meta.yaw_rad)
 
 
 def read_map_yaml(path: str | os.PathLike) -> MapMetadata:
@@ -276,7 +299,10 @@ def read_map_yaml(path: str | os.PathLike) -> MapMetadata:
     ------
     MapError
         On a missing file, invalid YAML, a missing required field (``image``,
-        ``resolution``, ``origin``), a value of the wrong type or range, an unknown field.
+        ``resolution``, ``origin``), a value of the wrong type or range.
+
+    Keys teamnav does not know are ignored, as map_server ignores them; one warning line
+    (logger ``teamnav.world.mapio``) names the file and the keys, once per file per process.
     """
     path = Path(path)
     try:
@@ -291,18 +317,18 @@ def read_map_yaml(path: str | os.PathLike) -> MapMetadata:
         raise MapError(path, "<yaml>", "valid YAML", _Described(f"a syntax error: {str(exc).splitlines()[0]}")) from None
     if not isinstance(doc, dict):
         raise MapError(path, "<yaml>", "a mapping of map fields (image, resolution, origin, ...)", _Described(type(doc).__name__))
-    for key in doc:
-        if key not in YAML_FIELDS:
-            close = difflib.get_close_matches(str(key), YAML_FIELDS, n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
-            raise MapError(path, str(key), f"one of the known fields {YAML_FIELDS}{hint}", _Described("an unknown field"))
+    ignored = tuple(str(key) for key in doc if key not in YAML_FIELDS)
+    if ignored:
+        _warn_ignored_keys(path, ignored)
     for key in ("image", "resolution", "origin"):
         if key not in doc:
-            raise MapError(path, key, "a required field", _Described("nothing (field missing)"))
+            close = [k for k in ignored if difflib.get_close_matches(k, [key], n=1)]
+            hint = f" (is {close[0]!r} a misspelling of it?)" if close else ""
+            raise MapError(path, key, f"a required field{hint}", _Described("nothing (field missing)"))
 
     image = _check_relpath(path, "image", doc["image"])
     resolution = _check_resolution(path, "resolution", doc["resolution"])
-    origin = _check_origin(path, doc["origin"])
+    origin, yaw = _check_origin(path, doc["origin"])
     negate = _check_negate(path, doc.get("negate", 0))
     occ = _check_thresh(path, "occupied_thresh", doc.get("occupied_thresh", DEFAULT_OCCUPIED_THRESH))
     free = _check_thresh(path, "free_thresh", doc.get("free_thresh", DEFAULT_FREE_THRESH))
@@ -332,7 +358,26 @@ def read_map_yaml(path: str | os.PathLike) -> MapMetadata:
         mode=mode,
         materials_image=materials_image,
         material_values=material_values,
+        yaw_rad=yaw,
+        ignored_keys=ignored,
     )
+
+
+_WARNED: set[tuple[str, tuple[str, ...]]] = set()
+
+
+def _warn_ignored_keys(path: Path, keys: tuple[str, ...]) -> None:
+    """One warning line per (file, keys) per process: map_server ignores unknown keys too."""
+    token = (str(path), keys)
+    if token in _WARNED:
+        return
+    _WARNED.add(token)
+    hints = []
+    for k in keys:
+        close = difflib.get_close_matches(k, YAML_FIELDS, n=1)
+        hints.append(f"{k!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+    _log.warning("warning: %s: ignoring key%s %s, which map_server ignores too (known keys: %s)",
+                 path, "s" if len(keys) > 1 else "", ", ".join(hints), ", ".join(YAML_FIELDS))
 
 
 def occupancy_values(
@@ -341,53 +386,72 @@ def occupancy_values(
     occupied_thresh: float = DEFAULT_OCCUPIED_THRESH,
     free_thresh: float = DEFAULT_FREE_THRESH,
     mode: str = "trinary",
+    max_value: int | None = None,
 ) -> np.ndarray:
     """map_server's per-pixel occupancy values (``nav_msgs/OccupancyGrid.data``).
 
-    Implements ``image_loader.cpp`` (ROS 1 map_server) step by step, see the module
-    docstring. The image is *not* flipped here.
+    Implements nav2's ``loadMapFromFile`` (``nav2_map_server/src/map_io.cpp``) step by step,
+    see the module docstring. The image is *not* flipped here.
 
     Parameters
     ----------
-    pixels : ndarray of shape (H, W) or (H, W, C), uint8
+    pixels : ndarray of shape (H, W) or (H, W, C), uint8 or uint16
         Image; C = 2 (grey + alpha), 3 (RGB) or 4 (RGBA). The last channel of a 2- or
         4-channel image is alpha.
     negate : bool, default False
     occupied_thresh, free_thresh : float, defaults 0.65, 0.196
     mode : {"trinary", "scale", "raw"}, default "trinary"
+    max_value : int, optional
+        Full scale of a channel: 255 for uint8 pixels, 65535 for uint16 (the default).
 
     Returns
     -------
     ndarray of shape (H, W), int8
-        100 occupied, 0 free, -1 unknown; scale mode also 1..99; raw mode any int8.
+        100 occupied, 0 free, -1 unknown; scale mode also 1..99 (0 and 100 where nav2's
+        rounding reaches them); raw mode 0..100 or -1.
 
     Examples
     --------
     >>> occupancy_values(np.array([[0, 205, 254]], np.uint8)).tolist()
     [[100, -1, 0]]
+    >>> occupancy_values(np.array([[0, 100, 101, 255]], np.uint8), mode="raw").tolist()
+    [[0, 100, -1, -1]]
     """
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
     px = np.asarray(pixels)
+    if max_value is None:
+        max_value = 65535 if px.dtype == np.uint16 else 255
+    full = float(max_value)
     if px.ndim == 2:
         px = px[..., None]
     n_channels = px.shape[-1]
     has_alpha = n_channels in (2, 4)
-    # map_server: trinary averages alpha in with the colours; scale and raw leave it out
-    avg_channels = n_channels if (mode == "trinary" or not has_alpha) else n_channels - 1
-    color_avg = px[..., :avg_channels].astype(np.float64).sum(axis=-1) / avg_channels
-    if negate:
-        color_avg = 255.0 - color_avg
+    colour = px[..., : n_channels - 1 if has_alpha else n_channels].astype(np.float64)
+    # nav2 reads red, green and blue quantums: a grey pixel counts three times
+    total = colour.sum(axis=-1) * (3.0 if colour.shape[-1] == 1 else 1.0)
+    count = 3
+    if mode == "trinary" and has_alpha:
+        # "To preserve existing behavior, average in alpha with color channels in Trinary mode."
+        total = total + px[..., -1].astype(np.float64)
+        count = 4
+    shade = (total / count) / full  # Magick::ColorGray::scaleQuantumToDouble(sum / n)
     if mode == "raw":
-        # unsigned char value = color_avg (truncation), stored into int8 data
-        return np.trunc(color_avg).astype(np.uint8).view(np.int8)
-    occ = (255.0 - color_avg) / 255.0
+        occ_percent = np.floor(shade * 255.0 + 0.5)  # std::round: halves away from zero
+        out = np.full(shade.shape, OCC_UNKNOWN, dtype=np.int8)
+        ok = (occ_percent >= OCC_FREE) & (occ_percent <= OCC_OCCUPIED)
+        out[ok] = occ_percent[ok].astype(np.int8)
+        return out
+    occ = shade if negate else 1.0 - shade
     out = np.full(occ.shape, OCC_UNKNOWN, dtype=np.int8)
     if mode == "scale":
-        alpha = px[..., -1] if has_alpha else np.full(occ.shape, 255, np.uint8)
-        band = (alpha >= 1) & (occ <= occupied_thresh) & (occ >= free_thresh)
+        opaque = (px[..., -1] == max_value) if has_alpha else np.ones(occ.shape, dtype=bool)
+        band = opaque & (occ <= occupied_thresh) & (occ >= free_thresh)
         ratio = (occ[band] - free_thresh) / (occupied_thresh - free_thresh)
-        out[band] = (1.0 + 98.0 * ratio).astype(np.int8)  # map_server truncates to 1..99
+        out[band] = np.rint(ratio * 100.0).astype(np.int8)  # std::rint, round half to even
+        out[opaque & (occ > occupied_thresh)] = OCC_OCCUPIED
+        out[opaque & (occ < free_thresh)] = OCC_FREE
+        return out
     out[occ > occupied_thresh] = OCC_OCCUPIED
     out[occ < free_thresh] = OCC_FREE
     return out
@@ -419,12 +483,21 @@ def occupancy_to_cells(values: np.ndarray) -> np.ndarray:
     return cells
 
 
-def save_map(grid: OccupancyGrid, yaml_path: str | os.PathLike) -> Path:
+def save_map(
+    grid: OccupancyGrid,
+    yaml_path: str | os.PathLike,
+    *,
+    occupied_thresh: float = DEFAULT_OCCUPIED_THRESH,
+    free_thresh: float = DEFAULT_FREE_THRESH,
+) -> Path:
     """Write ``grid`` as a map_server YAML + PGM (+ a material layer PGM if needed).
 
-    The occupancy image (``<stem>.pgm``) uses ``map_saver``'s pixel values: 254 free,
-    205 unknown, 0 for every other material (a ROS consumer sees glass and foam as
-    obstacles, as a robot bumps into them). Cells whose material is neither ``free``,
+    The YAML holds the grid's origin *and yaw* and the given thresholds (pass those a map was
+    read with to write them back as read). The occupancy image (``<stem>.pgm``) uses
+    ``map_saver``'s pixel values, 254 free, 205 unknown, 0 for every other material (a ROS
+    consumer sees glass and foam as obstacles, as a robot bumps into them), except where the
+    thresholds would read one of them otherwise: then the nearest pixel value that reads back
+    as that class is used (a ``MapError`` if the thresholds leave none). Cells whose material is neither ``free``,
     ``wall`` nor ``unknown`` also go to ``<stem>_materials.pgm``, pixel value = material id,
     with ``material_values`` naming every id >= 3 of ``grid.materials``. All files are
     written to temporary names in the target folder and moved in place with
@@ -458,13 +531,18 @@ def save_map(grid: OccupancyGrid, yaml_path: str | os.PathLike) -> Path:
         raise MapError(yaml_path, "<file>", f"a path ending in one of {YAML_SUFFIXES}", _Described(repr(yaml_path.suffix)))
     if not isinstance(grid, OccupancyGrid):
         raise TypeError(f"save_map: grid must be an OccupancyGrid, got {type(grid).__name__}")
+    occupied_thresh = _check_thresh(yaml_path, "occupied_thresh", occupied_thresh)
+    free_thresh = _check_thresh(yaml_path, "free_thresh", free_thresh)
+    if not occupied_thresh > free_thresh:
+        raise MapError(yaml_path, "occupied_thresh", f"a value greater than free_thresh={free_thresh!r}", occupied_thresh)
+    px_free, px_unknown, px_occupied = _pixels_for(yaml_path, occupied_thresh, free_thresh)
     folder = yaml_path.parent
     folder.mkdir(parents=True, exist_ok=True)
     names = np.asarray(grid.materials, dtype=object)
     cell_names = names[grid.cells]
-    image = np.full(grid.shape, PIXEL_OCCUPIED, dtype=np.uint8)
-    image[cell_names == "free"] = PIXEL_FREE
-    image[cell_names == "unknown"] = PIXEL_UNKNOWN
+    image = np.full(grid.shape, px_occupied, dtype=np.uint8)
+    image[cell_names == "free"] = px_free
+    image[cell_names == "unknown"] = px_unknown
     special = ~np.isin(cell_names, ("free", "wall", "unknown"))
 
     image_name = yaml_path.stem + ".pgm"
@@ -472,10 +550,10 @@ def save_map(grid: OccupancyGrid, yaml_path: str | os.PathLike) -> Path:
         "image": image_name,
         "mode": "trinary",
         "resolution": float(grid.resolution_m),
-        "origin": [float(grid.origin_xy_m[0]), float(grid.origin_xy_m[1]), 0.0],
+        "origin": [float(grid.origin_xy_m[0]), float(grid.origin_xy_m[1]), float(grid.yaw_rad)],
         "negate": 0,
-        "occupied_thresh": DEFAULT_OCCUPIED_THRESH,
-        "free_thresh": DEFAULT_FREE_THRESH,
+        "occupied_thresh": occupied_thresh,
+        "free_thresh": free_thresh,
     }
     files: list[tuple[Path, Any]] = [(folder / image_name, image[::-1])]
     if special.any():
@@ -508,13 +586,41 @@ def save_map(grid: OccupancyGrid, yaml_path: str | os.PathLike) -> Path:
 
 
 # ---------------------------------------------------------------------------- helpers
+def _pixels_for(path: Path, occupied_thresh: float, free_thresh: float) -> tuple[int, int, int]:
+    """8-bit pixel values (free, unknown, occupied) that nav2's trinary rule reads back as
+    free, unknown and occupied under these thresholds: map_saver's 254 / 205 / 0 where they
+    do, else the nearest value that does."""
+    values = occupancy_values(np.arange(256, dtype=np.uint8)[None, :], False, occupied_thresh, free_thresh)[0]
+    out = []
+    for want, preferred, what in ((OCC_FREE, PIXEL_FREE, "free"), (OCC_UNKNOWN, PIXEL_UNKNOWN, "unknown"),
+                                  (OCC_OCCUPIED, PIXEL_OCCUPIED, "occupied")):
+        ok = np.flatnonzero(values == want)
+        if ok.size == 0:
+            raise MapError(path, "occupied_thresh", f"thresholds under which some 8-bit pixel reads as {what}",
+                           _Described(f"occupied_thresh={occupied_thresh!r}, free_thresh={free_thresh!r}"))
+        out.append(int(ok[np.argmin(np.abs(ok - preferred))]))
+    return out[0], out[1], out[2]
+
+
 def _read_image(image_path: Path, field: str, *, source: Path) -> np.ndarray:
-    """Pixels of ``image_path`` as uint8 (H, W) or (H, W, C); errors name ``source``'s ``field``."""
+    """Pixels of ``image_path`` as uint8 or uint16 (H, W) or (H, W, C); errors name ``source``'s ``field``.
+
+    The size is read from the header and checked against :data:`MAX_MAP_CELLS` before any
+    pixel is decoded (a hostile header cannot make teamnav allocate the image).
+    """
     where = source if source == image_path else f"{source} -> {image_path}"
+    if image_path.is_dir():
+        raise MapError(where, field, "an image file", _Described("a directory"))
     if not image_path.is_file():
         raise MapError(where, field, "an existing image file", _Described("no such file"))
     try:
         with Image.open(image_path) as im:
+            w, h = im.size
+            try:
+                check_map_size(w, h, str(image_path))
+            except ValueError as exc:
+                raise MapError(where, field, f"an image of at most {MAX_MAP_CELLS} pixels",
+                               _Described(str(exc).split(": ", 1)[1])) from None
             im.load()
             if im.mode == "P":
                 im = im.convert("RGBA" if "transparency" in im.info else "RGB")
@@ -522,13 +628,22 @@ def _read_image(image_path: Path, field: str, *, source: Path) -> np.ndarray:
                 im = im.convert("L")
             elif im.mode == "PA":
                 im = im.convert("RGBA")
-            if im.mode not in ("L", "LA", "RGB", "RGBA"):
-                raise MapError(where, field, "an 8-bit greyscale, grey+alpha, RGB or RGBA image", _Described(f"image mode {im.mode!r}"))
-            pixels = np.array(im, dtype=np.uint8)
+            if im.mode in ("I;16", "I;16B", "I;16L", "I"):
+                # 16-bit greyscale (PNG, PGM with maxval > 255): keep the precision, as nav2 does
+                wide = np.array(im, dtype=np.int64)
+                if wide.size and (wide.min() < 0 or wide.max() > 65535):
+                    raise MapError(where, field, "16-bit greyscale values in 0..65535",
+                                   _Described(f"values in {wide.min()}..{wide.max()}"))
+                pixels = wide.astype(np.uint16)
+            elif im.mode in ("L", "LA", "RGB", "RGBA"):
+                pixels = np.array(im, dtype=np.uint8)
+            else:
+                raise MapError(where, field, "an 8- or 16-bit greyscale, grey+alpha, RGB or RGBA image",
+                               _Described(f"image mode {im.mode!r}"))
     except MapError:
         raise
-    except (UnidentifiedImageError, OSError, ValueError, SyntaxError, EOFError) as exc:
-        raise MapError(where, field, "a readable PNG or PGM image", _Described(f"{type(exc).__name__}: {exc}")) from None
+    except (UnidentifiedImageError, OSError, ValueError, SyntaxError, EOFError, Image.DecompressionBombError) as exc:
+        raise MapError(where, field, "a readable PNG, PGM or BMP image", _Described(f"{type(exc).__name__}: {exc}")) from None
     if pixels.ndim < 2 or pixels.shape[0] < 1 or pixels.shape[1] < 1:
         raise MapError(where, field, "a non-empty image", _Described(f"shape {pixels.shape}"))
     return pixels
@@ -537,6 +652,8 @@ def _read_image(image_path: Path, field: str, *, source: Path) -> np.ndarray:
 def _apply_material_layer(path: Path, meta: MapMetadata, cells: np.ndarray) -> tuple[np.ndarray, tuple[str, ...]]:
     assert meta.materials_image is not None and meta.material_values is not None
     layer = _read_image(meta.materials_image, "materials", source=path)
+    if layer.dtype != np.uint8:
+        raise MapError(path, "materials", "an 8-bit greyscale image", _Described("a 16-bit image"))
     if layer.ndim != 2:
         raise MapError(path, "materials", "a single-channel 8-bit greyscale image", _Described(f"an image with {layer.shape[2]} channels"))
     if layer.shape != cells.shape:
@@ -574,22 +691,19 @@ def _check_origin_xy(path: Path, field: str, v: Any) -> tuple[float, float]:
     return (float(v[0]), float(v[1]))
 
 
-def _check_origin(path: Path, v: Any) -> tuple[float, float]:
+def _check_origin(path: Path, v: Any) -> tuple[tuple[float, float], float]:
     if (
         not isinstance(v, list)
         or len(v) != 3
         or not all(_is_number(x) and math.isfinite(x) for x in v)
     ):
         raise MapError(path, "origin", "a list of three finite numbers [x_m, y_m, yaw_rad]", v)
-    if v[2] != 0:
-        raise MapError(path, "origin", "yaw (third element) 0: rotated maps are not supported", v)
-    return (float(v[0]), float(v[1]))
+    return (float(v[0]), float(v[1])), float(v[2])
 
 
 def _check_negate(path: Path, v: Any) -> bool:
-    if isinstance(v, bool):
-        return v
-    if isinstance(v, int) and v in (0, 1):
+    # nav2 reads negate as an int, else as a bool: any integer, non-zero meaning true
+    if isinstance(v, (bool, int)):
         return bool(v)
     raise MapError(path, "negate", "0, 1, true or false", v)
 

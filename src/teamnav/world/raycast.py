@@ -542,7 +542,6 @@ class RayCaster:
         self.max_range_m = _check_positive("max_range_m", max_range_m)
         self.blocking = grid.blocking(self.sees)
         self.clearance = clearance_map(self.blocking)
-        self._ox, self._oy = grid.origin_xy_m
         self._res = grid.resolution_m
 
     def cast(self, poses: np.ndarray, angles_rad: np.ndarray, out: np.ndarray | None = None, parallel: bool = True) -> np.ndarray:
@@ -559,14 +558,18 @@ class RayCaster:
         thetas = _check_vec("thetas", thetas, xs.shape[0])
         beams = _check_vec("angles_rad", angles_rad)
         out = _check_out(out, (xs.shape[0], beams.shape[0]))
-        return _run(self.clearance, self._ox, self._oy, self._res, xs, ys, thetas, beams, self.max_range_m, out, bool(parallel))
+        xs, ys, ox, oy = self.grid.kernel_frame(xs, ys)  # a rotated map: local frame (grid.py)
+        thetas = self.grid.kernel_theta(thetas)
+        return _run(self.clearance, ox, oy, self._res, xs, ys, thetas, beams, self.max_range_m, out, bool(parallel))
 
     def _cast_cs(self, xs, ys, thetas, cos_b, sin_b, parallel: bool) -> np.ndarray:
         """:meth:`cast_xyt` without input checks, the beams given by their ``cos`` and ``sin``
         (``np.cos(angles_rad)``, ``np.sin(angles_rad)``), into a fresh (P, B) array: the
         engine's per-step path, for contiguous finite float64 (P,) poses."""
         out = np.empty((xs.shape[0], cos_b.shape[0]), dtype=np.float64)
-        return _run_cs(self.clearance, self._ox, self._oy, self._res, xs, ys, thetas, cos_b, sin_b, self.max_range_m,
+        xs, ys, ox, oy = self.grid.kernel_frame(xs, ys)
+        thetas = self.grid.kernel_theta(thetas)
+        return _run_cs(self.clearance, ox, oy, self._res, xs, ys, thetas, cos_b, sin_b, self.max_range_m,
                        out, parallel)
 
 

@@ -124,7 +124,8 @@ class RobotDetector:
         self.fov_rad = math.radians(cfg.fov_deg)
         self.full_circle = self.fov_rad >= 2 * math.pi - _FULL_CIRCLE_EPS_RAD
         self.blocking = grid.blocking(cfg.sees)
-        self._ox, self._oy = grid.origin_xy_m
+        # a rotated map: line of sight is tested in the grid's local frame (origin (0, 0))
+        self._ox, self._oy = grid.kernel_frame(np.zeros(0), np.zeros(0))[2:]
         self._res = grid.resolution_m
 
     # ------------------------------------------------------------------ validation
@@ -196,7 +197,8 @@ class RobotDetector:
             key = np.minimum(a, b) * n_all + np.maximum(a, b)
             ukey, inv = np.unique(key, return_inverse=True)
             lo, hi = ukey // n_all, ukey % n_all
-            seen = line_of_sight(self.blocking, self._ox, self._oy, self._res, xs[lo], ys[lo], xs[hi], ys[hi])[inv]
+            lx, ly = self.grid.kernel_frame(xs, ys)[:2]
+            seen = line_of_sight(self.blocking, self._ox, self._oy, self._res, lx[lo], ly[lo], lx[hi], ly[hi])[inv]
             a, b, rng_m, bearing = a[seen], b[seen], rng_m[seen], bearing[seen]
         row = row_of[a]
         order = np.lexsort((b, row))
@@ -209,7 +211,8 @@ class RobotDetector:
         n_all = xs.shape[0]
         cap = obs.shape[0] * max(n_all - 1, 0)
         out = np.empty((3, cap), dtype=np.int64)
-        m = _pairs_in_sight(xs, ys, obs, self.max_range_m * self.max_range_m, self.cfg.line_of_sight,
+        lx, ly = self.grid.kernel_frame(xs, ys)[:2]  # range and line of sight: frame-free / local
+        m = _pairs_in_sight(lx, ly, obs, self.max_range_m * self.max_range_m, self.cfg.line_of_sight,
                             self.blocking, self._ox, self._oy, 1.0 / self._res, out)
         row, a, b = out[0, :m], out[1, :m], out[2, :m]
         if not m:
