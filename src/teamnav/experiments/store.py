@@ -54,7 +54,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from teamnav.experiments.executors import TrialResult
     from teamnav.experiments.sweep import Trial
 
-__all__ = ["BASE_COLUMNS", "STORE_NAME", "ResultsStore", "load_dataframe", "load_rows"]
+__all__ = ["BASE_COLUMNS", "STORE_NAME", "ResultsStore", "StoreError", "check_store", "load_dataframe", "load_rows"]
 
 #: file name of the store inside a sweep's output folder
 STORE_NAME = "results.sqlite"
@@ -96,6 +96,88 @@ CREATE TABLE IF NOT EXISTS sweeps (
     last_started_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now'))
 );
 """
+
+
+#: columns each table of a teamnav store must have (more are fine: param/metric columns)
+_REQUIRED = {
+    "trials": tuple(BASE_COLUMNS),
+    "columns": ("name", "kind", "key"),
+    "sweeps": ("name", "spec", "teamnav_version", "first_started_at", "last_started_at"),
+}
+_SQLITE_MAGIC = b"SQLite format 3\x00"
+
+
+class StoreError(ValueError):
+    """A results store path that holds something other than a teamnav results store (a text
+    file, a damaged or truncated SQLite file, a folder, another program's database, a store
+    missing a table). The message names the file and what to do."""
+
+
+def check_store(path: str | os.PathLike) -> None:
+    """Refuse ``path`` unless it is absent, empty, or a readable teamnav results store.
+
+    Reads only (the header, the schema and SQLite's ``PRAGMA quick_check``), so a sweep checks
+    its store before the first trial and nothing is written on refusal. An SQLite file with no
+    tables at all is accepted (it becomes a store).
+
+    Raises
+    ------
+    StoreError
+        Naming the file, what it holds instead, and what to do.
+    """
+    p = Path(path)
+    todo = "use --out with another folder (one that is empty or holds a teamnav sweep's results.sqlite)"
+    if not os.path.lexists(p):
+        return
+    if p.is_dir():
+        raise StoreError(f"results store {p}: expected a teamnav results.sqlite file, found a folder; {todo}")
+    if not p.is_file():
+        raise StoreError(f"results store {p}: expected a teamnav results.sqlite file, found something that is not a file; {todo}")
+    try:
+        with open(p, "rb") as f:
+            head = f.read(100)
+    except OSError as exc:
+        raise StoreError(f"results store {p}: cannot be read ({exc.strerror or exc}); {todo}") from None
+    if not head:
+        return  # an empty file: SQLite makes it a new database
+    if not head.startswith(_SQLITE_MAGIC):
+        try:
+            head.decode("utf-8")
+            what = "a text file"
+        except UnicodeDecodeError:
+            what = "a file that is not an SQLite database"
+        raise StoreError(f"results store {p}: expected a teamnav results store (an SQLite database), found {what}; {todo}")
+    try:
+        con = sqlite3.connect(f"{p.resolve().as_uri()}?mode=ro", uri=True, timeout=60.0)
+    except sqlite3.Error as exc:
+        raise StoreError(f"results store {p}: cannot be opened ({exc}); {todo}") from None
+    try:
+        tables = [name for (name,) in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")]
+        have = {t: {row[1] for row in con.execute(f"PRAGMA table_info({_quote(t)})")} for t in tables if t in _REQUIRED}
+        check = con.execute("PRAGMA quick_check(5)").fetchall()
+    except sqlite3.Error as exc:  # "file is not a database", "database disk image is malformed"
+        raise StoreError(f"results store {p}: the SQLite file is damaged or truncated ({exc}); {todo}") from None
+    finally:
+        con.close()
+    if check != [("ok",)]:
+        first = check[0][0] if check else "no answer"
+        raise StoreError(f"results store {p}: the SQLite file is damaged or truncated (integrity check: {first}); {todo}")
+    if not tables:
+        return  # an empty database: the store's tables are created in it
+    for table, cols in have.items():
+        lack = [c for c in _REQUIRED[table] if c not in cols]
+        if lack:
+            raise StoreError(
+                f"results store {p}: table {table} lacks the column(s) {', '.join(lack)} of a teamnav results store "
+                f"(another program's table, or an incompatible teamnav version); {todo}"
+            )
+    missing = [t for t in _REQUIRED if t not in have]
+    if missing:
+        kind = "another program's database" if not have else "a damaged or partial teamnav store"
+        raise StoreError(
+            f"results store {p}: expected the tables {', '.join(_REQUIRED)} of a teamnav results store, found "
+            f"{', '.join(tables)} (no table {', '.join(missing)}): this looks like {kind}; {todo}"
+        )
 
 
 def _quote(name: str) -> str:
@@ -146,10 +228,18 @@ class ResultsStore:
 
     def __init__(self, path: str | os.PathLike) -> None:
         self.path = Path(path)
-        self._con = sqlite3.connect(self.path, isolation_level=None, timeout=60.0)
-        self._con.execute("PRAGMA journal_mode=WAL")
-        self._con.execute("PRAGMA synchronous=FULL")
-        self._con.execute("BEGIN IMMEDIATE")
+        check_store(self.path)
+        try:
+            self._con = sqlite3.connect(self.path, isolation_level=None, timeout=60.0)
+        except sqlite3.Error as exc:
+            raise StoreError(f"results store {self.path}: cannot be opened ({exc}); use --out with another folder") from None
+        try:
+            self._con.execute("PRAGMA journal_mode=WAL")
+            self._con.execute("PRAGMA synchronous=FULL")
+            self._con.execute("BEGIN IMMEDIATE")
+        except sqlite3.Error as exc:  # a read-only folder, a store locked by another process for a minute
+            self._con.close()
+            raise StoreError(f"results store {self.path}: cannot be written ({exc}); use --out with another folder") from None
         try:
             for stmt in _SCHEMA.split(";"):
                 if stmt.strip():
@@ -290,6 +380,7 @@ def _store_file(path: str | os.PathLike) -> Path:
         p = p / STORE_NAME
     if not p.is_file():
         raise ValueError(f"store: expected a results.sqlite file or a sweep folder holding one, received {str(path)!r}")
+    check_store(p)
     return p
 
 
