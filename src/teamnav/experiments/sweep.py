@@ -796,7 +796,7 @@ def sweep(
         raised before any trial runs.
     """
     from teamnav.experiments.executors import TrialTask, make_executor
-    from teamnav.experiments.store import STORE_NAME, ResultsStore
+    from teamnav.experiments.store import STORE_NAME, ResultsStore, check_store
 
     t0 = time.perf_counter()
     if out_dir is None or not os.fspath(out_dir):
@@ -817,6 +817,7 @@ def sweep(
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise SweepError(f"out_dir: expected a folder, received the file {out}")
+    check_store(out / STORE_NAME)  # a results.sqlite that is not a teamnav store: refused before any trial
     out.mkdir(parents=True, exist_ok=True)
     result = SweepResult(spec.sweep_name, out / STORE_NAME, len(trials))
     with ResultsStore(out / STORE_NAME) as store:
