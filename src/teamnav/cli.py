@@ -4,11 +4,17 @@ The CLI only parses, loads the scenario and calls the library (STYLE habit 17). 
 input (a scenario, a map, an override, an output folder) ends in one message on stderr and
 exit status 2, never a traceback; an unexpected exception (a bug) still shows its traceback.
 
+Help pages are plain text (``rich_markup_mode=None``): a help string is printed as written, so
+a unit in brackets ("[s]") survives, and a pipe gets no box drawing. Every option that takes a
+value names it with a metavar (``KEY=VALUE``, ``SECONDS``, ``DIR``, ``N``); flags show none.
+
 Examples
 --------
 ::
 
     teamnav list
+    teamnav list --names                                        # one scenario name per line, for scripts
+    teamnav list --json
     teamnav run demo
     teamnav run demo --seed 3 --set robots.0.count=4 --set radio.p_loss=0.1 --duration 20
     teamnav run my_scenario.yaml --out runs/mine --gif
@@ -24,22 +30,55 @@ from __future__ import annotations
 
 import contextlib
 import datetime as _dt
+import json
 import math
 import os
 from pathlib import Path
-from typing import Iterator, List, Optional
+from typing import Any, Iterator, List, Optional
 
 import typer
+import typer.core
 from rich.console import Console
 from rich.table import Table
 
 from teamnav import __version__
 
+
+def _no_type(ctx: Any = None) -> None:
+    return None
+
+
+class _Group(typer.core.TyperGroup):
+    """The ``teamnav`` group: its commands' arguments show their metavar only.
+
+    Newer typer writes an argument's Python type after its name in help (``SCENARIO <str>``),
+    whatever its metavar says; every command got from the group (so every command registered,
+    now or later) has that type label removed from its arguments. Options are left alone: one
+    that takes a value names it with its metavar, and flags show no type in plain help.
+    """
+
+    def resolve_command(self, ctx, args):  # type: ignore[override]
+        # `teamnav --version true`: say that the flag takes no value, not "no such command 'true'"
+        if ctx.params.get("version") and args and super().get_command(ctx, args[0]) is None:
+            ctx.fail(f"--version takes no value (received {args[0]!r})")
+        return super().resolve_command(ctx, args)
+
+    def get_command(self, ctx, cmd_name):  # type: ignore[override]
+        cmd = super().get_command(ctx, cmd_name)
+        for param in getattr(cmd, "params", ()):
+            if getattr(param, "param_type_name", "") == "argument" and hasattr(param, "display_type_rich"):
+                param.display_type_rich = _no_type
+        return cmd
+
+
 app = typer.Typer(
     name="teamnav",
+    cls=_Group,
     help="Simulator and experiments for robot teams that help each other navigate.",
     no_args_is_help=True,
     add_completion=False,
+    rich_markup_mode=None,
+    context_settings={"max_content_width": 120},
     pretty_exceptions_show_locals=False,
 )
 
@@ -75,38 +114,71 @@ def _bad_input_exits() -> Iterator[None]:
         raise typer.Exit(EXIT_BAD_INPUT) from None
 
 
-def _version(value: bool) -> None:
-    if value:
-        _out().print(f"teamnav {__version__}")
-        raise typer.Exit()
-
-
-@app.callback()
+@app.callback(invoke_without_command=True)
 def _main(
-    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version and exit."),
+    ctx: typer.Context,
+    version: bool = typer.Option(False, "--version", help="Print the version and exit."),
 ) -> None:
     """teamnav: run the four papers' robot-team experiments, or your own scenarios."""
+    # --version is a plain flag handled here, not an eager callback: an eager one exits while
+    # parsing, before the words after it are looked at, so `teamnav --version true` passed.
+    # Here the command name has been resolved first, and an unknown one is a usage error (2).
+    if version:
+        typer.echo(f"teamnav {__version__}")
+        raise typer.Exit()
+    if ctx.invoked_subcommand is None:
+        ctx.fail("Missing command.")
 
 
 # ---------------------------------------------------------------------------- list
-@app.command("list")
-def list_() -> None:
-    """List built-in scenarios (with one-line descriptions), controllers and maps."""
+def catalogue() -> dict[str, Any]:
+    """What ``teamnav list --json`` prints: scenarios (name, description), controllers, maps."""
     from teamnav.control import registry as controllers
     from teamnav.experiments import registry as scenarios
     from teamnav.experiments.spec import package_maps
     from teamnav.world.generators import BUILTIN_MAPS
 
+    return {
+        "scenarios": [{"name": n, "description": scenarios.describe(n)} for n in scenarios.names()],
+        "controllers": list(controllers.names()),
+        "builtin_maps": sorted(BUILTIN_MAPS),
+        "packaged_maps": list(package_maps()),
+    }
+
+
+@app.command("list")
+def list_(
+    names: bool = typer.Option(False, "--names", help="Print only the scenario names, one per line (for scripts)."),
+    as_json: bool = typer.Option(
+        False, "--json", help="Print one JSON document: scenarios (name, description), controllers, builtin_maps, packaged_maps."
+    ),
+) -> None:
+    """List built-in scenarios, controllers and maps.
+
+    A table for people; --names or --json for scripts.
+    """
+    if names and as_json:
+        raise typer.BadParameter("give --names or --json, not both", param_hint="'--names' / '--json'")
+    # --names and --json are plain writes, not rich: nothing wrapped, styled or cut to a width
+    if names:
+        from teamnav.experiments import registry as scenarios
+
+        typer.echo("\n".join(scenarios.names()))
+        return
+    cat = catalogue()
+    if as_json:
+        typer.echo(json.dumps(cat, indent=2))
+        return
     con = _out()
     table = Table(title="Scenarios (teamnav run NAME)", title_justify="left")
     table.add_column("name", style="bold")
     table.add_column("description")
-    for name in scenarios.names():
-        table.add_row(name, scenarios.describe(name))
+    for s in cat["scenarios"]:
+        table.add_row(s["name"], s["description"])
     con.print(table)
-    con.print("[bold]Controllers[/bold] (robots\\[i].controller): " + ", ".join(controllers.names()))
-    con.print("[bold]Built-in maps[/bold] (map: {builtin: NAME}): " + ", ".join(sorted(BUILTIN_MAPS)))
-    con.print("[bold]Packaged maps[/bold] (map: {package: NAME}): " + ", ".join(package_maps()))
+    con.print("[bold]Controllers[/bold] (robots\\[i].controller): " + ", ".join(cat["controllers"]))
+    con.print("[bold]Built-in maps[/bold] (map: {builtin: NAME}): " + ", ".join(cat["builtin_maps"]))
+    con.print("[bold]Packaged maps[/bold] (map: {package: NAME}): " + ", ".join(cat["packaged_maps"]))
 
 
 # ---------------------------------------------------------------------------- run
@@ -130,25 +202,111 @@ def _fmt(v) -> str:
     return str(v)
 
 
-def metrics_table(values: dict, title: str) -> Table:
-    """A two-column rich table of metric values."""
+#: at most this many rows in the metrics table after ``teamnav run``
+MAX_TABLE_ROWS = 15
+
+_STATS = ("mean", "median", "min", "max", "total", "std")
+_SUFFIX_UNITS = {"s": "s", "m": "m", "mps": "m/s", "deg": "deg", "degps": "deg/s", "min": "min", "rad": "rad"}
+
+
+def _is_scalar(key: str, value: Any) -> bool:
+    """A number to print (not a series: no list, array, dict or JSON string)."""
+    return isinstance(value, (bool, int, float)) and not key.endswith("_series")
+
+
+def unit_from_key(key: str) -> str:
+    """The unit a metric key's suffix names (``path_length_m_mean`` -> m, ``mean_speed_mps`` -> m/s), else ''."""
+    parts = key.replace(".", "_").split("_")
+    if len(parts) > 1 and parts[-1] in _STATS:
+        parts = parts[:-1]
+    return _SUFFIX_UNITS.get(parts[-1], "") if len(parts) > 1 else ""
+
+
+def _declared_headlines() -> tuple[dict[str, tuple[tuple[str, str], ...]], dict[str, tuple[tuple[str, str], ...]]]:
+    """``{metric name: ((key, unit), ...)}`` of the paper metric sets and of the general metrics,
+    as :mod:`teamnav.experiments.metric_sets` declares them."""
+    import importlib
+    import pkgutil
+
+    from teamnav.experiments import metric_sets
+    from teamnav.experiments import metrics as _registry  # noqa: F401  (imports every metric set)
+
+    paper: dict[str, tuple[tuple[str, str], ...]] = {}
+    for info in sorted(pkgutil.iter_modules(metric_sets.__path__), key=lambda m: m.name):
+        if not info.name.startswith("_"):
+            paper.update(getattr(importlib.import_module(f"{metric_sets.__name__}.{info.name}"), "HEADLINE", {}))
+    return paper, dict(metric_sets.CORE_HEADLINE)
+
+
+def headline_rows(metric_names, values: dict[str, Any], data: Any = None,
+                  limit: int = MAX_TABLE_ROWS) -> list[tuple[str, Any, str]]:
+    """The rows ``teamnav run`` prints: ``(key, value, unit)``, at most ``limit``, never a series.
+
+    The headline keys each metric of ``metric_names`` declares (``HEADLINE`` in
+    :mod:`teamnav.experiments.metric_sets`), the paper metric sets' first and the general
+    metrics' after, each only where the run produced it. A metric declared nowhere shows its
+    scalar keys (read from ``data`` by computing it again, or, without ``data`` or when no
+    metric declares anything, every scalar of ``values``), units from the key's suffix.
+    """
+    from teamnav.experiments import metrics as registry
+
+    paper, core = _declared_headlines()
+    declared = {**paper, **core}
+    names = list(metric_names)
+    order = [n for n in names if n in paper] + [n for n in names if n in core]
+    rows: list[tuple[str, Any, str]] = []
+    seen: set[str] = set()
+
+    def add(key: str, unit: str) -> None:
+        if key not in seen and key in values and _is_scalar(key, values[key]):
+            seen.add(key)
+            rows.append((key, values[key], unit))
+
+    undeclared = [n for n in names if n not in declared]
+    if not any(n in declared for n in names) or (undeclared and data is None):
+        fallback_keys = list(values)
+    else:
+        fallback_keys = []
+        for n in undeclared:
+            try:
+                fallback_keys += list(registry.compute([n], data))
+            except Exception:  # noqa: BLE001 - a table row is not worth failing a finished run
+                continue
+    for n in order:
+        for key, unit in declared[n]:
+            add(key, unit)
+    for key in fallback_keys:
+        add(key, unit_from_key(key))
+    return rows[:limit]
+
+
+def metrics_table(rows, title: str) -> Table:
+    """A rich table of metric rows: ``(key, value, unit)`` tuples, or a ``{key: value}`` dict (no units)."""
+    if isinstance(rows, dict):
+        rows = [(k, v, "") for k, v in rows.items()]
     table = Table(title=title, title_justify="left")
     table.add_column("metric")
     table.add_column("value", justify="right")
-    for k, v in values.items():
-        table.add_row(k, _fmt(v))
+    table.add_column("unit")
+    for k, v, unit in rows:
+        table.add_row(k, _fmt(v), unit)
     return table
 
 
 @app.command()
 def run(
-    scenario: str = typer.Argument(..., help="Built-in scenario name (see `teamnav list`) or a scenario YAML file."),
-    seed: Optional[int] = typer.Option(None, "--seed", help="Random seed (replaces the scenario's)."),
-    set_: Optional[List[str]] = typer.Option(
-        None, "--set", help="Override a field: KEY=VALUE with a dotted KEY (robots.0.count=10, radio.p_loss=0.1). Repeatable."
+    scenario: str = typer.Argument(
+        ..., metavar="SCENARIO", help="Built-in scenario name (see `teamnav list`) or a scenario YAML file."
     ),
-    duration: Optional[float] = typer.Option(None, "--duration", help="Simulated time [s] (replaces duration_s)."),
-    out: Optional[Path] = typer.Option(None, "--out", help="Run folder to write (default runs/NAME-TIMESTAMP)."),
+    seed: Optional[int] = typer.Option(None, "--seed", metavar="N", help="Random seed (replaces the scenario's)."),
+    set_: Optional[List[str]] = typer.Option(
+        None, "--set", metavar="KEY=VALUE",
+        help="Override a field, with a dotted KEY (robots.0.count=10, radio.p_loss=0.1). Repeatable.",
+    ),
+    duration: Optional[float] = typer.Option(
+        None, "--duration", metavar="SECONDS", help="Simulated time [s] (replaces the scenario's duration_s)."
+    ),
+    out: Optional[Path] = typer.Option(None, "--out", metavar="DIR", help="Run folder to write (default runs/NAME-TIMESTAMP)."),
     gif: bool = typer.Option(False, "--gif", help="Also write run.gif."),
     force: bool = typer.Option(False, "--force", help="Replace --out if it exists and is not empty."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no table; print only the run folder."),
@@ -171,17 +329,24 @@ def run(
         con.print(str(result.run_dir), markup=False)
         return
     title = f"{scn.name}: {scn.n_robots} robots, {scn.duration_s:g} s simulated, seed {scn.seed}"
-    con.print(metrics_table(result.metrics, title))
+    rows = headline_rows(scn.metric_names, result.metrics, result.data)
+    con.print(metrics_table(rows, title))
+    con.print(f"all {len(result.metrics)} metrics: {result.run_dir / 'metrics.json'}", markup=False)
     con.print(f"run folder: {result.run_dir}", markup=False)
 
 
 # ---------------------------------------------------------------------------- validate
 @app.command()
 def validate(
-    scenario: str = typer.Argument(..., help="Scenario YAML file (or built-in name) to check."),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help="Override a field: KEY=VALUE (repeatable)."),
+    scenario: str = typer.Argument(..., metavar="SCENARIO", help="Scenario YAML file (or built-in name) to check."),
+    set_: Optional[List[str]] = typer.Option(
+        None, "--set", metavar="KEY=VALUE", help="Override a field, with a dotted KEY as in `teamnav run`. Repeatable."
+    ),
 ) -> None:
-    """Load and check a scenario (fields, map, controllers and their parameters) without running it."""
+    """Check a scenario (fields, map, controllers) without running it.
+
+    Loads the scenario and its map and checks every field, controller and controller parameter.
+    """
     from teamnav.experiments.spec import build_grid, load_scenario
 
     with _bad_input_exits():
@@ -200,14 +365,17 @@ def validate(
 # ---------------------------------------------------------------------------- replay / export
 @app.command()
 def replay(
-    run_dir: Path = typer.Argument(..., help="A run folder (written by `teamnav run`)."),
-    out: Optional[Path] = typer.Option(None, "--out", help="HTML file to write (default RUN_DIR/replay.html)."),
-    every: int = typer.Option(1, "--every", help="Keep every K-th recorded sample as a frame."),
-    max_frames: int = typer.Option(5000, "--max-frames", help="At most this many frames (--every grows to fit)."),
-    max_points: int = typer.Option(300, "--max-points", help="At most this many points per sample of a points layer."),
+    run_dir: Path = typer.Argument(..., metavar="RUN_DIR", help="A run folder (written by `teamnav run`)."),
+    out: Optional[Path] = typer.Option(None, "--out", metavar="FILE", help="HTML file to write (default RUN_DIR/replay.html)."),
+    every: int = typer.Option(1, "--every", metavar="K", help="Keep every K-th recorded sample as a frame."),
+    max_frames: int = typer.Option(5000, "--max-frames", metavar="N", help="At most N frames (--every grows to fit)."),
+    max_points: int = typer.Option(300, "--max-points", metavar="N", help="At most N points per sample of a points layer."),
     no_scans: bool = typer.Option(False, "--no-scans", help="Leave recorded range scans out (smaller file)."),
 ) -> None:
-    """Write a self-contained HTML replay of a run (open it from disk in any browser)."""
+    """Write a self-contained HTML replay of a run.
+
+    Open it from disk in any browser.
+    """
     from teamnav.viz.replay import build_replay
 
     with _bad_input_exits():
@@ -218,11 +386,14 @@ def replay(
 
 @app.command()
 def export(
-    run_dir: Path = typer.Argument(..., help="A run folder (written by `teamnav run`)."),
-    mcap: Path = typer.Option(..., "--mcap", help="MCAP file to write (opens in Foxglove)."),
+    run_dir: Path = typer.Argument(..., metavar="RUN_DIR", help="A run folder (written by `teamnav run`)."),
+    mcap: Path = typer.Option(..., "--mcap", metavar="FILE", help="MCAP file to write (opens in Foxglove)."),
     force: bool = typer.Option(False, "--force", help="Replace the MCAP file if it exists."),
 ) -> None:
-    """Export a run to MCAP with Foxglove's well-known schemas (map, poses, scans, frames, markers)."""
+    """Export a run to MCAP, to open in Foxglove.
+
+    Uses Foxglove's well-known schemas: map, poses, scans, frames, markers.
+    """
     from teamnav.viz.mcap_export import export_mcap
 
     with _bad_input_exits():

@@ -42,21 +42,36 @@ def sweep_command(
         ..., metavar="SWEEP_OR_SCENARIO", help="Named sweep, sweep YAML file, or scenario name/file (then give --grid/--seeds)."
     ),
     grid: Optional[List[str]] = typer.Option(
-        None, "--grid", help="Grid axis KEY=V1,V2,... with a dotted KEY as in --set (robots.0.count=2,4,8). Repeatable."
+        None, "--grid", metavar="KEY=V1,V2,...", help="Grid axis, with a dotted KEY as in --set (robots.0.count=2,4,8). Repeatable."
     ),
-    seeds: Optional[str] = typer.Option(None, "--seeds", help="N runs seeds 0..N-1; or a list such as 1,4,9. Default: the sweep's, else 1."),
-    set_: Optional[List[str]] = typer.Option(None, "--set", help="Fixed override KEY=VALUE for every trial. Repeatable."),
-    duration: Optional[float] = typer.Option(None, "--duration", help="Simulated time of every trial, in seconds."),
-    name: Optional[str] = typer.Option(None, "--name", help="The sweep's name in the results table (default: the sweep file's or scenario's)."),
-    out: Path = typer.Option(..., "--out", help="Folder of results.sqlite; rerunning into it resumes the sweep."),
-    executor: str = typer.Option("local", "--executor", help="'local' worker processes, or 'ray' (needs the ray extra of teamnav)."),
-    address: Optional[str] = typer.Option(None, "--address", help="Ray cluster address (auto, ray://host:10001); default: a local Ray."),
-    workers: Optional[int] = typer.Option(None, "--workers", "-j", help="Trials at once (default: all CPUs)."),
+    seeds: Optional[str] = typer.Option(
+        None, "--seeds", metavar="N|S1,S2,...", help="N runs seeds 0..N-1; or a list such as 1,4,9. Default: the sweep's, else 1."
+    ),
+    set_: Optional[List[str]] = typer.Option(
+        None, "--set", metavar="KEY=VALUE", help="Fixed override for every trial, with a dotted KEY. Repeatable."
+    ),
+    duration: Optional[float] = typer.Option(
+        None, "--duration", metavar="SECONDS", help="Simulated time of every trial [s] (replaces the scenario's duration_s)."
+    ),
+    name: Optional[str] = typer.Option(
+        None, "--name", metavar="NAME", help="The sweep's name in the results table (default: the sweep file's or scenario's)."
+    ),
+    out: Path = typer.Option(..., "--out", metavar="DIR", help="Folder of results.sqlite; rerunning into it resumes the sweep."),
+    executor: str = typer.Option(
+        "local", "--executor", metavar="local|ray", help="'local' worker processes, or 'ray' (needs the ray extra of teamnav)."
+    ),
+    address: Optional[str] = typer.Option(
+        None, "--address", metavar="ADDRESS", help="Ray cluster address (auto, ray://host:10001); default: a local Ray."
+    ),
+    workers: Optional[int] = typer.Option(None, "--workers", "-j", metavar="N", help="Trials at once (default: all CPUs)."),
     retry_failed: bool = typer.Option(True, "--retry-failed/--skip-failed", help="Rerun trials stored as failed (default) or skip them."),
     artifacts: bool = typer.Option(False, "--artifacts", help="Also write each trial's run folder under OUT/trials/."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar; one summary line at the end."),
 ) -> None:
-    """Run a sweep (grid x seeds) into OUT/results.sqlite; a rerun skips the trials already done."""
+    """Run a sweep (grid x seeds) into OUT/results.sqlite.
+
+    A rerun into the same folder skips the trials already done.
+    """
     from teamnav.experiments.errors import ScenarioError
     from teamnav.experiments.sweep import SweepError, sweep
 

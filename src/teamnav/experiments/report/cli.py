@@ -26,26 +26,48 @@ from typing import List, Optional
 import typer
 from rich.console import Console
 
-__all__ = ["EXIT_BAD_INPUT", "EXIT_SECTION_FAILED", "report_command"]
+__all__ = ["EXIT_BAD_INPUT", "EXIT_SECTION_FAILED", "QUICK_NOTE", "report_command", "section_line"]
 
 #: exit status for bad input
 EXIT_BAD_INPUT = 2
 #: exit status when the report was written but some section raised
 EXIT_SECTION_FAILED = 1
+#: said beside a quick report's claim count: its sweeps are too small for verdicts
+QUICK_NOTE = "quick mode: indicative only, small sample; run without --quick for the verdicts"
+
+
+def section_line(section, quick: bool) -> str:
+    """One section's line: key, status, wall time, claims that hold; a quick report says so on it."""
+    holds = sum(c.holds is True for c in section.comparisons)
+    line = f"  {section.key:<22} {section.status:<8} {section.wall_s:7.1f} s  {holds}/{len(section.comparisons)} claims hold"
+    if quick:
+        line += f" ({QUICK_NOTE})"
+    return line + (f"  ({section.error})" if section.error else "")
 
 
 def report_command(
     experiments: List[str] = typer.Argument(
         ..., metavar="EXPERIMENT|all", help="Section keys (los-help, collab-mcl, blazing-a-trail, try-to-see-it-my-way) or 'all'."
     ),
-    out: Path = typer.Option(..., "--out", help="Report folder (index.html, report.json, sweeps/); an earlier report's folder is reused."),
-    quick: bool = typer.Option(False, "--quick", help="The short version (few seeds, short runs): what CI runs."),
-    executor: str = typer.Option("local", "--executor", help="'local' worker processes, or 'ray' (needs the ray extra of teamnav)."),
-    address: Optional[str] = typer.Option(None, "--address", help="Ray cluster address (auto, ray://host:10001); default: a local Ray."),
-    workers: Optional[int] = typer.Option(None, "--workers", "-j", help="Trials at once (default: all CPUs)."),
+    out: Path = typer.Option(
+        ..., "--out", metavar="DIR", help="Report folder (index.html, report.json, sweeps/); an earlier report's folder is reused."
+    ),
+    quick: bool = typer.Option(
+        False, "--quick", help="The short version (few seeds, short runs): what CI runs. Its verdicts are indicative only."
+    ),
+    executor: str = typer.Option(
+        "local", "--executor", metavar="local|ray", help="'local' worker processes, or 'ray' (needs the ray extra of teamnav)."
+    ),
+    address: Optional[str] = typer.Option(
+        None, "--address", metavar="ADDRESS", help="Ray cluster address (auto, ray://host:10001); default: a local Ray."
+    ),
+    workers: Optional[int] = typer.Option(None, "--workers", "-j", metavar="N", help="Trials at once (default: all CPUs)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bars or section lines; print only the report's path."),
 ) -> None:
-    """Write a self-contained HTML report: each paper's claims beside our measurements."""
+    """Write an HTML report: each paper's claims beside our numbers.
+
+    One self-contained file, OUT/index.html. --quick gives indicative verdicts only.
+    """
     from teamnav.experiments.report import ReportError, run_report
     from teamnav.experiments.sweep import SweepError
 
@@ -58,9 +80,7 @@ def report_command(
     con = Console(highlight=False, soft_wrap=True)
     if not quiet:
         for s in result.sections:
-            holds = sum(c.holds is True for c in s.comparisons)
-            line = f"  {s.key:<22} {s.status:<8} {s.wall_s:7.1f} s  {holds}/{len(s.comparisons)} claims hold"
-            con.print(line + (f"  ({s.error})" if s.error else ""), markup=False)
+            con.print(section_line(s, result.quick), markup=False)
     con.print(str(result.index), markup=False)
     if not result.ok:
         for s in result.errors:
