@@ -106,6 +106,100 @@ def test_list_shows_scenarios_controllers_maps():
         assert word in result.stdout
 
 
+def test_list_names_one_per_line_and_json_for_scripts():
+    from teamnav.experiments import registry
+
+    result = invoke("list", "--names")
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines() == list(registry.names())
+    result = invoke("list", "--json")
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.stdout)
+    assert set(doc) == {"scenarios", "controllers", "builtin_maps", "packaged_maps"}
+    assert [s["name"] for s in doc["scenarios"]] == list(registry.names())
+    assert all(set(s) == {"name", "description"} and s["description"] for s in doc["scenarios"])
+    assert "wander-v1" in doc["controllers"] and "office_simple" in doc["builtin_maps"]
+    assert "nav2/depot.yaml" in doc["packaged_maps"]
+    result = invoke("list", "--names", "--json")
+    assert result.exit_code == 2 and "--names or --json" in result.stderr
+
+
+def test_list_names_and_json_parse_in_a_real_pipe():
+    names = subprocess.run(f'"{sys.executable}" -m teamnav list --names | sort', shell=True,
+                           capture_output=True, text=True, timeout=120)
+    assert names.returncode == 0, names.stderr
+    lines = names.stdout.splitlines()
+    assert "demo" in lines and all(ln and ln == ln.strip() and " " not in ln for ln in lines)
+    doc = subprocess.run([sys.executable, "-m", "teamnav", "list", "--json"], capture_output=True, text=True, timeout=120)
+    assert doc.returncode == 0, doc.stderr
+    assert sorted(s["name"] for s in json.loads(doc.stdout)["scenarios"]) == lines
+
+
+def _table_rows(stdout: str) -> list[list[str]]:
+    """The body rows of the rich metrics table: [metric, value, unit]."""
+    return [[c.strip() for c in ln.strip("│").split("│")] for ln in stdout.splitlines()
+            if ln.startswith("│")]
+
+
+@pytest.mark.parametrize("scenario, headline, hidden", [
+    ("demo", "path_length_m_mean", "odom_heading_error_deg_mean"),
+    ("collab-mcl-hallway", "loc_final_error_m", "loc_error_series"),
+])
+def test_run_prints_headline_metrics_with_units_and_where_the_rest_is(tmp_path, scenario, headline, hidden):
+    out = tmp_path / "run"
+    result = invoke("run", scenario, "--duration", "2", "--set", "robots.0.count=2", "--out", out)
+    assert result.exit_code == 0, result.output
+    rows = _table_rows(result.stdout)
+    assert 0 < len(rows) <= 15
+    assert all(len(r) == 3 for r in rows), rows
+    assert not any(c in r[1] for r in rows for c in "[{"), "no series in the table"
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert len(metrics) > len(rows)
+    by_key = {r[0]: r for r in rows}
+    assert headline in by_key and hidden not in result.stdout and hidden in metrics
+    assert by_key[headline][2] == "m"
+    assert f"{out / 'metrics.json'}" in result.stdout
+
+
+def test_headline_rows_fall_back_to_scalars_with_units_from_the_key():
+    from teamnav.cli import headline_rows, unit_from_key
+
+    values = {f"x{i}_s": i for i in range(20)}
+    values.update({"a_series": "[1, 2]", "b": [1, 2], "c": {"k": 1}, "speed_mps": 0.5, "length_m_max": 2.0})
+    rows = headline_rows(["not-a-declared-metric"], values)
+    assert len(rows) == 15 and rows[0] == ("x0_s", 0, "s")
+    assert not {"a_series", "b", "c"} & {k for k, _, _ in rows}
+    assert [unit_from_key(k) for k in ("speed_mps", "length_m_max", "lifetime_min_total", "count", "trips_total")] == \
+        ["m/s", "m", "min", "", ""]
+    # declared metrics give their declared keys, paper sets first, and no series
+    rows = headline_rows(["steps", "localization"], {"sim_time_s": 2.0, "steps": 20, "loc_final_error_m": 1.5,
+                                                     "loc_error_series": "{}", "loc_censored": 0})
+    assert rows == [("loc_censored", 0, "robots"), ("loc_final_error_m", 1.5, "m"), ("sim_time_s", 2.0, "s")]
+
+
+def test_quick_report_says_its_claims_are_indicative_on_the_same_line(tmp_path):
+    import teamnav.experiments.report as report
+    from teamnav.experiments.report.cli import section_line
+    from teamnav.experiments.report.model import Comparison, SectionSpec
+
+    claims = [Comparison("a", "1", "1", True), Comparison("b", "2", "3", False)]
+    report.register_section(SectionSpec(key="fake-claims", title="Fake", paper="fake.txt", build=lambda ctx: claims))
+    try:
+        quick = invoke("report", "fake-claims", "--quick", "--out", tmp_path / "r")
+        full = invoke("report", "fake-claims", "--out", tmp_path / "r")
+    finally:
+        report.unregister_section("fake-claims")
+    assert quick.exit_code == 0 and full.exit_code == 0, quick.output + full.output
+    line = next(ln for ln in quick.stdout.splitlines() if "fake-claims" in ln)
+    assert "1/2 claims hold (quick mode: indicative only, small sample; run without --quick for the verdicts)" in line
+    assert "1/2 claims hold" in full.stdout and "quick mode" not in full.stdout
+    from types import SimpleNamespace
+
+    s = SimpleNamespace(key="k", status="error", wall_s=1.0, comparisons=claims, error="RuntimeError: x")
+    assert section_line(s, quick=True).endswith("(quick mode: indicative only, small sample; run without --quick "
+                                                 "for the verdicts)  (RuntimeError: x)")
+
+
 def test_out_dir_not_empty_needs_force(tmp_path):
     out = tmp_path / "out"
     out.mkdir()
