@@ -15,7 +15,7 @@ from PIL import Image
 
 import teamnav.world
 from teamnav.world.grid import DEFAULT_MATERIALS, OccupancyGrid
-from teamnav.world.mapio import MapError, load_map, occupancy_values, save_map
+from teamnav.world.mapio import MapError, load_map, load_occupancy, occupancy_values, read_map_yaml, save_map
 
 # the real maps ship with the package (identical to /work/shared/data), so a clean checkout finds them
 DATA = Path(teamnav.world.__file__).parent / "maps"
@@ -349,3 +349,156 @@ def test_save_map_refuses_a_non_yaml_target(tmp_path):
     with pytest.raises(MapError, match=r"m\.pgm: field '<file>': expected a path ending in one of"):
         save_map(g, tmp_path / "m.pgm")
     assert not any(tmp_path.iterdir())
+
+
+# ---------------------------------------------------------------------------- nav2 map_server's own loader tests
+# Ported from navigation2's nav2_map_server/test/unit/test_map_io.cpp and test_constants.cpp:
+# a 10 x 10 map at 0.1 m with origin [2, 3, 1] (a yaw of 1 rad), whose OccupancyGrid.data is
+# g_valid_image_content, given bottom row first. The reference image (testmap.png/.pgm/.bmp)
+# is rebuilt from that content: 100 -> black (0), 0 -> white (255).
+NAV2_CONTENT = np.array([
+    0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+    100, 100, 100, 100, 0, 0, 100, 100, 100, 0,
+    100, 100, 100, 100, 0, 0, 100, 100, 100, 0,
+    100, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+    100, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+    100, 0, 0, 0, 0, 0, 100, 100, 0, 0,
+    100, 0, 0, 0, 0, 0, 100, 100, 0, 0,
+    100, 0, 0, 0, 0, 0, 100, 100, 0, 0,
+    100, 0, 0, 0, 0, 0, 100, 100, 0, 0,
+    100, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+], np.int8).reshape(10, 10)  # row 0 = the map's bottom row
+NAV2_RES, NAV2_ORIGIN = 0.1, [2.0, 3.0, 1.0]
+NAV2_YAML = ("image: \"testmap.{ext}\"\nresolution: 0.1\norigin: [2.0, 3.0, 1.0]\noccupied_thresh: 0.65\n"
+             "free_thresh: 0.196\nnegate: 0\nmode: \"trinary\"\n")
+
+
+def _nav2_testmap(folder: Path, ext: str) -> Path:
+    image = np.where(NAV2_CONTENT[::-1] == 100, 0, 255).astype(np.uint8)  # the image's top row first
+    Image.fromarray(image, mode="L").save(folder / f"testmap.{ext}")
+    (folder / "testmap.yaml").write_text(NAV2_YAML.format(ext=ext))
+    return folder / "testmap.yaml"
+
+
+def _nav2_save(values: np.ndarray, folder: Path, mode: str) -> Path:
+    """Write ``values`` (row 0 = bottom) as nav2's saveMapToFile does (tryWriteMapToFile), in ``mode``."""
+    top_first = values[::-1].astype(int)
+    unknown = (top_first < 0) | (top_first > 100)
+    if mode == "trinary":  # thresholds 0.196 / 0.65 -> rint(100 t) = 20 / 65
+        px = np.where(top_first <= 20, 254, np.where(top_first >= 65, 0, 205))
+        px = np.where(unknown, 205, px).astype(np.uint8)
+        Image.fromarray(px, mode="L").save(folder / "saved.pgm")
+        ext = "pgm"
+    elif mode == "scale":  # RGBA; unknown grey 0.5 and transparent, else grey (100 - v) / 100
+        grey = np.rint((100.0 - top_first) / 100.0 * 255.0)
+        rgba = np.stack([grey, grey, grey, np.full(grey.shape, 255.0)], axis=-1)
+        rgba[unknown] = (128, 128, 128, 0)
+        Image.fromarray(rgba.astype(np.uint8), mode="RGBA").save(folder / "saved.png")
+        ext = "png"
+    else:  # raw: the value itself as the grey level, unknown as MaxRGB
+        px = np.where(unknown, 255, top_first).astype(np.uint8)
+        Image.fromarray(px, mode="L").save(folder / "saved.png")
+        ext = "png"
+    (folder / "saved.yaml").write_text(
+        f"image: saved.{ext}\nmode: {mode}\nresolution: 0.1\norigin: [2, 3, 1]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    return folder / "saved.yaml"
+
+
+@pytest.mark.parametrize("ext", ["pgm", "png", "bmp"])
+def test_nav2_load_save_valid_image(tmp_path, ext):
+    """loadSaveValidPGM / loadSaveValidPNG / loadSaveValidBMP: the content cell for cell, then
+    saved (by nav2's saver and by teamnav's) and loaded back unchanged."""
+    values, meta = load_occupancy(_nav2_testmap(tmp_path, ext))
+    assert meta.resolution_m == NAV2_RES and values.shape == (10, 10)
+    np.testing.assert_array_equal(values, NAV2_CONTENT)
+    again, _ = load_occupancy(_nav2_save(values, tmp_path, "trinary"))
+    np.testing.assert_array_equal(again, NAV2_CONTENT)
+    grid = load_map(tmp_path / "testmap.yaml")
+    np.testing.assert_array_equal(grid.cells == WALL, NAV2_CONTENT == 100)
+    np.testing.assert_array_equal(grid.cells == FREE, NAV2_CONTENT == 0)
+    back, _ = load_occupancy(save_map(grid, tmp_path / "ours" / "testmap.yaml"))
+    np.testing.assert_array_equal(back, NAV2_CONTENT)
+
+
+@pytest.mark.parametrize("mode", ["scale", "raw"])
+def test_nav2_load_save_map_modes(tmp_path, mode):
+    """loadSaveMapModes: a map saved by nav2 in scale and in raw mode loads back to the same data."""
+    values, _ = load_occupancy(_nav2_testmap(tmp_path, "png"))
+    again, meta = load_occupancy(_nav2_save(values, tmp_path, mode))
+    assert meta.mode == mode
+    np.testing.assert_array_equal(again, NAV2_CONTENT)
+
+
+def test_nav2_load_valid_yaml(tmp_path):
+    """loadValidYAML: every field as nav2 reads it, the yaw included."""
+    meta = read_map_yaml(_nav2_testmap(tmp_path, "png"))
+    assert meta.image == tmp_path / "testmap.png"
+    assert meta.resolution_m == NAV2_RES
+    assert [*meta.origin_xy_m, meta.yaw_rad] == NAV2_ORIGIN
+    assert (meta.free_thresh, meta.occupied_thresh, meta.mode, meta.negate) == (0.196, 0.65, "trinary", False)
+
+
+def test_nav2_load_invalid_file_and_yaml(tmp_path):
+    """loadInvalidFile / loadInvalidYAML: a missing image, an empty name, a missing YAML."""
+    (tmp_path / "foo.yaml").write_text(NAV2_YAML.replace("testmap.{ext}", "foo"))
+    with pytest.raises(MapError, match=r"foo\.yaml -> .*foo: field 'image': expected an existing image file"):
+        load_map(tmp_path / "foo.yaml")
+    with pytest.raises(MapError, match="field '<file>'"):
+        load_map("")
+    with pytest.raises(MapError, match=r"invalid_file\.yaml: field '<file>': expected an existing map file, found no such file"):
+        load_map(tmp_path / "invalid_file.yaml")
+
+
+def test_nav2_invalid_image_yaml_is_refused_for_its_image_not_its_map_type(tmp_path, caplog):
+    """nav2's invalid_image.yaml: ``map_type: "occupancy"`` is ignored (one warning line
+    naming the file and the key) and the missing image is what fails."""
+    (tmp_path / "invalid_image.yaml").write_text("map_type: \"occupancy\"\n" + NAV2_YAML.replace("testmap.{ext}", "invalid.png"))
+    with caplog.at_level(logging.WARNING, logger="teamnav.world.mapio"):
+        with pytest.raises(MapError, match=r"field 'image': expected an existing image file"):
+            load_map(tmp_path / "invalid_image.yaml")
+        with pytest.raises(MapError):
+            load_map(tmp_path / "invalid_image.yaml")
+    warned = [r.getMessage() for r in caplog.records if "map_type" in r.getMessage()]
+    assert len(warned) == 1 and "invalid_image.yaml" in warned[0] and "ignoring key 'map_type'" in warned[0]
+
+
+@pytest.mark.parametrize("occ, free, field", [(2.0, 2.0, "occupied_thresh"), (-2.0, -2.0, "occupied_thresh"),
+                                              (0.2, 0.7, "occupied_thresh")])
+def test_nav2_save_invalid_parameters(tmp_path, occ, free, field):
+    """saveInvalidParameters: thresholds out of [0, 1] or free above occupied are refused and
+    nothing is written; so is a folder that cannot be made."""
+    grid = load_map(_nav2_testmap(tmp_path, "png"))
+    with pytest.raises(MapError, match=f"field '{field}'"):
+        save_map(grid, tmp_path / "out" / "m.yaml", occupied_thresh=occ, free_thresh=free)
+    assert not (tmp_path / "out").exists()
+    (tmp_path / "a_file").write_text("x")
+    with pytest.raises(MapError, match=r"a_file/sub/m\.yaml: field '<file>': expected a path in a folder"):
+        save_map(grid, tmp_path / "a_file" / "sub" / "m.yaml")
+
+
+def test_saved_map_keeps_origin_yaw_and_thresholds_and_reads_back_in_a_map_server_reader(tmp_path):
+    """A run folder's map.yaml: origin, yaw and thresholds written as read, and an independent
+    reader of nav2's rule (``_reference``) finds the same cells in the saved image."""
+    src = load_map(DATA / "nav2" / "depot.yaml")  # free_thresh 0.25: map_saver's 205 would read free
+    rotated = src.with_pose((2.0, 3.0), 1.0)
+    meta = read_map_yaml(DATA / "nav2" / "depot.yaml")
+    out = save_map(rotated, tmp_path / "map.yaml", occupied_thresh=meta.occupied_thresh, free_thresh=meta.free_thresh)
+    doc = yaml.safe_load(out.read_text())
+    assert doc["origin"] == [2.0, 3.0, 1.0]
+    assert (doc["occupied_thresh"], doc["free_thresh"]) == (meta.occupied_thresh, meta.free_thresh)
+    back = load_map(out)
+    np.testing.assert_array_equal(back.cells, src.cells)
+    assert back.yaw_rad == 1.0 and back.origin_xy_m == (2.0, 3.0)
+    px = np.asarray(Image.open(tmp_path / doc["image"]))
+    np.testing.assert_array_equal(_reference(px, bool(doc["negate"]), doc["occupied_thresh"], doc["free_thresh"], doc["mode"]),
+                                  src.cells)
+
+
+def test_hostile_image_header_is_refused_before_decoding(tmp_path):
+    """A PGM header claiming 1e5 x 1e5 pixels: refused from the header with the figure."""
+    (tmp_path / "bomb.pgm").write_bytes(b"P5\n100000 100000\n255\n" + b"\0" * 64)
+    (tmp_path / "bomb.yaml").write_text("image: bomb.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    with pytest.raises(MapError, match=r"bomb\.pgm: field 'image': expected an image of at most 50000000 pixels, "
+                                       r"found a map of 100000 x 100000 cells .* would need about 400\.0 GB"):
+        load_map(tmp_path / "bomb.yaml")

@@ -79,6 +79,7 @@ import logging
 import math
 import os
 import tempfile
+import threading
 import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
@@ -96,6 +97,7 @@ __all__ = [
     "MapError",
     "MapMetadata",
     "load_map",
+    "load_occupancy",
     "save_map",
     "read_map_yaml",
     "occupancy_values",
@@ -281,6 +283,37 @@ def load_map(
     # image row 0 is the top (highest y); grid row 0 is the bottom
     cells = np.ascontiguousarray(cells[::-1])
     return OccupancyGrid(cells, meta.resolution_m, meta.origin_xy_m, materials, str(path), meta.yaw_rad)
+
+
+def load_occupancy(path: str | os.PathLike) -> tuple[np.ndarray, MapMetadata]:
+    """The ``nav_msgs/OccupancyGrid`` nav2's map_server would publish for a map YAML.
+
+    Parameters
+    ----------
+    path : str or Path
+        A map_server YAML file.
+
+    Returns
+    -------
+    values : ndarray of shape (height, width), int8
+        ``OccupancyGrid.data`` reshaped: row 0 is the image's bottom row (nav2 stores
+        ``data[width * (height - y - 1) + x]`` for image row ``y``); 100 occupied, 0 free,
+        -1 unknown, graded values in scale and raw modes.
+    meta : MapMetadata
+        The YAML's validated fields (resolution, origin, yaw, thresholds, mode, negate).
+
+    Raises
+    ------
+    MapError
+        As :func:`load_map`.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise MapError(path, "<file>", "a map YAML file", _Described("a directory"))
+    meta = read_map_yaml(path)
+    pixels = _read_image(meta.image, "image", source=path)
+    values = occupancy_values(pixels, meta.negate, meta.occupied_thresh, meta.free_thresh, meta.mode)
+    return np.ascontiguousarray(values[::-1]), meta
 
 
 def read_map_yaml(path: str | os.PathLike) -> MapMetadata:
@@ -537,7 +570,11 @@ def save_map(
         raise MapError(yaml_path, "occupied_thresh", f"a value greater than free_thresh={free_thresh!r}", occupied_thresh)
     px_free, px_unknown, px_occupied = _pixels_for(yaml_path, occupied_thresh, free_thresh)
     folder = yaml_path.parent
-    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise MapError(yaml_path, "<file>", "a path in a folder that can be created and written",
+                       _Described(f"{type(exc).__name__}: {exc.strerror or exc}")) from None
     names = np.asarray(grid.materials, dtype=object)
     cell_names = names[grid.cells]
     image = np.full(grid.shape, px_occupied, dtype=np.uint8)
@@ -567,17 +604,23 @@ def save_map(
     files.append((yaml_path, yaml.safe_dump(doc, sort_keys=False)))
 
     temps: list[tuple[str, Path]] = []
+    umask = os.umask(0)
+    os.umask(umask)
     try:
         for target, content in files:
             fd, tmp = tempfile.mkstemp(prefix="." + target.name + ".", suffix=".tmp" + target.suffix, dir=folder)
             os.close(fd)
             temps.append((tmp, target))
+            os.chmod(tmp, 0o666 & ~umask)  # the user's umask, as any tool's files (mkstemp makes 0600)
             if isinstance(content, str):
                 Path(tmp).write_text(content, encoding="utf-8")
             else:
                 Image.fromarray(np.ascontiguousarray(content), mode="L").save(tmp, format="PPM")
         for tmp, target in temps:
             os.replace(tmp, target)
+    except OSError as exc:
+        raise MapError(yaml_path, "<file>", "a path in a folder that can be written",
+                       _Described(f"{type(exc).__name__}: {exc.strerror or exc}")) from None
     finally:
         for tmp, _ in temps:
             if os.path.exists(tmp):
@@ -614,7 +657,7 @@ def _read_image(image_path: Path, field: str, *, source: Path) -> np.ndarray:
     if not image_path.is_file():
         raise MapError(where, field, "an existing image file", _Described("no such file"))
     try:
-        with Image.open(image_path) as im:
+        with _open_header_only(image_path) as im:
             w, h = im.size
             try:
                 check_map_size(w, h, str(image_path))
@@ -647,6 +690,22 @@ def _read_image(image_path: Path, field: str, *, source: Path) -> np.ndarray:
     if pixels.ndim < 2 or pixels.shape[0] < 1 or pixels.shape[1] < 1:
         raise MapError(where, field, "a non-empty image", _Described(f"shape {pixels.shape}"))
     return pixels
+
+
+_PIL_LIMIT_LOCK = threading.Lock()
+
+
+def _open_header_only(image_path: Path) -> Image.Image:
+    """``Image.open`` (which reads only the header) without PIL's own decompression-bomb
+    refusal, so that the caller can refuse an oversized image with teamnav's figure and limit
+    (:data:`MAX_MAP_CELLS`, below PIL's)."""
+    with _PIL_LIMIT_LOCK:
+        saved = Image.MAX_IMAGE_PIXELS
+        Image.MAX_IMAGE_PIXELS = None
+        try:
+            return Image.open(image_path)
+        finally:
+            Image.MAX_IMAGE_PIXELS = saved
 
 
 def _apply_material_layer(path: Path, meta: MapMetadata, cells: np.ndarray) -> tuple[np.ndarray, tuple[str, ...]]:
