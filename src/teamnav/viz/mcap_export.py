@@ -34,8 +34,6 @@ topic                          schema                     what
 
 from __future__ import annotations
 
-import contextlib
-
 import colorsys
 import math
 import os
@@ -45,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from teamnav.viz.replay import odom_anchor, read_run
+from teamnav.viz.run_folder import OutputPathError, atomic_output
 
 __all__ = ["McapStats", "export_mcap"]
 
@@ -134,9 +133,10 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
 
     rec, grid, _robots = read_run(run_dir)
     path = Path(path)
+    if path.is_dir():
+        raise OutputPathError(f"MCAP file {path}: expected a file path, found a folder; choose another --mcap")
     if path.exists() and not force:
         raise ValueError(f"MCAP file {str(path)!r} exists; choose another --mcap or pass --force")
-    path.parent.mkdir(parents=True, exist_ok=True)
     T, N = rec.true_pose.shape[:2]
     true = np.asarray(rec.true_pose, float)
     odom = np.asarray(rec.odom_pose, float)
@@ -158,8 +158,9 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
 
     counts: dict[str, int] = {}
     ctx = foxglove.Context()
-    tmp = path.with_name(f".{path.name}.tmp")
-    try:
+    # written under a temporary name in the target folder, renamed once complete; a path that
+    # cannot be written is an OutputPathError naming it, and nothing is left behind
+    with atomic_output(path, "MCAP file", "--mcap") as tmp:
         with foxglove.open_mcap(tmp, allow_overwrite=True, context=ctx):
             def log(ch, msg, ns):
                 ch.log(msg, log_time=int(ns))
@@ -254,10 +255,5 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
                         ent["texts"] = [TextPrimitive(pose=_pose(0.0, 0.0, 0.0), billboard=True, font_size=14.0,
                                                       scale_invariant=True, color=colour, text=label)]
                     log(ch, SceneUpdate(entities=[SceneEntity(**{k: v for k, v in ent.items() if v is not None})]), lay_ns[s])
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):  # the temp file may not exist yet
-            tmp.unlink()
-        raise
     return McapStats(path=path, bytes=path.stat().st_size, messages=sum(counts.values()), channels=len(counts),
                      counts=dict(sorted(counts.items())))

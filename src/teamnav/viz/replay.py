@@ -48,7 +48,9 @@ from typing import Any
 
 import numpy as np
 
-from teamnav.sim.recorder import RunRecord, load
+from teamnav.sim.recorder import RunRecord
+from teamnav.viz.run_folder import atomic_output, read_map, read_run_folder
+from teamnav.viz.run_folder import scenario_name as run_scenario_name
 from teamnav.world.grid import OccupancyGrid
 
 __all__ = ["ReplayStats", "build_replay", "odom_anchor", "read_run"]
@@ -76,28 +78,19 @@ class ReplayStats:
 
 
 def read_run(run_dir: str | os.PathLike) -> tuple[RunRecord, OccupancyGrid | None, dict]:
-    """The recorder files, the map (None when the folder has no ``map.yaml``) and ``robots.json``.
+    """The recorder files, the map (None when the folder has no ``map.yaml``) and ``robots.json``,
+    every array and field checked (:func:`teamnav.viz.run_folder.read_run_folder`).
 
     Raises
     ------
-    ValueError
-        ``run_dir`` is not a folder, or holds no ``trajectories.npz``.
+    RunFolderError
+        ``run_dir`` is not a run folder, or a file in it is damaged or malformed (the message
+        names the file and the field).
+    MapError
+        ``map.yaml`` or its image is invalid.
     """
-    run_dir = Path(run_dir)
-    if not run_dir.is_dir():
-        raise ValueError(f"run folder {str(run_dir)!r} does not exist or is not a folder")
-    if not (run_dir / "trajectories.npz").is_file():
-        raise ValueError(f"{str(run_dir)!r} is not a run folder: it has no trajectories.npz (make one with `teamnav run`)")
-    rec = load(run_dir)
-    grid = None
-    if (run_dir / "map.yaml").is_file():
-        from teamnav.world.mapio import load_map
-
-        grid = load_map(run_dir / "map.yaml")
-    robots = {}
-    if (run_dir / "robots.json").is_file():
-        robots = json.loads((run_dir / "robots.json").read_text(encoding="utf-8"))
-    return rec, grid, robots
+    rec, robots = read_run_folder(run_dir)
+    return rec, read_map(run_dir), robots
 
 
 def odom_anchor(true_pose0: np.ndarray, odom_pose0: np.ndarray) -> np.ndarray:
@@ -427,14 +420,7 @@ def build_replay(
         map_meta = {"png": uri, "x0": gx0, "y0": gy0, "x1": gx0 + gw, "y1": gy0 + gh, "yaw": grid.yaw_rad,
                     "downsample": f, "name": grid.name}
 
-    scenario_name = ""
-    if (run_dir / "scenario.yaml").is_file():
-        import yaml
-
-        try:
-            scenario_name = str((yaml.safe_load((run_dir / "scenario.yaml").read_text(encoding="utf-8")) or {}).get("name", ""))
-        except yaml.YAMLError:
-            scenario_name = ""
+    scenario_name = run_scenario_name(run_dir)
     radius = robots.get("radius_m") if isinstance(robots.get("radius_m"), list) and len(robots["radius_m"]) == N else [0.2] * N
     group = robots.get("group") if isinstance(robots.get("group"), list) and len(robots["group"]) == N else [""] * N
     meta = {
@@ -451,10 +437,8 @@ def build_replay(
     meta_json = json.dumps(meta, separators=(",", ":")).replace("</", "<\\/")
     fill = {"TITLE": html.escape(meta["title"]), "META": meta_json, "DATA": payload}
     page = re.sub(r"\{\{(TITLE|META|DATA)\}\}", lambda m: fill[m.group(1)], page)  # one pass: data never re-scanned
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(page, encoding="utf-8")
-    os.replace(tmp, out)
+    with atomic_output(out, "HTML file", "--out") as tmp:  # nothing half-written, even on /proc or a full disk
+        tmp.write_text(page, encoding="utf-8")
     names = ["map", "true", "trails", "belief"] + (["scans"] if scans_meta else []) + [m["name"] for m in layers_meta]
     names += ["events"] if events else []
     return ReplayStats(path=out, n_frames=F, every=every, n_robots=N, bytes=out.stat().st_size, layers=tuple(names))
