@@ -147,8 +147,12 @@ def check_store(path: str | os.PathLike) -> None:
         except UnicodeDecodeError:
             what = "a file that is not an SQLite database"
         raise StoreError(f"results store {p}: expected a teamnav results store (an SQLite database), found {what}; {todo}")
+    # without a -wal file the main file is the whole database: open it immutable, so the check
+    # leaves no -wal/-shm files next to a file it refuses; with one, a normal read-only open
+    # replays it (a sweep killed with kill -9 leaves one, and its store is valid)
+    wal = Path(f"{p}-wal").exists()
     try:
-        con = sqlite3.connect(f"{p.resolve().as_uri()}?mode=ro", uri=True, timeout=60.0)
+        con = sqlite3.connect(f"{p.resolve().as_uri()}?mode=ro{'' if wal else '&immutable=1'}", uri=True, timeout=60.0)
     except sqlite3.Error as exc:
         raise StoreError(f"results store {p}: cannot be opened ({exc}); {todo}") from None
     try:
