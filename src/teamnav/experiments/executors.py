@@ -210,6 +210,35 @@ def _limit_numba_threads(threads: int) -> None:
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
 
 
+def _init_worker(threads: int, parent_pid: int | None) -> None:
+    """Initializer of a local worker process: end with the sweep (even when the sweep is
+    killed with SIGKILL, which leaves it no chance to stop its workers), and take ``threads``
+    numba threads."""
+    from teamnav.experiments.signals import die_with_parent
+
+    die_with_parent(parent_pid)
+    _limit_numba_threads(threads)
+
+
+def _stop_workers(pool: ProcessPoolExecutor, grace_s: float = 5.0) -> None:
+    """Shut ``pool`` down now: cancel what has not started, SIGTERM the workers (a trial's
+    run removes its staging folder), SIGKILL those still there after ``grace_s``."""
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        with contextlib.suppress(Exception):  # already gone
+            p.terminate()
+    deadline = time.monotonic() + grace_s
+    for p in procs:
+        with contextlib.suppress(Exception):
+            p.join(max(0.0, deadline - time.monotonic()))
+    for p in procs:
+        with contextlib.suppress(Exception):
+            if p.is_alive():
+                p.kill()
+                p.join(1.0)
+
+
 def _execute_one_thread(task: TrialTask) -> TrialResult:
     """:func:`execute` in a Ray task, which holds one CPU."""
     _limit_numba_threads(1)
@@ -236,8 +265,10 @@ class LocalExecutor:
         self.start_method = start_method
 
     def _pool(self, n: int) -> ProcessPoolExecutor:
+        # a spawned worker's parent is this process; a forkserver's is the server (which ends with us)
+        parent = os.getpid() if self.start_method == "spawn" else None
         return ProcessPoolExecutor(max_workers=n, mp_context=multiprocessing.get_context(self.start_method),
-                                   initializer=_limit_numba_threads, initargs=(max(1, default_workers() // n),))
+                                   initializer=_init_worker, initargs=(max(1, default_workers() // n), parent))
 
     def run(self, tasks: Iterable[TrialTask], on_result: Callable[[TrialResult], None]) -> None:
         n = self.workers or default_workers()
@@ -275,8 +306,8 @@ class LocalExecutor:
                     pool.shutdown(wait=True, cancel_futures=True)
                     pool = self._pool(n)
                 fill()
-        except BaseException:
-            pool.shutdown(wait=False, cancel_futures=True)
+        except BaseException:  # Ctrl-C, SIGTERM (signals.Terminated), a failing on_result
+            _stop_workers(pool)  # stop the trials in flight: nothing keeps running behind us
             raise
         pool.shutdown(wait=True)
 
