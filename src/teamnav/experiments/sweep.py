@@ -820,7 +820,10 @@ def sweep(
     check_store(out / STORE_NAME)  # a results.sqlite that is not a teamnav store: refused before any trial
     out.mkdir(parents=True, exist_ok=True)
     result = SweepResult(spec.sweep_name, out / STORE_NAME, len(trials))
-    with ResultsStore(out / STORE_NAME) as store:
+    from teamnav.experiments.signals import sigterm_raises
+
+    # SIGTERM as Ctrl-C: the workers are stopped and the store closed before the process ends
+    with sigterm_raises(), ResultsStore(out / STORE_NAME) as store:
         previous = store.existing()
         clash = [t for t in trials if t.trial_id in previous and previous[t.trial_id][1] != t.config_hash]
         if clash:
@@ -859,11 +862,21 @@ def sweep(
 
 
 class _Bar:
-    """A rich progress bar on stderr: done / total, ok and failed counts, elapsed and ETA."""
+    """Sweep progress on stderr: a rich bar (done / total, ok and failed counts, elapsed and
+    ETA) on a terminal; elsewhere (CI, nohup, a pipe) a plain line every
+    :func:`~teamnav.experiments.progress.period_s` seconds and one at the end."""
 
     def __init__(self, name: str, total: int, skipped: int, show: bool) -> None:
         self._progress = None
+        self._plain = None
+        self._total, self._ok, self._failed = total, 0, 0
         if not show:
+            return
+        from teamnav.experiments.progress import PlainProgress, stderr_is_terminal
+
+        note = f" ({skipped} already done)" if skipped else ""
+        if not stderr_is_terminal():
+            self._plain = PlainProgress(f"teamnav sweep {name}{note}", total, "trials", details=self._counts).start()
             return
         from rich.console import Console
         from rich.progress import (
@@ -888,20 +901,27 @@ class _Bar:
         )
         from rich.markup import escape
 
-        note = f" ({skipped} already done)" if skipped else ""
         self._task = self._progress.add_task(escape(f"sweep {name}{note}"), total=total, ok=0, failed=0, left=total)
-        self._total, self._ok, self._failed = total, 0, 0
         self._progress.start()
 
+    def _counts(self) -> str:
+        left = self._total - self._ok - self._failed
+        return f"{self._ok} ok, {self._failed} failed, {left} left"
+
     def advance(self, ok: bool) -> None:
-        if self._progress is None:
-            return
         self._ok += ok
         self._failed += not ok
+        if self._plain is not None:
+            self._plain.update(self._ok + self._failed)
+        if self._progress is None:
+            return
         left = self._total - self._ok - self._failed
         self._progress.update(self._task, advance=1, ok=self._ok, failed=self._failed, left=left)
 
     def close(self) -> None:
+        if self._plain is not None:
+            self._plain.close(final="{line}")
+            self._plain = None
         if self._progress is not None:
             self._progress.stop()
             self._progress = None

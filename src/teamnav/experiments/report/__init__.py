@@ -415,12 +415,29 @@ def run_report(
 
     index = out / "index.html"
     outcomes: list[SectionOutcome] = []
-    for i, key in enumerate(keys):
-        outcomes.append(_build_one(key, sections[key], make_ctx, say))
-        # rewrite the report after every section: a long full run shows what it has so far,
-        # and the sections still to come are marked as pending, not left out
-        pending = [_pending(k, sections[k]) for k in keys[i + 1 :]]
-        _write_outputs(out, index, outcomes + pending, quick, executor, workers, address, time.perf_counter() - t_start)
+    # off a terminal, a plain line every 10 s while a section works outside its sweeps (which
+    # print their own lines; this one keeps quiet while they do)
+    heartbeat = None
+    if progress:
+        from teamnav.experiments.progress import PlainProgress, stderr_is_terminal
+
+        if not stderr_is_terminal():
+            current = [""]
+            heartbeat = PlainProgress("teamnav report", len(keys), "sections", quiet_if_recent=True,
+                                      details=lambda: f"building {current[0]}").start()
+    try:
+        for i, key in enumerate(keys):
+            if heartbeat is not None:
+                current[0] = key
+                heartbeat.update(i)
+            outcomes.append(_build_one(key, sections[key], make_ctx, say))
+            # rewrite the report after every section: a long full run shows what it has so far,
+            # and the sections still to come are marked as pending, not left out
+            pending = [_pending(k, sections[k]) for k in keys[i + 1 :]]
+            _write_outputs(out, index, outcomes + pending, quick, executor, workers, address, time.perf_counter() - t_start)
+    finally:
+        if heartbeat is not None:
+            heartbeat.close()
     if not keys:  # pragma: no cover - resolve_names never returns an empty list
         _write_outputs(out, index, [], quick, executor, workers, address, time.perf_counter() - t_start)
     return ReportResult(index=index, sections=outcomes, quick=quick, wall_s=time.perf_counter() - t_start)
