@@ -12,8 +12,12 @@ A run folder holds everything needed to look at, score and reproduce the run::
     run.gif             optional animation
 
 Everything is written to a hidden staging folder next to the target and renamed into place
-at the end, so a failure (a bad scenario, an exception in a controller or a metric, Ctrl-C)
-never leaves a half-written run folder behind.
+at the end, so a failure (a bad scenario, an exception in a controller or a metric, Ctrl-C,
+SIGTERM) never leaves a half-written run folder behind. The staging folder's name carries the
+host and pid of the run that owns it (``.NAME.HOST-PID.XXXXXXXX.partial``): one left by a run
+killed outright (SIGKILL, a power cut) is removed by the next run into the same parent folder
+once that process is gone, never while it lives. The run folder and its files get the user's
+umask (folders ``0o777 & ~umask``, files ``0o666 & ~umask``), like any file a tool writes.
 """
 
 from __future__ import annotations
@@ -21,9 +25,11 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import shutil
-import sys
+import socket
 import tempfile
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,7 +42,9 @@ from teamnav.experiments.errors import Problem, ScenarioError
 from teamnav.experiments.spec import Scenario, build_grid, check_controllers, load_scenario, scenario_to_yaml
 from teamnav.world.mapio import save_map
 
-__all__ = ["OutputDirError", "RunResult", "check_scenario", "robot_radii", "run", "run_data"]
+__all__ = [
+    "OutputDirError", "RunResult", "check_scenario", "clean_stale_staging", "current_umask", "robot_radii", "run", "run_data",
+]
 
 #: a progress bar appears once a run has taken this long [s]
 PROGRESS_AFTER_S = 2.0
@@ -97,7 +105,7 @@ def _comm_counts(comm: dict) -> tuple[int, int, int]:
 
 
 def run_data(run_dir: Path, scenario: Scenario, grid, n_steps: int, wall_s: float, *,
-             finished: bool = False) -> metric_registry.RunData:
+             finished: bool = False, warmup_s: float = 0.0) -> metric_registry.RunData:
     """Read the recorder's files in ``run_dir`` into a :class:`~teamnav.experiments.metrics.RunData`."""
     from teamnav.sim.recorder import load
 
@@ -117,6 +125,7 @@ def run_data(run_dir: Path, scenario: Scenario, grid, n_steps: int, wall_s: floa
         n_steps=n_steps,
         dt_s=scenario.dt_s,
         wall_s=wall_s,
+        warmup_s=warmup_s,
         event_log=list(rec.events),
         logs=list(rec.logs),
         finished=finished,
@@ -126,7 +135,7 @@ def run_data(run_dir: Path, scenario: Scenario, grid, n_steps: int, wall_s: floa
 class _LazyBar:
     """A rich progress bar on stderr that appears only once the run has lasted a while."""
 
-    def __init__(self, total: int, label: str, show: bool) -> None:
+    def __init__(self, total: int, label: str, show: bool = True) -> None:
         self.total, self.label, self.show = total, label, show
         self.t0 = time.perf_counter()
         self.bar = None
@@ -152,6 +161,100 @@ class _LazyBar:
             self.bar.stop()
 
 
+# ---------------------------------------------------------------------------- staging and modes
+#: this host in staging folder names (letters, digits and '-'; at most 32)
+_HOST = re.sub(r"[^A-Za-z0-9-]", "-", socket.gethostname())[:32] or "host"
+#: ``.NAME.HOST-PID.XXXXXXXX.partial`` (staging) and ``.NAME.HOST-PID.XXXXXXXX.old`` (a run
+#: folder being replaced); XXXXXXXX is tempfile's random part
+_STAGING = re.compile(r"^\.(?P<name>.+)\.(?P<host>[A-Za-z0-9-]{1,32})-(?P<pid>\d+)\.[a-z0-9_]{8}\.(?P<kind>partial|old)$")
+#: ``teamnav-run-HOST-PID.XXXXXXXX.partial`` in the temporary folder (a run without out_dir)
+_TMP_STAGING = re.compile(r"^teamnav-run-(?P<host>[A-Za-z0-9-]{1,32})-(?P<pid>\d+)\.[a-z0-9_]{8}\.partial$")
+_UMASK_LOCK = threading.Lock()
+
+
+def current_umask() -> int:
+    """This process's umask, read without changing it where the system allows
+    (``/proc/self/status``); elsewhere set and restored at once, under a lock."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    with _UMASK_LOCK:
+        mask = os.umask(0o077)
+        os.umask(mask)
+    return mask
+
+
+def _apply_umask(root: Path, umask: int) -> None:
+    """Give ``root`` and everything under it the modes the user's umask asks for (mkdtemp and
+    mkstemp create 0700 folders and 0600 files whatever the umask)."""
+    dir_mode, file_mode = 0o777 & ~umask, 0o666 & ~umask
+    os.chmod(root, dir_mode)
+    for here, dirs, files in os.walk(root):
+        for d in dirs:
+            path = os.path.join(here, d)
+            if not os.path.islink(path):
+                os.chmod(path, dir_mode)
+        for f in files:
+            path = os.path.join(here, f)
+            if not os.path.islink(path):
+                os.chmod(path, file_mode)
+
+
+def clean_stale_staging(folder: str | os.PathLike) -> list[Path]:
+    """Remove the staging folders in ``folder`` that runs on this host left behind when they
+    were killed outright; returns them.
+
+    Only folders named by :func:`run` (``.NAME.HOST-PID.*.partial``, ``.NAME.HOST-PID.*.old``,
+    ``teamnav-run-HOST-PID.*.partial``) with this host's name and a PID that is no longer a
+    live process are touched: another run's staging, here or on another machine sharing the
+    folder, is kept. A ``.old`` folder holds a run folder that was being replaced; if the new
+    one never arrived, the old one is put back instead of deleted.
+    """
+    from teamnav.experiments.signals import pid_alive
+
+    folder = Path(folder)
+    removed: list[Path] = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    for entry in entries:
+        m = _STAGING.match(entry.name) or _TMP_STAGING.match(entry.name)
+        if m is None or m["host"] != _HOST or pid_alive(int(m["pid"])):
+            continue
+        try:
+            if not entry.is_dir(follow_symlinks=False):
+                continue
+        except OSError:
+            continue
+        path = Path(entry.path)
+        if m.groupdict().get("kind") == "old":
+            target, previous = folder / m["name"], path / "run"
+            if previous.is_dir() and not target.exists():
+                try:
+                    os.replace(previous, target)
+                except OSError:
+                    continue  # keep it: it holds the only copy of that run
+        shutil.rmtree(path, ignore_errors=True)
+        removed.append(path)
+    return removed
+
+
+def _make_staging(out: Path | None) -> Path:
+    """A new staging folder (after clearing stale ones) named after this host and process."""
+    owner = f"{_HOST}-{os.getpid()}"
+    if out is not None:
+        clean_stale_staging(out.parent)
+        return Path(tempfile.mkdtemp(prefix=f".{out.name}.{owner}.", suffix=".partial", dir=out.parent))
+    tmp = Path(tempfile.gettempdir())
+    clean_stale_staging(tmp)
+    return Path(tempfile.mkdtemp(prefix=f"teamnav-run-{owner}.", suffix=".partial", dir=tmp))
+
+
 def _check_out_dir(out: Path, force: bool) -> None:
     if out.exists() and not force:
         if not out.is_dir():
@@ -163,7 +266,7 @@ def _check_out_dir(out: Path, force: bool) -> None:
 def _move_into_place(staging: Path, out: Path) -> None:
     """Rename the finished staging folder to ``out``, replacing what is there."""
     if out.is_dir() and any(out.iterdir()):
-        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
+        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.{_HOST}-{os.getpid()}.", suffix=".old", dir=out.parent))
         os.replace(out, old / "run")
         os.replace(staging, out)
         shutil.rmtree(old, ignore_errors=True)
@@ -215,9 +318,10 @@ def run(
     out_dir : str or Path, optional
         Run folder to write (see the module docstring). None writes nothing.
     progress : bool, None or callable
-        ``True``: a progress bar on stderr once the run lasts more than 2 s; ``None``
-        (default): the same, only when stderr is a terminal; ``False``: none; a callable is
-        called with the number of steps done.
+        ``True`` or ``None`` (default): on a terminal, a progress bar on stderr once the run
+        lasts more than 2 s; elsewhere (CI, nohup, a pipe) a plain line on stderr every 10 s
+        (``TEAMNAV_PROGRESS_EVERY_S``, :mod:`teamnav.experiments.progress`) and one at the end
+        when there was any; ``False``: none; a callable is called with the number of steps done.
     gif : bool
         Also write ``run.gif`` (needs ``out_dir``).
     force : bool
@@ -241,6 +345,7 @@ def run(
     >>> result.metrics["steps"]  # doctest: +SKIP
     10
     """
+    from teamnav.experiments.signals import sigterm_raises
     from teamnav.sim.engine import Simulation
 
     if not isinstance(scenario, Scenario):
@@ -254,58 +359,109 @@ def run(
         _check_out_dir(out, force)
     if gif and out is None:
         raise ValueError("gif=True needs an out_dir to write run.gif into")
-    grid = build_grid(scenario)
-    try:
-        sim = Simulation(grid, scenario, known_map=grid if scenario.give_map else None)
-    except ScenarioError:
-        raise
-    except ValueError as exc:
-        raise ScenarioError(scenario.source, [Problem("", f"the simulator cannot set up this scenario: {exc}")]) from None
-
+    umask = current_umask()
     n_steps = scenario.n_steps
-    if callable(progress):
-        bar = None
-        callback = progress
-    else:
-        show = progress is True or (progress is None and sys.stderr.isatty())
-        bar = _LazyBar(n_steps, f"{scenario.name} ({scenario.n_robots} robots)", show and progress is not False)
-        callback = bar
-
-    if out is not None:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".partial", dir=out.parent))
-    else:
-        staging = Path(tempfile.mkdtemp(prefix="teamnav-run-"))
+    report = _Progress(progress, n_steps, scenario)
     try:
-        t0 = time.perf_counter()
+        grid = build_grid(scenario)
         try:
-            sim.run(n_steps, progress=callback, is_finished=all_finished if scenario.stop_when_finished else None)
-        finally:
-            if bar is not None:
-                bar.close()
-        wall_s = time.perf_counter() - t0
-        sim.record_last_step()
-        sim.recorder.save(staging)
-        data = run_data(staging, scenario, grid, int(sim.step_index), wall_s,
-                        finished=bool(scenario.stop_when_finished and all_finished(sim)))
-        values = metric_registry.compute(scenario.metric_names, data)
-        if out is None:
-            shutil.rmtree(staging, ignore_errors=True)
-            return RunResult(values, None, sim, scenario, data)
-        (staging / "scenario.yaml").write_text(scenario_to_yaml(scenario), encoding="utf-8")
-        (staging / "metrics.json").write_text(json.dumps(_json_ready(values), indent=2) + "\n", encoding="utf-8")
-        (staging / "robots.json").write_text(json.dumps(_robots_table(scenario)) + "\n", encoding="utf-8")
-        save_map(grid, staging / "map.yaml")
-        from teamnav.viz.plots import plot_run, save_gif
+            sim = Simulation(grid, scenario, known_map=grid if scenario.give_map else None)
+        except ScenarioError:
+            raise
+        except ValueError as exc:
+            raise ScenarioError(scenario.source, [Problem("", f"the simulator cannot set up this scenario: {exc}")]) from None
 
-        plot_run(staging, title=f"{scenario.name}: {scenario.n_robots} robots, {scenario.duration_s:g} s, seed {scenario.seed}")
-        if gif:
-            save_gif(staging)
-        _move_into_place(staging, out)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
+        if out is not None:
+            out.parent.mkdir(parents=True, exist_ok=True)
+        with sigterm_raises():  # SIGTERM: the staging folder is removed, then the process ends
+            staging = _make_staging(out)
+            try:
+                report.phase("first step: numba compiles (first run) or loads its kernels")
+                t0 = time.perf_counter()
+                sim.run(n_steps, progress=report.step, is_finished=all_finished if scenario.stop_when_finished else None)
+                wall_s = time.perf_counter() - t0
+                warmup_s = (report.t_first - t0) if report.t_first is not None else 0.0  # the first step
+                report.stepped()
+                sim.record_last_step()
+                sim.recorder.save(staging)
+                data = run_data(staging, scenario, grid, int(sim.step_index), wall_s,
+                                finished=bool(scenario.stop_when_finished and all_finished(sim)), warmup_s=warmup_s)
+                values = metric_registry.compute(scenario.metric_names, data)
+                if out is None:
+                    shutil.rmtree(staging, ignore_errors=True)
+                    return RunResult(values, None, sim, scenario, data)
+                (staging / "scenario.yaml").write_text(scenario_to_yaml(scenario), encoding="utf-8")
+                (staging / "metrics.json").write_text(json.dumps(_json_ready(values), indent=2) + "\n", encoding="utf-8")
+                (staging / "robots.json").write_text(json.dumps(_robots_table(scenario)) + "\n", encoding="utf-8")
+                save_map(grid, staging / "map.yaml")
+                from teamnav.viz.plots import plot_run, save_gif
+
+                plot_run(staging, title=f"{scenario.name}: {scenario.n_robots} robots, {scenario.duration_s:g} s, seed {scenario.seed}")
+                if gif:
+                    report.phase("writing run.gif")
+                    save_gif(staging)
+                _apply_umask(staging, umask)
+                _move_into_place(staging, out)
+            except BaseException:
+                shutil.rmtree(staging, ignore_errors=True)
+                raise
+    finally:
+        report.close()
     return RunResult(values, out, sim, scenario, data)
+
+
+class _Progress:
+    """What :func:`run` shows while it works (see its ``progress`` parameter) and the time of
+    its first step (numba compiles or loads its kernels there: the ``warmup_s`` metric)."""
+
+    def __init__(self, progress, n_steps: int, scenario: Scenario) -> None:
+        from teamnav.experiments.progress import PlainProgress, stderr_is_terminal
+
+        self.t_first: float | None = None  # perf_counter() at the end of the first step
+        self.bar: _LazyBar | None = None
+        self.plain: PlainProgress | None = None
+        self.user: Callable[[int], None] | None = progress if callable(progress) else None
+        if self.user is None and progress is not False:
+            if stderr_is_terminal():
+                self.bar = _LazyBar(n_steps, f"{scenario.name} ({scenario.n_robots} robots)")
+            else:
+                self.plain = PlainProgress(f"teamnav run {scenario.name}", n_steps, "steps").start()
+                self.plain.phase("setting up")
+
+    def step(self, k: int) -> None:
+        """The engine's ``progress(k)`` callback."""
+        if self.t_first is None:
+            self.t_first = time.perf_counter()
+            if self.plain is not None:
+                self.plain.phase("")
+        if self.bar is not None:
+            self.bar(k)
+        elif self.plain is not None:
+            self.plain.update(k)
+        elif self.user is not None:
+            self.user(k)
+
+    def phase(self, text: str) -> None:
+        if self.plain is not None:
+            self.plain.phase(text)
+
+    def stepped(self) -> None:
+        """Stepping is over: the bar goes, the plain lines say what comes next."""
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+        self.phase("scoring and writing the run folder")
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+        if self.plain is not None:
+            from teamnav.experiments.progress import format_duration
+
+            plain, self.plain = self.plain, None
+            final = f"{plain.label}: {plain.done} steps done in {format_duration(plain.elapsed_s())}"
+            plain.close(final=final if plain.lines else None)  # a run that printed nothing stays quiet
 
 
 # ---------------------------------------------------------------------------- conformance
