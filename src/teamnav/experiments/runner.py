@@ -244,15 +244,13 @@ def clean_stale_staging(folder: str | os.PathLike) -> list[Path]:
     return removed
 
 
-def _make_staging(out: Path | None) -> Path:
-    """A new staging folder (after clearing stale ones) named after this host and process."""
+def _staging_place(out: Path | None) -> tuple[Path, str]:
+    """Where the staging folder of a run into ``out`` goes, and its name's prefix (with this
+    host and process: see :func:`clean_stale_staging`)."""
     owner = f"{_HOST}-{os.getpid()}"
     if out is not None:
-        clean_stale_staging(out.parent)
-        return Path(tempfile.mkdtemp(prefix=f".{out.name}.{owner}.", suffix=".partial", dir=out.parent))
-    tmp = Path(tempfile.gettempdir())
-    clean_stale_staging(tmp)
-    return Path(tempfile.mkdtemp(prefix=f"teamnav-run-{owner}.", suffix=".partial", dir=tmp))
+        return out.parent, f".{out.name}.{owner}."
+    return Path(tempfile.gettempdir()), f"teamnav-run-{owner}."
 
 
 def _check_out_dir(out: Path, force: bool) -> None:
@@ -345,7 +343,7 @@ def run(
     >>> result.metrics["steps"]  # doctest: +SKIP
     10
     """
-    from teamnav.experiments.signals import sigterm_raises
+    from teamnav.experiments.signals import sigterm_deferred, sigterm_raises
     from teamnav.sim.engine import Simulation
 
     if not isinstance(scenario, Scenario):
@@ -374,8 +372,12 @@ def run(
         if out is not None:
             out.parent.mkdir(parents=True, exist_ok=True)
         with sigterm_raises():  # SIGTERM: the staging folder is removed, then the process ends
-            staging = _make_staging(out)
+            staging: Path | None = None
             try:
+                folder, prefix = _staging_place(out)
+                clean_stale_staging(folder)
+                with sigterm_deferred():  # no SIGTERM between creating the folder and knowing its name
+                    staging = Path(tempfile.mkdtemp(prefix=prefix, suffix=".partial", dir=folder))
                 report.phase("first step: numba compiles (first run) or loads its kernels")
                 t0 = time.perf_counter()
                 sim.run(n_steps, progress=report.step, is_finished=all_finished if scenario.stop_when_finished else None)
@@ -401,9 +403,11 @@ def run(
                     report.phase("writing run.gif")
                     save_gif(staging)
                 _apply_umask(staging, umask)
-                _move_into_place(staging, out)
+                with sigterm_deferred():  # the old folder out and the new one in, not half of it
+                    _move_into_place(staging, out)
             except BaseException:
-                shutil.rmtree(staging, ignore_errors=True)
+                if staging is not None:
+                    shutil.rmtree(staging, ignore_errors=True)
                 raise
     finally:
         report.close()

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 from typing import Iterator
 
-__all__ = ["Terminated", "die_with_parent", "pid_alive", "sigterm_raises"]
+__all__ = ["Terminated", "die_with_parent", "pid_alive", "sigterm_deferred", "sigterm_raises"]
 
 #: prctl option: signal this process gets when the thread that created it ends (linux/prctl.h)
 _PR_SET_PDEATHSIG = 1
@@ -77,6 +77,22 @@ def sigterm_raises() -> Iterator[None]:
     finally:
         if signal.getsignal(signal.SIGTERM) is handler:
             signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+@contextlib.contextmanager
+def sigterm_deferred() -> Iterator[None]:
+    """Hold SIGTERM back while inside (it is delivered on the way out): for steps that must
+    not be cut in two, such as creating a folder and recording its name. A no-op where
+    ``signal.pthread_sigmask`` does not exist (Windows)."""
+    block = getattr(signal, "pthread_sigmask", None)
+    if block is None:
+        yield
+        return
+    previous = block(signal.SIG_BLOCK, {signal.SIGTERM})
+    try:
+        yield
+    finally:
+        block(signal.SIG_SETMASK, previous)  # a held SIGTERM's handler runs here
 
 
 def pid_alive(pid: int) -> bool:
