@@ -376,10 +376,11 @@ class Scenario(SimConfig):
         """Replace ``place:`` / ``start.near`` references by coordinates of the built-in map."""
         if not isinstance(data, dict):
             return data
-        uses_places = any(isinstance(p, dict) and "place" in p for p in data.get("places") or ()) or any(
-            isinstance(g, dict) and isinstance(g.get("start"), dict) and "near" in g["start"]
-            for g in (data.get("robots") or ())
-            if isinstance(data.get("robots"), (list, tuple))
+        places, robots = data.get("places"), data.get("robots")
+        places = places if isinstance(places, (list, tuple)) else ()  # anything else is the field validators' to report
+        robots = robots if isinstance(robots, (list, tuple)) else ()
+        uses_places = any(isinstance(p, dict) and "place" in p for p in places) or any(
+            isinstance(g, dict) and isinstance(g.get("start"), dict) and "near" in g["start"] for g in robots
         )
         if not uses_places:
             return data
@@ -399,6 +400,8 @@ class Scenario(SimConfig):
         data = copy.deepcopy(data)
 
         def where(field: str, ref: Any) -> tuple[float, float]:
+            if not isinstance(ref, str):
+                raise ValueError(f"{field}: expected the name of a place of built-in map {builtin!r}, got {show_value(ref)}")
             if ref not in named:
                 close = difflib.get_close_matches(str(ref), named, n=1)
                 hint = f"; did you mean {close[0]!r}?" if close else ""
