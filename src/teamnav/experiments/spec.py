@@ -204,7 +204,7 @@ class _YamlLoader(yaml.SafeLoader):
                         if first is not key:
                             raise YamlLimitError(
                                 self._field(seg + f".{key.value}"),
-                                f"duplicate key {key.value!r} (first given at line {first.start_mark.line + 1}); "
+                                f"duplicate key {show_value(key.value)} (first given at line {first.start_mark.line + 1}); "
                                 "expected each key once in a mapping",
                                 key.start_mark,
                             )
@@ -406,7 +406,7 @@ class Scenario(SimConfig):
                 close = difflib.get_close_matches(str(ref), named, n=1)
                 hint = f"; did you mean {close[0]!r}?" if close else ""
                 raise ValueError(
-                    f"{field}: unknown place {ref!r} of built-in map {builtin!r}{hint} (known: {', '.join(named)})"
+                    f"{field}: unknown place {show_value(ref)} of built-in map {builtin!r}{hint} (known: {', '.join(named)})"
                 )
             return named[ref]
 
@@ -431,7 +431,7 @@ class Scenario(SimConfig):
                     x, y = where(f"robots[{i}].start.near", start.pop("near"))
                     spread = start.pop("spread_m", 1.0)
                     if not isinstance(spread, (int, float)) or not (0 < spread < 1e6):
-                        raise ValueError(f"robots[{i}].start.spread_m: expected a positive number of metres, got {spread!r}")
+                        raise ValueError(f"robots[{i}].start.spread_m: expected a positive number of metres, got {show_value(spread)}")
                     if "region" in start or "poses" in start:
                         raise ValueError(f"robots[{i}].start: give 'near' or 'region'/'poses', not both")
                     start["region"] = [x - spread, x + spread, y - spread, y + spread]
