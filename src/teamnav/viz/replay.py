@@ -22,6 +22,16 @@ What the page draws (each a layer the viewer can toggle):
 Controls: timeline scrubber, play/pause, speed, single steps, follow a robot, zoom (wheel) and
 pan (drag), a legend, the time and each robot's state at the current step.
 
+Hostile strings
+---------------
+Names and labels come from scenario files and run folders that anyone may hand over (robot
+groups, sensors, places, events, layer descriptions and labels, the scenario name). The page
+never runs them: the title is HTML-escaped, the metadata is JSON with ``<``, ``>``, ``&``,
+U+2028 and U+2029 written as ``\\u003c`` etc. (so it cannot close its ``<script>`` element),
+the page puts strings into the DOM only through ``textContent`` or its ``esc()``, and its
+Content-Security-Policy runs no script but its own (allowed by hash) and loads nothing from
+outside.
+
 Size
 ----
 Frames are every ``every``-th recorded sample, further thinned so that there are at most
@@ -35,6 +45,7 @@ robot screen positions, layer switches, timings) for tests and scripting.
 from __future__ import annotations
 
 import base64
+import hashlib
 import html
 import io
 import json
@@ -236,6 +247,41 @@ def _bounds(grid: OccupancyGrid | None, xy: np.ndarray) -> tuple[float, float, f
     return x0 - m, y0 - m, x1 + m, y1 + m
 
 
+#: characters that JSON inside a ``<script>`` element must not hold literally: ``<`` (``</script>``,
+#: ``<!--``), ``>``, ``&``, and the line separators that some JavaScript parsers end a line at
+_SCRIPT_JSON_ESCAPES = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
+
+
+def _script_json(value: Any) -> str:
+    """``value`` as JSON that is safe inside an HTML ``<script>`` element: ``<``, ``>``, ``&``,
+    U+2028 and U+2029 are written as ``\\u003c`` etc., so no string (a scenario's robot group
+    or place name, a layer label) can close the element or open a comment in it; ``JSON.parse``
+    and :func:`json.loads` read the same value back.
+
+    Examples
+    --------
+    >>> _script_json({"name": "</script><b>&"})
+    '{"name":"\\\\u003c/script\\\\u003e\\\\u003cb\\\\u003e\\\\u0026"}'
+    >>> json.loads(_script_json(["</script>"]))
+    ['</script>']
+    """
+    text = json.dumps(value, separators=(",", ":"))
+    return re.sub("[<>&\u2028\u2029]", lambda m: _SCRIPT_JSON_ESCAPES[m.group(0)], text)
+
+
+def _script_csp(page: str) -> str:
+    """The page's Content-Security-Policy: nothing from outside, images only as ``data:`` URIs,
+    and no script element or inline event handler but the page's own script (its last
+    ``<script>`` element, allowed by its SHA-256), so even a string that slipped through escaping
+    could not run. ``'unsafe-eval'`` lets drivers such as Playwright's ``wait_for_function``
+    evaluate expressions in the page (the page itself never evaluates strings)."""
+    start = page.rindex("<script>") + len("<script>")
+    body = page[start: page.index("</script>", start)]
+    digest = base64.b64encode(hashlib.sha256(body.encode("utf-8")).digest()).decode("ascii")
+    return (f"default-src 'none'; img-src data:; style-src 'unsafe-inline'; script-src 'sha256-{digest}' 'unsafe-eval'; "
+            "base-uri 'none'; form-action 'none'")
+
+
 def _colours(n: int) -> list[str]:
     """One distinct colour per robot (evenly spaced hues, golden-ratio order past 10)."""
     base = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"]
@@ -434,9 +480,11 @@ def build_replay(
     }
     payload = pack.encoded(compress_level)
     page = _TEMPLATE.read_text(encoding="utf-8")
-    meta_json = json.dumps(meta, separators=(",", ":")).replace("</", "<\\/")
-    fill = {"TITLE": html.escape(meta["title"]), "META": meta_json, "DATA": payload}
-    page = re.sub(r"\{\{(TITLE|META|DATA)\}\}", lambda m: fill[m.group(1)], page)  # one pass: data never re-scanned
+    # every string from the run folder goes in escaped: the title as HTML text, the metadata as
+    # JSON that cannot close its <script> element (the page puts strings into the DOM escaped)
+    fill = {"TITLE": html.escape(meta["title"]), "META": _script_json(meta), "DATA": payload,
+            "CSP": html.escape(_script_csp(page))}
+    page = re.sub(r"\{\{(TITLE|META|DATA|CSP)\}\}", lambda m: fill[m.group(1)], page)  # one pass: data never re-scanned
     with atomic_output(out, "HTML file", "--out") as tmp:  # nothing half-written, even on /proc or a full disk
         tmp.write_text(page, encoding="utf-8")
     names = ["map", "true", "trails", "belief"] + (["scans"] if scans_meta else []) + [m["name"] for m in layers_meta]
@@ -447,7 +495,7 @@ def build_replay(
 def _decode(html_text: str) -> tuple[dict, dict[str, Any]]:
     """Read back the metadata and the arrays (quantised, delta-coded) of a replay page (for tests)."""
     start = html_text.index('id="teamnav-meta">') + len('id="teamnav-meta">')
-    meta = json.loads(html_text[start: html_text.index("</script>", start)].replace("<\\/", "</"))
+    meta = json.loads(html_text[start: html_text.index("</script>", start)])
     start = html_text.index('id="teamnav-data">') + len('id="teamnav-data">')
     raw = zlib.decompress(base64.b64decode(html_text[start: html_text.index("</script>", start)].strip()))
     dt = {"i8": np.int8, "u8": np.uint8, "i16": np.int16, "u16": np.uint16, "i32": np.int32, "f32": np.float32,

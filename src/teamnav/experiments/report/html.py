@@ -9,8 +9,11 @@ missing blocks as grey boxes "not measured: WHAT — WHY", never as numbers. A f
 the teamnav version, the git commit when the package runs from a checkout, the date, the mode
 and, per section, its wall time and how many trials it ran and reused.
 
-All text from sections is escaped. A figure that cannot be drawn becomes a missing block
-naming the error, so one bad figure never loses the report.
+All text from sections is escaped (``html.escape``, quotes included: names of scenarios, robot
+groups, places and events may hold anything), and the page's Content-Security-Policy
+(:data:`CSP`) allows no script at all and nothing from outside, only ``data:`` images. A
+figure that cannot be drawn becomes a missing block naming the error, so one bad figure never
+loses the report.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ import numpy as np
 
 from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, Table, Text
 
-__all__ = ["git_commit", "render_report"]
+__all__ = ["CSP", "git_commit", "render_report"]
 
 _CSS = """
 body { font-family: system-ui, -apple-system, 'Segoe UI', Roboto, sans-serif; margin: 0 auto; max-width: 1100px;
@@ -51,6 +54,9 @@ figcaption, .note { color: #59636e; font-size: 0.9em; }
 footer { margin-top: 3em; border-top: 1px solid #d0d7de; color: #59636e; font-size: 0.88em; }
 nav ol { padding-left: 1.4em; }
 """
+
+#: the report's Content-Security-Policy: no scripts, nothing fetched, images only as data: URIs
+CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'; base-uri 'none'; form-action 'none'"
 
 _HOLDS = {True: ("✓", "yes", "holds"), False: ("✗", "no", "does not hold"), None: ("—", "na", "not measured")}
 
@@ -242,6 +248,7 @@ def render_report(sections: Sequence[Any], meta: dict[str, Any]) -> str:
     )
     return (
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+        f"<meta http-equiv=\"Content-Security-Policy\" content=\"{_e(CSP)}\">"
         "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
         f"<title>teamnav report ({'quick' if meta.get('quick') else 'full'})</title><style>{_CSS}</style></head><body>\n"
         f"<h1>teamnav: the four papers, reproduced</h1><p class=\"sub\">{_e(mode)} · {_e(now)}</p>\n"
