@@ -207,3 +207,19 @@ def test_metric_registry_refuses_duplicates_and_unknown():
         M.register("steps", M.steps, "again")
     with pytest.raises(ValueError, match="did you mean 'steps'"):
         M.compute(["stpes"], _data([[[3, 3, 0]]] * 2))
+
+
+def test_run_folder_map_keeps_the_source_maps_thresholds_and_cells(tmp_path):
+    """The run folder's map.yaml is written with the thresholds its map file was read with
+    (depot: free_thresh 0.25) and loads back to the same cells (issue 24)."""
+    from teamnav.experiments.runner import run as run_scenario
+    from teamnav.experiments.spec import PACKAGE_MAP_DIR, build_grid, load_scenario
+    from teamnav.world.mapio import load_map, read_map_yaml
+
+    scn = load_scenario("demo", overrides=["map={package: nav2/depot.yaml}", "robots.0.start.region=null",
+                                           "robots.0.count=2"], duration_s=0.5)
+    result = run_scenario(scn, out_dir=tmp_path / "run", progress=False)
+    written = read_map_yaml(result.run_dir / "map.yaml")
+    source = read_map_yaml(PACKAGE_MAP_DIR / "nav2" / "depot.yaml")
+    assert (written.occupied_thresh, written.free_thresh) == (source.occupied_thresh, source.free_thresh) == (0.65, 0.25)
+    np.testing.assert_array_equal(load_map(result.run_dir / "map.yaml").cells, build_grid(scn).cells)

@@ -39,8 +39,15 @@ import numpy as np
 
 from teamnav.experiments import metrics as metric_registry
 from teamnav.experiments.errors import Problem, ScenarioError
-from teamnav.experiments.spec import Scenario, build_grid, check_controllers, load_scenario, scenario_to_yaml
-from teamnav.world.mapio import save_map
+from teamnav.experiments.spec import (
+    PACKAGE_MAP_DIR,
+    Scenario,
+    build_grid,
+    check_controllers,
+    load_scenario,
+    scenario_to_yaml,
+)
+from teamnav.world.mapio import YAML_SUFFIXES, read_map_yaml, save_map
 
 __all__ = [
     "OutputDirError", "RunResult", "check_scenario", "clean_stale_staging", "current_umask", "robot_radii", "run", "run_data",
@@ -170,6 +177,17 @@ _STAGING = re.compile(r"^\.(?P<name>.+)\.(?P<host>[A-Za-z0-9-]{1,32})-(?P<pid>\d
 #: ``teamnav-run-HOST-PID.XXXXXXXX.partial`` in the temporary folder (a run without out_dir)
 _TMP_STAGING = re.compile(r"^teamnav-run-(?P<host>[A-Za-z0-9-]{1,32})-(?P<pid>\d+)\.[a-z0-9_]{8}\.partial$")
 _UMASK_LOCK = threading.Lock()
+
+
+def source_thresholds(scenario: Scenario) -> dict[str, float]:
+    """The thresholds of the scenario's map file, to write the run folder's ``map.yaml`` with
+    them (origin and yaw come with the grid); map_saver's defaults for generated maps."""
+    spec = scenario.map
+    path = Path(spec.file) if spec.file is not None else PACKAGE_MAP_DIR / str(spec.package) if spec.package else None
+    if path is None or path.suffix.lower() not in YAML_SUFFIXES:
+        return {}
+    meta = read_map_yaml(path)
+    return {"occupied_thresh": meta.occupied_thresh, "free_thresh": meta.free_thresh}
 
 
 def current_umask() -> int:
@@ -395,7 +413,7 @@ def run(
                 (staging / "scenario.yaml").write_text(scenario_to_yaml(scenario), encoding="utf-8")
                 (staging / "metrics.json").write_text(json.dumps(_json_ready(values), indent=2) + "\n", encoding="utf-8")
                 (staging / "robots.json").write_text(json.dumps(_robots_table(scenario)) + "\n", encoding="utf-8")
-                save_map(grid, staging / "map.yaml")
+                save_map(grid, staging / "map.yaml", **source_thresholds(scenario))
                 from teamnav.viz.plots import plot_run, save_gif
 
                 plot_run(staging, title=f"{scenario.name}: {scenario.n_robots} robots, {scenario.duration_s:g} s, seed {scenario.seed}")
