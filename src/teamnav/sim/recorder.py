@@ -498,7 +498,7 @@ def load(run_dir: str | os.PathLike) -> RunRecord:
     traj = run_dir / "trajectories.npz"
     if not traj.is_file():
         raise ValueError(f"run_dir must hold a recorded run (trajectories.npz), got {str(run_dir)!r}")
-    with np.load(traj) as z:
+    with np.load(traj, allow_pickle=False) as z:
         arrays = {k: np.asarray(z[k]) for k in z.files}
 
     def read(name: str, key: str | None, default):
@@ -513,7 +513,7 @@ def load(run_dir: str | os.PathLike) -> RunRecord:
     scans: dict[str, Scan] = {}
     meta = read("layers.json", None, None)
     if meta is not None and (run_dir / "layers.npz").is_file():
-        with np.load(run_dir / "layers.npz") as z:
+        with np.load(run_dir / "layers.npz", allow_pickle=False) as z:
             la = {k: np.asarray(z[k]) for k in z.files}
         for name, m in meta.get("layers", {}).items():
             layers[name] = Layer(name=name, kind=m["kind"], frame=m["frame"], hold=bool(m["hold"]),

@@ -212,7 +212,7 @@ def load_run_arrays(run_dir: str | Path) -> tuple[OccupancyGrid, dict[str, np.nd
     """
     run_dir = Path(run_dir)
     grid = load_map(run_dir / "map.yaml")
-    with np.load(run_dir / "trajectories.npz") as z:
+    with np.load(run_dir / "trajectories.npz", allow_pickle=False) as z:
         arrays = {k: np.asarray(z[k]) for k in ("t_s", "true_pose", "odom_pose") if k in z.files}
     n = arrays["true_pose"].shape[1]
     robots = run_dir / "robots.json"
