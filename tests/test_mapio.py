@@ -499,6 +499,25 @@ def test_hostile_image_header_is_refused_before_decoding(tmp_path):
     """A PGM header claiming 1e5 x 1e5 pixels: refused from the header with the figure."""
     (tmp_path / "bomb.pgm").write_bytes(b"P5\n100000 100000\n255\n" + b"\0" * 64)
     (tmp_path / "bomb.yaml").write_text("image: bomb.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
-    with pytest.raises(MapError, match=r"bomb\.pgm: field 'image': expected an image of at most 50000000 pixels, "
-                                       r"found a map of 100000 x 100000 cells .* would need about 400\.0 GB"):
+    with pytest.raises(MapError, match=r"bomb\.pgm: field 'image': expected an image of at most 53,687,091 pixels, "
+                                       r"found an image of 100000 x 100000 px has 10,000,000,000 cells, which needs about "
+                                       r"372\.5 GiB .*MAX_MAP_BYTES"):
         load_map(tmp_path / "bomb.yaml")
+
+
+def test_map_yaml_with_an_alias_bomb_or_a_duplicate_key_is_refused_quickly(tmp_path):
+    """A "billion laughs" under ``resolution`` and a key given twice: one bounded message each
+    (the loader counts values as aliases expand, so nothing is built or printed in full)."""
+    rows = ['a: &a ["x","x","x","x","x","x","x","x","x","x"]']
+    for prev, name in zip("abcdefgh", "bcdefghi"):
+        rows.append(f"{name}: &{name} [" + ",".join([f"*{prev}"] * 10) + "]")
+    (tmp_path / "lol.yaml").write_text("\n".join(rows) + "\nimage: x.pgm\nresolution: *i\norigin: [0, 0, 0]\n")
+    with pytest.raises(MapError, match=r"lol\.yaml: field '\w': expected YAML within teamnav's limits, found .*1,000,000 values") as info:
+        load_map(tmp_path / "lol.yaml")
+    assert len(str(info.value)) < 400
+    (tmp_path / "dup.yaml").write_text("image: x.pgm\nresolution: 0.1\nresolution: 0.2\norigin: [0, 0, 0]\n")
+    with pytest.raises(MapError, match=r"dup\.yaml: field 'resolution': .*duplicate key 'resolution' \(first given at line 2\)"):
+        load_map(tmp_path / "dup.yaml")
+    (tmp_path / "deep.yaml").write_text("image: x.pgm\nresolution: " + "[" * 20000 + "]" * 20000 + "\norigin: [0, 0, 0]\n")
+    with pytest.raises(MapError, match=r"deep\.yaml: field .*nested"):
+        load_map(tmp_path / "deep.yaml")

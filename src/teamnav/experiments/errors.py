@@ -101,80 +101,9 @@ class ScenarioError(ValueError):
 
 
 # ---------------------------------------------------------------------------- formatting
-def show_value(v: Any, limit: int = 80) -> str:
-    """A short display of a received value: ``repr`` for scalars, ``.nan``-style for NaN/inf.
-
-    The work is bounded by ``limit`` (see :func:`bounded_repr`), so a value that would print
-    as gigabytes (a YAML "billion laughs", a huge list) costs no more than a small one.
-    """
-    if isinstance(v, float) and not math.isfinite(v):
-        text = "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
-    else:
-        text = bounded_repr(v, limit)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-class _Full(Exception):
-    """Raised inside :func:`bounded_repr` once enough text has been produced."""
-
-
-def bounded_repr(v: Any, limit: int = 80, *, max_depth: int = 20) -> str:
-    """``repr(v)`` cut to ``limit`` characters (ending in ``...``), computed lazily.
-
-    Dicts, lists and tuples are walked item by item and the walk stops as soon as ``limit``
-    characters exist, so the cost is bounded by ``limit`` whatever the size of ``v`` (shared
-    sub-structures, as YAML aliases make, are never expanded in full); deeper than
-    ``max_depth`` shows ``...``, so a self-referencing value terminates. For values that fit,
-    the text equals ``repr(v)``.
-
-    Examples
-    --------
-    >>> bounded_repr([1, "a", {"b": (2,)}])
-    "[1, 'a', {'b': (2,)}]"
-    >>> x = [0] * 10
-    >>> for _ in range(30):
-    ...     x = [x] * 10  # 10**31 items if printed in full
-    >>> bounded_repr(x, 20)
-    '[[[[[[[[[[[[[[[[[...'
-    """
-    parts: list[str] = []
-    size = 0
-
-    def emit(text: str) -> None:
-        nonlocal size
-        parts.append(text)
-        size += len(text)
-        if size > limit:
-            raise _Full
-
-    def walk(x: Any, depth: int) -> None:
-        if depth > max_depth:
-            emit("...")
-        elif type(x) is dict:
-            emit("{")
-            for i, (k, val) in enumerate(x.items()):
-                emit(", " if i else "")
-                walk(k, depth + 1)
-                emit(": ")
-                walk(val, depth + 1)
-            emit("}")
-        elif type(x) in (list, tuple):
-            emit("[" if type(x) is list else "(")
-            for i, item in enumerate(x):
-                emit(", " if i else "")
-                walk(item, depth + 1)
-            emit("]" if type(x) is list else ("," if len(x) == 1 else "") + ")")
-        elif isinstance(x, (str, bytes)):
-            emit(repr(x[: limit + 1]) if len(x) > limit else repr(x))
-        else:
-            emit(repr(x))
-
-    try:
-        walk(v, 0)
-    except _Full:
-        pass
-    text = "".join(parts)
-    return text if len(text) <= limit else text[: max(limit - 3, 0)] + "..."
+# show_value, bounded_repr and YamlLimitError live in teamnav.safe_yaml (the map loader uses
+# them too) and are re-exported here.
+from teamnav.safe_yaml import YamlLimitError, bounded_repr, show_value  # noqa: E402,F401
 
 
 def format_loc(loc: Iterable[Any], data: Any = None) -> str:
@@ -314,29 +243,6 @@ def from_validation_error(
 def _nested(inner: str, outer: str) -> bool:
     """Whether field path ``inner`` is ``outer`` or lies under it."""
     return bool(outer) and (inner == outer or inner.startswith(outer + ".") or inner.startswith(outer + "["))
-
-
-class YamlLimitError(yaml.MarkedYAMLError):
-    """YAML that parses but that teamnav refuses: a duplicate key, nesting deeper than a limit,
-    aliases that expand past a limit, a self-referencing alias.
-
-    Parameters
-    ----------
-    field : str
-        Field path of the offending node (``robots[0].count``; ``""`` for the document).
-    problem : str
-        What is wrong and what was expected, in words.
-    mark : yaml.Mark or None
-        Where in the text (line and column).
-    """
-
-    def __init__(self, field: str, problem: str, mark: Any = None) -> None:
-        super().__init__(problem=problem, problem_mark=mark)
-        self.field = field
-
-    def __str__(self) -> str:
-        where = f" at line {self.problem_mark.line + 1}, column {self.problem_mark.column + 1}" if self.problem_mark else ""
-        return f"{self.field + ': ' if self.field else ''}{self.problem}{where}"
 
 
 def from_yaml_error(exc: yaml.YAMLError, file: str) -> ScenarioError:

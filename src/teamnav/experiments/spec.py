@@ -56,9 +56,10 @@ from teamnav.experiments.errors import (
     show_value,
 )
 from teamnav.sim.config import Model, SimConfig
+from teamnav.safe_yaml import YAML_MAX_DEPTH, YAML_MAX_NODES, LimitedSafeLoader  # noqa: F401 (re-exported)
 from teamnav.world.generators import BUILTIN_MAPS, MapBuilder
 from teamnav.world.grid import OccupancyGrid
-from teamnav.world.mapio import MapError, load_map, read_map_yaml
+from teamnav.world.mapio import IMAGE_SUFFIXES, YAML_SUFFIXES, MapError, load_map, read_map_yaml
 
 __all__ = [
     "ArenaSpec",
@@ -76,34 +77,10 @@ __all__ = [
 #: Folder of the maps shipped with teamnav (``map: {package: ...}`` is relative to it).
 PACKAGE_MAP_DIR: Path = Path(str(resources.files("teamnav.world"))) / "maps"
 
-_MAP_SUFFIXES = (".yaml", ".yml", ".png", ".pgm")
+_MAP_SUFFIXES = YAML_SUFFIXES + IMAGE_SUFFIXES  # the map loader's (map_server YAML, PNG, PGM, BMP)
 
-#: Most memory [bytes] a scenario's map may need (2 GiB); bigger maps and arenas are refused
-#: before anything is allocated, naming the estimate and this limit.
-MAX_MAP_BYTES = 2 * 1024**3
-#: Bytes a run needs per map cell: the cells and blocking masks (uint8), the float64 distance
-#: field and scipy's Euclidean distance transform's working arrays (measured peak: ~36 B/cell).
-MAP_BYTES_PER_CELL = 40
-
-
-def map_memory_problem(n_cells: float, what: str) -> str | None:
-    """Why a map of ``n_cells`` cells is refused (None when it fits :data:`MAX_MAP_BYTES`).
-
-    Examples
-    --------
-    >>> map_memory_problem(1200 * 1200, "map") is None
-    True
-    >>> print(map_memory_problem(20_000 * 20_000, "arena 10000 x 10000 m at 0.5 m"))
-    arena 10000 x 10000 m at 0.5 m has 400,000,000 cells, which needs about 14.9 GiB of memory (40 bytes per cell for the grid and its distance transform); expected at most 2.0 GiB (teamnav.experiments.spec.MAX_MAP_BYTES): use a coarser resolution_m or a smaller map
-    """
-    need = float(n_cells) * MAP_BYTES_PER_CELL
-    if need <= MAX_MAP_BYTES:
-        return None
-    return (
-        f"{what} has {int(n_cells):,} cells, which needs about {need / 1024**3:.1f} GiB of memory ({MAP_BYTES_PER_CELL} bytes "
-        f"per cell for the grid and its distance transform); expected at most {MAX_MAP_BYTES / 1024**3:.1f} GiB "
-        "(teamnav.experiments.spec.MAX_MAP_BYTES): use a coarser resolution_m or a smaller map"
-    )
+# the map memory limit lives with the grid (one definition for map files, images and arenas)
+from teamnav.world.grid import MAP_BYTES_PER_CELL, MAX_MAP_BYTES, map_memory_problem  # noqa: E402,F401
 
 
 def map_file_problem(path: str | os.PathLike) -> str | None:
@@ -139,89 +116,10 @@ def _builtin_problem(name: str, resolution_m: float | None) -> str | None:
     return map_memory_problem(cells, f"built-in map {name!r} at resolution_m {resolution_m:g}")
 
 
-#: Deepest nesting of mappings and lists a scenario, sweep or ``--set`` YAML may have (a
-#: scenario needs about 6; deeper documents are refused before Python's recursion limit).
-YAML_MAX_DEPTH = 100
-#: Most values (scalars, lists, mappings) a YAML document may hold once every alias
-#: (``*name``) is expanded: refuses a "billion laughs" before anything walks it.
-YAML_MAX_NODES = 1_000_000
-_MERGE_TAG = "tag:yaml.org,2002:merge"
-
-
-class _YamlLoader(yaml.SafeLoader):
-    """PyYAML's safe loader with YAML 1.2 booleans: only true/false, so ``on: enter`` (a
-    PlaceConfig field) stays the key ``"on"`` instead of YAML 1.1's ``True``.
-
-    It also refuses, with a :class:`~teamnav.experiments.errors.YamlLimitError` naming the
-    field and the line: a key given twice in one mapping (plain YAML keeps the last one
-    silently), nesting deeper than :data:`YAML_MAX_DEPTH`, more than :data:`YAML_MAX_NODES`
-    values once aliases are expanded, and an alias inside the node it refers to.
-    """
-
-    def __init__(self, stream) -> None:
-        super().__init__(stream)
-        self._path: list[str] = []
-        self._size: dict[int, int] = {}  # id(node) -> values under it, aliases expanded
-
-    def _field(self, extra: str = "") -> str:
-        text = "".join(self._path) + extra
-        text = text[1:] if text.startswith(".") else text
-        return text if len(text) <= 80 else text[:60] + "..." + text[-17:]
-
-    def compose_node(self, parent, index):  # noqa: D102 - PyYAML hook
-        event = self.peek_event()
-        if isinstance(index, yaml.ScalarNode):
-            seg = f".{index.value}"
-        elif isinstance(index, int):
-            seg = f"[{index}]"
-        else:
-            seg = ""  # the document, or a mapping key
-        if len(self._path) >= YAML_MAX_DEPTH:
-            raise YamlLimitError(
-                self._field(),
-                f"nested more than {YAML_MAX_DEPTH} levels deep; expected at most {YAML_MAX_DEPTH} levels of mappings and lists",
-                event.start_mark,
-            )
-        self._path.append(seg)
-        try:
-            node = super().compose_node(parent, index)
-        finally:
-            self._path.pop()
-        size = self._size.get(id(node))
-        if size is None:
-            if isinstance(event, yaml.AliasEvent):
-                raise YamlLimitError(
-                    self._field(seg),
-                    f"alias *{event.anchor} is used inside the node it names (a self-referencing structure); "
-                    "expected aliases to refer to complete nodes",
-                    event.start_mark,
-                )
-            if isinstance(node, yaml.MappingNode):
-                seen: dict[tuple[str, str], Any] = {}
-                for key, _ in node.value:
-                    if isinstance(key, yaml.ScalarNode) and key.tag != _MERGE_TAG:
-                        first = seen.setdefault((key.tag, key.value), key)
-                        if first is not key:
-                            raise YamlLimitError(
-                                self._field(seg + f".{key.value}"),
-                                f"duplicate key {show_value(key.value)} (first given at line {first.start_mark.line + 1}); "
-                                "expected each key once in a mapping",
-                                key.start_mark,
-                            )
-                size = 1 + sum(self._size[id(k)] + self._size[id(v)] for k, v in node.value)
-            elif isinstance(node, yaml.SequenceNode):
-                size = 1 + sum(self._size[id(v)] for v in node.value)
-            else:
-                size = 1
-            self._size[id(node)] = size
-        if size > YAML_MAX_NODES:
-            raise YamlLimitError(
-                self._field(seg),
-                f"expands to more than {YAML_MAX_NODES:,} values through aliases (*name) or sheer size; "
-                f"expected at most {YAML_MAX_NODES:,} (teamnav.experiments.spec.YAML_MAX_NODES)",
-                event.start_mark,
-            )
-        return node
+class _YamlLoader(LimitedSafeLoader):
+    """:class:`~teamnav.safe_yaml.LimitedSafeLoader` (no duplicate keys, bounded nesting and
+    alias expansion) with YAML 1.2 booleans: only true/false, so ``on: enter`` (a PlaceConfig
+    field) stays the key ``"on"`` instead of YAML 1.1's ``True``."""
 
 
 _YamlLoader.yaml_implicit_resolvers = {
@@ -323,7 +221,7 @@ class MapSpec(Model):
                 raise ValueError(f"map.file: expected a file ending in one of {', '.join(_MAP_SUFFIXES)}, got {self.file!r}")
             if not p.is_file():
                 raise ValueError(f"map.file: expected an existing map file, got {self.file!r} (no such file)")
-            if p.suffix.lower() in (".png", ".pgm") and self.resolution_m is None:
+            if p.suffix.lower() in IMAGE_SUFFIXES and self.resolution_m is None:
                 raise ValueError(f"map.resolution_m: a plain image map ({self.file!r}) needs resolution_m [m per pixel]")
         if self.arena is not None and self.resolution_m is not None:
             raise ValueError("map.resolution_m: an arena has its own 'arena.resolution_m'; remove map.resolution_m")

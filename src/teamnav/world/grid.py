@@ -42,35 +42,50 @@ UNKNOWN: int = 2
 GLASS: int = 3  # invisible to a laser, echoes sonar
 FOAM: int = 4  # absorbs sonar, seen by a laser
 
-#: Largest map teamnav builds, in cells. A grid costs about :data:`BYTES_PER_CELL` bytes a
-#: cell once the simulator has its blocking masks, distance field, ray-casting clearance maps
-#: and a localizer's likelihood field, so this bounds a run's map memory near 2 GB on the
-#: 24 GB machines teamnav is tested on. Map files and arenas larger than this are refused
-#: before anything is allocated (:func:`check_map_size`).
-MAX_MAP_CELLS: int = 50_000_000
-#: Bytes a cell costs in a run (measured order of magnitude: cells 1, blocking masks 1 each,
-#: distance field 8, clearance maps 4 each, EDT work arrays ~16, likelihood field 8).
-BYTES_PER_CELL: int = 40
+#: Most memory [bytes] a run's map may need (2 GiB); bigger maps, map images and arenas are
+#: refused before anything is allocated, naming the estimate and this limit.
+MAX_MAP_BYTES: int = 2 * 1024**3
+#: Bytes a run needs per map cell: the cells and blocking masks (uint8), the float64 distance
+#: field and scipy's Euclidean distance transform's working arrays (measured peak ~36 B/cell).
+MAP_BYTES_PER_CELL: int = 40
+#: The most cells a map may have (:data:`MAX_MAP_BYTES` / :data:`MAP_BYTES_PER_CELL`).
+MAX_MAP_CELLS: int = MAX_MAP_BYTES // MAP_BYTES_PER_CELL
+
+
+def map_memory_problem(n_cells: float, what: str) -> str | None:
+    """Why a map of ``n_cells`` cells is refused (None when it fits :data:`MAX_MAP_BYTES`).
+
+    Examples
+    --------
+    >>> map_memory_problem(1200 * 1200, "map") is None
+    True
+    >>> print(map_memory_problem(20_000 * 20_000, "arena 10000 x 10000 m at 0.5 m"))
+    arena 10000 x 10000 m at 0.5 m has 400,000,000 cells, which needs about 14.9 GiB of memory (40 bytes per cell for the grid and its distance transform); expected at most 2.0 GiB (teamnav.world.grid.MAX_MAP_BYTES): use a coarser resolution_m or a smaller map
+    """
+    need = float(n_cells) * MAP_BYTES_PER_CELL
+    if need <= MAX_MAP_BYTES:
+        return None
+    return (
+        f"{what} has {int(n_cells):,} cells, which needs about {need / 1024**3:.1f} GiB of memory ({MAP_BYTES_PER_CELL} bytes "
+        f"per cell for the grid and its distance transform); expected at most {MAX_MAP_BYTES / 1024**3:.1f} GiB "
+        "(teamnav.world.grid.MAX_MAP_BYTES): use a coarser resolution_m or a smaller map"
+    )
 
 
 def check_map_size(width_cells: int, height_cells: int, what: str) -> None:
-    """Raise ValueError naming ``what`` when a ``width x height`` grid is over :data:`MAX_MAP_CELLS`.
+    """Raise ValueError (the :func:`map_memory_problem` text) when a ``width x height`` grid is too big.
 
     Examples
     --------
     >>> check_map_size(100, 100, "m.png")
-    >>> check_map_size(100_000, 100_000, "m.png")
+    >>> check_map_size(100_000, 100_000, "m.png (100000 x 100000 px)")
     Traceback (most recent call last):
     ...
-    ValueError: m.png: a map of 100000 x 100000 cells (10000000000 cells) would need about 400.0 GB; teamnav's limit is 50000000 cells (about 2.0 GB)
+    ValueError: m.png (100000 x 100000 px) has 10,000,000,000 cells, which needs about 372.5 GiB of memory (40 bytes per cell for the grid and its distance transform); expected at most 2.0 GiB (teamnav.world.grid.MAX_MAP_BYTES): use a coarser resolution_m or a smaller map
     """
-    n = int(width_cells) * int(height_cells)
-    if n > MAX_MAP_CELLS:
-        raise ValueError(
-            f"{what}: a map of {int(width_cells)} x {int(height_cells)} cells ({n} cells) would need about "
-            f"{n * BYTES_PER_CELL / 1e9:.1f} GB; teamnav's limit is {MAX_MAP_CELLS} cells "
-            f"(about {MAX_MAP_CELLS * BYTES_PER_CELL / 1e9:.1f} GB)"
-        )
+    problem = map_memory_problem(int(width_cells) * int(height_cells), what)
+    if problem is not None:
+        raise ValueError(problem)
 
 
 #: What each built-in sensor kind sees by default.

@@ -89,6 +89,7 @@ import numpy as np
 import yaml
 from PIL import Image, UnidentifiedImageError
 
+from teamnav.safe_yaml import YamlLimitError, safe_load, show_value
 from teamnav.world.grid import DEFAULT_MATERIALS, MAX_MAP_CELLS, OccupancyGrid, check_map_size
 
 _log = logging.getLogger(__name__)
@@ -162,7 +163,7 @@ class MapError(ValueError):
         self.field = field
         self.expected = expected
         self.found = found
-        shown = found if isinstance(found, _Described) else repr(found)
+        shown = found if isinstance(found, _Described) else show_value(found)  # bounded, however big
         super().__init__(f"{self.file}: field {field!r}: expected {expected}, found {shown}")
 
 
@@ -345,9 +346,13 @@ def read_map_yaml(path: str | os.PathLike) -> MapMetadata:
     except (OSError, UnicodeDecodeError) as exc:
         raise MapError(path, "<file>", "a readable UTF-8 YAML file", _Described(f"{type(exc).__name__}: {exc}")) from None
     try:
-        doc = yaml.safe_load(text)
+        doc = safe_load(text)  # safe constructors only; nesting, alias expansion, duplicate keys bounded
+    except YamlLimitError as exc:
+        raise MapError(path, exc.field or "<yaml>", "YAML within teamnav's limits", _Described(str(exc))) from None
     except yaml.YAMLError as exc:
         raise MapError(path, "<yaml>", "valid YAML", _Described(f"a syntax error: {str(exc).splitlines()[0]}")) from None
+    except RecursionError:
+        raise MapError(path, "<yaml>", "YAML nested at most 100 levels deep", _Described("a document nested too deeply")) from None
     if not isinstance(doc, dict):
         raise MapError(path, "<yaml>", "a mapping of map fields (image, resolution, origin, ...)", _Described(type(doc).__name__))
     ignored = tuple(str(key) for key in doc if key not in YAML_FIELDS)
@@ -660,10 +665,9 @@ def _read_image(image_path: Path, field: str, *, source: Path) -> np.ndarray:
         with _open_header_only(image_path) as im:
             w, h = im.size
             try:
-                check_map_size(w, h, str(image_path))
+                check_map_size(w, h, f"an image of {w} x {h} px")
             except ValueError as exc:
-                raise MapError(where, field, f"an image of at most {MAX_MAP_CELLS} pixels",
-                               _Described(str(exc).split(": ", 1)[1])) from None
+                raise MapError(where, field, f"an image of at most {MAX_MAP_CELLS:,} pixels", _Described(str(exc))) from None
             im.load()
             if im.mode == "P":
                 im = im.convert("RGBA" if "transparency" in im.info else "RGB")
