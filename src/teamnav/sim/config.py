@@ -7,6 +7,10 @@ NaN stops the run before it starts with a message naming the field (STYLE habit 
 
 Units are in the field names: ``_m``, ``_s``, ``_deg`` (degrees are for humans writing YAML;
 the code converts to radians once, at the boundary).
+
+The ``faults`` section (:class:`FaultsConfig`: robots that die or lose their radio, radio
+blackouts, sensor dropouts, kidnappings, bursts of false detections) is validated here too,
+robots named by global index or by group name and index; :mod:`teamnav.sim.faults` applies it.
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_serializer, model_validator
 
 from teamnav.world.grid import DEFAULT_SEES
 
@@ -251,6 +255,220 @@ class PlaceConfig(Model):
     on: Literal["enter", "inside"] = "enter"
 
 
+# ---------------------------------------------------------------------------- faults
+#: most entries of one kind a ``faults`` section may list
+MAX_FAULTS = 1000
+FaultTime = Annotated[float, Field(ge=0.0, le=1e7)]
+
+
+class GroupRobot(Model):
+    """A robot named by its group: the ``index``-th robot (from 0) of the group ``group``
+    (``robots[g].name``; the name must belong to one group only)."""
+
+    group: str = Field(min_length=1, max_length=100)
+    index: int = Field(0, ge=0, le=100_000)
+
+
+#: a robot: its global index (robot ids follow the groups in order), or ``{group, index}``
+RobotRef = Union[Annotated[int, Field(ge=0, le=10_000_000)], GroupRobot]
+
+
+class _Window(Model):
+    """A time window ``[t0_s, t1_s]`` (both ends included) [s]."""
+
+    t0_s: FaultTime
+    t1_s: FaultTime
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if self.t1_s < self.t0_s:
+            raise ValueError(f"t1_s must be >= t0_s ({self.t0_s}), got {self.t1_s}")
+        return self
+
+
+class RobotDeath(Model):
+    """Robot ``robot`` dies at ``t_s``: from the first step at or after ``t_s`` its brain is no
+    longer stepped, its commands are zero (it stops where it is and stays there, an obstacle
+    that other robots' sensors, detectors and bodies still meet) and its radio is off."""
+
+    robot: RobotRef
+    t_s: FaultTime
+
+
+class RadioDropout(Model):
+    """Robot ``robot``'s radio fails at ``t_s`` (until ``until_s``, or for good when None): it
+    sends nothing and receives nothing; everything else works."""
+
+    robot: RobotRef
+    t_s: FaultTime
+    until_s: FaultTime | None = None
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if self.until_s is not None and self.until_s <= self.t_s:
+            raise ValueError(f"until_s must be > t_s ({self.t_s}), got {self.until_s}")
+        return self
+
+
+class RadioBlackout(_Window):
+    """No radio at all in ``[t0_s, t1_s]``: a message sent in the window is lost, and so is one
+    that would be delivered in it."""
+
+
+class SensorDropout(_Window):
+    """Robot ``robot``'s sensor ``sensor`` returns nothing in ``[t0_s, t1_s]``.
+
+    ``sensor``: the index of a range sensor in the group's ``sensors`` list, a range sensor's
+    ``name`` or ``kind`` (a kind must be unique in the group), or ``"detector"`` (the robot
+    detector). What "nothing" is, for a range sensor, is ``reading``:
+
+    - ``"no_return"`` (default): every beam reads ``max_range_m``, the
+      :class:`~teamnav.control.types.RangeScan` value for "no return" (a laser whose receiver
+      sees no echo; a brain cannot tell it from open space);
+    - ``"no_scan"``: the sensor publishes nothing, its key is absent from ``Observation.scans``
+      (a driver that stopped; the brains shipped with teamnav refuse an observation without
+      their scan, so the run then ends with that error).
+
+    The detector returns no detection at all (true or false). The sensor is still simulated
+    (its noise stream draws as usual), only its output is withheld.
+    """
+
+    robot: RobotRef
+    sensor: Union[Annotated[int, Field(ge=0, le=8192)], Annotated[str, Field(min_length=1, max_length=100)]]
+    reading: Literal["no_return", "no_scan"] = "no_return"
+
+
+class Kidnapping(Model):
+    """Robot ``robot`` is carried away at ``t_s`` (truth only: its odometry never sees the jump).
+
+    To ``pose`` ``[x_m, y_m, theta_deg]``, or, when ``pose`` is None, to a pose drawn uniformly
+    over the free space of ``region`` ``[xmin, xmax, ymin, ymax]`` (or of the whole map) with a
+    uniform heading, from the run's fault stream. A target overlapping another robot at that
+    moment is tried again at the next steps (explicit pose) or redrawn (random pose).
+    """
+
+    robot: RobotRef
+    t_s: float = Field(gt=0.0, le=1e7)
+    pose: tuple[float, float, float] | None = None
+    region: tuple[float, float, float, float] | None = None
+
+    @model_validator(mode="after")
+    def _one_way(self):
+        if self.pose is not None and self.region is not None:
+            raise ValueError("give either 'pose' or 'region' (a random pose in it), not both")
+        if self.region is not None:
+            xmin, xmax, ymin, ymax = self.region
+            if not (xmin < xmax and ymin < ymax):
+                raise ValueError(f"region must be [xmin, xmax, ymin, ymax] with xmin < xmax and ymin < ymax, "
+                                 f"got {list(self.region)}")
+        return self
+
+
+class FalsePositiveBurst(_Window):
+    """In ``[t0_s, t1_s]`` the robot detector of ``robot`` (every robot with a detector when
+    None) reports phantom robots: per step a Poisson number of them with mean
+    ``rate_hz * dt_s``, each at a range uniform in ``(0, max_range_m]`` and a bearing uniform
+    over the field of view, with the identity of a uniformly drawn other robot when the
+    detector reports identities (else none), as the detector's own ``p_false_positive`` rule."""
+
+    robot: RobotRef | None = None
+    rate_hz: float = Field(gt=0.0, le=1000.0)
+
+
+class FaultsConfig(Model):
+    """What goes wrong during a run, applied on the truth side by :mod:`teamnav.sim.faults`
+    (brains learn of a fault only through what they observe). Each list holds at most
+    :data:`MAX_FAULTS` entries; a time is applied at the first step at or after it."""
+
+    deaths: tuple[RobotDeath, ...] = Field((), max_length=MAX_FAULTS)
+    radio_dropouts: tuple[RadioDropout, ...] = Field((), max_length=MAX_FAULTS)
+    blackouts: tuple[RadioBlackout, ...] = Field((), max_length=MAX_FAULTS)
+    sensor_dropouts: tuple[SensorDropout, ...] = Field((), max_length=MAX_FAULTS)
+    kidnappings: tuple[Kidnapping, ...] = Field((), max_length=MAX_FAULTS)
+    false_positives: tuple[FalsePositiveBurst, ...] = Field((), max_length=MAX_FAULTS)
+
+    @property
+    def empty(self) -> bool:
+        """True when no fault is listed."""
+        return not any(getattr(self, k) for k in type(self).model_fields)
+
+
+def resolve_robot(ref: Any, robots: tuple[RobotGroupConfig, ...], field: str) -> int:
+    """The global robot index of ``ref`` (an int or a :class:`GroupRobot`).
+
+    Raises
+    ------
+    ValueError
+        ``"<field>: ..."``: an index past the team, an unknown or shared group name, an index
+        past the group's count.
+
+    Examples
+    --------
+    >>> groups = (RobotGroupConfig(name="a", count=2), RobotGroupConfig(name="b", count=3))
+    >>> resolve_robot(GroupRobot(group="b", index=1), groups, "robot"), resolve_robot(4, groups, "robot")
+    (3, 4)
+    """
+    n = sum(g.count for g in robots)
+    if isinstance(ref, GroupRobot):
+        where = [gi for gi, g in enumerate(robots) if g.name == ref.group]
+        if not where:
+            names = ", ".join(repr(g.name) for g in robots)
+            raise ValueError(f"{field}.group: expected the name of a robot group ({names}), got {ref.group!r}")
+        if len(where) > 1:
+            raise ValueError(f"{field}.group: group name {ref.group!r} is shared by robots[{where[0]}] and "
+                             f"robots[{where[1]}]; expected a unique name (or give the robot's global index)")
+        g = robots[where[0]]
+        if ref.index >= g.count:
+            raise ValueError(f"{field}.index: expected a robot index in [0, {g.count}) of group {ref.group!r} "
+                             f"(count {g.count}), got {ref.index}")
+        return sum(x.count for x in robots[: where[0]]) + ref.index
+    if not 0 <= int(ref) < n:
+        raise ValueError(f"{field}: expected a robot index in [0, {n}) (the scenario has {n} robots), got {ref}")
+    return int(ref)
+
+
+def group_of_robot(i: int, robots: tuple[RobotGroupConfig, ...]) -> int:
+    """The index of the group robot ``i`` belongs to."""
+    start = 0
+    for gi, g in enumerate(robots):
+        if start <= i < start + g.count:
+            return gi
+        start += g.count
+    raise ValueError(f"robot index {i} is past the team of {start} robots")
+
+
+def resolve_sensor(ref: int | str, group: RobotGroupConfig, field: str) -> int | None:
+    """The index in ``group.sensors`` of range sensor ``ref``, or None for ``"detector"``.
+
+    Raises
+    ------
+    ValueError
+        ``"<field>: ..."``: an index past the list, an unknown name or kind, a kind shared by
+        several sensors, ``"detector"`` for a group without one.
+    """
+    names = [s.name for s in group.sensors]
+    if isinstance(ref, int):
+        if ref >= len(names):
+            raise ValueError(f"{field}: expected a sensor index in [0, {len(names)}) (group {group.name!r} has "
+                             f"{len(names)} range sensors), got {ref}")
+        return ref
+    if ref == "detector":
+        if group.detector is None:
+            raise ValueError(f"{field}: group {group.name!r} has no detector, got 'detector'")
+        return None
+    if ref in names:
+        return names.index(ref)
+    kinds = [s.kind for s in group.sensors]
+    if kinds.count(ref) == 1:
+        return kinds.index(ref)
+    if kinds.count(ref) > 1:
+        raise ValueError(f"{field}: group {group.name!r} has {kinds.count(ref)} sensors of kind {ref!r}; expected "
+                         f"a sensor name ({', '.join(names)}) or index, got {ref!r}")
+    known = ", ".join([repr(x) for x in names] + ["'detector'"] * (group.detector is not None))
+    raise ValueError(f"{field}: expected a sensor index, name, kind or 'detector' of group {group.name!r} "
+                     f"({known or 'none'}), got {ref!r}")
+
+
 class SimConfig(Model):
     """Everything the engine needs besides the map."""
 
@@ -265,6 +483,10 @@ class SimConfig(Model):
     #: scan, the robot detector's detections and the delivered radio messages (the recorder's
     #: ``scan.*`` arrays and ``detections`` / ``messages`` segment layers, for replays and MCAP)
     record_scans: bool = False
+    #: what goes wrong during the run (:class:`FaultsConfig`); None: nothing. A run without
+    #: faults (None or an empty section) is the same, bit for bit, as before faults existed,
+    #: and the section is left out of the resolved scenario then.
+    faults: FaultsConfig | None = None
 
     @field_validator("robots")
     @classmethod
@@ -272,6 +494,38 @@ class SimConfig(Model):
         if not v:
             raise ValueError("needs at least one robot group")
         return v
+
+    @model_validator(mode="after")
+    def _faults_refer_to_robots(self) -> "SimConfig":
+        """Every robot and sensor a fault names exists (the first problem, its field named)."""
+        f = self.faults
+        if f is None:
+            return self
+        robots = self.robots
+        for kind in ("deaths", "radio_dropouts", "sensor_dropouts", "kidnappings", "false_positives"):
+            for j, entry in enumerate(getattr(f, kind)):
+                field = f"faults.{kind}[{j}]"
+                if entry.robot is None:  # a false-positive burst for every robot with a detector
+                    if not any(g.detector is not None for g in robots):
+                        raise ValueError(f"{field}.robot: no robot group has a detector to report false positives")
+                    continue
+                i = resolve_robot(entry.robot, robots, f"{field}.robot")
+                g = robots[group_of_robot(i, robots)]
+                if kind == "sensor_dropouts":
+                    resolve_sensor(entry.sensor, g, f"{field}.sensor")
+                elif kind == "false_positives" and g.detector is None:
+                    raise ValueError(f"{field}.robot: robot {i} (group {g.name!r}) has no detector to report false "
+                                     "positives")
+        return self
+
+    @model_serializer(mode="wrap")
+    def _without_empty_faults(self, handler):
+        """Leave ``faults`` out when there are none, so a resolved scenario without faults (and
+        its sweeps' config hash) is what it was before the section existed."""
+        data = handler(self)
+        if isinstance(data, dict) and (self.faults is None or self.faults.empty):
+            data.pop("faults", None)
+        return data
 
     @property
     def n_robots(self) -> int:

@@ -42,6 +42,17 @@ another group's noise.
 Work nobody needs is skipped: no radio when no per-robot controller runs (batched brains
 take no radio), no events without places that fire, no detector without a
 ``DetectorConfig``, and a batched group senses only its controller's ``range_sensor``.
+
+Faults
+------
+A scenario's ``faults`` (:class:`~teamnav.sim.config.FaultsConfig`) are applied on the truth
+side by a :class:`~teamnav.sim.faults.FaultInjector` (``Simulation.faults``; None without
+faults, and then no fault code runs): at the start of each step it says who is dead, whose
+radio and sensors are off, whether the radio is blacked out and where phantoms are reported;
+kidnappings move true poses after the odometry step. Its random stream is a sixth child of
+*subsystems*, spawned only when there are faults, so the other streams draw as without them.
+A dead robot's brain is not stepped (batched: its commands are zeroed). Brains are told
+nothing: they see only the observations the faults shaped.
 """
 
 from __future__ import annotations
@@ -294,6 +305,16 @@ class Simulation:
         self.step_index = 0
         self.recorder = Recorder(n, config.record_every)
         self.recorder.events = self.places.log
+        #: the run's faults (None without a ``faults`` section, or with an empty one)
+        self.faults = None
+        if config.faults is not None and not config.faults.empty:
+            from teamnav.sim.faults import FaultInjector
+
+            (fault_ss,) = sub_ss.spawn(1)  # a sixth child: the five streams above are unchanged
+            self.faults = FaultInjector(config.faults, config, grid, self._blocking, self._clear_m, self.dt_s,
+                                        np.random.default_rng(fault_ss), self.places.log)
+            self._check_faults()
+            self.faults.begin_step(0)
         if self.radio is not None:
             self.recorder.comm_counts = self.radio.counts
         self._rec_sensing = bool(config.record_scans)
@@ -360,6 +381,9 @@ class Simulation:
             h(self)
         s = self.state
         self.step_index += 1
+        fx = self.faults
+        if fx is not None:
+            fx.begin_step(self.step_index)
         np.copyto(self._x0, s.x_m)
         np.copyto(self._y0, s.y_m)
         np.copyto(self._th0, s.theta_rad)
@@ -368,8 +392,14 @@ class Simulation:
         move_discs(s.x_m, s.y_m, s.theta_rad, s.radius_m, self._pre, self._arc, self._turn, self._blocking,
                    self._clear_m, self._geo, self.config.robot_collisions, s.stalled)
         self.odometry.step(self._x0, self._y0, self._th0, s.x_m, s.y_m, s.theta_rad)
+        if fx is not None and fx.kidnap_due:
+            fx.kidnap(s)  # after the odometry step: odometry never feels the jump
         events = self.places.update(self.step_index, self.time_s, s.x_m, s.y_m) if self.places.active else None
-        inboxes = self.radio.collect() if self.radio is not None and self.radio.has_pending else None
+        if fx is None:
+            inboxes = self.radio.collect() if self.radio is not None and self.radio.has_pending else None
+        else:
+            inboxes = self.radio.collect(muted=fx.radio_off if fx.any_radio_off else None, blocked=fx.blackout) \
+                if self.radio is not None and self.radio.has_pending else None
         if inboxes is not None and self._rec_sensing and self.recorder.wants(self.step_index):
             self._record_messages(inboxes)
         self._observe_and_decide(events, inboxes)
@@ -379,6 +409,31 @@ class Simulation:
             h(self)
 
     # ------------------------------------------------------------------ internals
+    def _check_faults(self) -> None:
+        """Faults on robots of batched groups that their brain could never feel are refused:
+        a batched group senses only its controller's range sensor and has no detector."""
+        cfg = self.config.faults
+        for kind in ("sensor_dropouts", "false_positives"):
+            for j, entry in enumerate(getattr(cfg, kind)):
+                if entry.robot is None:
+                    continue
+                from teamnav.sim.config import resolve_robot, resolve_sensor
+
+                field = f"faults.{kind}[{j}]"
+                grp = self._groups[int(self.group_of[resolve_robot(entry.robot, self.config.robots, field + '.robot')])]
+                if not grp.batched:
+                    continue
+                sensed = grp.sensors[0].name
+                if kind == "false_positives":
+                    raise ValueError(f"{field}.robot: robots of group {grp.cfg.name!r} run the batched controller "
+                                     f"{grp.cfg.controller!r}, which has no detector to report false positives")
+                k = resolve_sensor(entry.sensor, grp.cfg, field + ".sensor")
+                if k is None or grp.cfg.sensors[k].name != sensed or entry.reading == "no_scan":
+                    raise ValueError(f"{field}.sensor: robots of group {grp.cfg.name!r} run the batched controller "
+                                     f"{grp.cfg.controller!r}, which senses only {sensed!r} and always gets its "
+                                     f"ranges; expected that sensor with reading 'no_return', got "
+                                     f"{entry.sensor!r} with {entry.reading!r}")
+
     def _plan_shared_sensing(self) -> None:
         """Group the per-robot groups' sensing that can run in one call per step.
 
@@ -497,12 +552,17 @@ class Simulation:
         shared = self._shared_readings() if self._scan_sets else None
         dets_of = self._shared_detections() if self._det_sets else None
         delta = self.odometry.delta.copy() if self._any_per_robot else None  # fresh, one copy for all groups
+        fx = self.faults
+        omit = None
         for grp in self._groups:
             sl = grp.sl
             gx, gy, gth = xs[sl], ys[sl], ths[sl]
             if grp.batched:
                 sensor = grp.sensors[0]
                 ranges = sensor._sense(gx, gy, gth, grp.rngs[0], grp.bodies[0])
+                if fx is not None and fx.dropped:
+                    k_cfg = [c.name for c in grp.cfg.sensors].index(sensor.name)
+                    ranges = fx.batch_ranges(grp.index, k_cfg, sl.start, ranges, float(sensor.max_range_m))
                 obs = BatchObservation(
                     robot_ids=grp.ids.copy(), step=step, time_s=t, odom_pose=odom[sl], ranges_m=ranges,
                     angles_rad=grp.angles[0], max_range_m=float(sensor.max_range_m), stalled=s.stalled[sl].copy(),
@@ -520,14 +580,24 @@ class Simulation:
                 for k, (sensor, rng, angles, bodies) in enumerate(zip(grp.sensors, grp.rngs, grp.angles, grp.bodies))
             ]
             dets = dets_of[grp.index] if grp.detector is not None else None
+            if fx is not None:
+                readings, omit = fx.readings(grp.index, sl.start, readings)
+                if dets is not None:
+                    dets = fx.detections(grp.index, sl.start, dets, grp.detector)
             if self._rec_sensing and self.recorder.wants(step):
                 self._record_sensing(grp, [(r[0], r[1]) for r in readings], dets)
             stalled = s.stalled[sl].tolist()
             for k, brain in enumerate(grp.brain):
                 i = sl.start + k
+                if fx is not None and fx.dead[i]:
+                    continue  # a dead robot's brain is off (its commands are zeroed below)
+                scans = {name: RangeScan(r[k], a, m) for name, r, a, m in readings}
+                if omit is not None and omit[k]:
+                    for name in omit[k]:
+                        del scans[name]  # a sensor that publishes nothing this step
                 obs = Observation(
                     robot_id=i, step=step, time_s=t, odom_pose=odom[i], odom_delta=delta[i],
-                    scans={name: RangeScan(r[k], a, m) for name, r, a, m in readings},
+                    scans=scans,
                     detections=tuple(dets[k]) if dets is not None else (),
                     stalled=stalled[k],
                     inbox=inboxes[i] if inboxes is not None else (),
@@ -549,6 +619,8 @@ class Simulation:
                 if outbox:
                     for m in outbox:
                         outgoing.append((i, m))
+        if fx is not None:
+            fx.zero_commands(self._v_cmd, self._w_cmd, self._dir_cmd)
         if not (np.isfinite(self._v_cmd).all() and np.isfinite(self._w_cmd).all()):
             bad = int(np.flatnonzero(~(np.isfinite(self._v_cmd) & np.isfinite(self._w_cmd)))[0])
             raise ValueError(
@@ -556,7 +628,10 @@ class Simulation:
                 f"v_mps and omega_radps, got ({self._v_cmd[bad]!r}, {self._w_cmd[bad]!r})"
             )
         if outgoing:
-            self.radio.send(outgoing, xs, ys)
+            if fx is None:
+                self.radio.send(outgoing, xs, ys)
+            else:
+                self.radio.send(outgoing, xs, ys, muted=fx.radio_off if fx.any_radio_off else None, blocked=fx.blackout)
 
     def _apply_batch(self, grp: _Group, act) -> None:
         n = grp.cfg.count

@@ -22,6 +22,13 @@ Rules:
 - Counted per robot: messages and bytes (:meth:`Message.size_bytes`) sent, and messages and
   bytes delivered to it (counted when they reach its inbox, so messages still in the air
   when a run ends are not delivered); and in total, deliveries lost.
+
+Faults (:mod:`teamnav.sim.faults`; only when a scenario lists them): ``send(..., muted=,
+blocked=)`` and ``collect(muted=, blocked=)``. A muted robot (dead, or its radio failed) sends
+nothing (its messages are not counted as sent) and hears nothing; a blocked radio (a blackout)
+carries nothing: what is sent then is not sent, what is due then is not delivered. The counts
+of what faults stopped appear under ``"faults"`` in :meth:`Radio.counts` once a fault has
+touched the radio, and never otherwise.
 """
 
 from __future__ import annotations
@@ -117,6 +124,9 @@ class Radio:
         self.by_kind: dict[str, int] = {}
         self._pending: list[list[tuple[Message, int]]] = [[] for _ in range(self.n)]
         self.has_pending = False
+        #: what faults stopped (None until a fault touches the radio): messages not sent
+        #: (their sender muted, or a blackout) and deliveries dropped (receiver muted, blackout)
+        self.fault_counts: dict[str, int] | None = None
 
     @property
     def sent_messages(self) -> np.ndarray:
@@ -189,7 +199,13 @@ class Radio:
         ok[rows, sidx] = False
         return ok
 
-    def send(self, outgoing: Sequence[tuple[int, Message]], xs: np.ndarray, ys: np.ndarray) -> None:
+    def _fault_count(self, key: str, k: int) -> None:
+        if self.fault_counts is None:
+            self.fault_counts = {"messages_not_sent": 0, "deliveries_dropped": 0}
+        self.fault_counts[key] += int(k)
+
+    def send(self, outgoing: Sequence[tuple[int, Message]], xs: np.ndarray, ys: np.ndarray, *,
+             muted: np.ndarray | None = None, blocked: bool = False) -> None:
         """Queue messages sent this step for delivery at the next :meth:`collect`.
 
         Parameters
@@ -198,11 +214,29 @@ class Radio:
             In sending order (the engine lists robots by id, each robot's outbox in order).
         xs, ys : ndarray of shape (N,)
             True positions now [m].
+        muted : ndarray of shape (N,), bool, optional
+            Robots whose radio is off (faults): their messages are not sent, nobody hears them
+            and they hear nobody.
+        blocked : bool
+            The radio carries nothing now (a blackout): no message is sent.
         """
         if not outgoing:
             return
+        if blocked:
+            self._fault_count("messages_not_sent", len(outgoing))
+            return
+        if muted is not None:
+            kept = [(s, m) for s, m in outgoing if not muted[int(s)]]
+            if len(kept) < len(outgoing):
+                self._fault_count("messages_not_sent", len(outgoing) - len(kept))
+            outgoing = kept
+            if not outgoing:
+                return
         senders = sorted({int(s) for s, _ in outgoing})
-        hears = dict(zip(senders, self._receivers_of(senders, xs, ys).tolist()))
+        ok = self._receivers_of(senders, xs, ys)
+        if muted is not None:
+            ok &= ~np.asarray(muted, dtype=bool)[None, :]
+        hears = dict(zip(senders, ok.tolist()))
         listeners: dict[int, list[int]] = {}  # sender -> the robots that hear its broadcasts
         p_loss = self.cfg.p_loss
         n = self.n
@@ -232,10 +266,19 @@ class Radio:
             if idx:
                 self.has_pending = True
 
-    def collect(self) -> list[tuple[Message, ...]]:
-        """Inboxes for this step (messages sent last step), one tuple per robot, and clear them."""
+    def collect(self, *, muted: np.ndarray | None = None, blocked: bool = False) -> list[tuple[Message, ...]]:
+        """Inboxes for this step (messages sent last step), one tuple per robot, and clear them.
+
+        With ``blocked`` (a blackout) every pending delivery is dropped; a ``muted`` robot's
+        (faults) are dropped.
+        """
         if not self.has_pending:
             return [()] * self.n
+        if blocked or muted is not None:
+            drop = sum(len(p) for r, p in enumerate(self._pending) if blocked or muted[r])
+            if drop:
+                self._fault_count("deliveries_dropped", drop)
+                self._pending = [[] if blocked or muted[r] else p for r, p in enumerate(self._pending)]
         boxes = []
         for r, pend in enumerate(self._pending):
             if pend:
@@ -264,4 +307,5 @@ class Radio:
                 "messages_delivered": self.delivered_messages.tolist(),
                 "bytes_delivered": self.delivered_bytes.tolist(),
             },
+            **({"faults": dict(self.fault_counts)} if self.fault_counts is not None else {}),
         }
