@@ -400,3 +400,18 @@ def test_generated_scenarios_are_accepted_or_refused_cleanly(gen_dir, case):
         assert "nested more than" in res.stderr
     if kind == "bomb":
         assert "expands to more than" in res.stderr
+
+
+@pytest.mark.parametrize("argv", [["run", "demo", "--duration", "0.5", "--set", "robots.0.count=2", "--out"],
+                                  ["sweep", "demo-robots", "--seeds", "1", "--duration", "0.5", "--out"]])
+def test_run_and_sweep_refuse_an_output_folder_that_cannot_be_made(tmp_path, argv):
+    """``--out`` under /proc (or below a file): one message naming the folder, nothing run or written."""
+    (tmp_path / "a_file").write_text("x", encoding="utf-8")
+    before = _tree(tmp_path)
+    targets = [str(tmp_path / "a_file" / "out")] + (["/proc/teamnav-test-out"] if Path("/proc/self").is_dir() else [])
+    for target in targets:
+        result = runner.invoke(app, argv + [target])
+        assert result.exit_code == 2, result.output
+        assert "Traceback" not in result.output and target in result.output and "--out" in result.output
+        assert not Path(target).exists()
+    assert _tree(tmp_path) == before

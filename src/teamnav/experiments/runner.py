@@ -388,14 +388,22 @@ def run(
             raise ScenarioError(scenario.source, [Problem("", f"the simulator cannot set up this scenario: {exc}")]) from None
 
         if out is not None:
-            out.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                out.parent.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise OutputDirError(f"output folder {out}: its parent {out.parent} cannot be created "
+                                     f"({exc.strerror or exc}); choose another --out") from None
         with sigterm_raises():  # SIGTERM: the staging folder is removed, then the process ends
             staging: Path | None = None
             try:
                 folder, prefix = _staging_place(out)
                 clean_stale_staging(folder)
                 with sigterm_deferred():  # no SIGTERM between creating the folder and knowing its name
-                    staging = Path(tempfile.mkdtemp(prefix=prefix, suffix=".partial", dir=folder))
+                    try:
+                        staging = Path(tempfile.mkdtemp(prefix=prefix, suffix=".partial", dir=folder))
+                    except OSError as exc:
+                        raise OutputDirError(f"output folder {out if out is not None else folder}: cannot write in "
+                                             f"{folder} ({exc.strerror or exc}); choose another --out") from None
                 report.phase("first step: numba compiles (first run) or loads its kernels")
                 t0 = time.perf_counter()
                 sim.run(n_steps, progress=report.step, is_finished=all_finished if scenario.stop_when_finished else None)

@@ -818,7 +818,11 @@ def sweep(
     if out.exists() and not out.is_dir():
         raise SweepError(f"out_dir: expected a folder, received the file {out}")
     check_store(out / STORE_NAME)  # a results.sqlite that is not a teamnav store: refused before any trial
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SweepError(f"out_dir: cannot create or write the folder {out} ({exc.strerror or exc}); "
+                         "use --out with another folder") from None
     result = SweepResult(spec.sweep_name, out / STORE_NAME, len(trials))
     from teamnav.experiments.signals import sigterm_raises
 

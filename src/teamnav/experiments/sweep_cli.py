@@ -73,7 +73,10 @@ def sweep_command(
     A rerun into the same folder skips the trials already done.
     """
     from teamnav.experiments.errors import ScenarioError
+    from teamnav.experiments.runner import OutputDirError
+    from teamnav.experiments.store import StoreError
     from teamnav.experiments.sweep import SweepError, sweep
+    from teamnav.world.mapio import MapError
 
     err = Console(stderr=True, highlight=False, soft_wrap=True)
     try:
@@ -92,7 +95,7 @@ def sweep_command(
             retry_failed=retry_failed,
             artifacts=artifacts,
         )
-    except (SweepError, ScenarioError) as exc:
+    except (SweepError, ScenarioError, StoreError, MapError, OutputDirError) as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(EXIT_BAD_INPUT) from None
     except ValueError as exc:
