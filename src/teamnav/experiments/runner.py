@@ -29,7 +29,6 @@ import re
 import shutil
 import socket
 import tempfile
-import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,6 +46,7 @@ from teamnav.experiments.spec import (
     load_scenario,
     scenario_to_yaml,
 )
+from teamnav.files import current_umask  # noqa: F401 (re-exported: teamnav.env uses it)
 from teamnav.world.mapio import YAML_SUFFIXES, read_map_yaml, save_map
 
 __all__ = [
@@ -176,7 +176,6 @@ _HOST = re.sub(r"[^A-Za-z0-9-]", "-", socket.gethostname())[:32] or "host"
 _STAGING = re.compile(r"^\.(?P<name>.+)\.(?P<host>[A-Za-z0-9-]{1,32})-(?P<pid>\d+)\.[a-z0-9_]{8}\.(?P<kind>partial|old)$")
 #: ``teamnav-run-HOST-PID.XXXXXXXX.partial`` in the temporary folder (a run without out_dir)
 _TMP_STAGING = re.compile(r"^teamnav-run-(?P<host>[A-Za-z0-9-]{1,32})-(?P<pid>\d+)\.[a-z0-9_]{8}\.partial$")
-_UMASK_LOCK = threading.Lock()
 
 
 def source_thresholds(scenario: Scenario) -> dict[str, float]:
@@ -188,22 +187,6 @@ def source_thresholds(scenario: Scenario) -> dict[str, float]:
         return {}
     meta = read_map_yaml(path)
     return {"occupied_thresh": meta.occupied_thresh, "free_thresh": meta.free_thresh}
-
-
-def current_umask() -> int:
-    """This process's umask, read without changing it where the system allows
-    (``/proc/self/status``); elsewhere set and restored at once, under a lock."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError, IndexError):
-        pass
-    with _UMASK_LOCK:
-        mask = os.umask(0o077)
-        os.umask(mask)
-    return mask
 
 
 def _apply_umask(root: Path, umask: int) -> None:

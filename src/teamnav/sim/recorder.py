@@ -81,6 +81,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from teamnav.files import file_mode
+
 __all__ = ["LAYER_KINDS", "Layer", "Recorder", "RunRecord", "Scan", "load"]
 
 #: layer kind -> allowed row widths (``state``: one label index per sample)
@@ -104,27 +106,13 @@ def _jsonable(v: Any) -> Any:
     return repr(v)
 
 
-def _umask() -> int:
-    """The process's umask, read without changing it where the system allows."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError, IndexError):
-        pass
-    mask = os.umask(0o077)
-    os.umask(mask)
-    return mask
-
-
 def _write_atomic(path: Path, write) -> None:
     """Call ``write(file_object)`` on a temporary file next to ``path``, then rename it into
     place, with the mode an ordinary file gets (``0o666 & ~umask``; mkstemp's is 0600)."""
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         if hasattr(os, "fchmod"):
-            os.fchmod(fd, 0o666 & ~_umask())
+            os.fchmod(fd, file_mode())
         with os.fdopen(fd, "wb") as f:
             write(f)
             f.flush()

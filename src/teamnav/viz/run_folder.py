@@ -43,6 +43,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
+from teamnav.files import file_mode
 from teamnav.sim.recorder import LAYER_KINDS, Layer, RunRecord, Scan
 
 __all__ = ["MAX_RUN_BYTES", "OutputPathError", "RunFolderError", "atomic_output", "read_map", "read_run_folder", "scenario_name"]
@@ -443,12 +444,6 @@ def read_map(run_dir: str | os.PathLike):
 
 
 # ---------------------------------------------------------------------------- writing
-def _umask() -> int:
-    mask = os.umask(0o077)
-    os.umask(mask)
-    return mask
-
-
 @contextlib.contextmanager
 def atomic_output(path: str | os.PathLike, what: str, option: str) -> Iterator[Path]:
     """Yield a temporary path in ``path``'s folder; on success rename it to ``path``.
@@ -480,7 +475,7 @@ def atomic_output(path: str | os.PathLike, what: str, option: str) -> Iterator[P
     try:
         parent.mkdir(parents=True, exist_ok=True)
         name = parent / f".{path.name}.{secrets.token_hex(4)}.tmp"
-        os.close(os.open(name, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666 & ~_umask()))
+        os.close(os.open(name, os.O_WRONLY | os.O_CREAT | os.O_EXCL, file_mode()))
         tmp = name
     except OSError as exc:
         undo()

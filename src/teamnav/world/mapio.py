@@ -89,6 +89,7 @@ import numpy as np
 import yaml
 from PIL import Image, UnidentifiedImageError
 
+from teamnav.files import file_mode
 from teamnav.safe_yaml import YamlLimitError, safe_load, show_value
 from teamnav.world.grid import DEFAULT_MATERIALS, MAX_MAP_CELLS, OccupancyGrid, check_map_size
 
@@ -609,14 +610,13 @@ def save_map(
     files.append((yaml_path, yaml.safe_dump(doc, sort_keys=False)))
 
     temps: list[tuple[str, Path]] = []
-    umask = os.umask(0)
-    os.umask(umask)
+    mode = file_mode()
     try:
         for target, content in files:
             fd, tmp = tempfile.mkstemp(prefix="." + target.name + ".", suffix=".tmp" + target.suffix, dir=folder)
             os.close(fd)
             temps.append((tmp, target))
-            os.chmod(tmp, 0o666 & ~umask)  # the user's umask, as any tool's files (mkstemp makes 0600)
+            os.chmod(tmp, mode)  # the user's umask, as any tool's files (mkstemp makes 0600)
             if isinstance(content, str):
                 Path(tmp).write_text(content, encoding="utf-8")
             else:
