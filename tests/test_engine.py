@@ -415,3 +415,21 @@ def test_start_poses_longer_than_count_use_the_first_count_and_too_few_is_an_err
     np.testing.assert_allclose(got[1, 2], np.pi / 2)
     with pytest.raises(ValueError, match=r"start.poses must list at least count=3 poses.*got 2"):
         RobotGroupConfig(name="g", count=3, controller="idle-v1", start=StartConfig(poses=poses[:2]))
+
+
+def test_long_sensor_names_are_recorded_under_distinct_short_keys(tmp_path):
+    """A sensor name past the recorder's 64-character key limit used to crash a run with
+    record_scans on; the key is cut and keeps the sensor's index (the full name stays in the
+    scan's metadata)."""
+    from teamnav.experiments.runner import run as run_scenario
+    from teamnav.experiments.spec import load_scenario
+    from teamnav.sim.recorder import load
+
+    long = "a_very_long_sensor_name_that_goes_on_and_on_and_on_past_sixty_four_characters_"
+    scn = load_scenario("demo", overrides=["record_scans=true", "robots.0.count=2", "robots.0.start.region=null",
+                                           f"robots.0.sensors=[{{kind: laser, name: {long}x}}, {{kind: laser, name: {long}y}}]"],
+                        duration_s=0.3)
+    result = run_scenario(scn, out_dir=tmp_path / "run", progress=False)
+    scans = load(result.run_dir).scans
+    assert len(scans) == 2 and all(len(k) <= 64 for k in scans)
+    assert sorted(s.sensor for s in scans.values()) == [long + "x", long + "y"]

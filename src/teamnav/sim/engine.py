@@ -651,8 +651,10 @@ class Simulation:
         """Record a group's scans (``[(sensor name, ranges (n, B))]``) and its detections as
         world segments from each observer's true pose (``config.record_scans``)."""
         step = self.step_index
-        for (name, ranges), sensor, angles in zip(scans, grp.sensors, grp.angles):
+        for si, ((name, ranges), sensor, angles) in enumerate(zip(scans, grp.sensors, grp.angles)):
             key = f"g{grp.index}_" + "".join(c if c.isalnum() or c in "_-" else "_" for c in name)
+            if len(key) > 64:  # the recorder's key limit: a long sensor name is cut, its index keeps it unique
+                key = key[:58] + f"_s{si}"
             self.recorder.add_scan(key, step, grp.ids, ranges, angles_rad=angles, max_range_m=float(sensor.max_range_m),
                                    group=grp.cfg.name, sensor=name, kind=str(getattr(sensor, "kind", "")))
         if dets is None:
