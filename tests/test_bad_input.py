@@ -415,3 +415,17 @@ def test_run_and_sweep_refuse_an_output_folder_that_cannot_be_made(tmp_path, arg
         assert "Traceback" not in result.output and target in result.output and "--out" in result.output
         assert not Path(target).exists()
     assert _tree(tmp_path) == before
+
+
+@pytest.mark.parametrize("command,option,extra", [("replay", "--out", []), ("export", "--mcap", ["--force"])])
+def test_output_over_the_run_folders_own_file_is_refused(run_folder, tmp_path, command, option, extra):
+    """``--out RUN/trajectories.npz`` would overwrite the very run being shown: refused, the
+    run folder untouched."""
+    import shutil
+
+    folder = tmp_path / "run"
+    shutil.copytree(run_folder, folder)
+    before = _tree(folder)
+    target = folder / "trajectories.npz"
+    _refused(runner.invoke(app, [command, str(folder), option, str(target)] + extra), str(target), "run folder's own", option)
+    assert _tree(folder) == before

@@ -160,7 +160,7 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
     ctx = foxglove.Context()
     # written under a temporary name in the target folder, renamed once complete; a path that
     # cannot be written is an OutputPathError naming it, and nothing is left behind
-    with atomic_output(path, "MCAP file", "--mcap") as tmp:
+    with atomic_output(path, "MCAP file", "--mcap", run_dir=run_dir) as tmp:
         with foxglove.open_mcap(tmp, allow_overwrite=True, context=ctx):
             def log(ch, msg, ns):
                 ch.log(msg, log_time=int(ns))

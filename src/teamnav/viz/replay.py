@@ -485,7 +485,7 @@ def build_replay(
     fill = {"TITLE": html.escape(meta["title"]), "META": _script_json(meta), "DATA": payload,
             "CSP": html.escape(_script_csp(page))}
     page = re.sub(r"\{\{(TITLE|META|DATA|CSP)\}\}", lambda m: fill[m.group(1)], page)  # one pass: data never re-scanned
-    with atomic_output(out, "HTML file", "--out") as tmp:  # nothing half-written, even on /proc or a full disk
+    with atomic_output(out, "HTML file", "--out", run_dir=run_dir) as tmp:  # nothing half-written, even on /proc or a full disk
         tmp.write_text(page, encoding="utf-8")
     names = ["map", "true", "trails", "belief"] + (["scans"] if scans_meta else []) + [m["name"] for m in layers_meta]
     names += ["events"] if events else []

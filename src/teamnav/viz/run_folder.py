@@ -46,7 +46,13 @@ import numpy as np
 from teamnav.files import file_mode
 from teamnav.sim.recorder import LAYER_KINDS, Layer, RunRecord, Scan
 
-__all__ = ["MAX_RUN_BYTES", "OutputPathError", "RunFolderError", "atomic_output", "read_map", "read_run_folder", "scenario_name"]
+#: Files a run folder holds (``teamnav run``); an output path must not be one of them.
+RUN_FILES: frozenset[str] = frozenset({
+    "trajectories.npz", "layers.npz", "layers.json", "logs.json", "events.json", "comm.json", "robots.json",
+    "metrics.json", "scenario.yaml", "map.yaml", "map.pgm", "map_materials.pgm", "trajectories.png", "run.gif",
+})
+
+__all__ = ["MAX_RUN_BYTES", "RUN_FILES", "OutputPathError", "RunFolderError", "atomic_output", "read_map", "read_run_folder", "scenario_name"]
 
 #: Most memory [bytes] the arrays of a run folder (trajectories.npz + layers.npz) may take once
 #: decompressed (2 GiB); larger folders are refused before anything is decompressed.
@@ -445,17 +451,21 @@ def read_map(run_dir: str | os.PathLike):
 
 # ---------------------------------------------------------------------------- writing
 @contextlib.contextmanager
-def atomic_output(path: str | os.PathLike, what: str, option: str) -> Iterator[Path]:
+def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: str | os.PathLike | None = None) -> Iterator[Path]:
     """Yield a temporary path in ``path``'s folder; on success rename it to ``path``.
 
     Folders missing above ``path`` are made; on any failure the temporary file and the folders
     made are removed, and an ``OSError`` becomes an :class:`OutputPathError` naming ``path``
-    (``what``: "HTML file", "MCAP file"; ``option``: the CLI option to change).
+    (``what``: "HTML file", "MCAP file"; ``option``: the CLI option to change). With
+    ``run_dir``, a ``path`` that is one of that run folder's own files (:data:`RUN_FILES`) is
+    refused: writing the replay over ``trajectories.npz`` would destroy the run it shows.
     """
     path = Path(path)
     todo = f"choose another {option}"
     if path.is_dir():
         raise OutputPathError(f"{what} {path}: expected a file path, found a folder; {todo}")
+    if run_dir is not None and path.name in RUN_FILES and path.exists() and path.parent.resolve() == Path(run_dir).resolve():
+        raise OutputPathError(f"{what} {path}: expected a new file, found the run folder's own {path.name}; {todo}")
     parent = path.parent
     made: list[Path] = []
     p = parent
