@@ -242,3 +242,22 @@ def test_yaml_booleans_are_yaml_1_2_so_on_stays_a_key(tmp_path):
     text = BASE + "places:\n  - {name: p, x_m: 5, y_m: 7, event: here, on: inside}\nrobot_collisions: false\n"
     s = load_scenario(write(tmp_path, text), overrides=["give_map=true"])
     assert s.places[0].on == "inside" and s.robot_collisions is False and s.give_map is True
+
+
+def test_a_map_file_given_with_set_is_relative_to_the_current_folder(tmp_path, monkeypatch):
+    """``--set map={file: maps/x.yaml}`` on a built-in scenario reads the map from where teamnav
+    runs (it used to look inside the package's scenario folder); a scenario file's own relative
+    map.file stays relative to that file."""
+    import shutil
+
+    from teamnav.experiments.spec import PACKAGE_MAP_DIR, load_scenario
+
+    (tmp_path / "maps").mkdir()
+    for f in ("tb3_sandbox.yaml", "tb3_sandbox.pgm"):
+        shutil.copy(PACKAGE_MAP_DIR / "nav2" / f, tmp_path / "maps" / f)
+    monkeypatch.chdir(tmp_path)
+    scn = load_scenario("demo", overrides=["map={file: maps/tb3_sandbox.yaml}", "robots.0.start.region=null"])
+    assert scn.map.file == str(tmp_path / "maps" / "tb3_sandbox.yaml")
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "s.yaml").write_text("name: s\nmap: {file: ../maps/tb3_sandbox.yaml}\nrobots: [{count: 1}]\n")
+    assert Path(load_scenario(str(tmp_path / "sub" / "s.yaml")).map.file).resolve() == tmp_path / "maps" / "tb3_sandbox.yaml"

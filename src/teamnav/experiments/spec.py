@@ -672,6 +672,7 @@ def load_scenario(
         base = path.resolve().parent
         data.setdefault("name", path.stem if path.stem[:1].isalnum() else "scenario")
     data = copy.deepcopy(data)
+    file_before = data.get("map", {}).get("file") if isinstance(data.get("map"), dict) else None
     notes = apply_overrides(data, overrides, file)
     if seed is not None:
         data["seed"] = seed
@@ -682,7 +683,10 @@ def load_scenario(
     spec = data.get("map")
     if base is not None and isinstance(spec, dict) and isinstance(spec.get("file"), str) and spec["file"]:
         p = Path(os.path.expanduser(spec["file"]))
-        spec["file"] = str(p if p.is_absolute() else (base / p))
+        # a map file named in the scenario file is relative to that file's folder; one given
+        # with --set (the scenario may be a built-in one) is relative to where teamnav runs
+        here = base if spec["file"] == file_before else Path.cwd()
+        spec["file"] = str(p if p.is_absolute() else (here / p))
     try:
         scn = Scenario.model_validate(data)
     except ValidationError as exc:
