@@ -19,6 +19,7 @@ Examples
     teamnav run demo --seed 3 --set robots.0.count=4 --set radio.p_loss=0.1 --duration 20
     teamnav run my_scenario.yaml --out runs/mine --gif
     teamnav run runs/mine/scenario.yaml --out runs/again      # reproduces runs/mine
+    teamnav run demo --controller my_brain:MyBrain            # your own Controller class (my_brain.py)
     teamnav validate my_scenario.yaml
     teamnav run demo --set record_scans=true --html             # + runs/demo-*/replay.html
     teamnav replay runs/mine --out mine.html --every 2
@@ -311,6 +312,11 @@ def run(
     force: bool = typer.Option(False, "--force", help="Replace --out if it exists and is not empty."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no table; print only the run folder."),
     html: bool = typer.Option(False, "--html", help="Also write replay.html (see `teamnav replay`)."),
+    controller: Optional[List[str]] = typer.Option(
+        None, "--controller", metavar="MODULE:CLASS",
+        help="Run your own Controller class for every group, or for one group as GROUP=MODULE:CLASS "
+             "(a module on the path or in this folder, or path/to/file.py:CLASS). Repeatable.",
+    ),
 ) -> None:
     """Run a scenario, write its run folder and print its metrics."""
     from teamnav.experiments.runner import run as run_scenario
@@ -318,6 +324,8 @@ def run(
 
     with _bad_input_exits():
         scn = load_scenario(scenario, overrides=set_ or None, seed=seed, duration_s=duration)
+        if controller:
+            scn = load_scenario(scn, overrides=controller_overrides(scn, controller))
         target = out if out is not None else _default_out(scn.name)
         result = run_scenario(scn, out_dir=target, progress=False if quiet else None, gif=gif, force=force)
         if html:
@@ -333,6 +341,53 @@ def run(
     con.print(metrics_table(rows, title))
     con.print(f"all {len(result.metrics)} metrics: {result.run_dir / 'metrics.json'}", markup=False)
     con.print(f"run folder: {result.run_dir}", markup=False)
+
+
+def controller_overrides(scn: Any, specs: List[str]) -> dict[str, Any]:
+    """``--controller`` values as scenario overrides: ``MODULE:CLASS`` for every group, or
+    ``GROUP=MODULE:CLASS`` (a group name or index) for one.
+
+    A group keeps its ``params`` when the new controller's ``Params`` takes them; otherwise they
+    are left out, with a note on stderr (``--set robots.N.params.KEY=VALUE`` gives new ones).
+    """
+    from teamnav.control import registry
+    from teamnav.experiments.errors import ScenarioError
+
+    names = [g.name for g in scn.robots]
+    chosen: dict[int, str] = {}
+    for spec in specs:
+        head, sep, tail = spec.partition("=")
+        if sep and head and ":" not in head and "/" not in head:
+            group, entry = head.strip(), tail.strip()
+            idx = [i for i, n in enumerate(names) if n == group]
+            if not idx and group.isdigit() and int(group) < len(names):
+                idx = [int(group)]
+            if not idx:
+                raise ScenarioError.one(scn.source, "--controller", f"expected GROUP=MODULE:CLASS with a group of the scenario "
+                                        f"({', '.join(dict.fromkeys(names))}) or its index", group)
+        else:
+            idx, entry = list(range(len(names))), spec.strip()
+        try:
+            registry.lookup(entry)
+        except KeyError as exc:
+            raise ScenarioError.one(scn.source, "--controller", str(exc.args[0])) from None
+        module, _, attr = entry.rpartition(":")
+        if module.endswith(".py") or "/" in module or os.sep in module:  # a file: absolute, so scenario.yaml reruns anywhere
+            entry = f"{Path(os.path.expanduser(module)).resolve()}:{attr}"
+        for i in idx:
+            chosen[i] = entry
+    overrides: dict[str, Any] = {}
+    for i, entry in sorted(chosen.items()):
+        overrides[f"robots.{i}.controller"] = entry
+        params = dict(scn.robots[i].params)
+        if params:
+            try:
+                registry.lookup(entry).Params.model_validate(params)
+            except Exception:  # noqa: BLE001 - any refusal: the parameters were the old controller's
+                overrides[f"robots.{i}.params"] = {}
+                _err().print(f"note: robots[{i}] ({names[i]!r}): params left out, {entry} does not take them "
+                             f"({', '.join(params)})", markup=False)
+    return overrides
 
 
 # ---------------------------------------------------------------------------- validate
