@@ -20,6 +20,24 @@ def ok_trial(scenario, out_dir):
     return {"count": np.int64(scenario.robots[0].count), "seed": scenario.seed, "out": str(out_dir)}
 
 
+def dies_once_trial(scenario, out_dir):
+    """Kills its own worker process the first time it runs for a seed (a marker file remembers)."""
+    import os
+    from pathlib import Path
+
+    marker = Path(os.environ["TEAMNAV_TEST_MARKERS"]) / f"seed{scenario.seed}"
+    if not marker.exists():
+        marker.write_text("started once")
+        os._exit(1)  # the worker process dies, as on a lost node
+    return {"seed": scenario.seed}
+
+
+def always_dies_trial(scenario, out_dir):
+    import os
+
+    os._exit(1)
+
+
 def slow_trial(scenario, out_dir):
     time.sleep(0.3)
     return {"seed": scenario.seed}
@@ -119,3 +137,56 @@ def test_ray_executor_starts_and_stops_its_own_local_ray(trials):
     RayExecutor(workers=2).run([TrialTask(t) for t in trials[:2]], seen.append)
     assert [r.status for r in seen] == ["ok", "ok"], [r.error for r in seen]
     assert not ray.is_initialized()
+
+
+def test_ray_trial_whose_worker_dies_is_run_again_and_the_result_says_so(trials, tmp_path, monkeypatch):
+    """A lost worker is the system's failure, not the trial's: the trial runs again (up to
+    RAY_MAX_RETRIES times) and its result carries the retries and what each lost start ended with."""
+    ray = pytest.importorskip("ray")
+    from teamnav.experiments.executors import RAY_MAX_RETRIES
+
+    import sys
+
+    import ray.cloudpickle
+
+    ray.cloudpickle.register_pickle_by_value(sys.modules[__name__])  # workers cannot import the tests folder
+    monkeypatch.setenv("TEAMNAV_TEST_MARKERS", str(tmp_path))
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False,
+             runtime_env={"env_vars": {"TEAMNAV_TEST_MARKERS": str(tmp_path)}})
+    try:
+        seen = []
+        RayExecutor(workers=2).run([TrialTask(t, dies_once_trial) for t in trials[:2]], seen.append)
+        assert sorted(r.trial_id for r in seen) == sorted(t.trial_id for t in trials[:2])  # each exactly once
+        assert all(r.status == "ok" and r.retries == 1 for r in seen), seen
+        assert all(len(r.retry_errors) == 1 and r.retry_errors[0] for r in seen)
+        gave_up = []
+        RayExecutor(workers=1).run([TrialTask(trials[0], always_dies_trial)], gave_up.append)
+        assert len(gave_up) == 1 and gave_up[0].status == "failed"
+        assert gave_up[0].retries == RAY_MAX_RETRIES and len(gave_up[0].retry_errors) == RAY_MAX_RETRIES + 1
+    finally:
+        ray.shutdown()
+
+
+def test_store_records_retries_and_opens_a_store_written_before_the_column(tmp_path):
+    """The store's retries / retry_errors columns: written from a result, and added to an older
+    store (without them) when it is opened."""
+    import sqlite3
+
+    from teamnav.experiments.executors import TrialResult
+    from teamnav.experiments.store import ResultsStore
+
+    spec_trials = expand(SweepSpec(scenario="demo", seeds=1, duration_s=0.5))
+    path = tmp_path / "old.sqlite"
+    with ResultsStore(path):
+        pass
+    con = sqlite3.connect(path)
+    con.execute("ALTER TABLE trials DROP COLUMN retry_errors")
+    con.execute("ALTER TABLE trials DROP COLUMN retries")
+    con.commit()
+    con.close()
+    with ResultsStore(path) as store:
+        res = TrialResult(spec_trials[0].trial_id, "ok", {"x": 1.0}, None, None, 0.1, "a", "b", "h", 1,
+                          retries=2, retry_errors=("NodeDiedError: gone", "WorkerCrashedError: gone"))
+        store.record(spec_trials[0], res)
+        row = store.rows()[0]
+    assert row["retries"] == 2 and "NodeDiedError" in row["retry_errors"]

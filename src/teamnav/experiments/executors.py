@@ -25,6 +25,8 @@ failure of the trials it was running. A failing trial never stops the sweep.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
+import re
 
 import datetime as _dt
 import importlib.util
@@ -96,6 +98,11 @@ class TrialResult:
         Host name of the worker.
     pid : int
         Process id of the worker.
+    retries : int
+        Times the trial was started again because the worker or node running it was lost
+        (a Ray node that died, a worker process killed); 0 when the first start finished.
+    retry_errors : tuple of str
+        What each lost start ended with, in order.
     """
 
     trial_id: str
@@ -108,6 +115,8 @@ class TrialResult:
     finished_at: str
     host: str
     pid: int
+    retries: int = 0
+    retry_errors: tuple[str, ...] = ()
 
 
 def _now() -> str:
@@ -328,8 +337,32 @@ def _import_ray():
     return ray
 
 
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")
+
+
+def _system_error_text(exc: BaseException) -> str:
+    """``"Type: first line"`` of what Ray raised for a lost trial (its cause where it wraps one),
+    without the terminal colour codes Ray puts in its messages."""
+    cause = getattr(exc, "cause", None)
+    shown = cause if isinstance(cause, BaseException) else exc
+    lines = [ln.strip() for ln in _ANSI.sub("", str(shown)).splitlines() if ln.strip()]
+    return f"{type(shown).__name__}: {lines[0] if lines else ''}"[:500]
+
+
+#: Times a Ray trial whose worker or node was lost is started again before it counts as failed.
+RAY_MAX_RETRIES = 3
+
+
 class RayExecutor:
     """Trials as Ray tasks (one CPU each).
+
+    A trial's own exceptions come back as failed results (:func:`execute` catches them in the
+    worker), so an exception out of ``ray.get`` means the system lost the trial: its worker
+    process died or its node left the cluster. Such a trial is started again, up to
+    :data:`RAY_MAX_RETRIES` times, on whatever node is left; the result carries ``retries``
+    and ``retry_errors`` and the store records them, so every trial is stored exactly once and
+    the store says which ones were retried. (Ray's own task retries are off: they would
+    hide which trials were lost.)
 
     Parameters
     ----------
@@ -370,15 +403,28 @@ class RayExecutor:
                         return
                     in_flight[remote.remote(task)] = (task, _now())
 
+            lost: dict[str, list[str]] = {}  # trial id -> errors of its lost starts
+
             fill()
             while in_flight:
                 ready, _ = ray.wait(list(in_flight), num_returns=1)
                 for ref in ready:
                     task, started = in_flight.pop(ref)
+                    tid = task.trial.trial_id
                     try:
                         res = ray.get(ref)
-                    except Exception as exc:  # noqa: BLE001 - worker crash, task cancelled, unpicklable
-                        res = _lost(task, f"{type(exc).__name__}: {exc}", started)
+                    except Exception as exc:  # noqa: BLE001 - worker or node lost, task cancelled, unpicklable
+                        errors = lost.setdefault(tid, [])
+                        errors.append(_system_error_text(exc))
+                        if len(errors) <= RAY_MAX_RETRIES:
+                            in_flight[remote.remote(task)] = (task, started)  # again, on a node that is left
+                            continue
+                        # given up: the last start was lost too (retries counts the restarts)
+                        res = dataclasses.replace(_lost(task, errors[-1], started), retries=len(errors) - 1,
+                                                  retry_errors=tuple(lost.pop(tid)))
+                    if tid in lost:  # finished after its earlier starts were lost
+                        errors = lost.pop(tid)
+                        res = dataclasses.replace(res, retries=len(errors), retry_errors=tuple(errors))
                     on_result(res)
                 fill()
         except BaseException:

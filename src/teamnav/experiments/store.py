@@ -24,6 +24,8 @@ Table ``trials`` (a tidy table: one row per trial, one column per variable)::
     finished_at      TEXT
     host             TEXT               worker host name
     attempts         INTEGER            how many times the trial ran (failed ones are retried)
+    retries          INTEGER            starts lost with their worker or node and run again (Ray)
+    retry_errors     TEXT (JSON list)   what each lost start ended with, or NULL
     <param key>      ...                one column per override key, e.g. "robots.0.count"
     <metric name>    ...                one column per scalar metric, e.g. path_length_m_mean
 
@@ -77,7 +79,11 @@ BASE_COLUMNS: dict[str, str] = {
     "finished_at": "TEXT",
     "host": "TEXT",
     "attempts": "INTEGER NOT NULL DEFAULT 1",
+    "retries": "INTEGER NOT NULL DEFAULT 0",
+    "retry_errors": "TEXT",
 }
+#: columns added after stores were first written: an older store gets them when opened
+_ADDED_COLUMNS = ("retries", "retry_errors")
 
 _SCHEMA = f"""
 CREATE TABLE IF NOT EXISTS trials ({", ".join(f"{k} {v}" for k, v in BASE_COLUMNS.items())});
@@ -100,7 +106,7 @@ CREATE TABLE IF NOT EXISTS sweeps (
 
 #: columns each table of a teamnav store must have (more are fine: param/metric columns)
 _REQUIRED = {
-    "trials": tuple(BASE_COLUMNS),
+    "trials": tuple(k for k in BASE_COLUMNS if k not in _ADDED_COLUMNS),
     "columns": ("name", "kind", "key"),
     "sweeps": ("name", "spec", "teamnav_version", "first_started_at", "last_started_at"),
 }
@@ -248,6 +254,10 @@ class ResultsStore:
             for stmt in _SCHEMA.split(";"):
                 if stmt.strip():
                     self._con.execute(stmt)
+            have = {row[1] for row in self._con.execute("PRAGMA table_info(trials)")}
+            for col in _ADDED_COLUMNS:
+                if col not in have:  # a store written before the column existed
+                    self._con.execute(f"ALTER TABLE trials ADD COLUMN {col} {BASE_COLUMNS[col]}")
             self._con.execute("COMMIT")
         except BaseException:
             self._con.execute("ROLLBACK")
@@ -336,6 +346,8 @@ class ResultsStore:
                 "started_at": result.started_at,
                 "finished_at": result.finished_at,
                 "host": result.host,
+                "retries": int(getattr(result, "retries", 0)),
+                "retry_errors": _json(list(result.retry_errors)) if getattr(result, "retry_errors", ()) else None,
             }
             for key, value in trial.params.items():
                 row[self._column("param", key, value, taken, names)] = _cell(value)
