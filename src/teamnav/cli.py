@@ -323,9 +323,12 @@ def run(
     from teamnav.experiments.spec import load_scenario
 
     with _bad_input_exits():
-        scn = load_scenario(scenario, overrides=set_ or None, seed=seed, duration_s=duration)
-        if controller:
-            scn = load_scenario(scn, overrides=controller_overrides(scn, controller))
+        if controller:  # the controllers first, so --set can give the new ones their parameters
+            base = load_scenario(scenario, seed=seed, duration_s=duration)
+            swap = [f"{k}={json.dumps(v)}" for k, v in controller_overrides(base, controller).items()]
+            scn = load_scenario(scenario, overrides=swap + list(set_ or []), seed=seed, duration_s=duration)
+        else:
+            scn = load_scenario(scenario, overrides=set_ or None, seed=seed, duration_s=duration)
         target = out if out is not None else _default_out(scn.name)
         result = run_scenario(scn, out_dir=target, progress=False if quiet else None, gif=gif, force=force)
         if html:
@@ -348,7 +351,8 @@ def controller_overrides(scn: Any, specs: List[str]) -> dict[str, Any]:
     ``GROUP=MODULE:CLASS`` (a group name or index) for one.
 
     A group keeps its ``params`` when the new controller's ``Params`` takes them; otherwise they
-    are left out, with a note on stderr (``--set robots.N.params.KEY=VALUE`` gives new ones).
+    are left out, with a note on stderr (``--set robots.N.params.KEY=VALUE``, applied after the
+    swap, gives the new controller its own).
     """
     from teamnav.control import registry
     from teamnav.experiments.errors import ScenarioError

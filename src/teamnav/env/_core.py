@@ -1,0 +1,687 @@
+"""One copy of a scenario driven from outside: the shared setup and the episode loop.
+
+:class:`EnvSetup` is computed once per environment (which robots are agents, their names, the
+scenario with proxy brains, the observation and action spaces, the reward terms);
+:class:`EnvCore` runs episodes of it with struct-of-arrays observations and actions. The
+PettingZoo, Gymnasium and batched environments are thin views of these two.
+
+Timing (the same as a built-in brain's): the observation of step k is built after the motion
+of step k; the agent's action for it is executed by the motion of step k + 1; its radio
+messages are heard from where the robot is at step k and delivered at step k + 1. Reset
+returns the observation of step 0, before any motion.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+from teamnav.control import registry
+from teamnav.control.types import Message
+from teamnav.env import _engine
+from teamnav.env._proxy import AGENT_ENTRY_POINT, ENTRY_POINT, EnvProxy, RobotPort
+from teamnav.env.config import EnvSpec, unknown_group_problem
+from teamnav.env.rewards import RewardContext, StepView, build_terms, default_terms
+from teamnav.experiments.errors import Problem, ScenarioError
+from teamnav.experiments.spec import Scenario, build_grid
+
+__all__ = ["Block", "EnvCore", "EnvSetup"]
+
+_NAN = float("nan")
+
+
+@dataclass
+class Block:
+    """Agents of one group: they share one observation space and one action space.
+
+    ``rows`` is their slice in the agents' order (agents are in robot-id order and a group's
+    robots have consecutive ids).
+    """
+
+    group: int
+    rows: slice
+    robot_ids: np.ndarray
+    obs_space: spaces.Dict
+    act_space: spaces.Box
+    scan_names: tuple[str, ...]
+    has_detector: bool
+    holonomic: bool
+    no_return: tuple[np.ndarray, ...] = ()  # per scan: every beam at max range
+
+
+def _agent_names(scenario: Scenario, ids: list[int]) -> list[str]:
+    """``GROUP`` for a group of one robot, ``GROUP_K`` (K: index in the group) otherwise; made
+    unique with ``_ID`` when group names repeat."""
+    group_of, index_in = [], []
+    for gi, g in enumerate(scenario.robots):
+        group_of += [gi] * g.count
+        index_in += list(range(g.count))
+    names = []
+    for i in ids:
+        g = scenario.robots[group_of[i]]
+        names.append(g.name if g.count == 1 else f"{g.name}_{index_in[i]}")
+    if len(set(names)) < len(names):
+        names = [f"{n}_{i}" if names.count(n) > 1 else n for n, i in zip(names, ids)]
+    return names
+
+
+class EnvSetup:
+    """Everything an environment fixes once: agents, spaces, the proxied scenario, rewards.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Resolved and validated.
+    spec : EnvSpec
+    file : str
+        For messages.
+    robots : list of int, optional
+        Explicit agent robot ids (overrides ``spec.agents_from``).
+    dtype : numpy dtype
+        Of the float observations and actions.
+    """
+
+    def __init__(self, scenario: Scenario, spec: EnvSpec, file: str, *, robots: list[int] | None = None,
+                 dtype: Any = np.float64) -> None:
+        self.scenario = scenario
+        self.spec = spec
+        self.file = file
+        self.dtype = np.dtype(dtype)
+        if self.dtype.kind != "f":
+            raise ValueError(f"dtype must be a float type (np.float32 or np.float64), got {self.dtype}")
+        groups = scenario.robots
+        offsets = np.concatenate([[0], np.cumsum([g.count for g in groups])]).astype(int)
+        self.offsets = offsets
+        self.n_robots = int(offsets[-1])
+        if robots is not None:
+            ids = sorted({int(r) for r in robots})
+            bad = [r for r in ids if not 0 <= r < self.n_robots]
+            if bad:
+                raise ValueError(f"robot ids must be in [0, {self.n_robots}), got {bad}")
+        else:
+            unknown_group_problem(spec, scenario, file)
+            chosen = set(range(len(groups)))
+            if spec.agents_from is not None:
+                chosen = {ref if isinstance(ref, int) else gi for ref in spec.agents_from
+                          for gi, g in enumerate(groups) if isinstance(ref, int) or g.name == ref}
+            ids = [i for gi in sorted(chosen) for i in range(offsets[gi], offsets[gi + 1])]
+        if not ids:
+            raise ScenarioError(file, [Problem("env.agents_from", "expected groups with at least one robot (every chosen group has count 0)")])
+        self.agent_ids = np.asarray(ids, dtype=np.int64)
+        self.agent_names = _agent_names(scenario, ids)
+        self.n_agents = len(ids)
+        lo, hi = int(self.agent_ids[0]), int(self.agent_ids[-1])
+        self.contiguous = hi - lo + 1 == self.n_agents
+        self.id_index: Any = slice(lo, hi + 1) if self.contiguous else self.agent_ids
+        group_of = np.repeat(np.arange(len(groups)), [g.count for g in groups])
+        self.group_of = group_of
+        self.proxied = sorted({int(group_of[i]) for i in ids})
+
+        # the scenario's own brains of the proxied groups (to wrap teammates, and for ports)
+        self.orig: dict[int, tuple[Any, Any]] = {}
+        id_set = set(ids)
+        entry: dict[int, str] = {}
+        for gi in self.proxied:
+            g = groups[gi]
+            cls = registry.lookup(g.controller)
+            params = cls.Params.model_validate(dict(g.params))
+            partial = any(i not in id_set for i in range(offsets[gi], offsets[gi + 1]))
+            if partial and getattr(cls, "batched", False):
+                raise ValueError(
+                    f"robots[{gi}] ({g.name!r}) runs the batched controller {g.controller!r}, which cannot keep some of "
+                    "the group's robots while others are agents; make the whole group agents or split the group"
+                )
+            self.orig[gi] = (cls, params)
+            entry[gi] = ENTRY_POINT if partial else AGENT_ENTRY_POINT
+        self.template = scenario.model_copy(update={"robots": tuple(
+            g.model_copy(update={"controller": entry[gi], "params": {}}) if gi in self.proxied else g
+            for gi, g in enumerate(groups)
+        )})
+
+        # events the observations encode: every event a place of the scenario fires
+        self.event_names = tuple(sorted({p.event for p in scenario.places if p.event is not None}))
+        self.event_index = {e: k for k, e in enumerate(self.event_names)}
+        self.terminate_on = frozenset(spec.terminate_on)
+        self.grid = build_grid(scenario)
+        self.n_steps = scenario.n_steps
+        self.blocks = self._blocks()
+        self.block_of_row = np.concatenate([[b_i] * (b.rows.stop - b.rows.start) for b_i, b in enumerate(self.blocks)])
+        self.obs_spaces = {}
+        self.act_spaces = {}
+        for b in self.blocks:
+            for j in range(b.rows.start, b.rows.stop):
+                self.obs_spaces[self.agent_names[j]] = b.obs_space
+                self.act_spaces[self.agent_names[j]] = b.act_space
+        # actions: which agents move by holonomic steps, and the shortest (vx, vy) that moves them
+        self.holonomic = np.zeros(self.n_agents, dtype=bool)
+        self.half_step_speed = np.zeros(self.n_agents)
+        for b in self.blocks:
+            g = groups[b.group]
+            self.holonomic[b.rows] = b.holonomic
+            self.half_step_speed[b.rows] = 0.5 * g.step_length_m / scenario.dt_s
+        self.any_holonomic = bool(self.holonomic.any())
+        self.all_holonomic = bool(self.holonomic.all())
+
+        terms = spec.reward_terms() or default_terms(scenario)
+        self.reward_spec = terms
+        build_terms(terms, RewardContext(scenario, self.agent_ids, file))  # check names and parameters now
+
+    # ---------------------------------------------------------------- spaces
+    def _blocks(self) -> list[Block]:
+        scn = self.scenario
+        out: list[Block] = []
+        ids = self.agent_ids.tolist()
+        j = 0
+        xmin, xmax, ymin, ymax = self.grid.bounds_m
+        r_map = max(abs(xmin), abs(xmax), abs(ymin), abs(ymax))
+        while j < len(ids):
+            gi = int(self.group_of[ids[j]])
+            k = j
+            while k < len(ids) and int(self.group_of[ids[k]]) == gi:
+                k += 1
+            g = scn.robots[gi]
+            holo = g.kinematics == "holonomic_step"
+            speed = g.step_length_m / scn.dt_s if holo else g.max_v_mps
+            space = self._obs_space(g, speed, r_map, (xmin, xmax, ymin, ymax))
+            names = tuple(s.name for s in g.sensors)
+            none = tuple(np.full(space[f"scan_{nm}"].shape, float(c.max_range_m)) for nm, c in zip(names, g.sensors))
+            out.append(Block(gi, slice(j, k), np.asarray(ids[j:k], dtype=np.int64), space, self._act_space(g, holo), names,
+                             g.detector is not None, holo, none))
+            j = k
+        return out
+
+    def _obs_space(self, g, speed: float, r_map: float, bounds) -> spaces.Dict:
+        scn, f = self.scenario, self.dtype
+        od = g.odometry
+        noise = 1.0 + 10.0 * (sum(od.alpha) + od.slip_std_m_per_sqrt_m) + abs(od.scale_error)
+        travel = speed * scn.duration_s
+        b = r_map + 2.0 * noise * travel + 10.0
+        db = 5.0 * noise * speed * scn.dt_s + 1.0
+        pi = math.pi
+        d: dict[str, spaces.Space] = {
+            "odom_pose": spaces.Box(np.array([-b, -b, -pi]), np.array([b, b, pi]), dtype=f),
+            "odom_delta": spaces.Box(np.array([-db, -db, -pi]), np.array([db, db, pi]), dtype=f),
+            "time_s": spaces.Box(0.0, float(scn.duration_s) + scn.dt_s, shape=(1,), dtype=f),
+            "stalled": spaces.Box(0.0, 1.0, shape=(1,), dtype=f),
+        }
+        for cfg in g.sensors:
+            n_beams = {"laser": lambda c: c.n_beams, "sonar": lambda c: c.n_transducers,
+                       "proximity": lambda c: len(c.angles_deg)}[cfg.kind](cfg)
+            d[f"scan_{cfg.name}"] = spaces.Box(0.0, float(cfg.max_range_m), shape=(n_beams,), dtype=f)
+        if g.detector is not None and self.spec.max_detections > 0:
+            det = g.detector
+            rmax = 2.0 * det.max_range_m + 10.0 * det.range_noise_std_m + 1.0
+            n = self.spec.max_detections
+            d["detections"] = spaces.Box(np.tile([0.0, -pi, -1.0], (n, 1)), np.tile([rmax, pi, self.n_robots - 1], (n, 1)),
+                                         dtype=f)
+            d["detections_count"] = spaces.Box(0, n, shape=(1,), dtype=np.int64)
+        if self.spec.max_inbox > 0:
+            n = self.spec.max_inbox
+            d["inbox"] = spaces.Box(np.tile([-1.0, 0.0, 0.0], (n, 1)),
+                                    np.tile([self.n_robots - 1, float(scn.duration_s) + scn.dt_s, 1e12], (n, 1)), dtype=f)
+            d["inbox_count"] = spaces.Box(0, n, shape=(1,), dtype=np.int64)
+        if self.event_names:
+            d["events"] = spaces.Box(0.0, 1.0, shape=(len(self.event_names),), dtype=f)
+        if self.spec.observe_truth:
+            xmin, xmax, ymin, ymax = bounds
+            d["privileged_true_pose"] = spaces.Box(np.array([xmin, ymin, -pi]), np.array([xmax, ymax, pi]), dtype=f)
+        return spaces.Dict(d)
+
+    def _act_space(self, g, holo: bool) -> spaces.Box:
+        if holo:
+            s = g.step_length_m / self.scenario.dt_s
+            return spaces.Box(np.array([-s, -s]), np.array([s, s]), dtype=self.dtype)
+        w = math.radians(g.max_omega_degps)
+        return spaces.Box(np.array([-g.max_v_mps, -w]), np.array([g.max_v_mps, w]), dtype=self.dtype)
+
+    # ---------------------------------------------------------------- scenario brains
+    def build_brain(self, robot_id: int, rng: np.random.Generator, info) -> Any:
+        """The scenario's controller for ``robot_id``, built as the engine builds it."""
+        gi = int(self.group_of[robot_id])
+        cls, params = self.orig[gi]
+        if getattr(cls, "batched", False):
+            raise ValueError(f"robots[{gi}] runs the batched controller {self.scenario.robots[gi].controller!r}: it has no "
+                             "per-robot instance to build")
+        return cls(params, rng, info)
+
+
+@dataclass
+class StepResult:
+    """One step of every agent, rows in the agents' order."""
+
+    obs: list[dict[str, np.ndarray]]  # per block
+    reward: np.ndarray
+    terms: dict[str, np.ndarray]
+    terminated: np.ndarray
+    truncated: bool
+    events: list[tuple[str, ...]] = field(default_factory=list)
+
+
+class EnvCore:
+    """Episodes of one copy of the scenario (see the module docstring)."""
+
+    def __init__(self, setup: EnvSetup) -> None:
+        self.setup = setup
+        self.sim: Any = None
+        self.proxies: list[EnvProxy] = []
+        self._proxy_of: dict[int, EnvProxy] = {}
+        self.ports = [RobotPort(n, i, self) for n, i in zip(setup.agent_names, setup.agent_ids.tolist())]
+        self.live = np.zeros(setup.n_agents, dtype=bool)
+        self.seed: int | None = None
+        self.episode_return = np.zeros(setup.n_agents)
+        self.wall_s = 0.0
+        self.episode_over = True
+
+    # ---------------------------------------------------------------- access
+    def proxy(self, robot_id: int) -> EnvProxy:
+        if self.sim is None:
+            raise RuntimeError("call reset() first")
+        return self._proxy_of[int(robot_id)]
+
+    def build_scenario_brain(self, robot_id: int, rng: np.random.Generator) -> Any:
+        return self.setup.build_brain(robot_id, rng, self.proxy(robot_id).info)
+
+    def episode_scenario(self) -> Scenario:
+        """The original scenario with this episode's seed (what `teamnav run` would run)."""
+        return self.setup.scenario.model_copy(update={"seed": int(self.seed)})
+
+    # ---------------------------------------------------------------- episode
+    def reset(self, seed: int) -> list[dict[str, np.ndarray]]:
+        from teamnav.sim.engine import Simulation
+
+        st = self.setup
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= 2**63 - 1:
+            raise ValueError(f"seed must be an int in [0, 2**63 - 1], got {seed!r}")
+        self.seed = int(seed)
+        scn = st.template.model_copy(update={"seed": self.seed})
+        try:
+            sim = Simulation(st.grid, scn, known_map=st.grid if scn.give_map else None)
+        except ValueError as exc:
+            raise ScenarioError(st.file, [Problem("", f"the simulator cannot set up this scenario: {exc}")]) from None
+        _engine.check_engine(sim)
+        self.sim = sim
+        self._proxy_of = {}
+        off = st.offsets
+        for gi in st.proxied:
+            for k, p in enumerate(sim.brains[gi]):
+                self._proxy_of[int(off[gi]) + k] = p
+        agent_set = set(st.agent_ids.tolist())
+        for i, p in self._proxy_of.items():
+            if i not in agent_set:
+                p.brain = st.build_brain(i, p.rng, p.info)  # a teammate: the scenario's brain, its own stream
+        self.proxies = [self._proxy_of[i] for i in st.agent_ids.tolist()]
+        for port in self.ports:
+            port._clear()
+        self.terms = build_terms(st.reward_spec, RewardContext(st.scenario, st.agent_ids, st.file))
+        self.live[:] = True
+        self._all_live = True
+        self.episode_return[:] = 0.0
+        self.wall_s = 0.0
+        self.episode_over = False
+        self._logged_step = -1
+        _engine.decide_first(sim)
+        died = _engine.dead(sim, st.id_index)
+        if died is not None and died.any():  # dead from the first step: never live
+            self.live &= ~died
+            self._all_live = False
+        view = StepView(sim, st.agent_ids, self._events(), self.ports)
+        for _, term in self.terms:
+            term.reset(view)
+        return self.encode()
+
+    def step(self, actions: np.ndarray) -> StepResult:
+        """Apply ``actions`` (n_agents, 2) (rows of agents no longer live are ignored), step once."""
+        st = self.setup
+        sim = self.sim
+        if sim is None or self.episode_over:
+            raise RuntimeError("the episode is over (or never started): call reset()")
+        a = np.asarray(actions, dtype=np.float64)
+        if a.shape != (st.n_agents, 2):
+            raise ValueError(f"actions must have shape ({st.n_agents}, 2), got {a.shape}")
+        live = self.live
+        all_live = self._all_live
+        if not all_live:
+            a = np.where(live[:, None], a, 0.0)
+        # finite actions only (NaN would reach the motion kernels): a Python pass is cheaper for a few agents
+        if not (all(map(math.isfinite, a.ravel().tolist())) if st.n_agents <= 32 else bool(np.isfinite(a).all())):
+            bad = int(np.flatnonzero(~np.isfinite(a).all(axis=1))[0])
+            raise ValueError(f"agent {st.agent_names[bad]!r}: action must be finite, got {a[bad].tolist()}")
+        if st.any_holonomic:
+            holo = st.holonomic
+            move = holo & (np.hypot(a[:, 0], a[:, 1]) >= st.half_step_speed)
+            if not all_live:
+                move &= live
+            _engine.set_commands(sim, st.id_index, np.where(holo, 0.0, a[:, 0]), np.where(holo, 0.0, a[:, 1]),
+                                 np.where(move, np.arctan2(a[:, 1], a[:, 0]), _NAN))
+        else:  # unicycles: the proxies' placeholder left direction_rad NaN, which unicycles ignore anyway
+            _engine.set_commands(sim, st.id_index, a[:, 0], a[:, 1], None)
+        step = sim.step_index
+        self._flush_ports(step)
+        stop_when_finished = st.scenario.stop_when_finished
+        if stop_when_finished and step > 0 and _all_finished(sim):
+            return self._finish_without_motion()
+        t0 = time.perf_counter()
+        sim.step()
+        self.wall_s += time.perf_counter() - t0
+        obs = self.encode()
+        events = self._events()
+        view = StepView(sim, st.agent_ids, events, self.ports)
+        terms = {name: term(view) for name, term in self.terms}
+        if len(terms) == 1:
+            reward = next(iter(terms.values()))
+        else:
+            reward = np.sum(list(terms.values()), axis=0) if terms else np.zeros(st.n_agents)
+        if not all_live:
+            reward = np.where(live, reward, 0.0)
+        self.episode_return += reward
+        terminated = np.zeros(st.n_agents, dtype=bool)
+        done = False
+        if st.terminate_on:
+            for j, ev in enumerate(events):
+                if ev and not st.terminate_on.isdisjoint(ev):
+                    terminated[j] = True
+                    done = True
+        if stop_when_finished and _all_finished(sim):
+            terminated[:] = True
+            done = True
+        died = _engine.dead(sim, st.id_index)
+        if died is not None and died.any():  # a faults death: the engine steps that brain no more
+            terminated |= died
+            done = True
+        truncated = sim.step_index >= st.n_steps
+        if done:
+            terminated &= live
+            live &= ~terminated
+            self._all_live = False
+            if not live.any():
+                self.episode_over = True
+        if truncated:
+            self.episode_over = True
+        if self.episode_over:
+            live[:] = False
+            self._all_live = False
+        return StepResult(obs, reward, terms, terminated, truncated, events)
+
+    def _events(self) -> list[tuple[str, ...]]:
+        return [() if p.obs is None else p.obs.events for p in self.proxies]
+
+    def _blank(self, b: Block, proxy) -> Any:
+        """An observation of nothing (zeros, no returns) for a robot that never got one."""
+        from teamnav.control.types import Observation, RangeScan
+
+        scans = {name: RangeScan(none.copy(), none.copy(), float(none[0]) if none.size else 0.0)
+                 for name, none in zip(b.scan_names, b.no_return)}
+        return Observation(robot_id=proxy.info.robot_id, step=self.sim.step_index, time_s=self.sim.time_s,
+                           odom_pose=np.zeros(3), odom_delta=np.zeros(3), scans=scans)
+
+    def _finish_without_motion(self) -> StepResult:
+        """Every robot with a task said it is done (``stop_when_finished``), the agents after
+        deciding on this observation: the episode ends here, as ``teamnav run`` stops once
+        the brains say so, with no further motion (the observation is this step's again)."""
+        st = self.setup
+        terminated = self.live.copy()
+        self.live[:] = False
+        self._all_live = False
+        self.episode_over = True
+        zeros = np.zeros(st.n_agents)
+        return StepResult(self.encode(), zeros, {name: zeros.copy() for name, _ in self.terms}, terminated, False,
+                          [() for _ in range(st.n_agents)])
+
+    def finalize_logs(self) -> None:
+        """Before a run folder is written: the agents' log values at the last step (the ones
+        given after it, else their latest), as a built-in brain's last log is recorded."""
+        sim = self.sim
+        step = sim.step_index
+        if self._logged_step == step:
+            return
+        sim.record_last_step()
+        for port in self.ports:
+            log = port._log if port._log is not None else port._last_log
+            port._log = None
+            if log:
+                _record_log(sim.recorder, step, sim.time_s, port.robot_id, log)
+        self._logged_step = step
+
+    def _flush_ports(self, step: int) -> None:
+        """The agents' messages go on the radio (heard from where they are now) and their log
+        values into the recorder at the step they belong to."""
+        sim = self.sim
+        outgoing: list[tuple[int, Message]] = []
+        rec = sim.recorder
+        wants = rec.wants(step)
+        t = sim.time_s
+        for port, alive in zip(self.ports, self.live.tolist()):
+            if not port._outbox and port._log is None:
+                continue
+            out, log = port._take()
+            if not alive:
+                continue
+            for m in out:
+                outgoing.append((port.robot_id, m))
+            if log is not None:
+                port._last_log = log
+                if log and wants:
+                    _record_log(rec, step, t, port.robot_id, log)
+        if wants:
+            self._logged_step = step
+        if outgoing:
+            _engine.send_messages(sim, outgoing)
+
+    # ---------------------------------------------------------------- observations
+    def encode(self) -> list[dict[str, np.ndarray]]:
+        """This step's observations as arrays, one dict per block (rows: its agents)."""
+        st = self.setup
+        f = st.dtype
+        out = []
+        sim = self.sim
+        for b in st.blocks:
+            obs = [p.obs for p in self.proxies[b.rows]]
+            if None in obs:  # a robot dead from the start was never observed
+                obs = [o if o is not None else self._blank(b, p) for o, p in zip(obs, self.proxies[b.rows])]
+            n = len(obs)
+            d: dict[str, np.ndarray] = {
+                "odom_pose": np.array([o.odom_pose for o in obs], dtype=f),
+                "odom_delta": np.array([o.odom_delta for o in obs], dtype=f),
+                "time_s": np.full((n, 1), obs[0].time_s, dtype=f),
+                "stalled": np.array([[o.stalled] for o in obs], dtype=f),
+            }
+            for name, none in zip(b.scan_names, b.no_return):
+                try:
+                    d[f"scan_{name}"] = np.array([o.scans[name].ranges_m for o in obs], dtype=f)
+                except KeyError:  # a sensor fault left the scan out: read as no return on every beam
+                    d[f"scan_{name}"] = np.array([o.scans[name].ranges_m if name in o.scans else none for o in obs], dtype=f)
+            if b.has_detector and st.spec.max_detections > 0:
+                m = st.spec.max_detections
+                det = np.zeros((n, m, 3), dtype=f)
+                cnt = np.zeros((n, 1), dtype=np.int64)
+                space = b.obs_space["detections"]
+                rmax = float(space.high[0, 0])
+                for j, o in enumerate(obs):
+                    if o.detections:
+                        rows = o.detections[:m]
+                        det[j, : len(rows)] = [(min(max(x.range_m, 0.0), rmax), x.bearing_rad,
+                                                -1 if x.robot_id is None else x.robot_id) for x in rows]
+                        cnt[j, 0] = len(rows)
+                d["detections"] = det
+                d["detections_count"] = cnt
+            if st.spec.max_inbox > 0:
+                m = st.spec.max_inbox
+                box = np.zeros((n, m, 3), dtype=f)
+                cnt = np.zeros((n, 1), dtype=np.int64)
+                top = st.n_robots
+                t_hi = float(st.scenario.duration_s) + st.scenario.dt_s
+                for j, o in enumerate(obs):
+                    if o.inbox:
+                        rows = o.inbox[:m]
+                        box[j, : len(rows)] = [(msg.sender if isinstance(msg.sender, (int, np.integer)) and 0 <= msg.sender < top
+                                                else -1, min(max(float(msg.stamp_s), 0.0), t_hi)
+                                                if math.isfinite(msg.stamp_s) else 0.0, min(msg.size_bytes(), 1e12))
+                                               for msg in rows]
+                        cnt[j, 0] = len(rows)
+                d["inbox"] = box
+                d["inbox_count"] = cnt
+            if st.event_names:
+                ev = np.zeros((n, len(st.event_names)), dtype=f)
+                index = st.event_index
+                for j, o in enumerate(obs):
+                    for e in o.events:
+                        k = index.get(e)
+                        if k is not None:
+                            ev[j, k] = 1.0
+                d["events"] = ev
+            if st.spec.observe_truth:
+                s = sim.state
+                ids = b.robot_ids
+                d["privileged_true_pose"] = np.stack([s.x_m[ids], s.y_m[ids], s.theta_rad[ids]], axis=1).astype(f)
+            out.append(d)
+        return out
+
+
+def _record_log(rec, step: int, t: float, robot: int, values: dict) -> None:
+    """A brain's log entry into the recorder, as ``Recorder.record`` stores one (its
+    ``"layers"`` entry into layers, the rest into ``logs``)."""
+    if "layers" in values:
+        values = dict(values)
+        layers = values.pop("layers")
+        if not isinstance(layers, dict):
+            raise ValueError(f"robot {robot}: log()['layers'] must be a dict of layer name to data, got {type(layers).__name__}")
+        for name, value in layers.items():
+            if isinstance(value, str):
+                spec = {"kind": "state", "data": value}
+            elif isinstance(value, dict):
+                if "data" not in value:
+                    raise ValueError(f"robot {robot}: log()['layers'][{name!r}] needs a 'data' entry")
+                spec = value
+            else:
+                spec = {"kind": "points", "data": value}
+            kind = spec.get("kind", "points")
+            rec.declare_layer(name, kind, frame=spec.get("frame", "world" if kind == "state" else "odom"),
+                              hold=bool(spec.get("hold", kind != "segments")), description=spec.get("description", ""))
+            rec.add_layer_sample(name, step, robot, spec["data"])
+    if values:
+        rec.logs.append({"step": int(step), "t_s": float(t), "robot": int(robot), "values": values})
+
+
+def _all_finished(sim) -> bool:
+    """Every per-robot brain with a ``finished`` flag says True, and at least one has one (the
+    rule of ``stop_when_finished`` in :func:`teamnav.experiments.runner.all_finished`)."""
+    seen = False
+    for group in sim.brains:
+        if not isinstance(group, list):
+            continue
+        for brain in group:
+            flag = getattr(brain, "finished", None)
+            if flag is None:
+                continue
+            seen = True
+            if not flag:
+                return False
+    return seen
+
+
+
+# ---------------------------------------------------------------------------- building from a scenario
+def make_setup(scenario, *, robots: list[int] | None = None, robot_ref: Any = None, single: bool = False,
+               agents_from=None, reward=None,
+               terminate_on=None, observe_truth=None, max_inbox=None, max_detections=None, dtype=np.float64,
+               seed=None, duration_s=None, overrides=None, fields: dict[str, Any] | None = None) -> EnvSetup:
+    """Load ``scenario`` (a built-in name, a file or a Scenario) with its ``env:`` section and
+    the constructor's settings on top, and fix the setup.
+
+    ``overrides`` (dotted ``KEY=VALUE`` strings or a dict) and ``fields`` (keyword overrides,
+    e.g. ``dt_s=0.05`` or ``**{"robots.0.count": 2}``) change the scenario; ``env.KEY`` keys
+    change its ``env:`` section.
+    """
+    from teamnav.env.config import env_spec, load_env_scenario
+
+    merged: Any = overrides
+    if fields:
+        if overrides is None:
+            merged = dict(fields)
+        elif isinstance(overrides, dict):
+            merged = {**overrides, **fields}
+        else:
+            merged = list(overrides) + [f"{k}={_yaml_value(v)}" for k, v in fields.items()]
+    scn, env_raw, file = load_env_scenario(scenario, overrides=merged, seed=seed, duration_s=duration_s)
+    given = {"agents_from": _as_tuple(agents_from), "reward": _reward_value(reward), "terminate_on": _as_tuple(terminate_on),
+             "observe_truth": observe_truth, "max_inbox": max_inbox, "max_detections": max_detections}
+    spec = env_spec(env_raw, given, file)
+    if robot_ref is not None:
+        robots = [_robot_id(scn, robot_ref, spec)]
+    elif single:  # the first robot of the first agent group (of every group: robot 0)
+        unknown_group_problem(spec, scn, file)
+        first = 0
+        if spec.agents_from is not None:
+            ref = spec.agents_from[0]
+            gi = ref if isinstance(ref, int) else [g.name for g in scn.robots].index(ref)
+            first = sum(g.count for g in scn.robots[:gi])
+        robots = [first]
+    return EnvSetup(scn, spec, file, robots=robots, dtype=dtype)
+
+
+def _yaml_value(v: Any) -> str:
+    import json
+
+    return json.dumps(v) if not isinstance(v, str) else v
+
+
+def _as_tuple(v: Any) -> Any:
+    if v is None:
+        return None
+    if isinstance(v, (str, int)):
+        return (v,)
+    return tuple(v)
+
+
+def _reward_value(v: Any) -> Any:
+    if v is None or isinstance(v, (str, dict)):
+        return v
+    return tuple(v)
+
+
+def _robot_id(scn: Scenario, ref: Any, spec: EnvSpec) -> int:
+    """A robot id from an id, an agent name (``GROUP`` or ``GROUP_K``) or a group name (its first robot)."""
+    n = scn.n_robots
+    if isinstance(ref, (int, np.integer)) and not isinstance(ref, bool):
+        if not 0 <= int(ref) < n:
+            raise ValueError(f"robot must be a robot id in [0, {n}), got {ref!r}")
+        return int(ref)
+    if isinstance(ref, str):
+        names = _agent_names(scn, list(range(n)))
+        if ref in names:
+            return names.index(ref)
+        off = 0
+        for g in scn.robots:
+            if g.name == ref and g.count > 0:
+                return off
+            off += g.count
+        raise ValueError(f"robot {ref!r} is neither an agent name ({', '.join(names[:12])}{' ...' if n > 12 else ''}) "
+                         f"nor a group of the scenario")
+    raise ValueError(f"robot must be a robot id, an agent name or a group name, got {ref!r}")
+
+
+class Seeds:
+    """Episode seeds as Gymnasium seeds episodes: ``reset(seed=s)`` runs the scenario with seed
+    ``s`` (bit for bit the episode ``teamnav run --seed s`` would start) and restarts the stream
+    that later unseeded resets draw their seeds from; the first reset without a seed uses
+    ``default`` (the scenario's own seed)."""
+
+    def __init__(self, default: int) -> None:
+        self.default = int(default)
+        self.rng: np.random.Generator | None = None
+
+    def next(self, seed: int | None) -> int:
+        if seed is not None:
+            if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= 2**63 - 1:
+                raise ValueError(f"seed must be an int in [0, 2**63 - 1] or None, got {seed!r}")
+            self.rng = np.random.default_rng(int(seed))
+            return int(seed)
+        if self.rng is None:
+            self.rng = np.random.default_rng(self.default)
+            return self.default
+        return int(self.rng.integers(0, 2**63 - 1))
