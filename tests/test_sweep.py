@@ -502,3 +502,27 @@ def test_cli_name_option_names_the_sweep(tmp_path):
         assert con.execute("select distinct sweep from trials").fetchall() == [("demo-renamed",)]
     bad = CliRunner().invoke(app, ["sweep", "demo", "--name", "no spaces", "--out", str(tmp_path / "t")])
     assert bad.exit_code == 2 and "name" in bad.output
+
+
+def test_trials_are_scheduled_longest_first_from_recorded_times_or_robot_steps():
+    """issue 27 §2: the longest expected trials go first (measured wall time of the same
+    configuration where the store has one, else robot-steps at the measured rate), ties in the
+    sweep's order."""
+    from teamnav.experiments.sweep import longest_first
+
+    trials = expand(SweepSpec(scenario="demo", grid={"robots.0.count": [2, 8, 4]}, seeds=2, duration_s=1))
+    by_count = {}
+    for t in trials:
+        by_count.setdefault(t.params["robots.0.count"], []).append(t)
+    assert by_count[8][0].work == 4 * by_count[2][0].work == 8 * 10  # 8 robots x 10 steps
+    # nothing measured: robot-steps decide, seeds keep their order
+    order = [t.params["robots.0.count"] for t in longest_first(trials, trials, [])]
+    assert order == [8, 8, 4, 4, 2, 2]
+    # the store says the 2-robot configuration took 60 s and the 8-robot one 10 s (measured
+    # beats robot-steps); the unmeasured 4-robot one is ranked at the median seconds per
+    # robot-step of the measured ones (3 s: 120 s expected)
+    rows = [{"config_hash": by_count[2][0].config_hash, "wall_time_s": 60.0},
+            {"config_hash": by_count[8][0].config_hash, "wall_time_s": 10.0}]
+    first = longest_first(trials, trials, rows)
+    assert [t.params["robots.0.count"] for t in first] == [4, 4, 2, 2, 8, 8]
+    assert [t.seed for t in first[2:4]] == [by_count[2][0].seed, by_count[2][1].seed]

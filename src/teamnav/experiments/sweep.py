@@ -56,6 +56,7 @@ import difflib
 import hashlib
 import itertools
 import json
+import math
 import os
 import pickle
 import time
@@ -541,6 +542,8 @@ class Trial:
     seed: int
     config_hash: str
     grid_keys: tuple[str, ...] = ()
+    #: robot-steps of the resolved scenario (robots x steps): the schedule's size estimate
+    work: float = 0.0
 
     @property
     def overrides(self) -> dict[str, Any]:
@@ -658,6 +661,7 @@ def expand(spec: SweepSpec) -> list[Trial]:
                     seed=seed,
                     config_hash=chash,
                     grid_keys=tuple(keys),
+                    work=float(scn.n_robots * scn.n_steps),
                 )
             )
     if bad:
@@ -842,6 +846,7 @@ def sweep(
         result.skipped = len(trials) - len(todo)
         store.register_sweep(spec.sweep_name, spec.model_dump(mode="json"))
         art = out / "trials" if artifacts else None
+        todo = longest_first(todo, trials, store.rows())  # both cores busy to the end (issue 27 §2)
         tasks = [TrialTask(t, trial_fn, str(art / t.trial_id) if art is not None else None) for t in todo]
         by_id = {t.trial_id: t for t in todo}
         bar = _Bar(spec.sweep_name, len(todo), result.skipped, show=progress and bool(todo))
@@ -863,6 +868,33 @@ def sweep(
             bar.close()
             result.elapsed_s = time.perf_counter() - t0
     return result
+
+
+def longest_first(todo: list[Trial], trials: list[Trial], rows: list[dict[str, Any]]) -> list[Trial]:
+    """``todo`` ordered by expected wall time, longest first, so that the last trials to start
+    are short ones and no worker idles while one long trial finishes.
+
+    The expected time of a trial is the mean ``wall_time_s`` the store holds for its
+    configuration (same ``config_hash``: the same scenario, another seed or an earlier try);
+    a configuration never run yet is estimated from its robot-steps (``Trial.work``) at the
+    median seconds per robot-step of the measured ones, or ranked by robot-steps alone when
+    nothing is measured. Ties keep the sweep's own order.
+    """
+    measured: dict[str, list[float]] = {}
+    for r in rows:
+        w = r.get("wall_time_s")
+        if isinstance(w, (int, float)) and math.isfinite(w) and w > 0:
+            measured.setdefault(r.get("config_hash"), []).append(float(w))
+    work = {t.config_hash: t.work for t in trials}
+    rates = sorted(sum(v) / len(v) / work[h] for h, v in measured.items() if work.get(h, 0) > 0)
+    rate = rates[len(rates) // 2] if rates else 1.0
+
+    def expected(t: Trial) -> float:
+        times = measured.get(t.config_hash)
+        return sum(times) / len(times) if times else t.work * rate
+
+    order = sorted(range(len(todo)), key=lambda i: (-expected(todo[i]), i))
+    return [todo[i] for i in order]
 
 
 class _Bar:
