@@ -58,6 +58,14 @@ with all of them; each one flag away from the paper's rules as written):
   seeds 0-7 25.0 ± 3.2 -> 27.3 ± 0.7 units; fresh seeds 8-11 23.8 ± 4.2 -> 27.8 ± 4.2; all 12
   per seed +2.8 ± 1.0 (s.e.). 0 m: the paper's rule.
 
+``reverse_carried_crumbs`` (on): a crumb dropped while carrying stores the opposite heading
+(:mod:`~teamnav.control.coop.crumbs`), so outbound and homebound crumbs at one spot agree
+instead of cancelling; False stores the robot's own heading, the paper as written.
+
+``paper_rules=True`` sets every gap-fill above whose other value is the paper's rule to that
+value (:attr:`BlazingTrailParams.PAPER_RULES`, Navigate's own passed down, cruise 0.25 m/s;
+:mod:`teamnav.control.paper_rules`): the reports' "paper as written" column.
+
 Choices where the paper is silent: crumb interval 1 s and radius 2 m (the paper gives neither;
 1.8 m corridors, a radius about a corridor wide, reaches the crumbs of the corridor the robot is
 in and the corner it approaches); the global list is unbounded as in the paper unless
@@ -67,7 +75,7 @@ in and the corner it approaches); the global list is unbounded as in the paper u
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -75,6 +83,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from teamnav.control.coop.crumbs import CrumbBatch, CrumbList, preferred_heading
 from teamnav.control.coop.forager import PlaceRound
 from teamnav.control.nav.navigate import Navigate, NavigateParams
+from teamnav.control.paper_rules import paper_rules_validator
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, Message, Observation
 
@@ -167,9 +176,47 @@ class BlazingTrailParams(BaseModel):
     navigate : dict
         Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields, over
         ``NAVIGATE_DEFAULTS`` (``trail_rule="side"``, Blazing §5.1; ``box_reach_m=2.0``, lanes).
+    reverse_carried_crumbs : bool
+        A crumb dropped while carrying stores the opposite of the robot's heading, so every crumb
+        points towards the source (:mod:`~teamnav.control.coop.crumbs`; a gap-fill; False: the
+        robot's own heading, the paper as written).
+    paper_rules : bool
+        Every gap-fill of :attr:`PAPER_RULES` (and Navigate's) at the paper's value
+        (:mod:`teamnav.control.paper_rules`); setting one of them as well is an error.
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    #: the gap-fills whose other value is the 2000 paper's rule (plus Navigate's, passed down)
+    PAPER_RULES: ClassVar[dict[str, Any]] = {
+        # Try §3.6: "a cruise speed of 0.25 m/s" (the 2000 paper gives none; the same robots and lab)
+        "cruise_speed_mps": 0.25,
+        # Blazing §4.1: crumbs "at regular time intervals", whether or not the robot moved
+        "crumb_min_move_m": 0.0,
+        # Blazing §4.1: the private list is broadcast as recorded (no loop pruning)
+        "prune_loops": False,
+        # Blazing §4.1: "records its current position and heading estimate" (homebound crumbs too)
+        "reverse_carried_crumbs": False,
+        # Blazing §4.1: crumbs "within a threshold radius of its current position estimate"
+        "lookahead_m": 0.0,
+        # Blazing §4.1: "If there are no such crumbs, the robot performs random exploration"
+        "recover_radius_m": 0.0,
+        # Blazing §4.2: the 180° turn on the trail's hint, whatever number of crumbs gave it
+        "reverse_min_crumbs": 1,
+        # Blazing §4.2 / §5.1: no turn on arrival; only the 180° rule turns the robot round
+        "turn_at_place": False,
+    }
+    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
+        "cruise_speed_mps": "Try §3.6: 0.25 m/s cruise (Blazing gives no speed)",
+        "crumb_min_move_m": "Blazing §4.1: a crumb every interval, moved or not",
+        "prune_loops": "Blazing §4.1: the private list broadcast as recorded",
+        "reverse_carried_crumbs": "Blazing §4.1: a crumb stores the robot's own heading, also while carrying",
+        "lookahead_m": "Blazing §4.1: crumbs around the position estimate",
+        "recover_radius_m": "Blazing §4.1: no crumb near: random exploration",
+        "reverse_min_crumbs": "Blazing §4.2: the 180° turn on any hint",
+        "turn_at_place": "Blazing §4.2, §5.1: no turn on arrival at a place",
+    }
+    PAPER_RULES_NESTED: ClassVar[dict[str, tuple[type, dict]]] = {"navigate": (NavigateParams, NAVIGATE_DEFAULTS)}
 
     home_event: str = Field("given_resource", min_length=1)
     source_event: str = Field("took_resource", min_length=1)
@@ -190,6 +237,10 @@ class BlazingTrailParams(BaseModel):
     sensor: str = Field("laser", min_length=1)
     layer_every_steps: int = Field(50, ge=1, le=1_000_000)
     navigate: dict[str, Any] = Field(default_factory=dict)
+    reverse_carried_crumbs: bool = True
+    paper_rules: bool = False
+
+    _paper_rules = paper_rules_validator()
 
     @model_validator(mode="after")
     def _check(self) -> "BlazingTrailParams":
@@ -262,12 +313,13 @@ class BlazingTrail:
         moved = self._crumb_xy is None or math.hypot(x - self._crumb_xy[0], y - self._crumb_xy[1]) >= p.crumb_min_move_m
         if t >= self._next_crumb_s and moved:  # before the events: a crumb on arrival goes out with the list
             self._crumb_xy = (x, y)
+            outbound = not (self.carrying and p.reverse_carried_crumbs)
             if p.prune_loops:
                 self.loops_cut += self.private.drop_pruning_loops(
-                    x, y, th, outbound=not self.carrying, path_m=self._path_m, radius_m=p.prune_radius_m,
+                    x, y, th, outbound=outbound, path_m=self._path_m, radius_m=p.prune_radius_m,
                     min_loop_m=p.prune_min_loop_m)
             else:
-                self.private.drop(x, y, th, outbound=not self.carrying, path_m=self._path_m)
+                self.private.drop(x, y, th, outbound=outbound, path_m=self._path_m)
             self._next_crumb_s = t + p.crumb_interval_s - 1e-9
         for reached in self.round.observe(obs.events, t):
             if reached == p.home_event:

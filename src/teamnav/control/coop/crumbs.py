@@ -20,7 +20,9 @@ Gap filled here (the paper is silent): crumbs are dropped on both legs, but the 
 headings of an outbound and a homebound crumb at one spot would cancel. So a crumb dropped while
 *carrying* stores the opposite of the robot's heading (``outbound=False`` in
 :meth:`CrumbList.drop`): every crumb in every list points *towards the source*, and a carrying
-robot follows the opposite of the average, as the paper says.
+robot follows the opposite of the average, as the paper says. The brain's
+``reverse_carried_crumbs`` flag turns this off (``outbound=True`` for every crumb: the paper as
+written, under ``paper_rules``).
 
 Everything is in the robot's own odometry frame; the lists are numpy arrays (a global list
 holds thousands of crumbs) and every query is vectorised.

@@ -145,6 +145,10 @@ default: no drift, seeds 0-7, eff 57.0 ± 2.5 % against 56.2 ± 3.7 % (paired +0
 65.5 ± 2.8 % against 71.3 ± 3.3 % (-5.7 ± 3.1); with the drift, seeds 0-5 (run cut short), eff
 +8.6 ± 1.7 points (better on 6 of 6).
 
+``paper_rules=True`` sets every gap-fill above whose other value is the paper's rule to that
+value (:attr:`TrailShareParams.PAPER_RULES`, Navigate's own passed down, cruise 0.25 m/s;
+:mod:`teamnav.control.paper_rules`): the reports' "paper as written" column.
+
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
 ``min_move_m`` since the previous temporary trail; radius 3 m (``radius_m``; 2 m, about a
 corridor's width, until session 11). Why 3: once robots keep their lanes (``box_reach_m`` in
@@ -166,15 +170,16 @@ N > 2 places where the next place is never the previous one.
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from teamnav.control.coop.blazing_trail import navigate_params
+from teamnav.control.coop.blazing_trail import NAVIGATE_DEFAULTS, navigate_params
 from teamnav.control.coop.forager import PlaceRound
 from teamnav.control.coop.trails import Trail, TrailMessage, temporary_trail
-from teamnav.control.nav.navigate import Navigate
+from teamnav.control.nav.navigate import Navigate, NavigateParams
+from teamnav.control.paper_rules import paper_rules_validator
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, Message, Observation
 
@@ -247,9 +252,35 @@ class TrailShareParams(BaseModel):
         Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields, over
         :data:`TRAIL_SHARE_NAVIGATE` (empty since session 11) over ``NAVIGATE_DEFAULTS``
         (``trail_rule="side"``, Blazing §5.1; ``box_reach_m=2.0``, lanes).
+    paper_rules : bool
+        Every gap-fill of :attr:`PAPER_RULES` (and Navigate's) at the paper's value
+        (:mod:`teamnav.control.paper_rules`); setting one of them as well is an error.
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    #: the gap-fills whose other value is the 2002 paper's rule (plus Navigate's, passed down)
+    PAPER_RULES: ClassVar[dict[str, Any]] = {
+        # Try §3.6: "a cruise speed of 0.25 m/s"
+        "cruise_speed_mps": 0.25,
+        # Try §2.3 step 1: the crumb with the lowest time-to-place within the radius, whichever it is
+        "descend_only": False,
+        # Try §2.3 step 1: crumbs "within a radius" of the robot's position estimate
+        "lookahead_m": 0.0,
+        # Try §2.3: no crumb near: Navigate explores
+        "recover_radius_m": 0.0,
+        # Try §3.3 (Blazing §4.2's Navigate): no turn on arrival; only the 180° rule turns the robot
+        "turn_at_place": False,
+    }
+    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
+        "cruise_speed_mps": "Try §3.6: 0.25 m/s cruise",
+        "descend_only": "Try §2.3: head for the lowest time-to-place crumb near, even up a trail",
+        "lookahead_m": "Try §2.3: crumbs around the position estimate",
+        "recover_radius_m": "Try §2.3: no crumb near: explore",
+        "turn_at_place": "Try §3.3 / Blazing §4.2: no turn on arrival at a place",
+    }
+    PAPER_RULES_NESTED: ClassVar[dict[str, tuple[type, dict]]] = {
+        "navigate": (NavigateParams, {**NAVIGATE_DEFAULTS, **TRAIL_SHARE_NAVIGATE})}
 
     round: list[str] = Field(default_factory=lambda: ["given_resource", "took_resource"], min_length=2,
                              max_length=100)
@@ -273,6 +304,9 @@ class TrailShareParams(BaseModel):
     sensor: str = Field("laser", min_length=1)
     layer_every_steps: int = Field(50, ge=1, le=1_000_000)
     navigate: dict[str, Any] = Field(default_factory=dict)
+    paper_rules: bool = False
+
+    _paper_rules = paper_rules_validator()
 
     @model_validator(mode="after")
     def _check(self) -> "TrailShareParams":

@@ -11,7 +11,7 @@ frame, or None to explore.
 One step, in priority order:
 
 1. **Panic** (:mod:`teamnav.control.nav.panic`) overrides everything: an obstacle critically
-   close to the front, or the stall flag, stops the robot and starts Panic; Navigate resumes
+   close to the front, or the stall flag (``panic_on_stall``, a gap-fill), stops the robot and starts Panic; Navigate resumes
    when Panic times out.
 2. A **sharp turn** under way (on the spot, by odometry heading) runs to its end; an
    **advance** to the centre of a chosen opening runs until the odometry has covered the
@@ -108,10 +108,12 @@ how far it has driven), never as a position in any shared frame.
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from teamnav.control.paper_rules import paper_rules_validator
 
 from teamnav.control.nav.openings import Opening, OpeningDetector
 from teamnav.control.nav.panic import Panic
@@ -151,9 +153,38 @@ class NavigateParams(BaseModel):
     corners, module docstring item 6): ``hint_skips_cooldown``, ``face_hint_after_panic``
     (``face_hint_min_deg``), ``give_way_s`` (``give_way_*``), ``meet_guard_deg``
     (``meet_guard_m``, ``meet_guard_s``).
+
+    ``paper_rules=True`` (:mod:`teamnav.control.paper_rules`): every gap-fill of
+    :attr:`PAPER_RULES` takes the paper's value (the trail brains pass it down with theirs).
+    ``box_ahead_free`` (True, a gap-fill): the sliding box drives straight only when the box
+    straight ahead is free too (:mod:`~teamnav.control.nav.wall_follow`, "Big open space");
+    ``panic_on_stall`` (True, a gap-fill): the stall flag starts Panic like an obstacle
+    critically close to the front.
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    #: Navigate's gap-fills whose other value is the paper's rule (Blazing §4.2, reused by Try §3.3)
+    PAPER_RULES: ClassVar[dict[str, Any]] = {
+        # Blazing §4.2: "If the robot is heading in approximately the opposite direction to the trail it
+        # makes a sharp 180° right turn" -- no time cool-down, no distance cool-down, no memory of spots
+        "reverse_cooldown_s": 0.0,
+        "reverse_cooldown_m": 0.0,
+        "reverse_memory_m": 0.0,
+        # Blazing §4.2: "If there are no obstacles in the first box that is placed it is assumed that the
+        # robot is in a big open space and therefore moves forward" -- the first box alone decides
+        "box_ahead_free": False,
+        # Blazing §4.2: "An emergency-stop mechanism ... monitoring the laser sensor; if the robot gets
+        # too close to any obstacle it will stop and switch to the panic behaviour" -- the laser only
+        "panic_on_stall": False,
+    }
+    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
+        "reverse_cooldown_s": "Blazing §4.2: the 180° turn whenever heading against the trail (no 5 s time cool-down)",
+        "reverse_cooldown_m": "Blazing §4.2: no distance cool-down after a 180° turn",
+        "reverse_memory_m": "Blazing §4.2: no memory of the spots where the robot reversed",
+        "box_ahead_free": "Blazing §4.2: first box free = big open space, straight on (no check of the box ahead)",
+        "panic_on_stall": "Blazing §4.2: the emergency stop watches the laser only (no stall-triggered Panic)",
+    }
 
     cruise_speed_mps: float = Field(0.25, gt=0.0, le=10.0)
     turn_rate_radps: float = Field(1.0, gt=0.0, le=20.0)
@@ -201,6 +232,11 @@ class NavigateParams(BaseModel):
     meet_guard_deg: float = Field(0.0, ge=0.0, le=180.0)
     meet_guard_m: float = Field(3.0, gt=0.0, le=100.0)
     meet_guard_s: float = Field(8.0, gt=0.0, le=600.0)
+    box_ahead_free: bool = True
+    panic_on_stall: bool = True
+    paper_rules: bool = False
+
+    _paper_rules = paper_rules_validator()
 
     @model_validator(mode="after")
     def _ordered(self) -> "NavigateParams":
@@ -275,7 +311,7 @@ class Navigate:
         offset_max = max(p.slide_step_m, p.box_reach_m - 0.5 * width)
         self.box = SlidingBox(self.angles_rad, width, p.box_length_m, p.box_near_m, offset_max,
                               p.slide_step_m, self.cruise_mps, p.steer_gain_per_s, self.turn_rate_radps,
-                              p.min_speed_fraction, p.wall_side)
+                              p.min_speed_fraction, p.wall_side, ahead_must_be_free=p.box_ahead_free)
         self.openings = OpeningDetector(self.angles_rad, p.opening_near_m, p.opening_jump_m,
                                         2.0 * radius + p.opening_margin_m, p.opening_extreme_deg,
                                         p.opening_sector_deg, p.opening_wall_tolerance_m)
@@ -515,7 +551,7 @@ class Navigate:
                 if obs.time_s < self._give_way_until_s and gw_front < self.params.give_way_m and not obs.stalled:
                     return 0.0, 0.0
                 self._gw_active = False
-        if obs.stalled or self.panic.critical(r):
+        if (obs.stalled and self.params.panic_on_stall) or self.panic.critical(r):
             self.panic.start(self.rng)
             self.mode = "panic"
             return self._clip(*self.panic.step(r))

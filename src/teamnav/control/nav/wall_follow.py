@@ -187,6 +187,9 @@ class SlidingBox:
         steering.
     side : {"left", "right"}
         Which wall the robot follows (the paper: left).
+    ahead_must_be_free : bool, default True
+        Straight on only when the box straight ahead is free as well as the first box (a
+        gap-fill; False: the paper's "no obstacles in the first box ... moves forward").
 
     Examples
     --------
@@ -199,7 +202,7 @@ class SlidingBox:
     def __init__(self, angles_rad: np.ndarray, box_width_m: float, box_length_m: float, box_near_m: float,
                  offset_max_m: float,
                  slide_step_m: float, cruise_speed_mps: float, steer_gain_per_s: float, turn_rate_radps: float,
-                 min_speed_fraction: float, side: str = "left") -> None:
+                 min_speed_fraction: float, side: str = "left", *, ahead_must_be_free: bool = True) -> None:
         if side not in ("left", "right"):
             raise ValueError(f"side must be 'left' or 'right', got {side!r}")
         self.angles_rad = np.asarray(angles_rad, dtype=np.float64).copy()
@@ -213,6 +216,7 @@ class SlidingBox:
         self.turn_rate_radps = float(turn_rate_radps)
         self.min_speed_fraction = float(min_speed_fraction)
         self.sign = 1.0 if side == "left" else -1.0
+        self.ahead_must_be_free = bool(ahead_must_be_free)
         n = int(math.floor(2.0 * offset_max_m / slide_step_m + 1e-9)) + 1
         # Slide order: first box on the followed side, then towards the other side.
         self.offsets_m = self.sign * (offset_max_m - slide_step_m * np.arange(n))
@@ -245,7 +249,7 @@ class SlidingBox:
         turn on the spot away from the nearest obstacle.
         """
         first, ahead_blocked = first_free_box(ranges_m, self._cos, self.box_near_m, self.exit_m)
-        if first == 0 and not ahead_blocked:
+        if first == 0 and not (ahead_blocked and self.ahead_must_be_free):
             self._away = 0.0
             return BoxCommand(self.cruise_speed_mps, 0.0, float(self.offsets_m[0]), "open")
         if first < 0:
