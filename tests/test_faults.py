@@ -326,6 +326,9 @@ def _err(faults, groups=None):
     ({"false_positives": [{"robot": 0, "t0_s": 0, "t1_s": 1, "rate_hz": 0}]}, "greater than 0"),
     ({"kidnappings": [{"robot": 0, "t_s": 1, "pose": [1, 1, 0], "region": [0, 1, 0, 1]}]}, "not both"),
     ({"radio_dropouts": [{"robot": 0, "t_s": 2, "until_s": 1}]}, "until_s must be > t_s"),
+    ({"kidnappings": [{"robot": 0, "t_s": 1, "pose": [1e9, 1, 0]}]}, "less than or equal to 1000000"),
+    ({"false_positives": [{"robot": 0, "t0_s": 0, "t1_s": 1, "rate_hz": 1e6}]}, "less than or equal to 1000"),
+    ({"deaths": [{"robot": 0, "t_s": 1}] * 1001}, "at most 1000 items"),
 ])
 def test_bad_fault_specs_are_refused(faults, fragment):
     assert fragment in _err(faults)

@@ -259,6 +259,9 @@ class PlaceConfig(Model):
 #: most entries of one kind a ``faults`` section may list
 MAX_FAULTS = 1000
 FaultTime = Annotated[float, Field(ge=0.0, le=1e7)]
+#: a world coordinate of a fault [m] and a heading [deg]
+FaultCoord = Annotated[float, Field(ge=-1e6, le=1e6)]
+FaultHeading = Annotated[float, Field(ge=-3600.0, le=3600.0)]
 
 
 class GroupRobot(Model):
@@ -349,8 +352,8 @@ class Kidnapping(Model):
 
     robot: RobotRef
     t_s: float = Field(gt=0.0, le=1e7)
-    pose: tuple[float, float, float] | None = None
-    region: tuple[float, float, float, float] | None = None
+    pose: tuple[FaultCoord, FaultCoord, FaultHeading] | None = None
+    region: tuple[FaultCoord, FaultCoord, FaultCoord, FaultCoord] | None = None
 
     @model_validator(mode="after")
     def _one_way(self):

@@ -17,7 +17,9 @@ with a ``fault`` key (and ``event`` None, so task metrics ignore it). From those
   (``fault_relocalize_s``, mean; a robot that never does counts as the rest of the run:
   censored, the mean is then a lower bound; ``fault_relocalize_censored`` counts them,
   ``fault_relocalized_fraction`` is the share that did); a jump that left the error below
-  1.5 m counts as re-localized at once.
+  1.5 m counts as re-localized at once. The error is the belief's distance to the true
+  position, so a robot that drives through its own wrong (tight) belief cloud also counts:
+  read it beside the localization metrics at the end of the run.
 
 A run without faults gives ``{}``.
 """
