@@ -113,6 +113,12 @@ def test_reset_with_a_seed_gives_the_same_episode_bit_for_bit():
     assert _same(env.reset()[0], first)
 
 
+def test_pettingzoo_seed_test():
+    from pettingzoo.test import parallel_seed_test
+
+    parallel_seed_test(lambda: ParallelEnv("los-help-simple", duration_s=2.0), num_cycles=20)
+
+
 def test_first_unseeded_reset_is_the_scenarios_seed():
     env = ParallelEnv("demo", duration_s=1.0)
     assert _same(env.reset()[0], env.reset(seed=load_scenario("demo").seed)[0])
@@ -411,6 +417,13 @@ def test_teamnav_run_with_a_controller_from_outside_the_package(tmp_path, monkey
     assert load_scenario(str(tmp_path / "b" / "scenario.yaml")).robots[0].controller == f"{tmp_path / 'my_brain.py'}:Circler"
     out = subprocess.run(cmd + ["--controller", "my_brain:Circle"], cwd=tmp_path, capture_output=True, text=True, env=env)
     assert out.returncode == 2 and "did you mean 'Circler'" in out.stderr and "Traceback" not in out.stderr
+
+
+def test_the_readme_brain_runs_from_its_file(tmp_path):
+    out = subprocess.run([sys.executable, "-m", "teamnav", "run", "demo", "--duration", "2", "-q", "--out", str(tmp_path / "r"),
+                          "--controller", str(EXAMPLES / "my_brain.py") + ":Cautious"], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert json.loads((tmp_path / "r" / "metrics.json").read_text())["messages_sent"] == 8 * 3  # observations of steps 0, 10 and 20
 
 
 def test_a_controller_by_entry_point_gets_the_same_observation_objects(tmp_path, monkeypatch):

@@ -1,0 +1,206 @@
+"""Environment benchmark: steps/s of ``teamnav.env`` beside the engine's own step, in one run.
+
+Usage::
+
+    python benchmarks/bench_env.py [--quick] [--agents 1,10,100] [--steps N] [--repeats R]
+                                   [--threads N] [--batched] [--vmas-python PATH]
+
+For N agents (robots of radius 0.2 m, unicycle, 180-beam 180° 8 m laser, σ = 1 cm) on the MIT
+basement map (``mit/basement_hallways_5cm.yaml``, 60 m x 60 m at 5 cm), started at random over
+the whole map, every robot drives a constant (v, ω) of its own. Measured, in this process:
+
+- **engine**: ``Simulation.step()`` with a brain per robot that returns that constant action
+  (:class:`ConstantDrive`, named as ``bench_env.py:ConstantDrive``): the same robots, the same
+  motion, the same sensing, and the cheapest possible brain;
+- **engine + wander-v1**: the same with the built-in ``wander-v1`` brain (a real rule);
+- **ParallelEnv**: ``env.step(actions)`` with the same constant actions, an ``(2,)`` array per
+  agent (observations encoded as Dict-of-Box arrays, rewards, PettingZoo dicts);
+- **BatchedEnv** (``--batched``): 4 copies stepped in one call, per copy;
+- **VMAS** (peer, a subprocess in its own interpreter: ``--vmas-python`` /
+  ``$TEAMNAV_BENCH_VMAS_PYTHON``, default ``/tmp/vmas-venv/bin/python``; see
+  ``benchmarks/peers/vmas_peer.py``): N agents with a 180-ray 8 m lidar in a 60 m square with
+  40 boxes (VMAS has no grid maps), one environment, torch on the CPU with 1 thread. A missing
+  peer is reported with its install command and marked "not measured".
+
+Each is built, stepped ``warmup`` times (numba kernels loaded, caches warm), then timed over
+``steps`` steps, best of ``repeats`` (``time.perf_counter``). Recording is left as the
+scenario has it (``record_every`` 10). Reported: steps/s, agent-steps/s and the ratio of the
+env's time per step to the engine's (goal ≤ 1.5x).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve()
+VMAS_PEER = HERE.parent / "peers" / "vmas_peer.py"
+VMAS_INSTALL = ("python -m venv /tmp/vmas-venv && /tmp/vmas-venv/bin/pip install torch==2.13.0 && "
+                "/tmp/vmas-venv/bin/pip install vmas")
+
+
+def vmas(python: str, n: int, steps: int, repeats: int) -> float | None:
+    """VMAS agent-steps per second for ``n`` agents (one environment), or None when not installed."""
+    if not Path(python).exists():
+        return None
+    out = subprocess.run([python, str(VMAS_PEER), "--agents", str(n), "--steps", str(steps), "--repeats", str(repeats)],
+                         capture_output=True, text=True, timeout=1800)
+    lines = [ln for ln in out.stdout.splitlines() if ln.startswith("{")]
+    if out.returncode != 0 or not lines:
+        print(f"VMAS peer failed: {out.stderr.strip().splitlines()[-1:] or out.returncode}", file=sys.stderr)
+        return None
+    return float(json.loads(lines[-1])["agent_steps_per_s"])
+
+
+class ConstantDrive:
+    """A brain that drives a constant (v, ω) drawn once from its own stream (the engine baseline)."""
+
+    from teamnav.control.protocol import NoParams as Params  # noqa: N811
+
+    def __init__(self, params, rng, info) -> None:
+        from teamnav.control.types import Action
+
+        v, w = _constant(info.robot_id)
+        self.out = (Action(v, w), [])
+
+    def step(self, obs):
+        return self.out
+
+
+def _constant(i: int) -> tuple[float, float]:
+    """Robot i's constant command (the same in the engine and the env runs)."""
+    rng = np.random.default_rng(1000 + i)
+    return float(rng.uniform(0.1, 0.4)), float(rng.uniform(-0.5, 0.5))
+
+
+def _overrides(n: int, controller: str) -> dict:
+    return {
+        "name": "bench-env",
+        "robots": [{
+            "name": "bot", "count": n, "radius_m": 0.2, "max_v_mps": 0.5, "max_omega_degps": 90,
+            "controller": controller, "params": {},
+            "sensors": [{"kind": "laser", "n_beams": 180, "fov_deg": 180, "max_range_m": 8.0, "noise_std_m": 0.01}],
+            "odometry": {"alpha": [0.02, 0.01, 0.02, 0.01]},
+        }],
+        "radio": {"mode": "range", "range_m": 10.0},
+        "places": [],
+        "metrics": ["steps"],
+    }
+
+
+def _scenario(n: int, controller: str, seed: int = 1):
+    from teamnav import load_scenario
+
+    return load_scenario("demo", overrides=_overrides(n, controller), seed=seed, duration_s=1e6)
+
+
+def _build_engine(n: int, controller: str, warmup: int):
+    from teamnav.experiments.spec import build_grid
+    from teamnav.sim.engine import Simulation
+
+    scn = _scenario(n, controller)
+    sim = Simulation(build_grid(scn), scn)
+    for _ in range(warmup):
+        sim.step()
+    return sim.step
+
+
+def _build_parallel(n: int, warmup: int):
+    from teamnav.env import ParallelEnv
+
+    env = ParallelEnv(_scenario(n, "idle-v1"))
+    env.reset(seed=1)
+    actions = {a: np.array(_constant(i)) for a, i in env.robot_ids.items()}
+    for _ in range(warmup):
+        env.step(actions)
+    return lambda: env.step(actions)
+
+
+def _build_batched(n: int, copies: int, warmup: int):
+    from teamnav.env import BatchedEnv
+
+    env = BatchedEnv(_scenario(n, "idle-v1"), copies)
+    env.reset(seed=1)
+    ids = env.setup.agent_ids.tolist()
+    actions = np.broadcast_to(np.array([_constant(i) for i in ids]), (copies, len(ids), 2)).copy()
+    for _ in range(warmup):
+        env.step(actions)
+    return lambda: env.step(actions)
+
+
+def _time(fn, steps: int) -> float:
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        fn()
+    return (time.perf_counter() - t0) / steps
+
+
+def measure(n: int, steps: int, repeats: int, warmup: int, batched: int = 0) -> dict[str, float]:
+    """Best seconds per step of each variant; the variants take turns, round after round, so
+    a change of load on the machine hits them alike."""
+    fns = {
+        "engine": _build_engine(n, "bench_env:ConstantDrive", warmup),
+        "wander": _build_engine(n, "wander-v1", warmup),
+        "env": _build_parallel(n, warmup),
+    }
+    if batched:
+        fns["batched"] = _build_batched(n, batched, warmup)
+    best = {k: float("inf") for k in fns}
+    for _ in range(repeats):
+        for k, fn in fns.items():
+            t = _time(fn, max(5, steps // batched) if k == "batched" else steps)
+            best[k] = min(best[k], t / batched if k == "batched" else t)
+    return best
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="fewer steps and repeats")
+    ap.add_argument("--agents", default="1,10,100", help="comma-separated agent counts")
+    ap.add_argument("--steps", type=int, help="timed steps per repeat (default: per size)")
+    ap.add_argument("--repeats", type=int, help="timings per cell, best kept (default 5, quick 2)")
+    ap.add_argument("--threads", type=int, help="numba threads (NUMBA_NUM_THREADS must be set before import)")
+    ap.add_argument("--batched", action="store_true", help="also time BatchedEnv (4 copies)")
+    ap.add_argument("--vmas-python", default=os.environ.get("TEAMNAV_BENCH_VMAS_PYTHON", "/tmp/vmas-venv/bin/python"),
+                    help="interpreter with vmas installed (the peer)")
+    args = ap.parse_args(argv)
+    if args.threads:
+        import numba
+
+        numba.set_num_threads(args.threads)
+    sys.path.insert(0, str(HERE.parent))  # so `bench_env:ConstantDrive` imports as a module
+    sizes = [int(x) for x in args.agents.split(",")]
+    repeats = args.repeats or (3 if args.quick else 9)
+    warmup = 20
+    print(f"teamnav.env benchmark: basement map, 180-beam laser, constant actions; best of {repeats}; "
+          f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}")
+    head = "| agents | engine steps/s | engine + wander-v1 steps/s | env steps/s | env agent-steps/s | env / engine (time per step) | env / engine + wander-v1 |"
+    if args.batched:
+        head += " batched env agent-steps/s (4 copies) |"
+    have_vmas = Path(args.vmas_python).exists()
+    head += " VMAS agent-steps/s (1 env, CPU) | env / VMAS (agent-steps/s) |"
+    if not have_vmas:
+        print(f"VMAS not measured: no {args.vmas_python}; install with: {VMAS_INSTALL}")
+    print(head)
+    print("|" + "---:|" * (head.count("|") - 1))
+    for n in sizes:
+        steps = args.steps or max(20, int((300 if args.quick else 1000) / max(1.0, n ** 0.8)))
+        t = measure(n, steps, repeats, warmup, 4 if args.batched else 0)
+        row = (f"| {n} | {1 / t['engine']:,.0f} | {1 / t['wander']:,.0f} | {1 / t['env']:,.0f} | {n / t['env']:,.0f} | "
+               f"{t['env'] / t['engine']:.2f}x | {t['env'] / t['wander']:.2f}x |")
+        if args.batched:
+            row += f" {n / t['batched']:,.0f} |"
+        v = vmas(args.vmas_python, n, max(3, min(50, 300 // n)), 2 if args.quick else 3) if have_vmas else None
+        row += f" {v:,.0f} | {n / t['env'] / v:,.0f}x |" if v else " not measured | — |"
+        print(row, flush=True)
+
+
+if __name__ == "__main__":
+    main()
