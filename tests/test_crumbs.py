@@ -245,18 +245,18 @@ def test_nearest_crumb_within_a_radius():
 
 # ---------------------------------------------------------------------------- closed loop
 def trail_scenario(controller: str, params: dict, duration_s: float = 40.0):
-    """trail_office, robot 0 starting 2.4 m west of the source facing it, robot 1 at home."""
+    """trail_office_corridors (the U shape), robot 0 starting 2.4 m east of the source facing it, robot 1 at home."""
     from teamnav.experiments.spec import Scenario, load_scenario
 
     robot = {"radius_m": 0.25, "max_v_mps": 0.5, "max_omega_degps": 100, "controller": controller, "params": params,
              "sensors": [{"kind": "laser", "n_beams": 181, "fov_deg": 180, "max_range_m": 8.0, "noise_std_m": 0.01}],
              "odometry": {"frame": "world", "heading_drift_deg_per_min": 1.0, "alpha": [0.01, 0.005, 0.01, 0.005]}}
     return load_scenario(Scenario.model_validate({
-        "name": "trail-closed-loop", "map": {"builtin": "trail_office"}, "duration_s": duration_s, "seed": 2,
+        "name": "trail-closed-loop", "map": {"builtin": "trail_office_corridors"}, "duration_s": duration_s, "seed": 2,
         "record_every": 5, "metrics": [],
         "places": [{"place": "home", "radius_m": 1.0, "event": "given_resource"},
                    {"place": "source", "radius_m": 1.0, "event": "took_resource"}],
-        "robots": [{**robot, "name": "near_source", "count": 1, "start": {"poses": [[22.0, 15.9, 0.0]]}},
+        "robots": [{**robot, "name": "near_source", "count": 1, "start": {"poses": [[7.8, 15.9, 180.0]]}},
                    {**robot, "name": "at_home", "count": 1, "start": {"near": "home", "spread_m": 0.3}}],
         "radio": {"mode": "broadcast"},
     }))

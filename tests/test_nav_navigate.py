@@ -391,9 +391,9 @@ def test_speed_and_turn_rate_are_capped_by_the_robot():
 
 
 # ------------------------------------------------------------------------ in the simulator
-def trail_office_scenario(controller, count, duration_s, params=None, start=None, seed=1):
+def trail_office_scenario(controller, count, duration_s, params=None, start=None, seed=1, map_name="trail_office"):
     return {
-        "name": "nav-test", "map": {"builtin": "trail_office"}, "duration_s": duration_s, "dt_s": 0.1, "seed": seed,
+        "name": "nav-test", "map": {"builtin": map_name}, "duration_s": duration_s, "dt_s": 0.1, "seed": seed,
         "robots": [{
             "name": "r", "count": count, "radius_m": RADIUS, "max_v_mps": 0.6, "max_omega_degps": 120,
             "controller": controller, "params": {"cruise_speed_mps": 0.4, **(params or {})},
@@ -478,19 +478,26 @@ def test_kernels_match_their_numpy_references(seed, scale):
 
 class _RouteParams(NavigateParams):
     back: bool = False
+    shape: str = "u"
 
 
 class RouteHint:
     """A perfect trail stand-in on the trail office: the home -> source heading from the robot's
-    own (drift-free, world-aligned) odometry: east along C1, north up C2, east along C3."""
+    own (drift-free, world-aligned) odometry: east along C1, north up C2, then west along C3
+    (``shape="u"``, the default map) or east (``"z"``, trail_office_z)."""
 
     Params = _RouteParams
 
     def __init__(self, params, rng, info):
         self.nav = Navigate(params, rng, info)
         self.back = params.back
+        self.shape = params.shape
 
     def heading(self, x, y):
+        if self.shape == "u":
+            if not self.back:
+                return 0.0 if (y < 6.0 and x < 13.5) else (math.pi if y >= 14.5 else math.pi / 2)
+            return 0.0 if (x < 13.5 and y > 14.5) else (math.pi if y <= 6.3 else -math.pi / 2)
         if not self.back:
             return 0.0 if (y < 6.0 and x < 13.5) or y >= 14.5 else math.pi / 2
         return math.pi if (x > 16.3 and y > 14.5) or y <= 6.3 else -math.pi / 2
@@ -502,14 +509,17 @@ class RouteHint:
         return {"mode": self.nav.mode}
 
 
+@pytest.mark.parametrize("shape", ["u", "z"])
 @pytest.mark.parametrize("back", [False, True])
-def test_trail_hint_takes_both_corners_at_near_cruise_efficiency(monkeypatch, back):
+def test_trail_hint_takes_both_corners_at_near_cruise_efficiency(monkeypatch, back, shape):
     """The hint only matters at openings and for 180 deg turns (Blazing §4.2): with a perfect one
     the robot makes both correct turns, passes every wrong turn and door, and covers the ~31.5 m
     home -> source route at >= 85 % of cruise speed (the 2002 paper measured 92 %, §3.6)."""
     monkeypatch.setitem(registry._REGISTRY, "route-hint-test-v1", f"{__name__}:RouteHint")
-    start, goal = ([24.4, 15.9, 180.0], (2.0, 4.9)) if back else ([2.0, 4.9, 0.0], (24.4, 15.9))
-    spec = trail_office_scenario("route-hint-test-v1", 1, 110.0, {"back": back}, {"poses": [start]})
+    sx, sth = (5.4, 0.0) if shape == "u" else (24.4, 180.0)
+    start, goal = ([sx, 15.9, sth], (2.0, 4.9)) if back else ([2.0, 4.9, 0.0], (sx, 15.9))
+    spec = trail_office_scenario("route-hint-test-v1", 1, 110.0, {"back": back, "shape": shape}, {"poses": [start]},
+                                 map_name="trail_office" if shape == "u" else "trail_office_z")
     result = run_scenario(spec)
     xy = result.data.true_pose[:, 0, :2]
     arrived = np.flatnonzero(np.hypot(*(xy - goal).T) < 1.0)

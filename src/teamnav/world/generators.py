@@ -646,41 +646,57 @@ def lab_and_corridor(resolution_m: float = 0.1) -> EnvironmentMap:
 
 
 # ---------------------------------------------------------------------------- Vaughan et al.
-def trail_office(resolution_m: float = 0.1, *, doors: bool = True) -> EnvironmentMap:
+def trail_office(resolution_m: float = 0.1, *, doors: bool = True, shape: str = "u") -> EnvironmentMap:
     """Vaughan, Støy, Sukhatme & Matarić: the office used in both trail papers.
 
     "Blazing a trail" §5: "the resource separated from the home position by two corners and
-    approximately 33 m of corridors"; "Try to see it my way" §3.2: "two corners and 31 m of
-    corridor ... the robots must make two correct turning decisions". Their Fig. 4 / Fig. 1
-    show part of an office building with narrow corridors and small rooms.
+    approximately 33 m of corridors"; §5.1: Ant came home "correctly turning right at both
+    corners", and "The correct turn is the same at each of the two corners"; "Try to see it my
+    way" §3.2: "two corners and 31 m of corridor ... the robots must make two correct turning
+    decisions". Their Fig. 4 / Fig. 1 show part of an office building with narrow corridors and
+    small rooms.
 
-    Geometry (1.8 m corridors, 0.2 m walls, 36 m x 24 m):
+    What the papers give: two corners, the route length, the same turn at both corners, narrow
+    corridors and small rooms. **Ours** (the papers give no numbers): the 1.8 m corridor width,
+    0.2 m walls, the 36 m x 24 m building, the rooms and 1 m doors, the passing places and every
+    dead-end branch (which junction offers which wrong turn, and how long it is).
+
+    Geometry (``shape="u"``, the default: a C/U shape, left at both corners going out, right at
+    both coming home, as the paper's robots turned):
 
     - ``home`` at the west end of the south corridor C1 (y = 4.9 m);
-    - corner 1 at x = 14.9 m: turn north into C2; C1 also carries on east (a wrong turn:
-      a dead end past three rooms);
-    - corner 2 at y = 15.9 m: turn east into the north corridor C3; C2 also carries on
-      north into a room, and C3 also runs west (two more wrong turns);
-    - ``source`` in C3 at x = 24.4 m, 9.5 m past corner 2; C3 goes on east to a dead end.
+    - corner 1 at x = 14.9 m: turn north (left) into C2; C1 also carries on east (a wrong turn:
+      a dead end past three rooms, 17.6 m to ``c1_dead_end``);
+    - corner 2 at y = 15.9 m: turn west (left) into the north corridor C3; C2 also carries on
+      north into a room, and C3 also runs east to a dead end (two more wrong turns);
+    - ``source`` in C3 at x = 5.4 m, 9.5 m past corner 2; C3 goes on west to the wall (x = 0.2).
 
-    Centre-line route length 12.9 + 11.0 + 9.5 = 33.4 m; a robot of radius 0.25 m cutting
-    the corners drives about 31.5 m, between the two papers' 31 m and 33 m. Rooms open off every corridor through 1 m doors. Each corridor
-    has a 2 m long passing place where it widens to 2.6–2.8 m (walled off from the room it
-    cuts into), since the robots (50 cm wide)
-    must pass each other ("passing within as little as 40 cm of each other", Blazing §4).
+    ``shape="z"`` (builtin ``trail_office_z``): the map of sessions 1-11, Z-shaped (left, then
+    right): C3 runs east from corner 2 to ``source`` at x = 24.4 m and on to a dead end, and west
+    to x = 6.0 m (a wrong turn). Kept for comparison with the earlier measurements.
 
-    ``doors=False`` closes every room door (builtin ``trail_office_corridors``): Blazing §6
-    "in these experiments we deliberately worked only in the corridors". The wrong turns at the
-    junctions (C1 on east, C2 on north, C3 west and east) stay, as dead-end corridors.
+    Centre-line route length 12.9 + 11.0 + 9.5 = 33.4 m in both shapes; a robot of radius 0.25 m
+    cutting the corners drives about 31.5 m, between the two papers' 31 m and 33 m. Rooms open off
+    every corridor through 1 m doors. Each corridor has a 2 m long passing place on the route
+    where it widens to 2.6–2.8 m (walled off from the room it cuts into), since the robots (50 cm
+    wide) must pass each other ("passing within as little as 40 cm of each other", Blazing §4).
+
+    ``doors=False`` closes every room door (builtin ``trail_office_corridors``,
+    ``trail_office_z_corridors``): Blazing §6 "in these experiments we deliberately worked only in
+    the corridors". The wrong turns at the junctions stay, as dead-end corridors.
     """
+    if shape not in ("u", "z"):
+        raise ValueError(f"shape must be 'u' or 'z', got {shape!r}")
     res = _res(resolution_m)
     b = MapBuilder(36.0, 24.0, res).fill("wall")
     # corridors
     b.clear_rect(0.2, 4.0, 34.0, 5.8)  # C1, y centre 4.9
     b.clear_rect(14.0, 4.0, 15.8, 23.8)  # C2, x centre 14.9; goes on north past C3 to a dead end
-    b.clear_rect(6.0, 15.0, 35.8, 16.8)  # C3, y centre 15.9
-    # passing places
-    b.clear_rect(19.0, 16.8, 21.0, 17.8)  # C3's (into the wall below N2, which starts at y = 18)
+    if shape == "z":
+        b.clear_rect(6.0, 15.0, 35.8, 16.8)  # C3, y centre 15.9
+        b.clear_rect(19.0, 16.8, 21.0, 17.8)  # C3's passing place (into the wall below N2, which starts at y = 18)
+    else:
+        b.clear_rect(0.2, 15.0, 35.8, 16.8)  # C3, y centre 15.9, from the west wall to the east dead end
 
     def door(*rect: float) -> None:
         if doors:
@@ -713,22 +729,32 @@ def trail_office(resolution_m: float = 0.1, *, doors: bool = True) -> Environmen
     b.clear_rect(7.0, 5.8, 9.0, 6.6)
     b.rect(16.6, 8.8, 16.8, 11.2).rect(16.0, 8.8, 16.8, 9.0).rect(16.0, 11.0, 16.8, 11.2)
     b.clear_rect(15.8, 9.0, 16.6, 11.0)
+    if shape == "u":
+        # C3's passing place on the route (x 10-12, between corner 2 and the source): a pocket cut
+        # into room N1, walled off from it like C1's, 0.8 m deep (C3 2.6 m wide there)
+        b.rect(9.8, 17.6, 12.2, 17.8).rect(9.8, 17.0, 10.0, 17.8).rect(12.0, 17.0, 12.2, 17.8)
+        b.clear_rect(10.0, 16.8, 12.0, 17.6)
+    source_x = 5.4 if shape == "u" else 24.4
     places = {
         "home": (2.0, 4.9),
-        "source": (24.4, 15.9),
+        "source": (source_x, 15.9),
         "corner_1": (14.9, 4.9),
         "corner_2": (14.9, 15.9),
         "c1_dead_end": (32.5, 4.9),
-        "c3_west_end": (7.0, 15.9),
+        "c3_west_end": (1.0, 15.9) if shape == "u" else (7.0, 15.9),
         "c3_east_end": (34.5, 15.9),
     }
-    regions = {"C1": (0.2, 4.0, 34.0, 5.8), "C2": (14.0, 4.0, 15.8, 23.8), "C3": (6.0, 15.0, 35.8, 16.8)}
+    c3 = (0.2, 15.0, 35.8, 16.8) if shape == "u" else (6.0, 15.0, 35.8, 16.8)
+    regions = {"C1": (0.2, 4.0, 34.0, 5.8), "C2": (14.0, 4.0, 15.8, 23.8), "C3": c3}
+    turn = ("C1 east 12.9 m, left into C2 north 11.0 m, left into C3 west 9.5 m: the same turn at both corners"
+            if shape == "u" else "C1 east 12.9 m, left into C2 north 11.0 m, right into C3 east 9.5 m (Z shape)")
     notes = (
-        "Vaughan et al. (Blazing §5, Try-to-see §3.2): home and source ~32 m apart through two "
-        "corners (C1 east 12.9 m, C2 north 11.0 m, C3 east 9.5 m); every junction offers a wrong "
-        "turn into dead ends and rooms; 1.8 m corridors with 2.8 m passing places."
+        f"Vaughan et al. (Blazing §5, Try-to-see §3.2): home and source ~32 m apart through two "
+        f"corners ({turn}); every junction offers a wrong turn into dead ends and rooms; 1.8 m corridors "
+        f"with 2.6-2.8 m passing places (corridor width, passing places, rooms and dead ends are ours)."
     )
-    name = "builtin:trail_office" if doors else "builtin:trail_office_corridors"
+    name = {("u", True): "builtin:trail_office", ("u", False): "builtin:trail_office_corridors",
+            ("z", True): "builtin:trail_office_z", ("z", False): "builtin:trail_office_z_corridors"}[(shape, doors)]
     return EnvironmentMap(b.build(name), places, notes, regions)
 
 
@@ -742,6 +768,8 @@ BUILTIN_MAPS: dict[str, Callable[[], EnvironmentMap]] = {
     "lab_and_corridor": lab_and_corridor,
     "trail_office": trail_office,
     "trail_office_corridors": functools.partial(trail_office, doors=False),
+    "trail_office_z": functools.partial(trail_office, shape="z"),
+    "trail_office_z_corridors": functools.partial(trail_office, doors=False, shape="z"),
 }
 
 
