@@ -1,0 +1,222 @@
+"""Verdict rules fixed before the data: one versioned claim file per report section.
+
+``experiments/claims/<section>.yaml`` holds, for each claim a report section judges: the
+paper's statement (quote and section), the paper's number, the metric, the verdict rule (one or
+more conditions, all of which must hold: a metric, a comparison, a threshold and, for a relative
+rule, the metric it is relative to), the seeds (report seeds only; tuning uses seeds >= 1000,
+never a report), the number of runs judged, which column is judged (``paper_rules``: the paper
+as written; ``teamnav``: our gap-fills) and the rule's history.
+
+The section computes the named metrics (store columns or derived metrics it names in its
+docstring) for each column and calls :func:`judge`; it never hard-codes a threshold. A claim file
+is committed before the runs it judges; a later change of a rule is its own commit whose message
+says why, and adds a ``history`` entry (the report prints the history beside the rule).
+
+>>> c = Claim.model_validate({"id": "x", "title": "t", "statement": {"quote": "q", "section": "§5"},
+...     "paper_number": "2.8x", "metric": "ratio", "rule": [{"metric": "ratio", "op": ">=", "threshold": 2.5}],
+...     "seeds": "0-9", "n": 10, "judged": "paper_rules",
+...     "history": [{"date": "2026-11-27", "change": "first", "why": "w", "before_data": True}]})
+>>> judge(c, {"ratio": 2.6})
+(True, 'ratio = 2.6 >= 2.5: holds')
+>>> judge(c, {"ratio": float("nan")})[0] is None
+True
+>>> c.seed_list[:3], rule_text(c)
+([0, 1, 2], 'ratio >= 2.5')
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from functools import lru_cache
+from pathlib import Path
+from typing import Literal, Mapping
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+__all__ = ["CLAIMS_DIR", "Claim", "ClaimFile", "Condition", "TUNING_SEED_MIN", "judge", "load_claims", "rule_text"]
+
+#: the folder of the claim files
+CLAIMS_DIR = Path(__file__).with_name("claims")
+#: seeds at or above this are tuning seeds; a claim's (report) seeds must lie below it
+TUNING_SEED_MIN = 1000
+
+_OPS = {">=": lambda a, b: a >= b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, "<": lambda a, b: a < b}
+_STRICT = ConfigDict(extra="forbid", frozen=True, strict=False)
+
+
+class Statement(BaseModel):
+    """The paper's words and where they are."""
+
+    model_config = _STRICT
+    quote: str = Field(min_length=1)
+    section: str = Field(min_length=1)
+
+
+class Condition(BaseModel):
+    """One condition: ``metric op threshold`` or, relative, ``metric op threshold x relative_to``."""
+
+    model_config = _STRICT
+    metric: str = Field(min_length=1)
+    op: Literal[">=", "<=", ">", "<"]
+    threshold: float
+    relative_to: str | None = None
+    offset: float = 0.0
+
+    @field_validator("threshold")
+    @classmethod
+    def _finite(cls, v: float) -> float:
+        if not math.isfinite(v):
+            raise ValueError(f"threshold must be finite, got {v!r}")
+        return v
+
+
+class HistoryEntry(BaseModel):
+    """One version of a rule: when, what, why, and whether it was fixed before the data it judges."""
+
+    model_config = _STRICT
+    date: str = Field(pattern=r"^\d{4}-\d{2}-\d{2}$")
+    change: str = Field(min_length=1)
+    why: str = Field(min_length=1)
+    before_data: bool
+    commit: str | None = Field(None, pattern=r"^[0-9a-f]{7,40}$")
+
+
+def _parse_seeds(text: str) -> list[int]:
+    out: list[int] = []
+    for part in text.split(","):
+        part = part.strip()
+        m = re.fullmatch(r"(\d+)(?:-(\d+))?", part)
+        if not m:
+            raise ValueError(f"seeds: expected 'a-b' or 'a,b,c', got {text!r}")
+        a, b = int(m[1]), int(m[2] or m[1])
+        if b < a:
+            raise ValueError(f"seeds: range {part!r} runs backwards")
+        out += list(range(a, b + 1))
+    return out
+
+
+class Claim(BaseModel):
+    """One verdict of a report section (module docstring)."""
+
+    model_config = _STRICT
+    id: str = Field(pattern=r"^[a-z0-9][a-z0-9-]*$")
+    title: str = Field(min_length=1)
+    statement: Statement
+    paper_number: str = Field(min_length=1)
+    metric: str = Field(min_length=1)
+    rule: list[Condition] = Field(min_length=1)
+    min_duration_s: float = Field(0.0, ge=0.0)
+    seeds: str
+    quick_seeds: str | None = None
+    n: int = Field(ge=1)  # runs judged in full mode (all cases and both teams where a rule reads both)
+    judged: Literal["paper_rules", "teamnav"]
+    history: list[HistoryEntry] = Field(min_length=1)
+    note: str = ""
+
+    @field_validator("seeds", "quick_seeds")
+    @classmethod
+    def _report_seeds(cls, v: str | None) -> str | None:
+        if v is None:
+            return v
+        seeds = _parse_seeds(v)
+        if max(seeds) >= TUNING_SEED_MIN:
+            raise ValueError(f"seeds {v!r}: seeds >= {TUNING_SEED_MIN} are tuning seeds, never a report's")
+        return v
+
+    @model_validator(mode="after")
+    def _n_covers_seeds(self) -> "Claim":
+        if self.n < len(self.seed_list):
+            raise ValueError(f"claim {self.id}: n = {self.n} runs judged is fewer than its {len(self.seed_list)} seeds")
+        return self
+
+    @property
+    def seed_list(self) -> list[int]:
+        return _parse_seeds(self.seeds)
+
+
+class ClaimFile(BaseModel):
+    """One section's claim file."""
+
+    model_config = _STRICT
+    section: str = Field(min_length=1)
+    paper: str = Field(min_length=1)
+    claims: list[Claim] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _unique(self) -> "ClaimFile":
+        ids = [c.id for c in self.claims]
+        dup = sorted({i for i in ids if ids.count(i) > 1})
+        if dup:
+            raise ValueError(f"claim ids must be unique, repeated: {dup}")
+        return self
+
+    def __getitem__(self, claim_id: str) -> Claim:
+        for c in self.claims:
+            if c.id == claim_id:
+                return c
+        raise KeyError(f"{self.section}: no claim {claim_id!r}; it has {[c.id for c in self.claims]}")
+
+
+@lru_cache(maxsize=None)
+def load_claims(section: str, folder: str | None = None) -> ClaimFile:
+    """The claim file of report section ``section`` (``claims/<section>.yaml``), validated.
+
+    Raises
+    ------
+    FileNotFoundError
+        No file for that section.
+    ValueError
+        The file breaks the schema (unknown keys included) or names another section.
+    """
+    from teamnav.safe_yaml import safe_load
+
+    path = Path(folder) / f"{section}.yaml" if folder else CLAIMS_DIR / f"{section}.yaml"
+    data = safe_load(path.read_text(encoding="utf-8"))
+    cf = ClaimFile.model_validate(data)
+    if cf.section != section:
+        raise ValueError(f"{path}: section is {cf.section!r}, expected {section!r}")
+    return cf
+
+
+def _fmt(v: float) -> str:
+    return f"{v:.3g}" if abs(v) < 1e4 else f"{v:.0f}"
+
+
+def judge(claim: Claim, values: Mapping[str, float], duration_s: float | None = None) -> tuple[bool | None, str]:
+    """Whether ``claim`` holds on ``values`` (metric name -> number), and how it was read.
+
+    None (not judged) when a metric is missing or not finite, or when ``duration_s`` is below
+    the claim's ``min_duration_s``.
+    """
+    if duration_s is not None and duration_s < claim.min_duration_s:
+        return None, f"not judged on {duration_s / 60:g}-min runs (the rule needs >= {claim.min_duration_s / 60:g} min)"
+    parts, holds = [], True
+    for c in claim.rule:
+        a = values.get(c.metric)
+        ref = values.get(c.relative_to) if c.relative_to else 1.0
+        if not isinstance(a, (int, float)) or not isinstance(ref, (int, float)) or not (math.isfinite(a) and math.isfinite(ref)):
+            return None, f"{c.metric}{' / ' + c.relative_to if c.relative_to else ''}: not measured"
+        bound = c.threshold * ref + c.offset
+        ok = _OPS[c.op](a, bound)
+        holds &= ok
+        if c.relative_to:
+            plus = f" + {_fmt(c.offset)}" if c.offset else ""
+            parts.append(f"{c.metric} = {_fmt(a)} {c.op} {_fmt(c.threshold)} x {c.relative_to}{plus} = {_fmt(bound)}")
+        else:
+            parts.append(f"{c.metric} = {_fmt(a)} {c.op} {_fmt(c.threshold)}")
+        if not ok:
+            parts[-1] += " (fails)"
+    return bool(holds), "; ".join(parts) + (": holds" if holds else ": does not hold")
+
+
+def rule_text(claim: Claim) -> str:
+    """The rule as one line (all conditions must hold)."""
+    return " and ".join(f"{c.metric} {c.op} {_fmt(c.threshold)}" + (f" x {c.relative_to}" if c.relative_to else "")
+                        + (f" + {_fmt(c.offset)}" if c.offset else "") for c in claim.rule)
+
+
+def history_text(claim: Claim) -> str:
+    """The rule's history as one line per version."""
+    return " | ".join(f"{h.date}{' ' + h.commit if h.commit else ''}: {h.change} ({'before' if h.before_data else 'AFTER'} "
+                      f"the data; {h.why})" for h in claim.history)
