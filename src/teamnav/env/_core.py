@@ -33,6 +33,7 @@ from teamnav.experiments.spec import Scenario, build_grid
 __all__ = ["Block", "EnvCore", "EnvSetup"]
 
 _NAN = float("nan")
+_TWO_PI = 2.0 * math.pi
 
 
 @dataclass
@@ -52,6 +53,9 @@ class Block:
     has_detector: bool
     holonomic: bool
     no_return: tuple[np.ndarray, ...] = ()  # per scan: every beam at max range
+    scans: tuple = ()  # per scan: (sensor name, observation key, no-return ranges)
+    det_rows: int = 0  # rows of the detections array (0: no detector, or max_detections 0)
+    det_rmax: float = 0.0  # detection ranges are clipped to [0, det_rmax]
 
 
 def _agent_names(scenario: Scenario, ids: list[int]) -> list[str]:
@@ -147,6 +151,7 @@ class EnvSetup:
         self.event_names = tuple(sorted({p.event for p in scenario.places if p.event is not None}))
         self.event_index = {e: k for k, e in enumerate(self.event_names)}
         self.terminate_on = frozenset(spec.terminate_on)
+        self.t_hi = float(scenario.duration_s) + scenario.dt_s  # top of time_s and of message stamps
         self.grid = build_grid(scenario)
         self.n_steps = scenario.n_steps
         self.blocks = self._blocks()
@@ -190,8 +195,11 @@ class EnvSetup:
             space = self._obs_space(g, speed, r_map, (xmin, xmax, ymin, ymax))
             names = tuple(s.name for s in g.sensors)
             none = tuple(np.full(space[f"scan_{nm}"].shape, float(c.max_range_m)) for nm, c in zip(names, g.sensors))
+            det_rows = self.spec.max_detections if g.detector is not None else 0
             out.append(Block(gi, slice(j, k), np.asarray(ids[j:k], dtype=np.int64), space, self._act_space(g, holo), names,
-                             g.detector is not None, holo, none))
+                             g.detector is not None, holo, none,
+                             tuple((nm, f"scan_{nm}", nr) for nm, nr in zip(names, none)), det_rows,
+                             float(space["detections"].high[0, 0]) if det_rows else 0.0))
             j = k
         return out
 
@@ -477,51 +485,54 @@ class EnvCore:
         """This step's observations as arrays, one dict per block (rows: its agents)."""
         st = self.setup
         f = st.dtype
+        spec = st.spec
         out = []
-        sim = self.sim
         for b in st.blocks:
-            obs = [p.obs for p in self.proxies[b.rows]]
+            proxies = self.proxies[b.rows]
+            obs = [p.obs for p in proxies]
             if None in obs:  # a robot dead from the start was never observed
-                obs = [o if o is not None else self._blank(b, p) for o, p in zip(obs, self.proxies[b.rows])]
+                obs = [o if o is not None else self._blank(b, p) for o, p in zip(obs, proxies)]
             n = len(obs)
-            d: dict[str, np.ndarray] = {
-                "odom_pose": np.array([o.odom_pose for o in obs], dtype=f),
-                "odom_delta": np.array([o.odom_delta for o in obs], dtype=f),
-                "time_s": np.full((n, 1), obs[0].time_s, dtype=f),
-                "stalled": np.array([[o.stalled] for o in obs], dtype=f),
-            }
-            for name, none in zip(b.scan_names, b.no_return):
+            if n == 1:  # one agent: the cheaper constructors (the common single-robot case)
+                o = obs[0]
+                d: dict[str, np.ndarray] = {
+                    "odom_pose": np.array(o.odom_pose, dtype=f, ndmin=2),
+                    "odom_delta": np.array(o.odom_delta, dtype=f, ndmin=2),
+                    "time_s": np.array([[o.time_s]], dtype=f),
+                    "stalled": np.array([[o.stalled]], dtype=f),
+                }
+            else:
+                d = {
+                    "odom_pose": np.array([o.odom_pose for o in obs], dtype=f),
+                    "odom_delta": np.array([o.odom_delta for o in obs], dtype=f),
+                    "time_s": np.full((n, 1), obs[0].time_s, dtype=f),
+                    "stalled": np.array([[o.stalled] for o in obs], dtype=f),
+                }
+            for name, key, none in b.scans:
                 try:
-                    d[f"scan_{name}"] = np.array([o.scans[name].ranges_m for o in obs], dtype=f)
+                    d[key] = np.array([o.scans[name].ranges_m for o in obs], dtype=f)
                 except KeyError:  # a sensor fault left the scan out: read as no return on every beam
-                    d[f"scan_{name}"] = np.array([o.scans[name].ranges_m if name in o.scans else none for o in obs], dtype=f)
-            if b.has_detector and st.spec.max_detections > 0:
-                m = st.spec.max_detections
+                    d[key] = np.array([o.scans[name].ranges_m if name in o.scans else none for o in obs], dtype=f)
+            if b.det_rows:
+                m, rmax = b.det_rows, b.det_rmax
                 det = np.zeros((n, m, 3), dtype=f)
                 cnt = np.zeros((n, 1), dtype=np.int64)
-                space = b.obs_space["detections"]
-                rmax = float(space.high[0, 0])
                 for j, o in enumerate(obs):
                     if o.detections:
                         rows = o.detections[:m]
-                        det[j, : len(rows)] = [(min(max(x.range_m, 0.0), rmax), x.bearing_rad,
+                        det[j, : len(rows)] = [(min(max(x.range_m, 0.0), rmax), math.remainder(x.bearing_rad, _TWO_PI),
                                                 -1 if x.robot_id is None else x.robot_id) for x in rows]
                         cnt[j, 0] = len(rows)
                 d["detections"] = det
                 d["detections_count"] = cnt
-            if st.spec.max_inbox > 0:
-                m = st.spec.max_inbox
+            m = spec.max_inbox
+            if m:
                 box = np.zeros((n, m, 3), dtype=f)
                 cnt = np.zeros((n, 1), dtype=np.int64)
-                top = st.n_robots
-                t_hi = float(st.scenario.duration_s) + st.scenario.dt_s
                 for j, o in enumerate(obs):
                     if o.inbox:
                         rows = o.inbox[:m]
-                        box[j, : len(rows)] = [(msg.sender if isinstance(msg.sender, (int, np.integer)) and 0 <= msg.sender < top
-                                                else -1, min(max(float(msg.stamp_s), 0.0), t_hi)
-                                                if math.isfinite(msg.stamp_s) else 0.0, min(msg.size_bytes(), 1e12))
-                                               for msg in rows]
+                        box[j, : len(rows)] = [self._message_row(msg) for msg in rows]
                         cnt[j, 0] = len(rows)
                 d["inbox"] = box
                 d["inbox_count"] = cnt
@@ -534,13 +545,24 @@ class EnvCore:
                         if k is not None:
                             ev[j, k] = 1.0
                 d["events"] = ev
-            if st.spec.observe_truth:
-                s = sim.state
+            if spec.observe_truth:
+                s = self.sim.state
                 ids = b.robot_ids
                 d["privileged_true_pose"] = np.stack([s.x_m[ids], s.y_m[ids], s.theta_rad[ids]], axis=1).astype(f)
             out.append(d)
         return out
 
+    def _message_row(self, msg: Message) -> tuple[float, float, float]:
+        """(sender, stamp [s], size [bytes]) of a delivered message, within the inbox Box: the
+        sender and stamp are what the sending brain wrote, so anything odd reads -1 / 0."""
+        st = self.setup
+        sender = msg.sender if isinstance(msg.sender, (int, np.integer)) and 0 <= msg.sender < st.n_robots else -1
+        try:
+            stamp = float(msg.stamp_s)
+        except (TypeError, ValueError):
+            stamp = 0.0
+        stamp = min(max(stamp, 0.0), st.t_hi) if math.isfinite(stamp) else 0.0
+        return sender, stamp, min(msg.size_bytes(), 1e12)
 
 def _record_log(rec, step: int, t: float, robot: int, values: dict) -> None:
     """A brain's log entry into the recorder, as ``Recorder.record`` stores one (its
