@@ -89,6 +89,18 @@ def test_check_env_on_single_robot_env(name, robot):
     assert frame.ndim == 3 and frame.shape[2] == 3 and frame.dtype == np.uint8
 
 
+def test_float32_observations_and_actions_for_learning_libraries():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no "precision lowered" warnings from the Boxes
+        env = ParallelEnv("los-help-simple", duration_s=1.0, dtype=np.float32, observe_truth=True)
+        obs, _ = env.reset(seed=1)
+        while env.agents:
+            for a, o in obs.items():
+                assert o in env.observation_space(a) and o["scan_laser"].dtype == np.float32
+            obs, *_ = env.step({a: env.action_space(a).sample() for a in env.agents})
+    assert env.action_space("R1").dtype == np.float32
+
+
 def test_gymnasium_registration():
     import gymnasium as gym
 

@@ -58,6 +58,14 @@ class Block:
     det_rmax: float = 0.0  # detection ranges are clipped to [0, det_rmax]
 
 
+def _box(low, high, shape=None, dtype=np.float64) -> spaces.Box:
+    """A Box whose bounds are given in its own dtype (no precision warning for float32)."""
+    dtype = np.dtype(dtype)
+    if shape is not None:
+        low, high = np.full(shape, low), np.full(shape, high)
+    return spaces.Box(np.asarray(low, dtype=dtype), np.asarray(high, dtype=dtype), dtype=dtype)
+
+
 def _agent_names(scenario: Scenario, ids: list[int]) -> list[str]:
     """``GROUP`` for a group of one robot, ``GROUP_K`` (K: index in the group) otherwise; made
     unique with ``_ID`` when group names repeat."""
@@ -212,40 +220,40 @@ class EnvSetup:
         db = 5.0 * noise * speed * scn.dt_s + 1.0
         pi = math.pi
         d: dict[str, spaces.Space] = {
-            "odom_pose": spaces.Box(np.array([-b, -b, -pi]), np.array([b, b, pi]), dtype=f),
-            "odom_delta": spaces.Box(np.array([-db, -db, -pi]), np.array([db, db, pi]), dtype=f),
-            "time_s": spaces.Box(0.0, float(scn.duration_s) + scn.dt_s, shape=(1,), dtype=f),
-            "stalled": spaces.Box(0.0, 1.0, shape=(1,), dtype=f),
+            "odom_pose": _box(np.array([-b, -b, -pi]), np.array([b, b, pi]), dtype=f),
+            "odom_delta": _box(np.array([-db, -db, -pi]), np.array([db, db, pi]), dtype=f),
+            "time_s": _box(0.0, float(scn.duration_s) + scn.dt_s, shape=(1,), dtype=f),
+            "stalled": _box(0.0, 1.0, shape=(1,), dtype=f),
         }
         for cfg in g.sensors:
             n_beams = {"laser": lambda c: c.n_beams, "sonar": lambda c: c.n_transducers,
                        "proximity": lambda c: len(c.angles_deg)}[cfg.kind](cfg)
-            d[f"scan_{cfg.name}"] = spaces.Box(0.0, float(cfg.max_range_m), shape=(n_beams,), dtype=f)
+            d[f"scan_{cfg.name}"] = _box(0.0, float(cfg.max_range_m), shape=(n_beams,), dtype=f)
         if g.detector is not None and self.spec.max_detections > 0:
             det = g.detector
             rmax = 2.0 * det.max_range_m + 10.0 * det.range_noise_std_m + 1.0
             n = self.spec.max_detections
-            d["detections"] = spaces.Box(np.tile([0.0, -pi, -1.0], (n, 1)), np.tile([rmax, pi, self.n_robots - 1], (n, 1)),
+            d["detections"] = _box(np.tile([0.0, -pi, -1.0], (n, 1)), np.tile([rmax, pi, self.n_robots - 1], (n, 1)),
                                          dtype=f)
-            d["detections_count"] = spaces.Box(0, n, shape=(1,), dtype=np.int64)
+            d["detections_count"] = _box(0, n, shape=(1,), dtype=np.int64)
         if self.spec.max_inbox > 0:
             n = self.spec.max_inbox
-            d["inbox"] = spaces.Box(np.tile([-1.0, 0.0, 0.0], (n, 1)),
+            d["inbox"] = _box(np.tile([-1.0, 0.0, 0.0], (n, 1)),
                                     np.tile([self.n_robots - 1, float(scn.duration_s) + scn.dt_s, 1e12], (n, 1)), dtype=f)
-            d["inbox_count"] = spaces.Box(0, n, shape=(1,), dtype=np.int64)
+            d["inbox_count"] = _box(0, n, shape=(1,), dtype=np.int64)
         if self.event_names:
-            d["events"] = spaces.Box(0.0, 1.0, shape=(len(self.event_names),), dtype=f)
+            d["events"] = _box(0.0, 1.0, shape=(len(self.event_names),), dtype=f)
         if self.spec.observe_truth:
             xmin, xmax, ymin, ymax = bounds
-            d["privileged_true_pose"] = spaces.Box(np.array([xmin, ymin, -pi]), np.array([xmax, ymax, pi]), dtype=f)
+            d["privileged_true_pose"] = _box(np.array([xmin, ymin, -pi]), np.array([xmax, ymax, pi]), dtype=f)
         return spaces.Dict(d)
 
     def _act_space(self, g, holo: bool) -> spaces.Box:
         if holo:
             s = g.step_length_m / self.scenario.dt_s
-            return spaces.Box(np.array([-s, -s]), np.array([s, s]), dtype=self.dtype)
+            return _box(np.array([-s, -s]), np.array([s, s]), dtype=self.dtype)
         w = math.radians(g.max_omega_degps)
-        return spaces.Box(np.array([-g.max_v_mps, -w]), np.array([g.max_v_mps, w]), dtype=self.dtype)
+        return _box(np.array([-g.max_v_mps, -w]), np.array([g.max_v_mps, w]), dtype=self.dtype)
 
     # ---------------------------------------------------------------- scenario brains
     def build_brain(self, robot_id: int, rng: np.random.Generator, info) -> Any:
