@@ -311,7 +311,8 @@ class _FakeCtx:
         key = name if isinstance(name, str) else name.name
         _FakeCtx.last = self
         self.calls.append((key, kw))
-        return _FakeResult(self.table(key, kw))
+        # both columns (paper as written: "<sweep>-paper-rules", teamnav) read the same made-up rows
+        return _FakeResult(self.table(key.removesuffix("-paper-rules"), kw))
 
 
 @pytest.mark.skipif("blazing-trail-v1" not in controllers.names(), reason="blazing-trail-v1 not registered yet")
@@ -351,12 +352,13 @@ def test_blazing_section_verdicts_follow_the_data():
 
 @pytest.mark.skipif("blazing-trail-v1" not in controllers.names(), reason="blazing-trail-v1 not registered yet")
 @pytest.mark.parametrize("solo_trip_s, route_follow_units, holds", [
-    (180.0, 3, False),   # 9.5 / (1800 / 360 = 5) = 1.9x by the paper's method; 3.2x over route-follow
-    (280.0, 9, True),    # 9.5 / 3.21 = 2.96x by the paper's method; 1.06x over route-follow
-    (255.0, 1, False),   # 2.69x: just under the paper's 2.8 less its tolerance
+    (180.0, 3, True),    # 9.5 / 3 = 3.17x over route-follow (1.9x by the paper's method: shown, not judged)
+    (280.0, 9, False),   # 1.06x over route-follow (2.96x by the paper's method)
+    (255.0, 4, False),   # 2.38x: under the claim file's 2.5x
 ])
-def test_blazing_three_times_is_judged_by_the_papers_method_not_route_follow(solo_trip_s, route_follow_units, holds):
-    """§5.1: team units / (duration / one robot's optimal round trip), at >= 2.7x; route-follow shown, not judged."""
+def test_blazing_three_times_is_judged_against_the_route_follow_robot(solo_trip_s, route_follow_units, holds):
+    """§5.1: team units >= 2.5x one route-follow-v1 robot's (claims/blazing-a-trail.yaml, restored by
+    issue 25 §3); the paper's method (one robot at its optimal round-trip rate) is shown, not judged."""
     from teamnav.experiments.report.sections.blazing_a_trail import SECTION
 
     def table(key, kw):
@@ -370,6 +372,8 @@ def test_blazing_three_times_is_judged_by_the_papers_method_not_route_follow(sol
     (three,) = [b for b in blocks if isinstance(b, Comparison) and "3x" in b.claim]
     assert three.holds is holds
     assert f"{9.5 / route_follow_units:.2f}x" in three.ours
+    assert f"{9.5 / (1800 / (2 * solo_trip_s)):.2f}x (shown, not judged)" in three.ours
+    assert "paper as written:" in three.ours and "teamnav:" in three.ours
     (solo_call,) = [kw for key, kw in _FakeCtx.last.calls if key == "trail-solo-blazing"]
     assert solo_call == {"seeds": 10, "duration_s": 1800.0}
     # quick mode: one seed of the one-robot baseline at the quick duration
@@ -403,7 +407,7 @@ def test_blazing_drift_verdict_reads_the_trend_over_all_runs(runs, dur_s, holds)
 
     verdict, text = drift_verdict(runs, dur_s)
     assert verdict is holds
-    assert text.startswith("rank correlation with k: breakdown time ")
+    assert ("rho_breakdown_k = " in text) if holds is not None else text.startswith("not judged")
 
 
 def test_paper_method_ratio_on_the_papers_numbers_and_without_trips():
@@ -446,7 +450,7 @@ def test_try_efficiency_is_split_into_detours_and_time_moving():
 
     ours = [b for b in SECTION.build(_FakeCtx(table, quick=False)) if isinstance(b, Comparison)][0].ours
     assert "efficiency 52 ± 0 % (n = 2) = route 31.5 m / 45.0 ± 0.0 m (n = 2) driven per trip" in ours
-    assert "x 75 ± 0 % (n = 2) of cruise on average" in ours
+    assert "x 75 ± 0 % (n = 2) of cruise over the lifetime" in ours
 
 
 @pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
@@ -622,10 +626,11 @@ def test_try_section_needs_the_2000_team_to_collapse_not_just_slow_down(blazing_
 
 
 @pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
-def test_try_section_judges_the_drift_claim_where_the_2000_team_breaks_not_at_the_highest_k():
-    """EXPERIMENTS.md: "with drift that breaks the Blazing-a-trail system": at k = 6 the 2000 team
-    keeps a trickle (4 of 9) and the 2002 team degrades (4 of 9); at k = 4 the 2000 team
-    collapses (1 of 9) while the 2002 team keeps 6 of 9: the claim is judged at k = 4."""
+def test_try_section_judges_the_drift_claim_at_the_highest_k_both_ran():
+    """claims/try-to-see-it-my-way.yaml (restored by issue 25 §3): at the highest k both ran. At
+    k = 6 the 2000 team keeps a trickle (4 of 9) and the 2002 team degrades (4 of 9): does not
+    hold, although at k = 4 the 2000 team collapses (1 of 9) while the 2002 team keeps 6 of 9
+    (the rule ece0e2d had chosen after seeing such data)."""
     from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
 
     def table(key, kw):
@@ -643,5 +648,6 @@ def test_try_section_judges_the_drift_claim_where_the_2000_team_breaks_not_at_th
 
     claim = _claim([b for b in SECTION.build(_FakeCtx(table, quick=False)) if isinstance(b, Comparison)],
                    "collapses")
-    assert "at k = 4 the 2002 team keeps" in claim.ours and "the 2000 team 11 %" in claim.ours
-    assert claim.holds is True
+    assert "at k = 6 the 2002 team keeps 44 %" in claim.ours and "the 2000 team 44 %" in claim.ours
+    assert "k = 4: " in claim.ours  # every k is shown
+    assert claim.holds is False

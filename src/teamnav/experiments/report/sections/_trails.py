@@ -35,8 +35,83 @@ TRAIL_BRAINS = ("blazing-trail-v1", "trail-share-v1")
 #: a team "works" when it delivers at least this many units per 10 minutes (the paper's 4 robots
 #: delivered ~9 per 10 min before the breakdown; one optimal robot delivers ~4)
 WORKING_UNITS_PER_10MIN = 1.0
-#: the map every trail scenario runs on
+#: the map every trail scenario runs on (the U shape since issue 25; trail_office_z_corridors is
+#: the Z map of sessions 1-11)
 TRAIL_MAP = "trail_office_corridors"
+#: the papers' cruise speed (Try §3.6), the "paper as written" column's
+PAPER_CRUISE_MPS = 0.25
+#: the two columns of every trail table: (key, heading)
+COLUMNS = (("paper_rules", "paper as written"), ("teamnav", "teamnav"))
+
+
+def paper_rules_spec(name_or_spec: Any, **kwargs: Any):
+    """Sweep ``name_or_spec`` (with ``resolve_spec``'s ``seeds``, ``duration_s``, ``set``...) as
+    the papers wrote it: every robot group whose brain declares ``PAPER_RULES``
+    (:mod:`teamnav.control.paper_rules`) gets ``paper_rules: true`` and loses the params those rules
+    set (its cruise speed among them: 0.25 m/s); any other brain with a cruise speed (the
+    route-follow-v1 baseline) drives at :data:`PAPER_CRUISE_MPS`. Named ``<sweep>-paper-rules``.
+    """
+    from teamnav.control import registry
+    from teamnav.experiments.spec import load_scenario
+    from teamnav.experiments.sweep import resolve_spec
+
+    spec = resolve_spec(name_or_spec, **kwargs)
+    scen = load_scenario(spec.scenario)
+    extra: dict[str, Any] = {}
+    for i, group in enumerate(scen.robots):
+        controller = spec.set.get(f"robots.{i}.controller", group.controller)
+        params = dict(spec.set.get(f"robots.{i}.params", group.params) or {})
+        cls = getattr(registry.lookup(controller), "Params", None)
+        rules = getattr(cls, "PAPER_RULES", None)
+        if rules:
+            for key in rules:
+                head, _, tail = key.partition(".")
+                if not tail:
+                    params.pop(head, None)
+                elif isinstance(params.get(head), dict):
+                    params[head] = {k: v for k, v in params[head].items() if k != tail}
+            nested = getattr(cls, "PAPER_RULES_NESTED", {})
+            for head, (model, _) in nested.items():
+                if isinstance(params.get(head), dict):
+                    params[head] = {k: v for k, v in params[head].items() if k not in getattr(model, "PAPER_RULES", {})}
+            params["paper_rules"] = True
+        elif "cruise_speed_mps" in params:
+            params["cruise_speed_mps"] = PAPER_CRUISE_MPS
+        extra[f"robots.{i}.params"] = params
+    return resolve_spec(spec, set=extra, name=f"{spec.sweep_name}-paper-rules")
+
+
+def column_sweep(ctx: Any, column: str, name_or_spec: Any, **kwargs: Any) -> list[dict]:
+    """The finished rows of a sweep in one of the :data:`COLUMNS` (``"paper_rules"`` or ``"teamnav"``)."""
+    if column == "paper_rules":
+        # the spec carries the paper's params; seeds, duration and the rest are applied by ctx.sweep as for teamnav
+        return ok(ctx.sweep(paper_rules_spec(name_or_spec), **kwargs))
+    return ok(ctx.sweep(name_or_spec, **kwargs))
+
+
+def claim_rows(claims: Any, values: dict[str, dict[str, float]], verdicts: dict[str, dict[str, tuple]]) -> list[list]:
+    """Rows of a section's claim table: claim, paper's number, rule (claim file), then per column the
+    claim's metric and its verdict, and the rule's history."""
+    from teamnav.experiments.claims import history_text, rule_text
+
+    rows = []
+    for c in claims.claims:
+        row = [c.title, c.paper_number, rule_text(c)]
+        for col, _ in COLUMNS:
+            v = values.get(col, {}).get(c.id, {}).get(c.metric, float("nan"))
+            h, _text = verdicts.get(col, {}).get(c.id, (None, ""))
+            verdict = "holds" if h else ("does not hold" if h is not None else "not judged")
+            row.append(f"{c.metric} = {v:.3g} ({verdict})" if isinstance(v, float) and math.isfinite(v) else f"n/a ({verdict})")
+        row.append(history_text(c))
+        rows.append(row)
+    return rows
+
+
+def gap_fill_rows(params_cls: type, ours: dict) -> list[list]:
+    """Rows of a gap-fill table: field, teamnav value, paper value, where the paper says so."""
+    from teamnav.control.paper_rules import gap_fills
+
+    return [[g.field, repr(g.teamnav_value), repr(g.paper_value), g.note] for g in gap_fills(params_cls, ours)]
 
 
 def cruise_mps(scenario: str = "try-to-see-it-my-way") -> float:

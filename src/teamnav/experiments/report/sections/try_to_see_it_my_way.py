@@ -1,5 +1,11 @@
 """Report section ``try-to-see-it-my-way``: Vaughan, Støy, Sukhatme & Matarić (2002).
 
+Every verdict rule is read from ``experiments/claims/try-to-see-it-my-way.yaml``
+(:mod:`teamnav.experiments.claims`); claims 1-5 are measured in two columns, "paper as written"
+(``paper_rules: true``, cruise 0.25 m/s; :func:`_trails.paper_rules_spec`) and "teamnav" (our
+gap-fills, 0.4 m/s), judged on the column the claim file names (the paper-rules one). The profiled
+runs (claim 6), the slip, scale, mail-round and 2000-algorithm 3-h runs are teamnav only.
+
 EXPERIMENTS.md rows, each a :class:`Comparison`:
 
 1. "4 robots, 3 h 8 min, 262 trips, 8.2 km, ≈ 92 % of cruise speed" → the try-paper runs go on
@@ -51,6 +57,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from teamnav.experiments.claims import judge, load_claims, rule_text
 from teamnav.experiments.report.model import Comparison, Missing, SectionSpec, Table, Text
 from teamnav.experiments.metric_sets.trails import ROUTE_LENGTH_M
 from teamnav.experiments.report.sections import _trails as T
@@ -61,7 +68,8 @@ from teamnav.experiments.report.sections._try_blocks import (  # noqa: F401
 )
 from teamnav.experiments.report.sections._try_long_runs import (  # noqa: F401
     HOURS_S, HOURS_SCALE, HOURS_SEEDS, PROFILE_BLAZE_HOURS, PROFILE_BLAZE_SCALE, PROFILE_CRUMB_FACTOR, PROFILE_HOURS,
-    PROFILE_RSS_GROWTH_MB, PROFILE_SAMPLE_S, PROFILE_SCALE, _profile_blocks, _profile_rows, hours_blocks, profile_spec,
+    PROFILE_RSS_GROWTH_MB, PROFILE_SAMPLE_S, PROFILE_SCALE, _profile_blocks, _profile_rows, hours_blocks, hours_values,
+    profile_spec,
 )
 from teamnav.experiments.sweep import SweepSpec
 
@@ -87,6 +95,80 @@ def _last_quarter_units(rows, dur_s: float) -> np.ndarray:
     return c[:, 1] - c[:, 0]
 
 
+def _column_runs(ctx, col: str, quick: bool, seeds: int, dur: float, drift_dur: float) -> dict:
+    """The sweeps of claims 1-5 in one column (``"paper_rules"`` or ``"teamnav"``)."""
+    from teamnav.experiments.report.sections.blazing_a_trail import DRIFT_SCALES
+
+    S = lambda *a, **k: T.column_sweep(ctx, col, *a, **k)  # noqa: E731
+    share = S("try-paper", seeds=seeds, duration_s=dur)
+    # the hours at the drift that breaks the 2000 team (full mode)
+    hours = [] if quick else S(T.drift_spec("try-drift", [HOURS_SCALE]), seeds=HOURS_SEEDS, duration_s=HOURS_S)
+    if quick:
+        # the blazing section's quick drift trials (same arguments: reused)
+        d_share = S(T.drift_spec("try-drift", [0.0, 4.0]), seeds=seeds, duration_s=drift_dur)
+        d_blaze = S(T.drift_spec("blazing-drift", [0.0, 4.0]), seeds=seeds, duration_s=drift_dur)
+    else:
+        d_share = S(T.drift_spec("try-drift", list(SHARE_RUN_SCALES)), seeds=SHARE_DRIFT_SEEDS, duration_s=drift_dur)
+        # k = 1 and k = HOURS_SCALE: the first hour of the long runs at those drifts (not run again)
+        d_share += [T.first_part(r, drift_dur, "x1") for r in share if isinstance(r.get("units_series"), str)]
+        d_share += [T.first_part(r, drift_dur, f"x{HOURS_SCALE:g}") for r in hours
+                    if isinstance(r.get("units_series"), str)]
+        d_blaze = S(T.drift_spec("blazing-drift", list(DRIFT_SCALES)), seeds=seeds, duration_s=drift_dur)
+    plain = [] if quick else S("try-no-transforms", seeds=seeds, duration_s=drift_dur)
+    return {"share": share, "hours": hours, "d_share": d_share, "d_blaze": d_blaze, "plain": plain}
+
+
+def _efficiency(share: list, cruise: float) -> tuple:
+    """(efficiency per run, metres per trip, mean speed over the lifetime / cruise) of try-paper runs."""
+    eff = T.values(share, "place_speed_mps") / cruise
+    full = [r for r in share if T.values([r], "distance_m_total").size and T.values([r], "lifetime_min_total").size
+            and T.values([r], "trips_total").size and r["trips_total"] > 0 and r["lifetime_min_total"] > 0]
+    per_trip = T.values(full, "distance_m_total") / T.values(full, "trips_total")
+    moving = T.values(full, "distance_m_total") / (T.values(full, "lifetime_min_total") * 60.0) / cruise
+    return eff, per_trip, moving
+
+
+def _drift_points(d_share: list, d_blaze: list) -> tuple:
+    """Per k, last-10-min means of both teams, and k_max, the highest k both ran."""
+    (xs_s, bd_s, _, _), (xs_b, bd_b, _, _), (_, last_s, _, _), (_, last_b, _, _) = drift_curves(d_share, d_blaze)
+    ls, lb = dict(zip(xs_s, last_s)), dict(zip(xs_b, last_b))
+    bs, bb = dict(zip(xs_s, bd_s)), dict(zip(xs_b, bd_b))
+    common = sorted(set(ls) & set(lb))
+    return ls, lb, bs, bb, (common[-1] if common else None)
+
+
+def _values(r: dict, cruise: float, dur: float, drift_dur: float) -> dict[str, dict[str, float]]:
+    """Each claim's metrics (names as in the claim file) from one column's runs."""
+    nan = float("nan")
+    share = r["share"]
+    eff, _, _ = _efficiency(share, cruise)
+    cens = T.values(share, "breakdown_censored")
+    same_share = T.by_scale(r["d_share"]).get(1.0, [])
+    same_blaze = T.by_scale(r["d_blaze"]).get(1.0, [])
+    ls, lb, _, _, km = _drift_points(r["d_share"], r["d_blaze"])
+    late_share = _last_quarter_units(same_share, drift_dur)
+    first, second = T.values(share, "crumbs_max_first_half"), T.values(share, "crumbs_max_second_half")
+    return {
+        "hours-efficiency": {"no_breakdown_fraction": float(cens.mean()) if cens.size else nan,
+                             "efficiency_median": float(np.median(eff)) if eff.size else nan},
+        "hours-at-breaking-drift": hours_values(r["hours"], T.by_scale(r["d_blaze"]).get(HOURS_SCALE, []),
+                                                T.by_scale(r["d_blaze"]).get(0.0, [])) if r["hours"] else {},
+        "place-transforms": {
+            "share_last_quarter_mean": T.mean(late_share),
+            "share_last_quarter_per_10min": T.mean(late_share) / (0.25 * drift_dur / 600.0),
+            "plain_last_quarter_mean": T.mean(_last_quarter_units(r["plain"], drift_dur)),
+            "blaze_last_quarter_mean": T.mean(_last_quarter_units(same_blaze, drift_dur))},
+        "drift-collapse": {"k_max": km if km is not None else nan,
+                           "share_last10_kmax": ls.get(km, nan), "blaze_last10_kmax": lb.get(km, nan),
+                           "share_last10_k0": ls.get(0.0, nan), "blaze_last10_k0": lb.get(0.0, nan)},
+        "memory-flat": {"crumbs_first_half_mean": T.mean(first), "crumbs_second_half_mean": T.mean(second)},
+    }
+
+
+#: the run length each claim's min_duration_s is read against: the drift runs' or the long runs'
+_DRIFT_CLAIMS = ("hours-at-breaking-drift", "place-transforms", "drift-collapse")
+
+
 def build(ctx) -> list:
     missing = T.brains_missing(["trail-share-v1", "blazing-trail-v1"])
     if missing is not None:
@@ -95,31 +177,15 @@ def build(ctx) -> list:
     seeds = 2 if quick else 10
     dur = 300.0 if quick else 10800.0
     drift_dur = 300.0 if quick else 3600.0
-    # quick: the blazing section's quick drift trials (same arguments: reused)
-    from teamnav.experiments.report.sections.blazing_a_trail import DRIFT_SCALES
-
     cruise = T.cruise_mps("try-to-see-it-my-way")
 
-    share = T.ok(ctx.sweep("try-paper", seeds=seeds, duration_s=dur))
-    # the hours at the drift that breaks the 2000 team (full mode)
-    hours = [] if quick else T.ok(ctx.sweep(T.drift_spec("try-drift", [HOURS_SCALE]), seeds=HOURS_SEEDS,
-                                            duration_s=HOURS_S))
-    if quick:
-        d_share = T.ok(ctx.sweep(T.drift_spec("try-drift", [0.0, 4.0]), seeds=seeds, duration_s=drift_dur))
-        d_blaze = T.ok(ctx.sweep(T.drift_spec("blazing-drift", [0.0, 4.0]), seeds=seeds, duration_s=drift_dur))
-    else:
-        d_share = T.ok(ctx.sweep(T.drift_spec("try-drift", list(SHARE_RUN_SCALES)), seeds=SHARE_DRIFT_SEEDS,
-                                 duration_s=drift_dur))
-        # k = 1 and k = HOURS_SCALE: the first hour of the long runs at those drifts (not run again)
-        d_share += [T.first_part(r, drift_dur, "x1") for r in share if isinstance(r.get("units_series"), str)]
-        d_share += [T.first_part(r, drift_dur, f"x{HOURS_SCALE:g}") for r in hours
-                    if isinstance(r.get("units_series"), str)]
-        d_blaze = T.ok(ctx.sweep(T.drift_spec("blazing-drift", list(DRIFT_SCALES)), seeds=seeds, duration_s=drift_dur))
+    claims = load_claims("try-to-see-it-my-way")
+    cols = {col: _column_runs(ctx, col, quick, seeds, dur, drift_dur) for col, _ in T.COLUMNS}
+    share, hours, d_share, d_blaze, plain = (cols["teamnav"][k] for k in ("share", "hours", "d_share", "d_blaze", "plain"))
     slip_s = [] if quick else T.ok(ctx.sweep(T.case_spec("try-drift", ["x1-slip"]), seeds=SLIP_SEEDS["try-drift"],
                                              duration_s=drift_dur))
     slip_b = [] if quick else T.ok(ctx.sweep(T.case_spec("blazing-drift", ["x1-slip"]),
                                              seeds=SLIP_SEEDS["blazing-drift"], duration_s=drift_dur))
-    plain = [] if quick else T.ok(ctx.sweep("try-no-transforms", seeds=seeds, duration_s=drift_dur))
     # the 2000 algorithm for as long as the 2002 one, same drift (fewer seeds: the drift sweep has 10 at 1 h)
     long_blaze = [] if quick else T.ok(ctx.sweep("blazing-under-try-drift", seeds=LONG_BLAZE_SEEDS, duration_s=dur))
     # wheel-scale error (the drift sweeps' scale cases), fewer seeds: a bounded error, see the table's note
@@ -153,97 +219,113 @@ def build(ctx) -> list:
                            "(the runs' wall_time metric; one core per trial when the report runs with --workers 1 "
                            "on an idle machine, more on a shared one)."))
 
+    from teamnav.control.coop.trail_share import TrailShareParams
+    from teamnav.experiments.spec import load_scenario
+
+    vals = {col: _values(cols[col], cruise if col == "teamnav" else T.PAPER_CRUISE_MPS, dur, drift_dur)
+            for col, _ in T.COLUMNS}
+    verdicts = {col: {c.id: judge(c, vals[col][c.id], drift_dur if c.id in _DRIFT_CLAIMS else dur)
+                      for c in claims.claims} for col, _ in T.COLUMNS}
+    judged = {c.id: verdicts[c.judged][c.id] for c in claims.claims}
+
+    def both(fn) -> str:
+        return "; ".join(f"{head}: {fn(cols[col], vals[col], cruise if col == 'teamnav' else T.PAPER_CRUISE_MPS)}"
+                         for col, head in T.COLUMNS)
+
+    def rule(cid: str) -> str:
+        c = claims[cid]
+        other = "teamnav" if c.judged == "paper_rules" else "paper_rules"
+        return (f" Rule ({claims.section}.yaml, judged on {c.judged}): {rule_text(c)}; {judged[cid][1]}; "
+                f"the other column: {verdicts[other][cid][1]}.")
+
+    blocks.append(Table("Claims: the paper, the paper as written, teamnav",
+                        ["claim", "paper", "rule (claim file)", "paper as written", "teamnav", "rule history"],
+                        T.claim_rows(claims, vals, verdicts),
+                        note="verdicts judged on the paper-as-written column (paper_rules: true, cruise "
+                             f"{T.PAPER_CRUISE_MPS:g} m/s); the teamnav column (cruise {cruise:g} m/s) is what the "
+                             "gap-fills buy"))
+    blocks.append(Table("Gap-fills: teamnav's value and the paper's (paper_rules: true sets the paper's)",
+                        ["parameter (trail-share-v1)", "teamnav", "paper as written", "where the paper says so"],
+                        T.gap_fill_rows(TrailShareParams, load_scenario("try-to-see-it-my-way").robots[0].params),
+                        note="kept in both columns (the paper gives no value): crumb radius 3 m, 'moving' = 5 cm "
+                             "since the last temporary trail, the sliding box's 2.0 m reach (lanes), the 180° "
+                             "rule's 150° threshold; the map's corridor width, passing places and dead ends are ours"))
+
     # 1. hours without breakdown, efficiency
-    trips = T.values(share, "trips_total")
-    dist_km = T.values(share, "distance_m_total") / 1000.0
-    cens = T.values(share, "breakdown_censored")
-    interval = T.values(share, "place_interval_s")
-    speed = T.values(share, "place_speed_mps")
-    eff = speed / cruise
-    # the efficiency's two factors: metres driven per trip against the route (detours), and the
-    # mean speed over the lifetime against cruise (stops, turns on the spot, Panic)
-    full = [r for r in share if T.values([r], "distance_m_total").size and T.values([r], "lifetime_min_total").size
-            and T.values([r], "trips_total").size and r["trips_total"] > 0 and r["lifetime_min_total"] > 0]
-    per_trip = T.values(full, "distance_m_total") / T.values(full, "trips_total")
-    moving = T.values(full, "distance_m_total") / (T.values(full, "lifetime_min_total") * 60.0) / cruise
-    b_rows, b_dur = (long_blaze, dur) if long_blaze else (same_blaze, drift_dur)
+    b_rows, b_dur = (long_blaze, dur) if long_blaze else (T.by_scale(d_blaze).get(1.0, []), drift_dur)
     b_cens = T.values(b_rows, "breakdown_censored")
     b_bd = T.values(b_rows, "breakdown_s")
-    late_long = _last_quarter_units(share, dur)
     late_long_b = _last_quarter_units(long_blaze, dur)
-    # "for hours": no verdict on runs shorter than an hour (quick mode)
-    holds1 = bool(cens.size and cens.mean() >= 0.8 and eff.size and np.median(eff) >= 0.75) if dur >= 3600.0 else None
+
+    def one(r, v, cr):
+        sh = r["share"]
+        eff, per_trip, moving = _efficiency(sh, cr)
+        cens = T.values(sh, "breakdown_censored")
+        return (f"{dur / 60:g} min at {cr:g} m/s: {T.msd(T.values(sh, 'trips_total'), '{:.0f}')} trips, "
+                f"{T.msd(T.values(sh, 'distance_m_total') / 1000.0, '{:.2f}', 'km')}; "
+                f"{T.msd(T.values(sh, 'place_interval_s'), '{:.0f}', 's')} between places: efficiency "
+                f"{T.msd(eff * 100, '{:.0f}', '%')} = route {ROUTE_M:g} m / {T.msd(per_trip, '{:.1f}', 'm')} driven per "
+                f"trip x {T.msd(moving * 100, '{:.0f}', '%')} of cruise over the lifetime; no breakdown in "
+                f"{int(cens.sum())} of {cens.size} runs, units in the last quarter {T.msd(_last_quarter_units(sh, dur))}")
     blocks.append(Comparison(
         "Runs for hours under drift, with no breakdown; efficiency near the paper's",
         "4 robots, 3 h 8 min: 262 trips, 8.2 km; 9 h 43 m 40 s of lifetime / 262 trips = 2 m 13 s between places "
         "= 0.23 m/s over 31 m, of 0.25 m/s cruise (92 %)",
-        f"{dur / 60:g} min: {T.msd(trips, '{:.0f}')} trips, {T.msd(dist_km, '{:.2f}', 'km')}; "
-        f"{T.msd(interval, '{:.0f}', 's')} between places = {T.msd(speed, '{:.2f}', 'm/s')}: efficiency "
-        f"{T.msd(eff * 100, '{:.0f}', '%')} = route {ROUTE_M:g} m / {T.msd(per_trip, '{:.1f}', 'm')} driven per trip "
-        f"x {T.msd(moving * 100, '{:.0f}', '%')} of cruise on average over the lifetime; no breakdown in {int(cens.sum())} of {cens.size} runs, units in the last "
-        f"quarter {T.msd(late_long)} (2000 algorithm, same drift, {b_dur / 60:g} min: no breakdown in "
+        both(one) + f" (2000 algorithm, teamnav, same drift, {b_dur / 60:g} min: no breakdown in "
         f"{int(b_cens.sum()) if b_cens.size else 0} of {b_cens.size}, breakdown at {T.msd(b_bd / 60, '{:.0f}', 'min')}"
         + (f", units in the last quarter {T.msd(late_long_b)}" if late_long_b.size else "") + ")",
-        holds1,
+        judged["hours-efficiency"][0],
         f"our robots never fail, so every lifetime is about the whole run (the paper's ran out of power or lost "
-        f"odometry); route {ROUTE_M:g} m, cruise {cruise:g} m/s (paper 31 m, 0.25 m/s)"))
+        f"odometry); route {ROUTE_M:g} m (paper 31 m); efficiency = place speed / the column's cruise."
+        + rule("hours-efficiency")))
 
     # 1b. hours at the drift that breaks the 2000 team (the long-run claim, several seeds)
-    blocks += hours_blocks(hours, T.by_scale(d_blaze).get(HOURS_SCALE, []), T.by_scale(d_blaze).get(0.0, []),
-                           drift_dur, quick)
+    c1b = claims["hours-at-breaking-drift"]
+    for col, head in T.COLUMNS:
+        blocks += hours_blocks(cols[col]["hours"], T.by_scale(cols[col]["d_blaze"]).get(HOURS_SCALE, []),
+                               T.by_scale(cols[col]["d_blaze"]).get(0.0, []), drift_dur, quick, column=head,
+                               judged=col == c1b.judged)
 
     # 2. with vs without Place transforms, and the 2000 algorithm, same drift, same length
+    same_share = T.by_scale(d_share).get(1.0, [])
+    same_blaze = T.by_scale(d_blaze).get(1.0, [])
     late_share = _last_quarter_units(same_share, drift_dur)
     late_plain = _last_quarter_units(plain, drift_dur)
     late_blaze = _last_quarter_units(same_blaze, drift_dur)
-    holds2 = None
-    if late_share.size and late_plain.size and late_blaze.size:
-        per_10min = late_share.mean() / (0.25 * drift_dur / 600.0)  # the 2002 team must still be working
-        holds2 = bool(per_10min >= T.WORKING_UNITS_PER_10MIN and late_share.mean() >= late_plain.mean()
-                      and late_share.mean() > late_blaze.mean())
+
+    def two(r, v, cr):
+        return (f"units in the last quarter of {drift_dur / 60:g}-min runs at the paper's drift: with transforms "
+                f"{T.msd(_last_quarter_units(T.by_scale(r['d_share']).get(1.0, []), drift_dur))}, without "
+                f"{T.msd(_last_quarter_units(r['plain'], drift_dur))}, 2000 algorithm "
+                f"{T.msd(_last_quarter_units(T.by_scale(r['d_blaze']).get(1.0, []), drift_dur))}")
     blocks.append(Comparison(
         "Trails are shared despite diverged frames (Place transforms)",
         "frames rotated 0.35–2 deg/min in both directions; trails shared throughout the 188 min",
-        f"units in the last quarter of {drift_dur / 60:g}-min runs at the paper's drift: with transforms "
-        f"{T.msd(late_share)}, without {T.msd(late_plain)}, 2000 algorithm {T.msd(late_blaze)}",
-        holds2,
+        both(two), judged["place-transforms"][0],
         "the paper had no no-transform or 2000-algorithm control under the same drift; ours are simulated with "
-        "pure heading drift (no wheel noise)"))
+        "pure heading drift (no wheel noise)." + rule("place-transforms")))
 
-    # 3. drift sweep, both algorithms
-    (xs_s, bd_s, lo_s, hi_s), (xs_b, bd_b, lo_b, hi_b), (_, last_s, llo_s, lhi_s), (_, last_b, llo_b, lhi_b) = \
-        drift_curves(d_share, d_blaze)
-    # judged at the drift that breaks the 2000 algorithm (EXPERIMENTS.md: "with drift that breaks the
-    # Blazing-a-trail system"): the k > 0 both ran where the 2000 team's last-10-min throughput is
-    # lowest, each team against its own k = 0
-    ls, lb = dict(zip(xs_s, last_s)), dict(zip(xs_b, last_b))
-    bs, bb = dict(zip(xs_s, bd_s)), dict(zip(xs_b, bd_b))
-    common = sorted(set(ls) & set(lb))
-    worst = [k for k in common if k > 0.0]
-    km = min(worst, key=lambda k: lb[k]) if worst else (common[-1] if common else None)
-    holds3 = None
-    if km is not None and drift_dur >= T.MIN_VERDICT_S:
-        holds3 = bool(ls[km] >= T.WORKING_UNITS_PER_10MIN and ls[km] > lb[km]
-                      and (0.0 not in ls or km == 0.0 or ls[km] >= 0.5 * ls[0.0])
-                      and (0.0 not in lb or km == 0.0 or lb[km] < 0.5 * lb[0.0]))  # the 2000 one must collapse
-    kept = ""
-    if km and ls.get(0.0, 0) > 0 and lb.get(0.0, 0) > 0:
-        kept = (f"; at k = {km:g} the 2002 team keeps {100 * ls[km] / ls[0.0]:.0f} % of its k = 0 "
-                f"throughput, the 2000 team {100 * lb[km] / lb[0.0]:.0f} %")
-    nan2 = (float("nan"), float("nan"))
+    # 3. drift sweep, both algorithms, judged at the highest k both ran (claim file)
+    def three(r, v, cr):
+        ls, lb, bs, bb, km = _drift_points(r["d_share"], r["d_blaze"])
+        nan2 = (float("nan"), float("nan"))
 
-    def at(k):
-        a, b = (ls[k], bs[k]) if k in ls else nan2
-        c, d = (lb[k], bb[k]) if k in lb else nan2
-        return f"k = {k:g}: {a:.1f} ({b / 60:.0f} min) / {c:.1f} ({d / 60:.0f} min)"
-
+        def at(k):
+            a, b = (ls[k], bs[k]) if k in ls else nan2
+            c, d = (lb[k], bb[k]) if k in lb else nan2
+            return f"k = {k:g}: {a:.1f} ({b / 60:.0f} min) / {c:.1f} ({d / 60:.0f} min)"
+        kept = ""
+        if km and ls.get(0.0, 0) > 0 and lb.get(0.0, 0) > 0:
+            kept = (f"; at k = {km:g} the 2002 team keeps {100 * ls[km] / ls[0.0]:.0f} % of its k = 0 "
+                    f"throughput, the 2000 team {100 * lb[km] / lb[0.0]:.0f} %")
+        return ("last-10-min units (median breakdown), 2002 / 2000: " + ", ".join(at(k) for k in sorted(set(ls) | set(lb)))
+                + kept)
     blocks.append(Comparison(
         "The 2000 algorithm's throughput collapses as drift grows; the 2002 one keeps working",
         "2000: breaks down at ~27 min; 2002: works for 3 h with 0.35–2 deg/min",
-        "last-10-min units (median breakdown), 2002 / 2000: " + "; ".join(at(k) for k in sorted(set(ls) | set(lb)))
-        + kept,
-        holds3,
-        f"{drift_dur / 60:g}-min runs; seeds per point in the drift table; k scales the 2002 paper's per-robot drift"))
+        both(three), judged["drift-collapse"][0],
+        f"{drift_dur / 60:g}-min runs; seeds per point in the drift table; k scales the 2002 paper's per-robot drift."
+        + rule("drift-collapse")))
     blocks += drift_table(d_share, d_blaze, drift_dur, quick)
     blocks += odometry_table(scale_s, scale_b, slip_s, slip_b, d_share, d_blaze, drift_dur, quick)
 
@@ -251,15 +333,13 @@ def build(ctx) -> list:
     blocks.append(table1_block(share))
 
     # memory
-    first, second = T.values(share, "crumbs_max_first_half"), T.values(share, "crumbs_max_second_half")
-    if first.size:
-        # the 4-min expiry needs the first half to be longer than 4 min before halves can be compared
-        flat = bool(second.mean() <= 1.25 * first.mean() + 10) if dur >= 2 * 240.0 * 2 else None
+    if T.values(share, "crumbs_max_first_half").size:
         blocks.append(Comparison(
             "Memory stays flat (crumbs older than 4 min are destroyed)",
             "34,743 crumbs received by Ant over 188 min, many fewer held at any time",
-            f"max crumbs held: first half {T.msd(first, '{:.0f}')}, second half {T.msd(second, '{:.0f}')}",
-            flat, ""))
+            both(lambda r, v, cr: f"max crumbs held: first half {T.msd(T.values(r['share'], 'crumbs_max_first_half'), '{:.0f}')}, "
+                                  f"second half {T.msd(T.values(r['share'], 'crumbs_max_second_half'), '{:.0f}')}"),
+            judged["memory-flat"][0], rule("memory-flat").strip()))
     else:
         blocks.append(Missing("crumb counts", "trail-share-v1 did not log n_crumbs"))
     blocks += _profile_blocks(prof, prof_b, T.by_scale(d_blaze).get(PROFILE_SCALE, []),
