@@ -261,3 +261,17 @@ def test_a_map_file_given_with_set_is_relative_to_the_current_folder(tmp_path, m
     (tmp_path / "sub").mkdir()
     (tmp_path / "sub" / "s.yaml").write_text("name: s\nmap: {file: ../maps/tb3_sandbox.yaml}\nrobots: [{count: 1}]\n")
     assert Path(load_scenario(str(tmp_path / "sub" / "s.yaml")).map.file).resolve() == tmp_path / "maps" / "tb3_sandbox.yaml"
+
+
+def test_an_env_section_is_accepted_by_run_and_left_out_when_absent(tmp_path):
+    """A scenario file with an ``env:`` section (teamnav.env's settings) validates for
+    ``teamnav run``; without one, the resolved scenario and its config hash do not mention it."""
+    from teamnav.experiments.spec import load_scenario, scenario_to_yaml
+    from teamnav.experiments.sweep import config_hash
+
+    plain = load_scenario("demo")
+    assert "env" not in scenario_to_yaml(plain)
+    with_env = load_scenario("demo", overrides=["env={agents_from: [wanderer], observe_truth: false}"])
+    assert with_env.env == {"agents_from": ["wanderer"], "observe_truth": False}
+    assert config_hash(with_env) != config_hash(plain)
+    assert load_scenario(plain).env is None and config_hash(load_scenario("demo")) == config_hash(plain)

@@ -39,7 +39,7 @@ import os
 import re
 from importlib import resources
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, ClassVar, Mapping, Sequence
 
 import yaml
 from pydantic import Field, PrivateAttr, ValidationError, field_validator, model_validator
@@ -265,6 +265,11 @@ class Scenario(SimConfig):
     metrics: tuple[str, ...] = ()
     give_map: bool = False
     stop_when_finished: bool = False
+    #: settings for :mod:`teamnav.env` (agents, rewards, observations), validated there;
+    #: ``teamnav run`` ignores them, so one file serves both. Left out of the resolved scenario
+    #: when absent (config hashes of scenarios without it are unchanged).
+    env: dict[str, Any] | None = None
+    _OMIT_WHEN_NONE: ClassVar[tuple[str, ...]] = ("env",)
 
     _source: str = PrivateAttr(default="<code>")
 

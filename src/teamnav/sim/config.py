@@ -16,7 +16,7 @@ robots named by global index or by group name and index; :mod:`teamnav.sim.fault
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, ClassVar, Literal, Union
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_serializer, model_validator
 
@@ -490,6 +490,8 @@ class SimConfig(Model):
     #: faults (None or an empty section) is the same, bit for bit, as before faults existed,
     #: and the section is left out of the resolved scenario then.
     faults: FaultsConfig | None = None
+    #: fields a subclass adds that serialisation leaves out when None (config hashes unchanged)
+    _OMIT_WHEN_NONE: ClassVar[tuple[str, ...]] = ()
 
     @field_validator("robots")
     @classmethod
@@ -528,6 +530,10 @@ class SimConfig(Model):
         data = handler(self)
         if isinstance(data, dict) and (self.faults is None or self.faults.empty):
             data.pop("faults", None)
+        if isinstance(data, dict):  # sections of subclasses that are left out when absent (Scenario.env)
+            for key in self._OMIT_WHEN_NONE:
+                if data.get(key, 0) is None:
+                    data.pop(key)
         return data
 
     @property
