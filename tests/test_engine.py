@@ -433,3 +433,27 @@ def test_long_sensor_names_are_recorded_under_distinct_short_keys(tmp_path):
     scans = load(result.run_dir).scans
     assert len(scans) == 2 and all(len(k) <= 64 for k in scans)
     assert sorted(s.sensor for s in scans.values()) == [long + "x", long + "y"]
+
+
+def test_decide_first_and_set_commands_let_an_outside_agent_act_on_step_0():
+    """Simulation.decide_first takes the step-0 decision without motion (idempotent), and
+    set_commands replaces the stored commands of chosen robots before the next step moves
+    them; bad ids or shapes are refused."""
+    from teamnav.experiments.spec import build_grid, load_scenario
+
+    scn = load_scenario("demo", overrides=["robots.0.count=3"], duration_s=1.0)
+    sim = Simulation(build_grid(scn), scn)
+    x0 = sim.state.x_m.copy()
+    sim.decide_first()
+    sim.decide_first()
+    assert sim.step_index == 0 and np.array_equal(sim.state.x_m, x0)
+    sim.set_commands([1], [0.0], [0.0])
+    sim.step()
+    assert sim.state.x_m[1] == x0[1] and sim.state.y_m[1] == sim.state.y_m[1]  # robot 1 held still
+    assert not np.array_equal(sim.state.x_m[[0, 2]], x0[[0, 2]])  # the others moved on their brains
+    with pytest.raises(ValueError, match="robot indices"):
+        sim.set_commands([3], [0.0], [0.0])
+    with pytest.raises(ValueError, match="shape"):
+        sim.set_commands([0, 1], [0.0], [0.0, 0.0])
+    with pytest.raises(ValueError, match="finite"):
+        sim.set_commands([0], [float("nan")], [0.0])

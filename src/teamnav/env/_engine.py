@@ -1,5 +1,8 @@
-"""The two things an environment needs from :class:`~teamnav.sim.engine.Simulation` that its
-public API does not offer yet, in one place.
+"""What an environment needs from :class:`~teamnav.sim.engine.Simulation`, in one place.
+
+``Simulation.decide_first`` and ``Simulation.set_commands`` are the engine's public hooks for
+it (used here when present); the fallbacks below write the same internals for an engine
+without them.
 
 An outside agent decides *after* it has seen its observation, but the engine asks a brain for
 its action in the same call that builds the observation (``Simulation.step`` senses, then
@@ -69,7 +72,7 @@ def set_commands(sim, ids, v_mps, omega_radps, direction_rad) -> None:
     them to each robot's limits."""
     hook = getattr(sim, "set_commands", None)
     if callable(hook):
-        hook(ids, v_mps, omega_radps, np.nan if direction_rad is None else direction_rad)
+        hook(ids, v_mps, omega_radps, direction_rad)
         return
     sim._v_cmd[ids] = v_mps
     sim._w_cmd[ids] = omega_radps

@@ -372,11 +372,52 @@ class Simulation:
         if steps.shape[0] == 0 or int(steps[-1]) != self.step_index:
             self._record()
 
-    def step(self) -> None:
-        """Advance the simulation by one fixed step ``dt_s`` (see the module docstring)."""
+    def decide_first(self) -> None:
+        """Take the first decision now: every brain sees the observation of step 0 and its
+        commands are stored, with no motion (what the first :meth:`step` does lazily).
+        Idempotent. An outside agent (:mod:`teamnav.env`) needs the step-0 observation before
+        it acts."""
         if not self._decided:
             self._observe_and_decide(None, None)
             self._decided = True
+
+    def set_commands(self, ids, v_mps, omega_radps, direction_rad=None) -> None:
+        """Replace the stored commands of robots ``ids`` before the next :meth:`step` moves
+        them: what an outside agent decided on the observation it was given (the brain's
+        own commands for those robots are overwritten).
+
+        Parameters
+        ----------
+        ids : array of int, shape (k,), or a slice
+            Robot indices, each in ``0..n_robots-1`` (a group's slice, e.g.).
+        v_mps, omega_radps : array of float, shape (k,)
+            Speed [m/s] and turn rate [rad/s] (unicycles); limited by the robot's own limits
+            as any brain's command is.
+        direction_rad : float or array of float, shape (k,), optional
+            Heading of motion for holonomic robots (NaN: none, as for unicycles); a scalar
+            applies to every robot of ``ids``; None leaves the stored directions as they are.
+        """
+        ids = np.arange(self.n_robots)[ids] if isinstance(ids, slice) else np.asarray(ids, dtype=np.int64).reshape(-1)
+        k = ids.shape[0]
+        if k and (ids.min() < 0 or ids.max() >= self.n_robots):
+            raise ValueError(f"ids must be robot indices in 0..{self.n_robots - 1}, got {ids.tolist()}")
+        v = np.asarray(v_mps, dtype=np.float64).reshape(-1)
+        w = np.asarray(omega_radps, dtype=np.float64).reshape(-1)
+        d = self._dir_cmd[ids] if direction_rad is None else np.asarray(direction_rad, dtype=np.float64).reshape(-1)
+        if d.shape == (1,) and k != 1:
+            d = np.full(k, d[0])
+        for name, arr in (("v_mps", v), ("omega_radps", w), ("direction_rad", d)):
+            if arr.shape != (k,):
+                raise ValueError(f"{name} must have shape ({k},) like ids, got {arr.shape}")
+        if not (np.isfinite(v).all() and np.isfinite(w).all()) or np.isinf(d).any():
+            raise ValueError("v_mps and omega_radps must be finite, direction_rad finite or NaN")
+        self._v_cmd[ids] = v
+        self._w_cmd[ids] = w
+        self._dir_cmd[ids] = d
+
+    def step(self) -> None:
+        """Advance the simulation by one fixed step ``dt_s`` (see the module docstring)."""
+        self.decide_first()
         for h in self._pre_hooks:
             h(self)
         s = self.state
