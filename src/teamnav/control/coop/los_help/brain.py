@@ -350,7 +350,9 @@ class _LosBrain(abc.ABC):
         (:func:`~.goal_sharing.point_visible`)."""
         if self._scan is None:
             return False
-        bx, by = self._odom_to_body(x, y)
+        dx, dy = x - self._px, y - self._py  # _odom_to_body, inline (speed: ~5 calls per step)
+        c, s = self._c, self._s
+        bx, by = c * dx + s * dy, -s * dx + c * dy
         d = math.hypot(bx, by)
         if d > self.vis_radius_m:
             return False
@@ -363,7 +365,9 @@ class _LosBrain(abc.ABC):
         range and *some* beam within 1.5 beam spacings of its bearing reaches past it."""
         if self._scan is None:
             return False
-        bx, by = self._odom_to_body(x, y)
+        dx, dy = x - self._px, y - self._py  # _odom_to_body, inline
+        c, s = self._c, self._s
+        bx, by = c * dx + s * dy, -s * dx + c * dy
         d = math.hypot(bx, by)
         if d > self.vis_radius_m:
             return False
@@ -444,24 +448,32 @@ class _LosBrain(abc.ABC):
         """Read the inbox: frames from mutual bearings, Id rule, D arbitration, Tr bits."""
         self._teammate_tr = {}
         self._teammate_tr_xy = {}
+        me = self.me
+        history = self._history
+        goal_sharing = self.params.goal_sharing
+        receive_goal, receive_report = self.sharing.receive_goal, self.sharing.receive_report
         for msg in obs.inbox:
             body = msg.body
-            if not isinstance(body, LosHelpMsg) or msg.sender == self.me:
+            if not isinstance(body, LosHelpMsg) or msg.sender == me:
                 continue
             self.msgs_received += 1
             s = int(msg.sender)
             if body.trouble is not None:
                 self._teammate_tr[s] = bool(body.trouble)
-                sent = self._history.get(int(body.step))
+                sent = history.get(int(body.step))
                 if sent is not None and s in sent[1]:
                     rng_s, b_s = sent[1][s]
                     self._teammate_tr_xy[s] = self._body_to_odom(sent[0], rng_s * math.cos(b_s), rng_s * math.sin(b_s))
-            if not self.params.goal_sharing:
+            if not goal_sharing:
                 continue
-            hist = self._history.get(int(body.step))
+            hist = history.get(int(body.step))
             if hist is None or s not in hist[1]:
                 continue  # I did not see the sender when it sent: no frame
-            back = next((sg for sg in body.sightings if sg.robot_id == self.me), None)
+            back = None
+            for sg in body.sightings:
+                if sg.robot_id == me:
+                    back = sg
+                    break
             if back is None:
                 continue  # the sender did not see me: no mutual bearing
             (kx, ky, kth), seen_k = hist
@@ -473,18 +485,19 @@ class _LosBrain(abc.ABC):
             sender_xy = (kx + ck * r0 - sk * r1, ky + sk * r0 + ck * r1)
             c, sn = math.cos(rel[2]), math.sin(rel[2])
             for g in body.goals:
-                if g.owner == self.me:
+                if g.owner == me:
                     continue
                 bx, by = r0 + c * g.gx_m - sn * g.gy_m, r1 + sn * g.gx_m + c * g.gy_m
-                self.sharing.receive_goal(g.owner, g.goal_id, (kx + ck * bx - sk * by, ky + sk * bx + ck * by))
+                receive_goal(g.owner, g.goal_id, (kx + ck * bx - sk * by, ky + sk * bx + ck * by))
             me_k = (kx, ky)
+            step_k = int(body.step)
             for r in body.reports:
                 via = None
                 if r.via_d_m is not None:
                     bx, by = r0 + c * r.via_x_m - sn * r.via_y_m, r1 + sn * r.via_x_m + c * r.via_y_m
                     via = (kx + ck * bx - sk * by, ky + sk * bx + ck * by)
-                self.sharing.receive_report(r.owner, r.goal_id, s, sender_xy, r.d_m, me_xy=me_k, step=int(body.step),
-                                            via_xy=via, via_d_m=r.via_d_m)
+                receive_report(r.owner, r.goal_id, s, sender_xy, r.d_m, me_xy=me_k, step=step_k, via_xy=via,
+                               via_d_m=r.via_d_m)
 
     # ------------------------------------------------------------------ broadcast (§4.4)
     def _broadcast(self, obs: Observation, sightings: dict[int, tuple[float, float]]) -> list[Message]:
@@ -495,11 +508,14 @@ class _LosBrain(abc.ABC):
         reports: tuple[VisReport, ...] = ()
         sights: tuple[Sighting, ...] = ()
         if p.goal_sharing:
-            sights = tuple(Sighting(rid, b, r) for rid, (r, b) in sorted(sightings.items()))
-            goals = tuple(GoalShare(owner, gid, *self._odom_to_body(x, y)) for owner, gid, x, y in self.sharing.shares())
+            sights = tuple([Sighting(rid, b, r) for rid, (r, b) in sorted(sightings.items())])
+            # _odom_to_body of each point, inline (speed; the same operations)
+            px, py, c, s = self._px, self._py, self._c, self._s
+            goals = tuple([GoalShare(owner, gid, c * (x - px) + s * (y - py), -s * (x - px) + c * (y - py))
+                           for owner, gid, x, y in self.sharing.shares()])
             if p.share_via:
-                reports = tuple(VisReport(owner, gid, d, *self._odom_to_body(vx, vy), vd)
-                                for owner, gid, d, vx, vy, vd in self.sharing.reports_via(self._me_xy()))
+                reports = tuple([VisReport(owner, gid, d, c * (vx - px) + s * (vy - py), -s * (vx - px) + c * (vy - py), vd)
+                                 for owner, gid, d, vx, vy, vd in self.sharing.reports_via((px, py))])
             else:
                 reports = tuple(VisReport(owner, gid, d) for owner, gid, d in self.sharing.reports(self._me_xy()))
         body = LosHelpMsg(int(obs.step), sights, goals, reports, bool(self.trouble.tr) if p.state_sharing else None)

@@ -56,7 +56,8 @@ from typing import Callable, Iterable
 import numpy as np
 from numba import njit
 
-from teamnav.control.nav.local.base import pymod
+from teamnav.control.nav.local.base import mod_two_pi, pymod
+from teamnav.control.types import _fast_frozen_init
 from teamnav.geometry.bearings import relative_frame_from_bearings, transform_goal
 from teamnav.geometry.se2 import compose, transform_points
 
@@ -239,10 +240,10 @@ def nearest_beam_visible(ranges_m, angles_rad, d_m, bearing_rad, margin_m, max_g
     if n == 0:
         raise ValueError("attempt to get argmin of an empty sequence")
     best = 0
-    best_diff = abs(pymod(angles_rad[0] - bearing_rad + math.pi, _TWO_PI) - math.pi)
+    best_diff = abs(mod_two_pi(angles_rad[0] - bearing_rad + math.pi) - math.pi)
     if best_diff == best_diff:  # NaN: np.argmin returns the first NaN
         for i in range(1, n):
-            diff = abs(pymod(angles_rad[i] - bearing_rad + math.pi, _TWO_PI) - math.pi)
+            diff = abs(mod_two_pi(angles_rad[i] - bearing_rad + math.pi) - math.pi)
             if diff != diff:
                 best, best_diff = i, diff
                 break
@@ -258,7 +259,7 @@ def beam_near_reaches(ranges_m, angles_rad, d_m, bearing_rad, max_diff_rad):
     """Some beam within ``max_diff_rad`` of ``bearing_rad`` reads at least ``d_m`` (numba; the
     brains' lenient ``keep_direct_view`` test)."""
     for i in range(angles_rad.shape[0]):
-        diff = abs(pymod(angles_rad[i] - bearing_rad + math.pi, _TWO_PI) - math.pi)
+        diff = abs(mod_two_pi(angles_rad[i] - bearing_rad + math.pi) - math.pi)
         if diff <= max_diff_rad and ranges_m[i] >= d_m:
             return True
     return False
@@ -291,7 +292,7 @@ def see_past_teammates(ranges_m, angles_rad, max_range_m, ranges_det_m, bearings
         half = 2.0 * math.atan(1.5 * radius_m / d)
         reach = 1.7 * d + 2.0 * radius_m
         for i in range(n):
-            diff = abs(pymod(angles_rad[i] - bearings_det_rad[j] + math.pi, _TWO_PI) - math.pi)
+            diff = abs(mod_two_pi(angles_rad[i] - bearings_det_rad[j] + math.pi) - math.pi)
             if diff <= half and ranges_m[i] <= reach:
                 masked[i] = True
                 any_masked = True
@@ -332,6 +333,7 @@ def max_beam_gap(angles: np.ndarray) -> float:
 
 
 # ------------------------------------------------------------------ memory (§4.2–§4.4)
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class KnownGoal:
     """Robot ``owner``'s goal as this robot stores it: identifier and position in its own frame."""
@@ -342,6 +344,7 @@ class KnownGoal:
     gy_m: float
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class GoalPath:
     """Where a robot believes one goal is seen from (see the module docstring).
@@ -496,10 +499,14 @@ class GoalSharing:
         if owner == self.me:
             return False
         old = self.known.get(owner)
-        if not accept_goal_id(None if old is None else old.goal_id, gid):
-            return False
-        if old is not None and goal_index(old.goal_id, self.team_size) != goal_index(gid, self.team_size):
-            self.paths.pop(owner, None)
+        if old is not None:
+            # accept_goal_id and goal_index, inline (speed: called per goal per message)
+            og = int(old.goal_id)
+            if not int(gid) >= og:
+                return False
+            m = int(self.team_size)
+            if (og - 1) // m != (int(gid) - 1) // m:
+                self.paths.pop(owner, None)
         self.known[owner] = KnownGoal(int(owner), int(gid), float(goal_xy[0]), float(goal_xy[1]))
         return True
 
@@ -525,15 +532,25 @@ class GoalSharing:
         """
         if not (math.isfinite(d_m) and d_m >= 0.0):
             return False
-        stored = self.goal_of(owner)
-        if stored is None or goal_index(stored[0], self.team_size) != goal_index(gid, self.team_size):
+        # goal_of and goal_index, inline (speed: called per report per message)
+        if owner == self.me:
+            if self.own_k is None:
+                return False
+            stored_id = self.own_id
+        else:
+            g = self.known.get(owner)
+            if g is None:
+                return False
+            stored_id = g.goal_id
+        m = int(self.team_size)
+        if (int(stored_id) - 1) // m != (int(gid) - 1) // m:
             return False
         path = self.paths.get(owner)
         cand = math.hypot(reporter_xy[0] - me_xy[0], reporter_xy[1] - me_xy[1]) + float(d_m)
         if path is not None:
             if path.kind == "direct":
                 return False
-            now = path.distance_m(me_xy)
+            now = math.hypot(path.px_m - me_xy[0], path.py_m - me_xy[1]) + path.d_point_m  # path.distance_m
             margin = self.report_margin_m
             if owner == self.me and path.reached and self.lead_on:
                 # a teammate further along the light path leads on (see ``lead_on``)
@@ -545,7 +562,7 @@ class GoalSharing:
         via = (None, None, None)
         if via_xy is not None and via_d_m is not None and math.isfinite(via_d_m):
             via = (float(via_xy[0]), float(via_xy[1]), float(via_d_m))
-        self.paths[owner] = GoalPath(stored[0], float(reporter_xy[0]), float(reporter_xy[1]), float(d_m), "ghost",
+        self.paths[owner] = GoalPath(stored_id, float(reporter_xy[0]), float(reporter_xy[1]), float(d_m), "ghost",
                                      int(reporter), int(step), d_promised_m=cand,
                                      via_x_m=via[0], via_y_m=via[1], via_d_m=via[2])
         return True
@@ -580,20 +597,22 @@ class GoalSharing:
             a goal seen through a door at a slant flickers in and out of the one beam nearest
             its bearing as the robot moves; see the brain's ``keep_direct_view``). None: ``sees``.
         """
-        for owner in [self.me, *self.known]:
-            stored = self.goal_of(owner)
-            if stored is None:
-                continue
-            gid, gx, gy = stored
-            path = self.paths.get(owner)
+        # goal_of per owner, inline (speed): the own goal first, then the known ones in order
+        goals = [(g.owner, g.goal_id, g.gx_m, g.gy_m) for g in self.known.values()]
+        if self.own_k is not None:
+            goals.insert(0, (self.me, self.own_id, self.own_goal[0], self.own_goal[1]))
+        paths = self.paths
+        me = self.me
+        for owner, gid, gx, gy in goals:
+            path = paths.get(owner)
             kept = (keeps is not None and path is not None and path.kind == "direct"
                     and (path.px_m, path.py_m) == (gx, gy) and keeps(gx, gy))
             if kept or sees(gx, gy, 0.0):  # rule 3: direct view (§2 point 4); beats any report (§3.1)
-                self.paths[owner] = GoalPath(gid, gx, gy, 0.0, "direct", self.me, int(step))
+                paths[owner] = GoalPath(gid, gx, gy, 0.0, "direct", me, int(step))
                 continue
             if path is None:
                 continue
-            if owner == self.me:
+            if owner == me:
                 if path.kind == "direct":  # the owner lost its view: back to its navigator
                     del self.paths[owner]
                 continue
@@ -605,8 +624,11 @@ class GoalSharing:
                 # §4.3: the point left the view: substitute the last own position from which it
                 # was visible, with its distance to the goal.
                 d_prev = math.hypot(path.px_m - prev_me_xy[0], path.py_m - prev_me_xy[1]) + path.d_point_m
-                self.paths[owner] = replace(path, px_m=float(prev_me_xy[0]), py_m=float(prev_me_xy[1]),
-                                            d_point_m=d_prev, kind="self", source=self.me, step=int(step))
+                # (``replace(path, px_m=..., py_m=..., d_point_m=d_prev, kind="self", source=me,
+                # step=step)``, written out: dataclasses.replace walks the fields each call)
+                self.paths[owner] = GoalPath(path.goal_id, float(prev_me_xy[0]), float(prev_me_xy[1]), d_prev, "self",
+                                             me, int(step), path.reached, path.d_promised_m, path.via_x_m,
+                                             path.via_y_m, path.via_d_m)
 
     def mark_reached(self, owner: int) -> None:
         """The owner reached its path's point without seeing the goal: keep it only to arbitrate."""
@@ -620,9 +642,11 @@ class GoalSharing:
         out = []
         if self.own_k is not None:
             out.append((self.me, self.own_id, self.own_goal[0], self.own_goal[1]))
+        m = int(self.team_size)
         for g in self.known.values():
-            if can_relay(g.goal_id, self.team_size):
-                out.append((g.owner, relayed_id(g.goal_id), g.gx_m, g.gy_m))
+            gid = int(g.goal_id)
+            if gid - ((gid - 1) // m) * m > 1:  # can_relay: hops(gid) > 1, inline (speed)
+                out.append((g.owner, gid - 1, g.gx_m, g.gy_m))
         return out
 
     def reports(self, me_xy) -> list[tuple[int, int, float]]:
@@ -633,12 +657,10 @@ class GoalSharing:
         """(owner, Id, D, via_x, via_y, via_d) for every other robot's goal this robot sees:
         :meth:`reports` plus the point its D leads through (own frame) and that point's
         promised distance (see :class:`~.messages.VisReport`)."""
-        out = []
-        for owner, p in self.paths.items():
-            if owner == self.me:
-                continue
-            out.append((owner, p.goal_id, p.distance_m(me_xy), p.px_m, p.py_m, p.d_point_m))
-        return out
+        mx, my = me_xy[0], me_xy[1]
+        me = self.me
+        return [(owner, p.goal_id, math.hypot(p.px_m - mx, p.py_m - my) + p.d_point_m, p.px_m, p.py_m, p.d_point_m)
+                for owner, p in self.paths.items() if owner != me]
 
     def points(self) -> Iterable[GoalPath]:
         """All stored paths (for drawing)."""

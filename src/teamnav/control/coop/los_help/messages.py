@@ -27,12 +27,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from teamnav.control.types import _fast_frozen_init
+
 __all__ = ["GoalShare", "LosHelpMsg", "Sighting", "VisReport", "MESSAGE_KIND", "message_size_bytes"]
 
 #: ``Message.kind`` of the system's messages (per-kind traffic counts).
 MESSAGE_KIND = "los_help"
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class Sighting:
     """A teammate the sender sees: its id, bearing [rad] and range [m] in the sender's body frame."""
@@ -42,6 +45,7 @@ class Sighting:
     range_m: float
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class GoalShare:
     """Robot ``owner``'s goal, identifier ``goal_id`` (Id = k·M, minus one per hop), at
@@ -53,6 +57,7 @@ class GoalShare:
     gy_m: float
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class VisReport:
     """The sender sees (directly, reflected or delayed) goal ``goal_id`` of ``owner`` with
@@ -74,6 +79,7 @@ class VisReport:
     via_d_m: float | None = None
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class LosHelpMsg:
     """One step's broadcast of a robot (see the module docstring).

@@ -103,6 +103,27 @@ def pymod(a, b):
     return m
 
 
+@njit(cache=True, inline="always")
+def mod_two_pi(x):
+    """``pymod(x, 2π)`` (``np.mod(x, 2π)``, 2π the float ``2.0 * math.pi``), the same bits, without
+    ``fmod`` on ``(−2π, 4π)``, where the beam tests' ``angle − bearing + π`` falls: there
+    ``fmod`` is ``x`` (``0 < x < 2π``), exactly ``x − 2π`` (``2π ≤ x < 4π``: Sterbenz, the
+    difference is exact and equals ``fmod``'s exact result) or ``x`` and then ``+ 2π`` in
+    pymod's own sign fix (``−2π < x < 0``); zeros (−0.0 too) give +0.0 as pymod; anything
+    else (NaN, far angles) goes through :func:`pymod`."""
+    if x > 0.0:
+        if x < _TWO_PI:
+            return x
+        if x < 2.0 * _TWO_PI:
+            return x - _TWO_PI
+    elif x < 0.0:
+        if x > -_TWO_PI:
+            return x + _TWO_PI
+    elif x == 0.0:
+        return 0.0
+    return pymod(x, _TWO_PI)
+
+
 def wrap_scalar(a: float) -> float:
     """``float(wrap_angle(a))`` for one angle, on Python floats (the same operations:
     Python's float ``%`` is numpy's ``np.mod``)."""

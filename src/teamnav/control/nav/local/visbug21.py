@@ -124,6 +124,7 @@ from teamnav.control.nav.local.visbug21_geometry import (
     END_TOL_M,
     FOLLOW_GAP_M,
     _follow_kernel,
+    _last_visible,
     boundary_heading,
 )
 from teamnav.control.types import RangeScan
@@ -656,11 +657,13 @@ class VisBug21:
     def _intermediate_target(self, xy, points, r_safe, reach_m) -> np.ndarray | None:
         """Step 1's Ti: the visible M-line point nearest the goal, at least one step away (else None)."""
         cand, t = self._mline_samples(self._t_anchor)
-        ok = self._visible(xy, points, cand, r_safe, reach_m)
+        # speed: the last visible candidate, searched from the goal end (``_last_visible``: the
+        # arithmetic of ``_visible``, which tested every candidate; kept for the tests)
+        j = int(_last_visible(float(xy[0]), float(xy[1]), points[:, 0], points[:, 1], cand[:, 0], cand[:, 1],
+                              float(r_safe), float(reach_m), float(self._slack)))
         self._blocked_xy = None
-        if not ok.any():
+        if j < 0:
             return None
-        j = int(np.flatnonzero(ok)[-1])
         ti = cand[j]
         if t[j] >= 1.0 - 1e-12 or math.hypot(*(ti - xy)) >= self.step_length_m:
             return ti

@@ -181,3 +181,59 @@ def _continues(pts, dirs, r, hit, px, py, i, j, k):
     if not r_line > 0.0:
         return False
     return r[k] <= r_line + END_TOL_M + END_TOL_FRACTION * min(r[k], r_line)
+
+
+@njit(cache=True)
+def _last_visible(x, y, px, py, cx, cy, r_safe, reach_m, slack_rad):
+    """Step 1's Ti search (numba): the index of the *last* candidate point (``cx``, ``cy``)
+    that :meth:`~teamnav.control.nav.local.visbug21.VisBug21._visible` finds visible from
+    (``x``, ``y``), or -1; the candidates after it are tested, the ones before it are not.
+
+    The same arithmetic per candidate as ``_visible`` and ``segment_clear``: a candidate is
+    visible when ``hypot(c - xy) <= reach_m`` and no sensed point with ``hypot(p - xy) <=
+    reach_m + 2 r_safe`` lies nearer than ``r_safe`` to the segment xy -> c, a point counting
+    ``slack_rad · hypot(p - xy)`` nearer (``math.hypot`` is libm's ``hypot``, as ``np.hypot``).
+    Testing from the goal end backwards stops at the answer instead of testing every M-line
+    sample (``_intermediate_target`` only uses the last visible one).
+    """
+    nk = px.shape[0]
+    kx = np.empty(nk)
+    ky = np.empty(nk)
+    ks = np.empty(nk)
+    lim_p = reach_m + 2.0 * r_safe
+    m = 0
+    for k in range(nk):
+        rp = math.hypot(px[k] - x, py[k] - y)
+        if rp <= lim_p:
+            kx[m] = px[k]
+            ky[m] = py[k]
+            ks[m] = slack_rad * rp
+            m += 1
+    for j in range(cx.shape[0] - 1, -1, -1):
+        if not math.hypot(cx[j] - x, cy[j] - y) <= reach_m:
+            continue
+        if m == 0:
+            return j
+        d0 = cx[j] - x
+        d1 = cy[j] - y
+        len2 = d0 * d0 + d1 * d1
+        if len2 < 1e-24:
+            len2 = 1e-24
+        ok = True
+        for k in range(m):
+            rx = kx[k] - x
+            ry = ky[k] - y
+            t = (rx * d0 + ry * d1) / len2
+            if t < 0.0:
+                t = 0.0
+            if t > 1.0:
+                t = 1.0
+            ex = rx - t * d0
+            ey = ry - t * d1
+            v = math.sqrt(ex * ex + ey * ey) - ks[k]
+            if not v >= r_safe:
+                ok = False
+                break
+        if ok:
+            return j
+    return -1
