@@ -4,7 +4,6 @@ is unchanged, bad fault specs are refused naming the field, and a fault scenario
 
 from __future__ import annotations
 
-import json
 import math
 import textwrap
 

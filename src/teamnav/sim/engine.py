@@ -68,7 +68,7 @@ from teamnav.control import registry
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, BatchAction, BatchObservation, Message, Observation, RangeScan
 from teamnav.sim.collisions import move_discs
-from teamnav.sim.config import SimConfig
+from teamnav.sim.config import SimConfig, resolve_robot, resolve_sensor
 from teamnav.sim.events import Places
 from teamnav.sim.kinematics import motion_primitives
 from teamnav.sim.odometry import Odometry
@@ -458,8 +458,6 @@ class Simulation:
             for j, entry in enumerate(getattr(cfg, kind)):
                 if entry.robot is None:
                     continue
-                from teamnav.sim.config import resolve_robot, resolve_sensor
-
                 field = f"faults.{kind}[{j}]"
                 grp = self._groups[int(self.group_of[resolve_robot(entry.robot, self.config.robots, field + '.robot')])]
                 if not grp.batched:

@@ -294,7 +294,8 @@ def _mcl(ctx) -> list:
         f"Collaborative MCL (§5.1 setting, 240 s, seeds {_seeds_text(rows)}): Robin, the corridor robot",
         ["case", "runs with Robin localized at the end", "Robin's time to localize [s]", "Robin's final error [m]"],
         table, note="Time to localize: the first time Robin's error falls below 1.5 m (censored at 240 s: a lower "
-                    "bound then; with a kidnapping, the first localization, before the jump). Kidnappings at 100 s (Robin anywhere in the corridor, Marian anywhere in the lab); "
+                    "bound then; with a kidnapping, the first localization, before the jump). Kidnappings at 100 s "
+                    "(Robin anywhere in the corridor, Marian anywhere in the lab); "
                     "phantoms: 1 per second in Marian's detector, 30-120 s, each naming Robin; blackout 30-120 s.")]
     kid = []
     for c, who in (("kidnap-robin", "Robin (corridor)"), ("kidnap-marian", "Marian (observer)")):
