@@ -112,3 +112,43 @@ def test_sharing_records_keep_dataclass_behaviour():
     for obj in (p, KnownGoal(1, 8, 0.5, -0.5), Sighting(1, 0.1, 2.0), GoalShare(1, 8, 0.0, 1.0), msg):
         with pytest.raises(FrozenInstanceError):
             obj.__setattr__(type(obj).__dataclass_fields__.__iter__().__next__(), 0)
+
+
+@given(seeds, st.floats(-5.0, 5.0), st.floats(-5.0, 5.0), st.floats(-4.0, 4.0), st.sampled_from([8, 36, 72]),
+       st.floats(0.0, 1.2))
+@FAST
+def test_leave_point_equals_numpy(seed, x, y, th, n_beams, hit_frac):
+    """Step 2's leave test with ``_leave_candidates`` gives the point (bits), the M-line anchor
+    and None exactly when the numpy version (``_leave_point_numpy``) does."""
+    from teamnav.control.nav.local.visbug21 import MODE_FOLLOW, VisBug21, VisBugParams
+    from teamnav.control.types import RangeScan
+
+    rng = np.random.default_rng(seed)
+    angles = np.linspace(-math.pi, math.pi, n_beams, endpoint=False)
+    r = rng.uniform(0.3, 8.0, n_beams)
+    r[rng.random(n_beams) < 0.4] = 8.0
+    if seed % 4 == 0:
+        r[:] = 8.0  # nothing sensed
+    scan = RangeScan(r, angles, 8.0)
+    pose = np.array([x, y, th])
+    goal = pose[:2] + rng.uniform(-9, 9, 2)
+    start = pose[:2] + rng.uniform(-2, 2, 2)
+    navs = []
+    leave_run = float(rng.choice([0.0, 0.5, 2.0]))
+    for _ in range(2):
+        nav = VisBug21(VisBugParams(leave_run_m=leave_run),
+                       np.random.default_rng(0), 0.2, 0.2)
+        nav.goal_xy = goal.copy()
+        nav.mline = (start.copy(), goal.copy())
+        nav.mode = MODE_FOLLOW
+        nav.hit_dist_m = hit_frac * math.hypot(*(goal - start)) + 0.05
+        nav._slack = math.pi / n_beams
+        navs.append(nav)
+    points = base.scan_points(pose, scan)
+    r_safe = 0.25 + 0.03
+    got = navs[0]._leave_point(pose, scan, points, r_safe, 8.0 - 0.25)
+    want = navs[1]._leave_point_numpy(pose, scan, points, r_safe, 8.0 - 0.25)
+    assert (got is None) == (want is None)
+    if got is not None:
+        assert np.array_equal(got.view(np.int64), want.view(np.int64))
+    assert _bits(navs[0]._t_anchor) == _bits(navs[1]._t_anchor)

@@ -125,6 +125,7 @@ from teamnav.control.nav.local.visbug21_geometry import (
     FOLLOW_GAP_M,
     _follow_kernel,
     _last_visible,
+    _leave_candidates,
     boundary_heading,
 )
 from teamnav.control.types import RangeScan
@@ -675,12 +676,46 @@ class VisBug21:
         """Step 2's leave test: a visible M-line point closer to the goal than H by the margin."""
         xy = pose[:2]
         cand, t = self._mline_samples(0.0)
+        s, g = self.mline
+        u = (g - s) / max(math.hypot(*(g - s)), 1e-12)
+        # speed: the samples closer to the goal than d_H less the margin, visible
+        # (``_visible``), and with a clear run on towards T when short of it, in one kernel
+        # with the arithmetic of the numpy code it replaced (``_leave_point_numpy``)
+        sel, ok, tested, run = _leave_candidates(
+            float(xy[0]), float(xy[1]), points[:, 0], points[:, 1], cand[:, 0], cand[:, 1], t,
+            float(self.goal_xy[0]), float(self.goal_xy[1]), self.hit_dist_m - self.params.leave_margin_m,
+            float(g[0]), float(g[1]), float(u[0]), float(u[1]), float(r_safe),
+            float(r_safe - self.params.leave_hysteresis_m), float(reach_m), float(self._slack),
+            float(self.params.leave_run_m))
+        if sel.size == 0:
+            return None
+        cand, t = cand[sel], t[sel]
+        # Bug2: from Q the robot must be able to move on towards T (or Q is T), and the robot
+        # must have *seen* that run free, not merely sensed nothing near it: from afar it sees
+        # the near face of a wall, never its far side (a door jamb's thickness), and a run
+        # grazing an unseen face made it leave, hit at once, and walk the whole boundary
+        # again, lap after lap (office_simple, R1 alone, task 4)
+        keep = np.flatnonzero(ok & tested)
+        if keep.size:
+            ok[keep] = self._run_seen(pose, scan, cand[keep], run[keep], u, r_safe - self.params.leave_hysteresis_m)
+        if not ok.any():
+            return None
+        j = int(np.flatnonzero(ok)[-1])
+        # moving to it must be possible: it is at least a step away, or it is the goal
+        if t[j] < 1.0 - 1e-12 and math.hypot(*(cand[j] - xy)) < self.step_length_m:
+            return None
+        self._t_anchor = float(t[j])
+        return cand[j]
+
+    def _leave_point_numpy(self, pose, scan, points, r_safe, reach_m) -> np.ndarray | None:
+        """The numpy :meth:`_leave_point` (kept for the equivalence tests and the benchmark)."""
+        xy = pose[:2]
+        cand, t = self._mline_samples(0.0)
         closer = np.hypot(cand[:, 0] - self.goal_xy[0], cand[:, 1] - self.goal_xy[1]) < self.hit_dist_m - self.params.leave_margin_m
         if not closer.any():
             return None
         cand, t = cand[closer], t[closer]
         ok = self._visible(xy, points, cand, r_safe, reach_m)
-        # Bug2: from Q the robot must be able to move on towards T (or Q is T)
         idx = np.flatnonzero(ok & (t < 1.0 - 1e-12))
         if idx.size:
             s, g = self.mline
@@ -690,10 +725,6 @@ class VisBug21:
             if points.shape[0]:
                 slack = self._slack * np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1])
                 ok[idx] = segment_clear(points, cand[idx], ahead, r_safe - self.params.leave_hysteresis_m, slack)
-            # ... and the robot must have *seen* that run free, not merely sensed nothing near
-            # it: from afar it sees the near face of a wall, never its far side (a door jamb's
-            # thickness), and a run grazing an unseen face made it leave, hit at once, and walk
-            # the whole boundary again, lap after lap (office_simple, R1 alone, task 4)
             keep = ok[idx]
             if keep.any():
                 ok[idx[keep]] = self._run_seen(pose, scan, cand[idx[keep]], run[keep], u,
@@ -701,7 +732,6 @@ class VisBug21:
         if not ok.any():
             return None
         j = int(np.flatnonzero(ok)[-1])
-        # moving to it must be possible: it is at least a step away, or it is the goal
         if t[j] < 1.0 - 1e-12 and math.hypot(*(cand[j] - xy)) < self.step_length_m:
             return None
         self._t_anchor = float(t[j])

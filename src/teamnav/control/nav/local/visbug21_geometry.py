@@ -237,3 +237,107 @@ def _last_visible(x, y, px, py, cx, cy, r_safe, reach_m, slack_rad):
         if ok:
             return j
     return -1
+
+
+@njit(cache=True)
+def _leave_candidates(x, y, px, py, cx, cy, t, gx, gy, d_max, mgx, mgy, ux, uy, r_vis, r_run, reach_m, slack_rad,
+                      leave_run_m):
+    """Step 2's leave test up to its last part (numba): which M-line samples are leave-point
+    candidates before the "seen free" test, with the arithmetic of the numpy code of
+    :meth:`~teamnav.control.nav.local.visbug21.VisBug21._leave_point` it replaces.
+
+    Returns ``(sel, ok, tested, run)``: ``sel`` the indices of the samples closer to the goal
+    (``gx``, ``gy``) than ``d_max`` (``hypot < d_max``); per selected sample, ``ok``: visible from
+    (``x``, ``y``) through a corridor of half-width ``r_vis`` (``_visible``), and, for a sample
+    short of the goal (``t < 1 − 1e-12``, then ``tested``), the run ``run = min(leave_run_m,
+    hypot(g − c))`` along ``(ux, uy)`` clear by ``r_run`` of every sensed point, a point counting
+    ``slack_rad · hypot(p − xy)`` nearer (``segment_clear``); the run's ``g`` is the M-line's end
+    (``mgx``, ``mgy``). ``math.hypot`` is libm's, as ``np.hypot``.
+    """
+    nc = cx.shape[0]
+    nk = px.shape[0]
+    sel = np.empty(nc, dtype=np.int64)
+    ns = 0
+    for j in range(nc):
+        if math.hypot(cx[j] - gx, cy[j] - gy) < d_max:
+            sel[ns] = j
+            ns += 1
+    sel = sel[:ns]
+    ok = np.zeros(ns, dtype=np.bool_)
+    tested = np.zeros(ns, dtype=np.bool_)
+    run = np.zeros(ns)
+    if ns == 0:
+        return sel, ok, tested, run
+    # _visible: points within reach + 2 r_vis, with their slack
+    rp = np.empty(nk)
+    kx = np.empty(nk)
+    ky = np.empty(nk)
+    ks = np.empty(nk)
+    lim_p = reach_m + 2.0 * r_vis
+    m = 0
+    for k in range(nk):
+        rp[k] = math.hypot(px[k] - x, py[k] - y)
+        if rp[k] <= lim_p:
+            kx[m] = px[k]
+            ky[m] = py[k]
+            ks[m] = slack_rad * rp[k]
+            m += 1
+    t_goal = 1.0 - 1e-12
+    for i in range(ns):
+        j = sel[i]
+        if not math.hypot(cx[j] - x, cy[j] - y) <= reach_m:
+            continue
+        vis = True
+        if m > 0:
+            d0 = cx[j] - x
+            d1 = cy[j] - y
+            len2 = d0 * d0 + d1 * d1
+            if len2 < 1e-24:
+                len2 = 1e-24
+            for k in range(m):
+                rx = kx[k] - x
+                ry = ky[k] - y
+                tt = (rx * d0 + ry * d1) / len2
+                if tt < 0.0:
+                    tt = 0.0
+                if tt > 1.0:
+                    tt = 1.0
+                ex = rx - tt * d0
+                ey = ry - tt * d1
+                if not math.sqrt(ex * ex + ey * ey) - ks[k] >= r_vis:
+                    vis = False
+                    break
+        if not vis:
+            continue
+        ok[i] = True
+        if not t[j] < t_goal:
+            continue
+        tested[i] = True
+        h = math.hypot(mgx - cx[j], mgy - cy[j])
+        rr = leave_run_m if leave_run_m < h else h  # np.minimum (h >= 0; NaN propagates)
+        if h != h:
+            rr = h
+        run[i] = rr
+        if nk == 0:
+            continue
+        sx = cx[j]
+        sy = cy[j]
+        d0 = (sx + rr * ux) - sx
+        d1 = (sy + rr * uy) - sy
+        len2 = d0 * d0 + d1 * d1
+        if len2 < 1e-24:
+            len2 = 1e-24
+        for k in range(nk):
+            rx = px[k] - sx
+            ry = py[k] - sy
+            tt = (rx * d0 + ry * d1) / len2
+            if tt < 0.0:
+                tt = 0.0
+            if tt > 1.0:
+                tt = 1.0
+            ex = rx - tt * d0
+            ey = ry - tt * d1
+            if not math.sqrt(ex * ex + ey * ey) - slack_rad * rp[k] >= r_run:
+                ok[i] = False
+                break
+    return sel, ok, tested, run
