@@ -152,3 +152,35 @@ def test_leave_point_equals_numpy(seed, x, y, th, n_beams, hit_frac):
     if got is not None:
         assert np.array_equal(got.view(np.int64), want.view(np.int64))
     assert _bits(navs[0]._t_anchor) == _bits(navs[1]._t_anchor)
+
+
+# ------------------------------------------------------------------ the brains' corridor test
+@given(seeds, st.floats(-4.0, 4.0), st.floats(-4.0, 4.0), st.floats(0.0, 8.0), st.sampled_from([0.2, 0.21, 0.5]),
+       st.sampled_from([0.0, 1e-12, 1e-9, 1e-6, 1e-3]))
+@settings(max_examples=150, deadline=None)
+def test_corridor_clear_skip_of_far_returns_keeps_the_answer(seed, theta, heading, length, clear, eps):
+    """``corridor_clear`` skips returns farther than ``L + min_clear`` (plus a margin): its answer
+    is the numpy test's (``_corridor_clear_numpy``, every return) also for returns placed
+    right at that distance, on either side of it and at every bearing."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.choice([8, 72, 181]))
+    angles = np.linspace(-math.pi, math.pi, n, endpoint=False)
+    edge = length + clear
+    r = edge + rng.choice([-1.0, 1.0], n) * eps * rng.uniform(0.0, 2.0, n)
+    r[rng.random(n) < 0.3] = rng.uniform(0.05, 8.0)
+    r = np.clip(r, 0.0, 8.0)
+    got = base.corridor_clear(r, angles, 8.0, theta, heading, length, clear)
+    assert got == _corridor_clear_numpy(r, angles, 8.0, theta, heading, length, clear)
+
+
+def _corridor_clear_numpy(r, angles, max_range_m, theta, heading, length, min_clear):
+    """The brains' corridor test as numpy code, every return tested (as in
+    ``tests/test_los_speed_equivalence.py``; np.cos/np.sin/np.hypot are libm's here)."""
+    hit = r < max_range_m * (1.0 - 1e-9)
+    if not hit.any():
+        return True
+    rel = angles[hit] + (theta - heading)
+    along = r[hit] * np.cos(rel)
+    across = np.abs(r[hit] * np.sin(rel))
+    t = np.clip(along, 0.0, length)
+    return bool(np.hypot(along - t, across).min() >= min_clear)

@@ -150,10 +150,18 @@ def corridor_clear(ranges_m, angles_rad, max_range_m, theta_rad, heading_rad, le
     """
     thr = max_range_m * (1.0 - 1e-9)
     off = theta_rad - heading_rad
+    # speed: a return farther than L + min_clear (with a wide margin for rounding) from the
+    # robot is at least min_clear from the segment (triangle inequality), so its test passes
+    # whatever its bearing; skipping it does not change the answer (a NaN bearing is tested)
+    far = length_m + min_clear_m + 1e-9 * (1.0 + length_m + min_clear_m)
+    if not (length_m >= 0.0 and min_clear_m >= 0.0):
+        far = math.inf
     for i in range(ranges_m.shape[0]):
         r = ranges_m[i]
         if r < thr:
             rel = angles_rad[i] + off
+            if r > far and r < 1e6 and rel == rel:
+                continue
             along = r * math.cos(rel)
             across = abs(r * math.sin(rel))
             t = along

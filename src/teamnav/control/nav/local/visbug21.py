@@ -272,6 +272,7 @@ class VisBug21:
         self._reverse_for: tuple[np.ndarray, float] | None = None
         self._order_for = None
         self._samples_key = None
+        self._dir_key = None
         self._monitor = ProgressMonitor(params.progress_window_steps, params.progress_fraction, self.step_length_m)
         self._restart()
 
@@ -644,6 +645,17 @@ class VisBug21:
         self._samples_key = (self.mline, t_from, pts, t)
         return pts, t
 
+    def _mline_dir(self) -> tuple[np.ndarray, np.ndarray]:
+        """The M-line's end T and its unit direction ``(g − s) / max(|g − s|, 1e-12)`` (kept
+        while the M-line is the same object)."""
+        key = self._dir_key
+        if key is not None and key[0] is self.mline:
+            return key[1], key[2]
+        s, g = self.mline
+        u = (g - s) / max(math.hypot(*(g - s)), 1e-12)
+        self._dir_key = (self.mline, g, u)
+        return g, u
+
     def _visible(self, xy: np.ndarray, pts: np.ndarray, cand: np.ndarray, r_safe: float, reach_m: float) -> np.ndarray:
         """Which candidate points the robot reaches through a free corridor of half-width ``r_safe``."""
         dist = np.hypot(cand[:, 0] - xy[0], cand[:, 1] - xy[1])
@@ -676,19 +688,17 @@ class VisBug21:
         """Step 2's leave test: a visible M-line point closer to the goal than H by the margin."""
         xy = pose[:2]
         cand, t = self._mline_samples(0.0)
-        s, g = self.mline
-        u = (g - s) / max(math.hypot(*(g - s)), 1e-12)
+        g, u = self._mline_dir()
         # speed: the samples closer to the goal than d_H less the margin, visible
         # (``_visible``), and with a clear run on towards T when short of it, in one kernel
         # with the arithmetic of the numpy code it replaced (``_leave_point_numpy``)
-        sel, ok, tested, run = _leave_candidates(
-            float(xy[0]), float(xy[1]), points[:, 0], points[:, 1], cand[:, 0], cand[:, 1], t,
-            float(self.goal_xy[0]), float(self.goal_xy[1]), self.hit_dist_m - self.params.leave_margin_m,
-            float(g[0]), float(g[1]), float(u[0]), float(u[1]), float(r_safe),
-            float(r_safe - self.params.leave_hysteresis_m), float(reach_m), float(self._slack),
-            float(self.params.leave_run_m))
-        if sel.size == 0:
-            return None
+        p = self.params
+        sel, ok, tested, run, n_ok = _leave_candidates(
+            float(xy[0]), float(xy[1]), points, cand, t, float(self.goal_xy[0]), float(self.goal_xy[1]),
+            self.hit_dist_m - p.leave_margin_m, float(g[0]), float(g[1]), float(u[0]), float(u[1]), float(r_safe),
+            float(r_safe - p.leave_hysteresis_m), float(reach_m), float(self._slack), float(p.leave_run_m))
+        if n_ok == 0:
+            return None  # no sample closer than d_H, or none visible with a clear run
         cand, t = cand[sel], t[sel]
         # Bug2: from Q the robot must be able to move on towards T (or Q is T), and the robot
         # must have *seen* that run free, not merely sensed nothing near it: from afar it sees

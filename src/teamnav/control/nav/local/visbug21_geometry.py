@@ -209,6 +209,7 @@ def _last_visible(x, y, px, py, cx, cy, r_safe, reach_m, slack_rad):
             ky[m] = py[k]
             ks[m] = slack_rad * rp
             m += 1
+    last = -1  # the point that blocked the previous candidate: tested first (the same answer)
     for j in range(cx.shape[0] - 1, -1, -1):
         if not math.hypot(cx[j] - x, cy[j] - y) <= reach_m:
             continue
@@ -219,41 +220,62 @@ def _last_visible(x, y, px, py, cx, cy, r_safe, reach_m, slack_rad):
         len2 = d0 * d0 + d1 * d1
         if len2 < 1e-24:
             len2 = 1e-24
-        ok = True
-        for k in range(m):
-            rx = kx[k] - x
-            ry = ky[k] - y
-            t = (rx * d0 + ry * d1) / len2
-            if t < 0.0:
-                t = 0.0
-            if t > 1.0:
-                t = 1.0
-            ex = rx - t * d0
-            ey = ry - t * d1
-            v = math.sqrt(ex * ex + ey * ey) - ks[k]
-            if not v >= r_safe:
-                ok = False
-                break
-        if ok:
+        block = _first_blocking(kx, ky, ks, m, x, y, d0, d1, len2, r_safe, last)
+        if block < 0:
             return j
+        last = block
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _clear_of(px, py, slack, x, y, d0, d1, len2, lim):
+    """``segment_clear``'s test of one point: its distance to the segment from (x, y) along
+    (d0, d1), less its slack, is at least ``lim`` (False for NaN)."""
+    rx = px - x
+    ry = py - y
+    t = (rx * d0 + ry * d1) / len2
+    if t < 0.0:
+        t = 0.0
+    if t > 1.0:
+        t = 1.0
+    ex = rx - t * d0
+    ey = ry - t * d1
+    return math.sqrt(ex * ex + ey * ey) - slack >= lim
+
+
+@njit(cache=True)
+def _first_blocking(kx, ky, ks, m, x, y, d0, d1, len2, lim, first):
+    """Index of a point among the first ``m`` that is not clear of the segment (``_clear_of``),
+    or -1 when all are; point ``first`` (if >= 0) is tested before the others. Which points
+    block does not depend on the order, so neither does "some point blocks"."""
+    if first >= 0 and not _clear_of(kx[first], ky[first], ks[first], x, y, d0, d1, len2, lim):
+        return first
+    for k in range(m):
+        if k != first and not _clear_of(kx[k], ky[k], ks[k], x, y, d0, d1, len2, lim):
+            return k
     return -1
 
 
 @njit(cache=True)
-def _leave_candidates(x, y, px, py, cx, cy, t, gx, gy, d_max, mgx, mgy, ux, uy, r_vis, r_run, reach_m, slack_rad,
+def _leave_candidates(x, y, pts, cand, t, gx, gy, d_max, mgx, mgy, ux, uy, r_vis, r_run, reach_m, slack_rad,
                       leave_run_m):
     """Step 2's leave test up to its last part (numba): which M-line samples are leave-point
     candidates before the "seen free" test, with the arithmetic of the numpy code of
     :meth:`~teamnav.control.nav.local.visbug21.VisBug21._leave_point` it replaces.
 
-    Returns ``(sel, ok, tested, run)``: ``sel`` the indices of the samples closer to the goal
+    ``pts`` (K, 2) are the sensed points, ``cand`` (J, 2) the M-line samples, ``t`` their
+    M-line parameters. Returns ``(sel, ok, tested, run, n_ok)``: ``sel`` the indices of the samples closer to the goal
     (``gx``, ``gy``) than ``d_max`` (``hypot < d_max``); per selected sample, ``ok``: visible from
     (``x``, ``y``) through a corridor of half-width ``r_vis`` (``_visible``), and, for a sample
     short of the goal (``t < 1 − 1e-12``, then ``tested``), the run ``run = min(leave_run_m,
     hypot(g − c))`` along ``(ux, uy)`` clear by ``r_run`` of every sensed point, a point counting
     ``slack_rad · hypot(p − xy)`` nearer (``segment_clear``); the run's ``g`` is the M-line's end
-    (``mgx``, ``mgy``). ``math.hypot`` is libm's, as ``np.hypot``.
+    (``mgx``, ``mgy``); ``n_ok`` counts ``ok``. ``math.hypot`` is libm's, as ``np.hypot``.
     """
+    px = pts[:, 0]
+    py = pts[:, 1]
+    cx = cand[:, 0]
+    cy = cand[:, 1]
     nc = cx.shape[0]
     nk = px.shape[0]
     sel = np.empty(nc, dtype=np.int64)
@@ -267,7 +289,7 @@ def _leave_candidates(x, y, px, py, cx, cy, t, gx, gy, d_max, mgx, mgy, ux, uy, 
     tested = np.zeros(ns, dtype=np.bool_)
     run = np.zeros(ns)
     if ns == 0:
-        return sel, ok, tested, run
+        return sel, ok, tested, run, 0
     # _visible: points within reach + 2 r_vis, with their slack
     rp = np.empty(nk)
     kx = np.empty(nk)
@@ -283,33 +305,28 @@ def _leave_candidates(x, y, px, py, cx, cy, t, gx, gy, d_max, mgx, mgy, ux, uy, 
             ks[m] = slack_rad * rp[k]
             m += 1
     t_goal = 1.0 - 1e-12
+    slack_all = np.empty(nk)
+    for k in range(nk):
+        slack_all[k] = slack_rad * rp[k]
+    last_vis = -1  # blocking points tested first (``_first_blocking``: the same answers)
+    last_run = -1
+    n_ok = 0
     for i in range(ns):
         j = sel[i]
         if not math.hypot(cx[j] - x, cy[j] - y) <= reach_m:
             continue
-        vis = True
         if m > 0:
             d0 = cx[j] - x
             d1 = cy[j] - y
             len2 = d0 * d0 + d1 * d1
             if len2 < 1e-24:
                 len2 = 1e-24
-            for k in range(m):
-                rx = kx[k] - x
-                ry = ky[k] - y
-                tt = (rx * d0 + ry * d1) / len2
-                if tt < 0.0:
-                    tt = 0.0
-                if tt > 1.0:
-                    tt = 1.0
-                ex = rx - tt * d0
-                ey = ry - tt * d1
-                if not math.sqrt(ex * ex + ey * ey) - ks[k] >= r_vis:
-                    vis = False
-                    break
-        if not vis:
-            continue
+            block = _first_blocking(kx, ky, ks, m, x, y, d0, d1, len2, r_vis, last_vis)
+            if block >= 0:
+                last_vis = block
+                continue
         ok[i] = True
+        n_ok += 1
         if not t[j] < t_goal:
             continue
         tested[i] = True
@@ -327,17 +344,9 @@ def _leave_candidates(x, y, px, py, cx, cy, t, gx, gy, d_max, mgx, mgy, ux, uy, 
         len2 = d0 * d0 + d1 * d1
         if len2 < 1e-24:
             len2 = 1e-24
-        for k in range(nk):
-            rx = px[k] - sx
-            ry = py[k] - sy
-            tt = (rx * d0 + ry * d1) / len2
-            if tt < 0.0:
-                tt = 0.0
-            if tt > 1.0:
-                tt = 1.0
-            ex = rx - tt * d0
-            ey = ry - tt * d1
-            if not math.sqrt(ex * ex + ey * ey) - slack_rad * rp[k] >= r_run:
-                ok[i] = False
-                break
-    return sel, ok, tested, run
+        block = _first_blocking(px, py, slack_all, nk, sx, sy, d0, d1, len2, r_run, last_run)
+        if block >= 0:
+            last_run = block
+            ok[i] = False
+            n_ok -= 1
+    return sel, ok, tested, run, n_ok
