@@ -46,11 +46,12 @@ VMAS_INSTALL = ("python -m venv /tmp/vmas-venv && /tmp/vmas-venv/bin/pip install
                 "/tmp/vmas-venv/bin/pip install vmas")
 
 
-def vmas(python: str, n: int, steps: int, repeats: int) -> float | None:
-    """VMAS agent-steps per second for ``n`` agents (one environment), or None when not installed."""
+def vmas(python: str, n: int, steps: int, repeats: int, num_envs: int = 1) -> float | None:
+    """VMAS agent-steps per second for ``n`` agents in ``num_envs`` environments, or None when not installed."""
     if not Path(python).exists():
         return None
-    out = subprocess.run([python, str(VMAS_PEER), "--agents", str(n), "--steps", str(steps), "--repeats", str(repeats)],
+    out = subprocess.run([python, str(VMAS_PEER), "--agents", str(n), "--steps", str(steps), "--repeats", str(repeats),
+                          "--num-envs", str(num_envs)],
                          capture_output=True, text=True, timeout=1800)
     lines = [ln for ln in out.stdout.splitlines() if ln.startswith("{")]
     if out.returncode != 0 or not lines:
@@ -167,7 +168,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--steps", type=int, help="timed steps per repeat (default: per size)")
     ap.add_argument("--repeats", type=int, help="timings per cell, best kept (default 5, quick 2)")
     ap.add_argument("--threads", type=int, help="numba threads (NUMBA_NUM_THREADS must be set before import)")
-    ap.add_argument("--batched", action="store_true", help="also time BatchedEnv (4 copies)")
+    ap.add_argument("--batched", action="store_true", help="also time BatchedEnv (--copies copies) beside VMAS with as many environments")
+    ap.add_argument("--copies", type=int, default=4, help="copies of the batched env and VMAS environments (default 4)")
     ap.add_argument("--vmas-python", default=os.environ.get("TEAMNAV_BENCH_VMAS_PYTHON", "/tmp/vmas-venv/bin/python"),
                     help="interpreter with vmas installed (the peer)")
     args = ap.parse_args(argv)
@@ -183,7 +185,7 @@ def main(argv: list[str] | None = None) -> None:
           f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}")
     head = "| agents | engine steps/s | engine + wander-v1 steps/s | env steps/s | env agent-steps/s | env / engine (time per step) | env / engine + wander-v1 |"
     if args.batched:
-        head += " batched env agent-steps/s (4 copies) |"
+        head += f" batched env agent-steps/s ({args.copies} copies) |"
     have_vmas = Path(args.vmas_python).exists()
     head += " VMAS agent-steps/s (1 env, CPU) | env / VMAS (agent-steps/s) |"
     if not have_vmas:
@@ -192,7 +194,7 @@ def main(argv: list[str] | None = None) -> None:
     print("|" + "---:|" * (head.count("|") - 1))
     for n in sizes:
         steps = args.steps or max(20, int((300 if args.quick else 1000) / max(1.0, n ** 0.8)))
-        t = measure(n, steps, repeats, warmup, 4 if args.batched else 0)
+        t = measure(n, steps, repeats, warmup, args.copies if args.batched else 0)
         row = (f"| {n} | {1 / t['engine']:,.0f} | {1 / t['wander']:,.0f} | {1 / t['env']:,.0f} | {n / t['env']:,.0f} | "
                f"{t['env'] / t['engine']:.2f}x | {t['env'] / t['wander']:.2f}x |")
         if args.batched:
@@ -200,6 +202,11 @@ def main(argv: list[str] | None = None) -> None:
         v = vmas(args.vmas_python, n, max(3, min(50, 300 // n)), 2 if args.quick else 3) if have_vmas else None
         row += f" {v:,.0f} | {n / t['env'] / v:,.0f}x |" if v else " not measured | — |"
         print(row, flush=True)
+        if args.batched and have_vmas:
+            vb = vmas(args.vmas_python, n, max(3, min(20, 60 // n)), 2 if args.quick else 3, args.copies)
+            if vb:
+                print(f"  batched, {n} agents x {args.copies} copies: teamnav {n / t['batched']:,.0f} agent-steps/s, "
+                      f"VMAS ({args.copies} envs, CPU) {vb:,.0f}: {n / t['batched'] / vb:,.1f}x", flush=True)
 
 
 if __name__ == "__main__":

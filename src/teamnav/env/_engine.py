@@ -72,7 +72,7 @@ def set_commands(sim, ids, v_mps, omega_radps, direction_rad) -> None:
     them to each robot's limits."""
     hook = getattr(sim, "set_commands", None)
     if callable(hook):
-        hook(ids, v_mps, omega_radps, direction_rad)
+        hook(ids, v_mps, omega_radps, direction_rad, check=False)  # the environment checked its actions
         return
     sim._v_cmd[ids] = v_mps
     sim._w_cmd[ids] = omega_radps

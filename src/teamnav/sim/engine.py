@@ -381,7 +381,7 @@ class Simulation:
             self._observe_and_decide(None, None)
             self._decided = True
 
-    def set_commands(self, ids, v_mps, omega_radps, direction_rad=None) -> None:
+    def set_commands(self, ids, v_mps, omega_radps, direction_rad=None, *, check: bool = True) -> None:
         """Replace the stored commands of robots ``ids`` before the next :meth:`step` moves
         them: what an outside agent decided on the observation it was given (the brain's
         own commands for those robots are overwritten).
@@ -396,7 +396,17 @@ class Simulation:
         direction_rad : float or array of float, shape (k,), optional
             Heading of motion for holonomic robots (NaN: none, as for unicycles); a scalar
             applies to every robot of ``ids``; None leaves the stored directions as they are.
+        check : bool, default True
+            Check indices, shapes and finiteness (refusing with ValueError). A caller that has
+            checked its actions already (:mod:`teamnav.env`) passes False: the checks cost more
+            than the step of a one-robot team.
         """
+        if not check:
+            self._v_cmd[ids] = v_mps
+            self._w_cmd[ids] = omega_radps
+            if direction_rad is not None:
+                self._dir_cmd[ids] = direction_rad
+            return
         ids = np.arange(self.n_robots)[ids] if isinstance(ids, slice) else np.asarray(ids, dtype=np.int64).reshape(-1)
         k = ids.shape[0]
         if k and (ids.min() < 0 or ids.max() >= self.n_robots):
