@@ -136,3 +136,14 @@ def test_cli_run_html_writes_the_replay_next_to_the_run(tmp_path):
     assert res.exit_code == 0, res.output
     meta, arrays = _decode((tmp_path / "r" / "replay.html").read_text(encoding="utf-8"))
     assert meta["n_frames"] == 11 and meta["n_robots"] == 3 and meta["scans"][0]["beams"] == 24
+
+
+def test_replay_labels_fault_records_by_their_kind(tmp_path):
+    """Faults are recorded with event None and their kind under "fault": the replay's event
+    list shows "fault: died", not "None"."""
+    res = CliRunner().invoke(app, ["run", "trail-team", "--duration", "8", "--quiet", "--out", str(tmp_path / "run"),
+                                   "--set", "faults={deaths: [{robot: 1, t_s: 2}], blackouts: [{t0_s: 1, t1_s: 4}]}"])
+    assert res.exit_code == 0, res.output
+    meta, _ = _decode(build_replay(tmp_path / "run", tmp_path / "r.html").path.read_text(encoding="utf-8"))
+    labels = {e["event"] for e in meta["events"]}
+    assert {"fault: died", "fault: blackout_start", "fault: blackout_end"} <= labels and "None" not in labels

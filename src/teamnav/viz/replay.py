@@ -455,8 +455,10 @@ def build_replay(
         except (KeyError, TypeError, ValueError):
             continue
         if fr < F:
+            # a fault (teamnav.sim.faults) is recorded with event None and its kind under "fault"
+            label = e.get("event") if e.get("event") is not None else (f"fault: {e['fault']}" if e.get("fault") else "")
             events.append({"f": fr, "t": float(e.get("t_s", 0.0)), "robot": int(e.get("robot", -1)),
-                           "event": str(e.get("event")), "place": str(e.get("place", ""))})
+                           "event": str(label), "place": str(e.get("place") or "")})
 
     map_meta = None
     if grid is not None:
