@@ -573,46 +573,15 @@ class EnvCore:
         return sender, stamp, min(msg.size_bytes(), 1e12)
 
 def _record_log(rec, step: int, t: float, robot: int, values: dict) -> None:
-    """A brain's log entry into the recorder, as ``Recorder.record`` stores one (its
-    ``"layers"`` entry into layers, the rest into ``logs``)."""
-    if "layers" in values:
-        values = dict(values)
-        layers = values.pop("layers")
-        if not isinstance(layers, dict):
-            raise ValueError(f"robot {robot}: log()['layers'] must be a dict of layer name to data, got {type(layers).__name__}")
-        for name, value in layers.items():
-            if isinstance(value, str):
-                spec = {"kind": "state", "data": value}
-            elif isinstance(value, dict):
-                if "data" not in value:
-                    raise ValueError(f"robot {robot}: log()['layers'][{name!r}] needs a 'data' entry")
-                spec = value
-            else:
-                spec = {"kind": "points", "data": value}
-            kind = spec.get("kind", "points")
-            rec.declare_layer(name, kind, frame=spec.get("frame", "world" if kind == "state" else "odom"),
-                              hold=bool(spec.get("hold", kind != "segments")), description=spec.get("description", ""))
-            rec.add_layer_sample(name, step, robot, spec["data"])
-    if values:
-        rec.logs.append({"step": int(step), "t_s": float(t), "robot": int(robot), "values": values})
+    """A brain's log entry into the recorder, as ``Recorder.record`` stores one."""
+    rec.record_log(step, t, robot, values)
 
 
 def _all_finished(sim) -> bool:
-    """Every per-robot brain with a ``finished`` flag says True, and at least one has one (the
-    rule of ``stop_when_finished`` in :func:`teamnav.experiments.runner.all_finished`)."""
-    seen = False
-    for group in sim.brains:
-        if not isinstance(group, list):
-            continue
-        for brain in group:
-            flag = getattr(brain, "finished", None)
-            if flag is None:
-                continue
-            seen = True
-            if not flag:
-                return False
-    return seen
+    """The rule of ``stop_when_finished`` (:func:`teamnav.experiments.runner.all_finished`)."""
+    from teamnav.experiments.runner import all_finished
 
+    return all_finished(sim)
 
 
 # ---------------------------------------------------------------------------- building from a scenario

@@ -320,11 +320,17 @@ class Recorder:
         self.size += 1
         if logs:
             for robot, values in logs.items():
-                if values and "layers" in values:
-                    values = dict(values)
-                    self._log_layers(int(step), int(robot), values.pop("layers"))
-                if values:
-                    self.logs.append({"step": int(step), "t_s": float(time_s), "robot": int(robot), "values": values})
+                self.record_log(step, time_s, robot, values)
+
+    def record_log(self, step: int, time_s: float, robot: int, values: dict | None) -> None:
+        """Store one brain's ``log()`` entry: its ``"layers"`` entry into layers (module
+        docstring), the rest into :attr:`logs` (a brain driven from outside, :mod:`teamnav.env`,
+        logs through this too)."""
+        if values and "layers" in values:
+            values = dict(values)
+            self._log_layers(int(step), int(robot), values.pop("layers"))
+        if values:
+            self.logs.append({"step": int(step), "t_s": float(time_s), "robot": int(robot), "values": values})
 
     # ------------------------------------------------------------------ layers
     def declare_layer(self, name: str, kind: str, *, frame: str = "world", hold: bool = False,
