@@ -247,11 +247,18 @@ class AvoidPast(PotentialField):
         coef, away = _avoid_terms(g.grid, g.i0, g.j0, int(math.floor(xy[0] / p.cell_m)),
                                   int(math.floor(xy[1] / p.cell_m)), k, float(xy[0]), float(xy[1]), p.cell_m,
                                   p.memory_radius_m)
+        v0, v1 = float(v[0]), float(v[1])
         if not coef.shape[0]:
-            return v + np.zeros(2)
-        va = p.avoid_gain_per_m * (coef @ away)  # numpy's matmul, as _vector_of_cells
-        norm = math.hypot(va[0], va[1])
-        return v + (va * (p.avoid_max / norm) if norm > p.avoid_max else va)
+            return np.array((v0 + 0.0, v1 + 0.0))  # v + np.zeros(2)
+        rep = coef @ away  # numpy's matmul, as _vector_of_cells
+        # the rest on floats, the same operations per component as the array expressions
+        # ``va = gain * rep``, ``v + (va * (max / norm) if norm > max else va)``
+        va0, va1 = p.avoid_gain_per_m * float(rep[0]), p.avoid_gain_per_m * float(rep[1])
+        norm = math.hypot(va0, va1)
+        if norm > p.avoid_max:
+            f = p.avoid_max / norm
+            va0, va1 = va0 * f, va1 * f
+        return np.array((v0 + va0, v1 + va1))
 
 
 @njit(cache=True)

@@ -198,6 +198,9 @@ def check_scan(scan) -> RangeScan:
     """``scan`` if it is a RangeScan with matching beams, or ValueError."""
     if not isinstance(scan, RangeScan):
         raise ValueError(f"scan must be a RangeScan, got {type(scan).__name__}")
+    r, a = scan.ranges_m, scan.angles_rad
+    if type(r) is np.ndarray and type(a) is np.ndarray and r.ndim == 1 and r.shape == a.shape:
+        return scan  # the common case, without np.shape / np.ndim calls (the same test)
     if np.shape(scan.ranges_m) != np.shape(scan.angles_rad) or np.ndim(scan.ranges_m) != 1:
         raise ValueError(
             f"scan.ranges_m and scan.angles_rad must be 1-D of one length, got {np.shape(scan.ranges_m)} "

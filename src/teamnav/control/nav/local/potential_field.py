@@ -116,17 +116,22 @@ def field_vector(pose: np.ndarray, goal_xy: np.ndarray, points: np.ndarray, n_be
     >>> field_vector(np.zeros(3), np.array([3.0, 4.0]), np.zeros((0, 2)), 72, p, 0.25).tolist()
     [0.6, 0.8]
     """
-    to_goal = goal_xy - pose[:2]
-    dist = math.hypot(to_goal[0], to_goal[1])
-    v = params.attraction_gain * to_goal / dist if dist > 0.0 else np.zeros(2)
+    # speed: the attraction on floats (the same IEEE operations per component as the array
+    # expression ``gain * (goal - xy) / dist``), one array at the end
+    t0 = float(goal_xy[0]) - float(pose[0])
+    t1 = float(goal_xy[1]) - float(pose[1])
+    dist = math.hypot(t0, t1)
+    gain = params.attraction_gain
+    v0, v1 = (gain * t0 / dist, gain * t1 / dist) if dist > 0.0 else (0.0, 0.0)
     if points.shape[0]:
         r_safe = radius_m + params.safety_margin_m
         s_inf = r_safe + params.influence_m
         pts = np.asarray(points, dtype=np.float64)
         coef, away = _repulsion_terms(float(pose[0]), float(pose[1]), pts[:, 0], pts[:, 1], r_safe, s_inf,
                                       params.repulsion_gain * 2.0 * math.pi / max(n_beams, 1))
-        v = v + coef @ away  # numpy's matmul (its summation order), as before
-    return v
+        rep = coef @ away  # numpy's matmul (its summation order), as before
+        v0, v1 = v0 + float(rep[0]), v1 + float(rep[1])
+    return np.array((v0, v1))
 
 
 @njit(cache=True)
