@@ -321,3 +321,65 @@ def test_a_disagreement_between_confident_robots_is_split_when_the_sender_may_be
     share = 0.3 / (0.3 + 0.7 * floor)
     assert abs(_mass_near(b, THERE) - share) < 0.03
     assert (share > 0.9) == (sender_prior == 0.0)
+
+
+# ---------------------------------------------------------------------------- paper_rules (issue 26 §1)
+from teamnav.control.paper_rules import gap_fills  # noqa: E402
+
+#: a value other than the paper's for every PAPER_RULES field
+_NOT_PAPER = {"inject_fraction": 0.1, "inject_min_draws": 500, "inject_sender_lost_prior": 0.3,
+              "likelihood_exponent": 0.1, "resample_ess_fraction": 0.5, "provenance": True, "receive_gate": True,
+              "send_min_cluster_weight": 0.5, "false_positive_filter": True, "anonymous": "associate"}
+
+
+def test_paper_rules_sets_every_listed_field():
+    p = MCLWanderParams(paper_rules=True)
+    assert set(MCLWanderParams.PAPER_RULES) == set(MCLWanderParams.PAPER_RULE_NOTES) == set(_NOT_PAPER)
+    for key, value in MCLWanderParams.PAPER_RULES.items():
+        assert getattr(p, key) == value, key
+    # the issue's list: no sensor resetting, untempered likelihood, resampling every update, the
+    # two rules of §2.3 only (no provenance, no receive gate), anonymous sights ignored
+    assert (p.inject_fraction, p.likelihood_exponent, p.resample_ess_fraction) == (0.0, 1.0, 1.0)
+    assert not p.provenance and not p.receive_gate and p.anonymous == "ignore"
+    # defaults stay teamnav's (existing runs do not move)
+    q = MCLWanderParams()
+    assert not q.paper_rules and q.likelihood_exponent == 0.5 and q.resample_ess_fraction == 0.5
+    assert q.provenance and q.receive_gate and q.anonymous == "associate"
+    # the kept gap-fills name fields, the KLD floor among them, and no field is both kept and a rule
+    kept = set(MCLWanderParams.GAP_FILLS_KEPT)
+    assert "min_particles" in kept and kept <= set(MCLWanderParams.model_fields)
+    assert not kept & set(MCLWanderParams.PAPER_RULES)
+
+
+@pytest.mark.parametrize("key", sorted(_NOT_PAPER))
+def test_paper_rules_refuses_a_conflicting_value(key):
+    with pytest.raises(ValueError, match=key):
+        MCLWanderParams(paper_rules=True, **{key: _NOT_PAPER[key]})
+    # the paper's value given as well is fine
+    assert getattr(MCLWanderParams(paper_rules=True, **{key: MCLWanderParams.PAPER_RULES[key]}), key) \
+        == MCLWanderParams.PAPER_RULES[key]
+
+
+def test_gap_fill_table_takes_the_scenario_values():
+    ours = load_scenario("collab-mcl-hallway").robots[0].params
+    g = {x.field: x for x in gap_fills(MCLWanderParams, ours)}
+    assert g["inject_fraction"].teamnav_value == 0.1 and g["inject_fraction"].paper_value == 0.0
+    assert g["likelihood_exponent"].teamnav_value == 0.1 and g["likelihood_exponent"].paper_value == 1.0
+    assert g["receive_gate"].teamnav_value is True and g["receive_gate"].paper_value is False
+
+
+def test_paper_rules_brain_has_no_receive_gate():
+    """With paper_rules the seen robot applies a second tree from the same observer at once (only
+    the observer's 2.5 m rule gates); teamnav's default drops it until it has moved 2.5 m."""
+    from teamnav.localization.sync import detection_tree
+
+    for paper, expect in ((True, 2), (False, 1)):
+        robin = _brain(1, seed=3, pose=(20.0, 9.6, 0.0), **({"paper_rules": True} if paper else {}))
+        assert robin.sync.params.receive_gate is (not paper)
+        model = robin.model
+        for k in range(2):
+            tree = detection_tree(np.array([[17.0, 9.6, 0.0]]), np.array([1.0]), 3.0, 0.0, model,
+                                  np.random.default_rng(k))
+            body = SyncMessage("detection", 0, 1, 3.0, 0.0, model.p_false_positive, tree)
+            robin.step(_obs(1, k + 1, inbox=[Message(0, 0.1 * k, body, to=1, kind=SYNC_KIND)]))
+        assert robin.sync.applied["detection"] == expect, paper

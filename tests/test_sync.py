@@ -109,6 +109,26 @@ def test_mutual_detection_updates_each_robot_once():
     assert sa.on_message(a, Message(5, 0.0, {"x": 1.0}), 0.3) == []
 
 
+def test_mutual_detection_without_the_receive_gate_is_the_papers_rule_2():
+    """§2.3 rule 2 as written gates the detecting robot only: when two robots see each other on the
+    same frame, each applies the other's detection tree and the answer to its own (twice each)."""
+    a = filter_with_modes([np.array([5.0, 3.0, 0.0])], seed=10)
+    b = filter_with_modes([np.array([8.0, 3.0, math.pi])], seed=11)
+    p = SyncParams(receive_gate=False)
+    sa = BeliefSync(0, MODEL, p, np.random.default_rng(12))
+    sb = BeliefSync(1, MODEL, p, np.random.default_rng(13))
+    (ma,) = sa.on_detections(a, (Detection(3.0, 0.0, 1),), 0.0)
+    (mb,) = sb.on_detections(b, (Detection(3.0, 0.0, 0),), 0.0)
+    (ra,) = sb.on_message(b, ma, 0.1)
+    (rb,) = sa.on_message(a, mb, 0.1)
+    sa.on_message(a, ra, 0.2)
+    sb.on_message(b, rb, 0.2)
+    assert sa.applied == {"detection": 1, "inverse": 1} and sb.applied == {"detection": 1, "inverse": 1}
+    # the detecting side's gate still holds: no second detection of b within 2.5 m
+    assert sa.on_detections(a, (Detection(3.0, 0.0, 1),), 1.0) == []
+    assert sa.receive_allowed(1) and SyncParams().receive_gate
+
+
 def test_gate_and_sync_validate_input():
     with pytest.raises(ValueError, match="min_travel_m"):
         SightingGate(-1.0)

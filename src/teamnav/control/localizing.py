@@ -82,6 +82,14 @@ Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report sect
     globally uncertain, or two robots equally plausible) are dropped. With ``anonymous="ignore"``
     the brain does what the paper's method does with anonymous sights: nothing.
 
+``paper_rules=True`` is the paper as written (:attr:`MCLWanderParams.PAPER_RULES`,
+:mod:`teamnav.control.paper_rules`; the reports' "paper as written" column): eq. 14 alone on a
+received tree (no sensor resetting), the untempered likelihood (eq. 12), resampling at every
+update (§3.1), §2.3's two rules only (no provenance, no gate on the receiving side), every
+detection sent (§3.2), no false-positive filter and anonymous sights ignored (§7.2). Setting one
+of those fields as well is an error. What the paper gives no value for is kept in both columns
+and listed in :attr:`MCLWanderParams.GAP_FILLS_KEPT` (the KLD floor among them).
+
 The filter never sees a true pose; experiments score it from what :meth:`MCLWander.log`
 records (a weighted subsample of the particles every recorded step, see
 :mod:`teamnav.experiments.metric_sets.localization`).
@@ -93,12 +101,13 @@ import math
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from teamnav.control.nav.wander import Wander, WanderParams
+from teamnav.control.paper_rules import paper_rules_validator
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.tree_injection import inject_tree
 from teamnav.control.types import Action, Message, Observation
@@ -265,6 +274,10 @@ class MCLWanderParams(BaseModel):
         multiplied its own belief in again (double counting: a confidently wrong sender was
         confirmed by the teammate it had just dragged along). False (default): the reply is
         built from the belief as it was before the message.
+    receive_gate : bool
+        Rule 2 of §2.3 applied on the receiving side too (:class:`~teamnav.localization.SyncParams`):
+        a tree from a given teammate is applied at most once per ``min_travel_m`` of own travel
+        (beyond the paper; False: the paper's rule, which gates the detecting robot only).
     provenance : bool
         Rule 2 of §2.3 made transitive (:class:`~teamnav.localization.SyncParams`): a tree that
         holds this robot's own information from less than ``min_travel_m`` ago, passed on by a
@@ -292,9 +305,67 @@ class MCLWanderParams(BaseModel):
         Particles (drawn by weight) logged every recorded step for scoring.
     layer_every : int
         Every this many log() calls, a ``particles`` layer of ``layer_points`` for the replay.
+    paper_rules : bool
+        Every gap-fill of :attr:`PAPER_RULES` at the paper's value
+        (:mod:`teamnav.control.paper_rules`); setting one of them as well is an error.
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    #: the gap-fills whose other value is the paper's rule (Fox, Burgard, Kruppa & Thrun 2000)
+    PAPER_RULES: ClassVar[dict[str, Any]] = {
+        # §3.2, eq. 14: "These density values are then multiplied into each individual sample <l, p>
+        # of the detected robot": the received tree only reweights the samples there are
+        "inject_fraction": 0.0,
+        # §3.2, eq. 14: no draws from the tree, so no minimum number of them either
+        "inject_min_draws": 0,
+        # §2.3, eq. 10: the sender's belief enters as it is (no prior that the sender is wrong)
+        "inject_sender_lost_prior": 0.0,
+        # §3.1, eq. 12: "p <- alpha P(o | l)" (the perception model untempered)
+        "likelihood_exponent": 1.0,
+        # §3.1 step 1: "When a robot moves, MCL generates K new samples ... by randomly drawing a
+        # sample from the previously computed sample set": a resampling at every update
+        "resample_ess_fraction": 1.0,
+        # §2.3: "our approach uses the following two rules" (rule 2 not made transitive)
+        "provenance": False,
+        # §2.3 rule 2: "blocks the ability to see the same robot again until the *detecting* robot
+        # has traveled a prespecified distance": no gate on the receiving side
+        "receive_gate": False,
+        # §3.2: "When one robot detects another, both sample sets are synchronized" (every detection)
+        "send_min_cluster_weight": 0.0,
+        # §7.2: false positives were "not modeled"; "Our sample-based implementation ... is not robust"
+        "false_positive_filter": False,
+        # §7.2: "The factorial representation, however, cannot deal with measurements such as
+        # 'either robot A or robot B'": sights without identity are not used
+        "anonymous": "ignore",
+    }
+    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
+        "inject_fraction": "Fox §3.2 eq. 14: the tree only reweights the existing samples (no sensor resetting)",
+        "inject_min_draws": "Fox §3.2 eq. 14: no draws from the tree",
+        "inject_sender_lost_prior": "Fox §2.3 eq. 10: the sender's belief is used as it is",
+        "likelihood_exponent": "Fox §3.1 eq. 12: p <- alpha P(o | l), untempered",
+        "resample_ess_fraction": "Fox §3.1: K new samples drawn at every motion update",
+        "provenance": "Fox §2.3: the two rules only (rule 2 not transitive)",
+        "receive_gate": "Fox §2.3 rule 2: only the detecting robot waits 2.5 m",
+        "send_min_cluster_weight": "Fox §3.2: every detection synchronises both beliefs",
+        "false_positive_filter": "Fox §7.2: false positives not filtered",
+        "anonymous": "Fox §7.2: sights without identity are not used",
+    }
+    #: gap-fills the paper gives no value for: the same value in both columns (field: why)
+    GAP_FILLS_KEPT: ClassVar[dict[str, str]] = {
+        "min_particles": "KLD floor: §3.1 adapts the sample count on the fly (Fox et al. 1999a) and gives no "
+                         "floor and no counts for its experiments",
+        "max_particles": "§3.1 global localization uses many samples; no count is given",
+        "random_fraction": "§3.1 'a small number of uniformly distributed, random samples'; no number",
+        "min_update_m": "the paper updates on each odometry reading and scan; no rate is given",
+        "min_update_deg": "as min_update_m",
+        "beam": "Fig. 1's mixture; its weights and widths are not given (ours: the simulated sensor's)",
+        "motion": "Fig. 2's motion model; its noise is not given",
+        "tree_min_samples": "§3.2's stopping rule 'see Thrun et al. (1999b)'; no value",
+        "inject_lost_prior": "inert with inject_fraction 0 (the paper's), as are inject_weighting and the "
+                             "inject_heading_* settings",
+        "wander": "§5: the robots follow an operator or a random walk; our wanderer's settings",
+    }
 
     sensor: str | None = Field(None, min_length=1)
     wander: WanderParams = WanderParams(cruise_speed_mps=0.3, turn_rate_radps=0.8)
@@ -348,6 +419,10 @@ class MCLWanderParams(BaseModel):
     log_points: int = Field(64, ge=1, le=1000)
     layer_every: int = Field(20, ge=1, le=100_000)
     layer_points: int = Field(200, ge=1, le=1000)
+    receive_gate: bool = True
+    paper_rules: bool = False
+
+    _paper_rules = paper_rules_validator()
 
     def mcl_params(self) -> MCLParams:
         """The library's filter parameters these stand for."""
@@ -406,7 +481,8 @@ class MCLWander:
         self.sync = (BeliefSync(self.robot_id, self.model, SyncParams(min_travel_m=params.min_travel_m,
                                                                       tree_min_samples=params.tree_min_samples,
                                                                       tree_max_depth=params.tree_max_depth,
-                                                                      provenance=params.provenance), rng)
+                                                                      provenance=params.provenance,
+                                                                      receive_gate=params.receive_gate), rng)
                      if params.collaborate else None)
         self._free = (info.known_map.cells == FREE)
         self._next_frame_s = 0.0
@@ -598,7 +674,7 @@ class MCLWander:
                 self.stats["rejected"] += 1
                 return []
         if (p.inject_fraction > 0 and body.kind == "detection" and body.target == self.robot_id
-                and self.sync.receive_gate.allowed(body.observer)):
+                and self.sync.receive_allowed(body.observer)):
             return self._inject_and_apply(msg, obs)
         return self.sync.on_message(self.mcl, msg, obs.time_s)
 

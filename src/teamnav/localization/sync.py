@@ -25,8 +25,15 @@ The two rules of §2.3 against the factorial representation's over-confidence:
    factorial form cannot use "robot A or robot B") start a synchronisation;
 2. once a robot has used a detection of another robot, it may not use that robot again until
    it has travelled ``min_travel_m`` (2.5 m in the paper), measured with its own odometry
-   (:class:`SightingGate`): both when it detects that robot and when it applies a tree coming
-   from it. Two robots that detect each other therefore update each once, not twice.
+   (:class:`SightingGate`): when it detects that robot and, with ``receive_gate`` (beyond the
+   paper, below), also when it applies a tree coming from it. Two robots that detect each other
+   then update each once, not twice.
+
+Rule 2 as the paper states it gates the *detecting* robot ("blocks the ability to see the same
+robot again until the detecting robot has traveled a prespecified distance"). Beyond the paper,
+``SyncParams.receive_gate`` (default True) gates the *receiving* side too: a robot applies a tree
+from a given teammate at most once per ``min_travel_m`` of its own travel, so two robots that see
+each other on the same frame update each once; False is the paper's rule only.
 
 Beyond the paper, ``SyncParams.provenance`` makes rule 2 transitive: trees carry the robots
 whose information they hold, and a robot drops its own information coming back through a third
@@ -68,6 +75,10 @@ class SyncParams(BaseModel):
     rule of the density trees; ``symmetric``: answer a received tree with one's own position
     tree so that the detecting robot is constrained too (§2.3).
 
+    ``receive_gate`` (beyond the paper, default True; False: §2.3's rule 2 as written, which
+    gates only the detecting robot): a robot applies trees (detection or answer) from a given
+    teammate at most once per ``min_travel_m`` of its own travel.
+
     ``provenance`` (beyond the paper; False: the paper's two rules only): rule 2 made
     transitive. Rule 2 stops robot n from using robot m twice within ``min_travel_m``, but
     not from getting m's information back through a third robot (m -> n -> k -> m): in a
@@ -86,6 +97,7 @@ class SyncParams(BaseModel):
     tree_min_samples: int = Field(20, ge=1, le=100_000)
     tree_max_depth: int = Field(20, ge=1, le=64)
     symmetric: bool = True
+    receive_gate: bool = True
     provenance: bool = False
 
 
@@ -255,6 +267,10 @@ class BeliefSync:
             if int(rid) != self.robot_id:
                 self.sources[int(rid)] = max(self.sources.get(int(rid), -math.inf), float(odo))
 
+    def receive_allowed(self, other: int) -> bool:
+        """Whether a tree from robot ``other`` may be applied now (always, without ``receive_gate``)."""
+        return not self.params.receive_gate or self.receive_gate.allowed(other)
+
     def travel(self, odom_delta) -> None:
         """Advance both gates' odometers by this step's travel."""
         self.detect_gate.travel(odom_delta)
@@ -295,7 +311,7 @@ class BeliefSync:
         replies: list[Message] = []
         if body.kind == "detection" and body.target == self.robot_id:
             other = body.observer
-            if not self.receive_gate.allowed(other):
+            if not self.receive_allowed(other):
                 return []
             if self.params.symmetric:
                 tree = position_tree(mcl.particles, mcl.weights, self.params)
@@ -315,7 +331,7 @@ class BeliefSync:
             self.receive_gate.use(other)
         elif body.kind == "inverse" and body.observer == self.robot_id:
             other = body.target
-            if not self.receive_gate.allowed(other):
+            if not self.receive_allowed(other):
                 return []
             if self._looped(body):
                 self.looped += 1
