@@ -202,3 +202,20 @@ def test_hallway_verdict_needs_a_paired_reduction_beyond_two_standard_errors(tea
     comparison = _hallway(SimpleNamespace(quick=False, sweep=lambda *a, **k: res))[0]
     assert comparison.holds is holds
     assert "faster together in" in comparison.ours
+
+
+def test_claim_file_report_seeds_and_the_rules_changed_with_their_data():
+    """Issue 26 §3: the section's rules live in claims/collab-mcl.yaml, on >= 20 report seeds (< 1000)
+    in full mode; the two commits that tightened a rule after its data are in the history."""
+    from teamnav.experiments.claims import load_claims
+
+    cf = load_claims("collab-mcl")
+    ids = {c.id for c in cf.claims}
+    assert {"hallway-faster", "hexagon-together", "single-detection", "fp-breaks", "fp-filter", "anon-assoc"} == ids
+    for c in cf.claims:
+        assert len(c.seed_list) >= 20 and max(c.seed_list) < 1000 and c.history
+        assert c.judged == ("teamnav" if c.id in ("fp-filter", "anon-assoc") else "paper_rules")
+    after = {(c.id, h.commit) for c in cf.claims for h in c.history if not h.before_data}
+    assert after == {("hallway-faster", "79674cc"), ("hexagon-together", "b81d177"), ("single-detection", "b81d177")}
+    assert [(r.metric, r.op, r.threshold) for r in cf["single-detection"].rule] == [
+        ("team_final_error_mean_m", "<", 1.5), ("alone_final_error_mean_m", ">=", 1.5), ("team_localized_frac", ">=", 0.9)]
