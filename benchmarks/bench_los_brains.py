@@ -202,6 +202,7 @@ def _kernels() -> None:
         "VisBug boundary_heading": (lambda: boundary_heading(xy, pts, 0.33, 1, 1.5),
                                     lambda: eq._boundary_heading_numpy(xy, pts, 0.33, 1, 1.5)),
     }
+    pairs.update(_leave_pair(pose, scan, pts))
     pairs.update(_radio_pairs())
     print(f"{'fast path':34s} {'new us':>8s} {'numpy us':>9s} {'ratio':>6s}")
     for name, (new, old) in pairs.items():
@@ -214,6 +215,26 @@ def _kernels() -> None:
                 f()
             times.append(1e6 * (time.process_time() - t0) / n)
         print(f"{name:34s} {times[0]:8.1f} {times[1]:9.1f} {times[1] / times[0]:6.1f}", flush=True)
+
+
+def _leave_pair(pose, scan, pts) -> dict:
+    """Issue 21 §5: VisBug-21's leave test (kernel) against its numpy version, following the
+    corridor's wall with the goal 6 m ahead (every sample closer than d_H tested)."""
+    import math
+
+    import numpy as np
+
+    from teamnav.control.nav.local.visbug21 import MODE_FOLLOW, VisBug21, VisBugParams
+
+    navs = []
+    for _ in range(2):
+        nav = VisBug21(VisBugParams(), np.random.default_rng(0), 0.2, 0.2)
+        nav.goal_xy = np.array([6.3, 0.6])
+        nav.mline = (np.array([-3.0, 0.6]), nav.goal_xy.copy())
+        nav.mode, nav.hit_dist_m, nav._slack = MODE_FOLLOW, 9.0, math.pi / 72
+        navs.append(nav)
+    return {"VisBug _leave_point": (lambda: navs[0]._leave_point(pose, scan, pts, 0.28, 7.75),
+                                    lambda: navs[1]._leave_point_numpy(pose, scan, pts, 0.28, 7.75))}
 
 
 def _radio_pairs() -> dict:

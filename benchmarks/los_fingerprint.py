@@ -29,6 +29,12 @@ arctan2 differ from libm in the last bit; VisBug-21 alone, all in numba kernels,
 Re-recorded in session 10 after ``see_past_teammates`` (fc95e88): the 12 runs of R1 alone
 reproduced session 9's hashes (the rule acts only on steps with a teammate in sight), the 12
 team runs moved, as they must; a re-check reproduces the new file.
+
+``los_fingerprints_epyc.json``: the same 24 runs at defbca7 on a 2-core AMD EPYC with AVX-512
+(same NumPy and numba), where 16 of the hashes above (every potential-field and Avoid-Past run)
+come out differently already at the commit that recorded them: check against the file recorded
+on your kind of machine (issue 21 §5 held both: the file above's 8 VisBug-21 runs and all 24 of
+this one).
 """
 
 from __future__ import annotations
