@@ -168,8 +168,8 @@ def test_report_section_quick_build(tmp_path):
         quick, out_dir, progress = True, tmp_path, False
 
         def sweep(self, spec, **kw):
-            return sweep(spec, out_dir=tmp_path / "sweeps" / (kw.get("name") or spec), workers=2, progress=False,
-                         **kw)
+            name = kw.get("name") or (spec if isinstance(spec, str) else spec.sweep_name)
+            return sweep(spec, out_dir=tmp_path / "sweeps" / name, workers=2, progress=False, **kw)
 
     t0 = time.perf_counter()
     blocks = SECTION.build(Ctx())

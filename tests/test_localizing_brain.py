@@ -383,3 +383,22 @@ def test_paper_rules_brain_has_no_receive_gate():
             body = SyncMessage("detection", 0, 1, 3.0, 0.0, model.p_false_positive, tree)
             robin.step(_obs(1, k + 1, inbox=[Message(0, 0.1 * k, body, to=1, kind=SYNC_KIND)]))
         assert robin.sync.applied["detection"] == expect, paper
+
+
+def test_every_received_detection_tree_is_logged_with_the_belief_it_met():
+    """Issue 26 §2: Robin's sample count, spread and heaviest cluster at every detection tree, in
+    the next log() record (once), whether the tree was applied or gated."""
+    from teamnav.localization.sync import detection_tree
+
+    robin = _brain(1, seed=5, pose=(20.0, 9.6, 0.0))
+    model = robin.model
+    for k in range(2):  # the second tree, 0 m later, is gated by the receive side's 2.5 m rule
+        tree = detection_tree(np.array([[17.0, 9.6, 0.0]]), np.array([1.0]), 3.0, 0.0, model,
+                              np.random.default_rng(k))
+        body = SyncMessage("detection", 0, 1, 3.0, 0.0, model.p_false_positive, tree)
+        robin.step(_obs(1, k + 1, inbox=[Message(0, 0.1 * k, body, to=1, kind=SYNC_KIND)]))
+    first = robin.log()["det_belief"]
+    assert [r["applied"] for r in first] == [True, False] and [r["from"] for r in first] == [0, 0]
+    assert first[0]["n_particles"] == robin.mcl.n_particles or first[0]["n_particles"] >= 100
+    assert 0.0 < first[0]["spread_m"] < 2.0 and 0.0 < first[0]["cluster_weight"] <= 1.0
+    assert "det_belief" not in robin.log()  # logged once

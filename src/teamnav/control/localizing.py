@@ -496,6 +496,10 @@ class MCLWander:
         self._min_rot = math.radians(params.min_update_deg)
         self._n_log = 0
         self._time_s = 0.0
+        #: one record per detection tree received (time, sender, the belief's sample count, spread and
+        #: heaviest cluster's weight just before it, whether it was applied); logged as "det_belief"
+        self._det_log: list[dict[str, Any]] = []
+        self._det_logged = 0
         #: Counters for logs: detections seen / sent, phantoms filtered, messages dropped, associations.
         self.stats = {"seen": 0, "sent": 0, "filtered": 0, "rejected": 0, "assoc": 0, "assoc_dropped": 0}
 
@@ -654,6 +658,23 @@ class MCLWander:
         return float(np.dot(self.mcl.weights, tree(self.mcl.particles[:, :2])))
 
     def _on_message(self, msg: Message, obs: Observation) -> list[Message]:
+        """Handle one message; a detection tree addressed to this robot is logged with the belief it
+        met (issue 26 §2: the paper's Fig. 10a shows that belief still spread along the corridor)."""
+        body = msg.body
+        if not (msg.kind == SYNC_KIND and isinstance(body, SyncMessage) and body.kind == "detection"
+                and body.target == self.robot_id):
+            return self._handle(msg, obs)
+        est = self.mcl.estimate()
+        before = self.sync.applied["detection"]
+        out = self._handle(msg, obs)
+        self._det_log.append({"t_s": round(float(obs.time_s), 2), "from": int(body.observer),
+                              "n_particles": int(est.n_particles),
+                              "spread_m": round(float(math.sqrt(max(0.0, est.cov[0, 0] + est.cov[1, 1]))), 3),
+                              "cluster_weight": round(float(est.cluster_weight), 3),
+                              "applied": bool(self.sync.applied["detection"] > before)})
+        return out
+
+    def _handle(self, msg: Message, obs: Observation) -> list[Message]:
         p = self.params
         body = msg.body
         if msg.kind == ASSOC_KIND:
@@ -718,6 +739,9 @@ class MCLWander:
             "looped": int(self.sync.looped) if self.sync is not None else 0,
             "pts": [round(float(v), 2) for v in sub[:, :2].ravel()],
         }
+        if len(self._det_log) > self._det_logged:
+            out["det_belief"] = self._det_log[self._det_logged:]
+            self._det_logged = len(self._det_log)
         if self._n_log == 0:
             out["sensor_kind"] = self.sensor.kind
             out["group"] = str(self.info.extras.get("group", ""))

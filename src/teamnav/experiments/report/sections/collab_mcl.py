@@ -1,25 +1,46 @@
 """Report section: collaborative multi-robot MCL (Fox, Burgard, Kruppa & Thrun 2000).
 
 Three experiments of the paper and two beyond it, each a named sweep of an ``collab-mcl-*``
-scenario (brain ``mcl-wander-v1``, metrics :mod:`teamnav.experiments.metric_sets.localization`):
+scenario (brain ``mcl-wander-v1``, metrics :mod:`teamnav.experiments.metric_sets.localization`),
+every one in two columns beside the paper's number:
+
+- "paper as written": every mcl-wander-v1 group at ``paper_rules: true``
+  (:attr:`~teamnav.control.localizing.MCLWanderParams.PAPER_RULES`: eq. 14 alone, no sensor
+  resetting, untempered likelihood, resampling at every update, §2.3's two rules only, every
+  detection sent, no false-positive filter, anonymous sights ignored), the params those rules set
+  dropped from the scenario (:func:`._trails.paper_rules_spec`);
+- "teamnav": the scenarios as they are (our gap-fills).
+
+Verdict rules are read from ``experiments/claims/collab-mcl.yaml`` (:mod:`teamnav.experiments.claims`),
+never written here, and judged on the column each claim names (the paper as written, except the
+two §7.2 extensions only teamnav has); the seeds are the claim's report seeds (its
+``quick_seeds`` in quick mode; tuning seeds are >= 1000 and never run here).
 
 - §5.2.1 / Fig. 12: ``collab-mcl-hallway``, 8 sonar robots, single vs collaborative MCL:
-  error vs time with 95 % bands, time to localize (error < 1.5 m) mean ± std over runs;
+  error vs time with 95 % bands, time to localize (error < 1.5 m) mean ± std over runs, the
+  paired per-seed change (claim ``hallway-faster``, :func:`hallway_values`);
 - §5.2.2 / Fig. 14: ``collab-mcl-hexagon``, 4 sonar + 4 laser robots, alone vs together,
-  error per sensor kind;
-- §5.1 / Figs. 10–11: ``collab-mcl-detection``, the corridor robot's error over 10 runs with
-  95 % intervals, and its belief just before and after the detection (one run);
-- beyond the paper (§7.2): 3.5 % false-positive detections with and without the brain's
-  filter, and detections without identity, ignored (the paper's method) or associated by
-  belief — on the §5.1 setting, where sights are rare (the case §7.2 warns about).
+  localized share per sensor kind (claim ``hexagon-together``, :func:`hexagon_values`);
+- §5.1 / Figs. 10–11: ``collab-mcl-detection``, the corridor robot's error with 95 % intervals
+  (claim ``single-detection``, :func:`detection_values`), its belief just before and after the
+  detection in one run per column, and its sample count and spread whenever a tree reached it
+  (the brain's ``det_belief`` log: the paper's Fig. 10a precondition, a belief still spread);
+- beyond the paper (§7.2, full mode): 3.5 % false-positive detections with the paper's method
+  (both columns; claim ``fp-breaks``) and with the brain's filter, and detections without
+  identity, ignored (the paper's method) or associated by belief (teamnav; claims ``fp-filter``,
+  ``anon-assoc``) — on the §5.1 setting, where sights are rare (the case §7.2 warns about).
+
+Then a claim table (both columns, each rule and its history) and, per scenario, the gap-fills
+with both values (and those kept in both columns because the paper gives no value).
 
 Time to localize: per run, the mean over robots of the first time the error falls below
 1.5 m; a robot that never does counts as the run's duration (censored; the mean is then a
 lower bound and the table says how many robots were censored). Spreads are over runs.
-Quick mode (CI) runs few robots and particles, 1-2 seeds and 40-90 s runs (8 trials), and
-leaves the belief pictures and the §7.2 variants to the full report: its numbers show that the
-pipeline works, not the paper's result. The full report runs 16 hallway runs of 600 s (8 robots, about 30 CPU s each),
-16 hexagon runs of 300 s, 20 + 50 two-robot runs of 150 s and one pictured run.
+Quick mode (CI) runs few robots and particles, 1-2 seeds and 40-90 s runs, and leaves the §7.2
+variants to the full report: its numbers show that the pipeline works, not the paper's result.
+The full report runs 20 seeds of the hallway (600 s, 8 robots) and of the hexagon (300 s) per
+condition and column, 30 seeds of the §5.1 setting (150 s) and 20 of each §7.2 variant.
+What was measured, with seeds and CPU cost: ``docs/report/collab-mcl.md``.
 
 Files: the row helpers (error curves with 95 % bands) in :mod:`._collab_common`, the §7.2 variants
 in :mod:`._collab_beyond`; the paper's experiments here.
@@ -49,186 +70,381 @@ QUICK_HEXAGON = {"robots.0.count": 2, "robots.1.count": 2, "robots.0.params.max_
 QUICK_DETECTION = {"robots.1.params.max_particles": 3000}
 
 
+# ---------------------------------------------------------------------------- columns and claims
+def _seeds(ctx, claim) -> list[int]:
+    """The claim's report seeds (its quick seeds in quick mode)."""
+    from teamnav.experiments.claims import _parse_seeds
+
+    return _parse_seeds(claim.quick_seeds) if ctx.quick and claim.quick_seeds else claim.seed_list
+
+
+def _col_sweep(ctx, col: str, sweep_name: str, **kw) -> list[dict]:
+    """Finished rows of sweep ``sweep_name`` in column ``col``: ``"teamnav"`` as the scenario is,
+    ``"paper_rules"`` with every mcl-wander-v1 group at ``paper_rules: true`` (the params those
+    rules set dropped from the scenario; :func:`._trails.paper_rules_spec`), in its own folder."""
+    if col == "paper_rules":
+        from teamnav.experiments.report.sections._trails import paper_rules_spec
+
+        if kw.get("name"):
+            kw["name"] = f"{kw['name']}-paper-rules"
+        return _ok(ctx.sweep(paper_rules_spec(sweep_name), **kw))
+    return _ok(ctx.sweep(sweep_name, **kw))
+
+
+def _verdicts(claim, vals: dict[str, dict]) -> dict[str, tuple]:
+    """``{column: judge(claim, that column's values)}``."""
+    from teamnav.experiments.claims import judge
+
+    return {col: judge(claim, vals[col]) for col, _ in COLUMNS}
+
+
+def _rule_text(claim, verdicts: dict[str, tuple], n_text: str) -> str:
+    """The rule, its reading on the judged column and on the other one, and the runs judged."""
+    from teamnav.experiments.claims import rule_text
+
+    other = "teamnav" if claim.judged == "paper_rules" else "paper_rules"
+    return (f" Rule (claims/collab-mcl.yaml, {claim.id}, judged on {HEAD[claim.judged]}): {rule_text(claim)}; "
+            f"{verdicts[claim.judged][1]}. {HEAD[other]}: {verdicts[other][1]}. {n_text}")
+
+
+#: the two columns: (key, heading)
+COLUMNS = (("paper_rules", "paper as written"), ("teamnav", "teamnav"))
+HEAD = dict(COLUMNS)
+
+
 # ---------------------------------------------------------------------------- §5.2.1
-def _hallway(ctx) -> list:
-    kw = {"seeds": 2, "duration_s": 40, "set": QUICK_HALLWAY} if ctx.quick else {}
-    res = ctx.sweep("collab-mcl-hallway", **kw)
-    rows = _ok(res)
+def hallway_values(rows: list[dict]) -> dict[str, float]:
+    """Claim ``hallway-faster``'s metrics from one column's hallway runs (both conditions).
+
+    ``alone_ttl_mean_s`` / ``together_ttl_mean_s``: mean over runs of the per-run time to localize;
+    ``alone_final_localized`` / ``together_final_localized``: mean share of robots localized at the
+    end; ``paired_change_upper_s``: mean + 2 s.e. of the per-seed change together - alone (NaN
+    below two pairs); ``ttl_change_pct``; ``n_pairs``, ``faster_pairs``, ``paired_mean_s``,
+    ``paired_se_s``.
+    """
+    nan = float("nan")
     alone = [r for r in rows if not _param(r, "robots.0.params.collaborate", True)]
     team = [r for r in rows if _param(r, "robots.0.params.collaborate", False)]
-    if not alone or not team:
-        return [Missing("collab-mcl-hallway results", f"sweep finished {len(rows)} of {res.total} trials")]
     ta, tt = _metric(alone, "loc_time_to_localize_s"), _metric(team, "loc_time_to_localize_s")
-    ca, ct = sum(_metric(alone, "loc_censored")), sum(_metric(team, "loc_censored"))
-    ma, mt = float(np.mean(ta)), float(np.mean(tt))
-    red = 100.0 * (mt - ma) / ma if ma > 0 else float("nan")
-    fa = float(np.mean(_metric(alone, "loc_final_localized_fraction")))
-    ft = float(np.mean(_metric(team, "loc_final_localized_fraction")))
-    # "Clearly faster" (the issue) is judged per seed: the same seed starts both conditions from the
-    # same poses, so the paired difference removes the run-to-run spread that the two means share.
-    # The full report needs the mean paired reduction beyond two standard errors.
+    ma = float(np.mean(ta)) if ta else nan
+    mt = float(np.mean(tt)) if tt else nan
+    fa, ft = _metric(alone, "loc_final_localized_fraction"), _metric(team, "loc_final_localized_fraction")
     by_seed = {r["seed"]: r["metrics"]["loc_time_to_localize_s"] for r in alone
                if isinstance(r["metrics"].get("loc_time_to_localize_s"), (int, float))}
     diffs = [r["metrics"]["loc_time_to_localize_s"] - by_seed[r["seed"]] for r in team
              if r["seed"] in by_seed and isinstance(r["metrics"].get("loc_time_to_localize_s"), (int, float))]
-    if len(diffs) >= 2:
-        d_mean, d_se = float(np.mean(diffs)), float(np.std(diffs, ddof=1) / math.sqrt(len(diffs)))
-        paired = (f"; per seed {d_mean:+.0f} ± {d_se:.0f} s (s.e.), faster together in "
-                  f"{sum(d < 0 for d in diffs)} / {len(diffs)} seeds")
-        clear = d_mean < -2.0 * d_se
-    else:
-        paired, clear = "", False
-    holds = bool(mt < ma and ft >= fa and (ctx.quick or clear))
+    d_mean = float(np.mean(diffs)) if diffs else nan
+    d_se = float(np.std(diffs, ddof=1) / math.sqrt(len(diffs))) if len(diffs) >= 2 else nan
+    return {"alone_ttl_mean_s": ma, "together_ttl_mean_s": mt,
+            "alone_final_localized": float(np.mean(fa)) if fa else nan,
+            "together_final_localized": float(np.mean(ft)) if ft else nan,
+            "paired_change_upper_s": d_mean + 2.0 * d_se, "paired_mean_s": d_mean, "paired_se_s": d_se,
+            "n_pairs": float(len(diffs)), "faster_pairs": float(sum(d < 0 for d in diffs)),
+            "ttl_change_pct": 100.0 * (mt - ma) / ma if ma > 0 else nan}
+
+
+def _hallway(ctx, out: dict | None = None) -> list:
+    """Blocks of claim ``hallway-faster``; its metrics per column go into ``out[column]["hallway-faster"]``."""
+    from teamnav.experiments.claims import load_claims
+
+    claim = load_claims("collab-mcl")["hallway-faster"]
+    seeds = _seeds(ctx, claim)
+    kw = {"seeds": seeds, "duration_s": 40, "set": QUICK_HALLWAY} if ctx.quick else {"seeds": seeds}
+    cols = {col: _col_sweep(ctx, col, "collab-mcl-hallway", **kw) for col, _ in COLUMNS}
+    split = {col: ([r for r in rs if not _param(r, "robots.0.params.collaborate", True)],
+                   [r for r in rs if _param(r, "robots.0.params.collaborate", False)]) for col, rs in cols.items()}
+    if not all(a and t for a, t in split.values()):
+        return [Missing("collab-mcl-hallway results",
+                        "; ".join(f"{HEAD[c]}: {len(rs)} trials finished" for c, rs in cols.items()))]
+    vals = {col: hallway_values(rs) for col, rs in cols.items()}
+    verdicts = _verdicts(claim, vals)
+    for col in (out or {}):
+        out[col]["hallway-faster"] = vals[col]
+
+    def ours(col: str) -> str:
+        alone, team = split[col]
+        v = vals[col]
+        ca, ct = sum(_metric(alone, "loc_censored")), sum(_metric(team, "loc_censored"))
+        paired = (f"; per seed {v['paired_mean_s']:+.0f} ± {v['paired_se_s']:.0f} s (s.e.), faster together in "
+                  f"{int(v['faster_pairs'])} / {int(v['n_pairs'])} seeds" if v["n_pairs"] >= 2 else "")
+        return (f"{HEAD[col]}: {_ms(_metric(alone, 'loc_time_to_localize_s'))} s → "
+                f"{_ms(_metric(team, 'loc_time_to_localize_s'))} s ({v['ttl_change_pct']:+.0f} %), "
+                f"n = {len(alone)} / {len(team)} runs{paired}; robots never below 1.5 m (censored at the "
+                f"duration): {ca} alone, {ct} together")
+
+    n_text = f"Seeds {seeds[0]}-{seeds[-1]}" + (" (quick: 4 robots, 1000 samples, 40 s)." if ctx.quick else ".")
     blocks = [
         Comparison(
             "§5.2.1: collaborative localization is faster than single-robot MCL (8 sonar robots, hallway)",
             "379 ± 37 s → 153 ± 17 s (−60 %)",
-            f"{_ms(ta)} s → {_ms(tt)} s ({red:+.0f} %), n = {len(alone)} / {len(team)} runs{paired}; "
-            f"robots never below 1.5 m (censored at the duration): {ca} alone, {ct} together",
-            holds,
+            "; ".join(ours(col) for col, _ in COLUMNS),
+            verdicts[claim.judged][0],
             "Our times are mean ± std over runs of the per-run mean over robots, censored robots counted at the "
-            "run's duration (a lower bound). The full report's verdict needs the paired per-seed reduction beyond "
-            "two standard errors, not only a lower mean. Our hallway, sonar model and sample counts are not the paper's. "
-            "Collaboration needs sensor resetting on received trees (inject_fraction) with our sample sets. In this "
-            "hallway (beyond the paper, each a scenario setting): the wanderer takes no side openings (with them a "
-            "robot shuttles along one stretch of corridor and the team splits into groups that never meet); a tree "
-            "becomes at least 500 draws whose headings come from the receiver's scan (a wrong robot here sits on a "
-            "rotated copy of its place); and the receiver weighs the chance that the sender is wrong, so two "
-            "confident robots that disagree no longer hand the receiver to the sender.",
+            "run's duration (a lower bound). Our hallway, sonar model and sample counts are not the paper's. "
+            "The teamnav column adds, beyond the paper (each a scenario setting): sensor resetting on received "
+            "trees (inject_fraction), at least 500 draws whose headings come from the receiver's scan, the chance "
+            "that the sender is wrong, a tempered likelihood (0.1), selective resampling, provenance and a "
+            "receive-side 2.5 m gate; both columns use the wanderer without side openings (the paper's robots "
+            "follow an operator or a random walk)." + _rule_text(claim, verdicts, n_text),
         ),
         Plot("Fig. 12(b): localization error vs time, 8 sonar robots", "time [s]",
              "mean distance of samples to the true pose [m]",
-             _series("single-robot MCL", alone, lambda d: d["mean"]) + _series("collaborative", team,
-                                                                               lambda d: d["mean"]),
+             [s for col, head in COLUMNS for s in
+              _series(f"single-robot MCL, {head}", split[col][0], lambda d: d["mean"])
+              + _series(f"collaborative, {head}", split[col][1], lambda d: d["mean"])],
              hlines=[(1.5, "localized (1.5 m)")],
              caption="Mean over runs of the robots' mean error; bands: 95 % confidence interval over runs."),
         Table("Hallway: per-run summary (mean ± std over runs)",
-              ["setting", "runs", "time to localize [s]", "final error [m]", "localized at the end", "syncs",
-               "bytes sent"],
-              [[name, len(rs), _ms(_metric(rs, "loc_time_to_localize_s")), _ms(_metric(rs, "loc_final_error_m")),
+              ["column", "setting", "runs", "time to localize [s]", "final error [m]", "localized at the end",
+               "syncs", "bytes sent"],
+              [[head, name, len(rs), _ms(_metric(rs, "loc_time_to_localize_s")), _ms(_metric(rs, "loc_final_error_m")),
                 _ms(_metric(rs, "loc_final_localized_fraction")), _ms(_metric(rs, "loc_syncs")),
-                _ms(_metric(rs, "bytes_sent"))] for name, rs in (("single-robot", alone), ("collaborative", team))]),
+                _ms(_metric(rs, "bytes_sent"))]
+               for col, head in COLUMNS for name, rs in (("single-robot", split[col][0]),
+                                                         ("collaborative", split[col][1]))]),
     ]
     return blocks
 
 
 # ---------------------------------------------------------------------------- §5.2.2
-def _hexagon(ctx) -> list:
-    kw = {"seeds": 1, "duration_s": 40} if ctx.quick else {}
-    base = dict(QUICK_HEXAGON) if ctx.quick else {}
-    team = _ok(ctx.sweep("collab-mcl-hexagon", set=base, **kw))
-    alone = _ok(ctx.sweep("collab-mcl-hexagon", name="collab-mcl-hexagon-alone",
-                          set={**base, "robots.0.params.collaborate": False, "robots.1.params.collaborate": False},
-                          **kw))
-    if not team or not alone:
-        return [Missing("collab-mcl-hexagon results", "no finished trials")]
-    series = []
-    for kind in ("sonar", "laser"):
-        series += _series(f"{kind} alone", alone, lambda d, k=kind: d["by_kind"].get(k))
-        series += _series(f"{kind} together", team, lambda d, k=kind: d["by_kind"].get(k))
-    rows = []
-    frac = {}
+def hexagon_values(alone: list[dict], team: list[dict]) -> dict[str, float]:
+    """Claim ``hexagon-together``'s metrics from one column's hexagon runs, and per-kind shares
+    (``frac_<setting>_<kind>``)."""
+    out: dict[str, float] = {}
     for name, rs in (("alone", alone), ("together", team)):
         for kind in ("sonar", "laser"):
             f = _metric(rs, f"loc_final_localized_fraction_{kind}")
-            frac[(name, kind)] = float(np.mean(f)) if f else float("nan")
-            rows.append([name, kind, len(rs), _ms(_metric(rs, f"loc_final_error_m_{kind}")), _ms(f),
-                         _ms(_metric(rs, f"loc_time_to_localize_s_{kind}"))])
-    together_all = min(frac[("together", "sonar")], frac[("together", "laser")])
-    alone_best = max(frac[("alone", "sonar")], frac[("alone", "laser")])
+            out[f"frac_{name}_{kind}"] = float(np.mean(f)) if f else float("nan")
+    out["together_min_localized"] = min(out["frac_together_sonar"], out["frac_together_laser"])
+    out["alone_best_localized"] = max(out["frac_alone_sonar"], out["frac_alone_laser"])
     # runs in which every robot ended localized: "each robot is able to uniquely determine its position"
-    full = {name: sum(1 for r in rs if r["metrics"].get("loc_final_localized_fraction") == 1.0)
-            for name, rs in (("alone", alone), ("together", team))}
+    for name, rs in (("alone", alone), ("together", team)):
+        full = sum(1 for r in rs if r["metrics"].get("loc_final_localized_fraction") == 1.0)
+        out[f"{name}_all_runs"] = float(full)
+        out[f"{name}_all_runs_frac"] = full / len(rs) if rs else float("nan")
+    return out
+
+
+def _hexagon(ctx, out: dict | None = None) -> list:
+    """Blocks of claim ``hexagon-together``; its metrics per column go into ``out[column]["hexagon-together"]``."""
+    from teamnav.experiments.claims import load_claims
+
+    claim = load_claims("collab-mcl")["hexagon-together"]
+    seeds = _seeds(ctx, claim)
+    kw = {"seeds": seeds, "duration_s": 40} if ctx.quick else {"seeds": seeds}
+    base = dict(QUICK_HEXAGON) if ctx.quick else {}
+    alone_set = {**base, "robots.0.params.collaborate": False, "robots.1.params.collaborate": False}
+    runs = {col: (_col_sweep(ctx, col, "collab-mcl-hexagon", name="collab-mcl-hexagon-alone", set=alone_set, **kw),
+                  _col_sweep(ctx, col, "collab-mcl-hexagon", set=base, **kw)) for col, _ in COLUMNS}
+    if not all(a and t for a, t in runs.values()):
+        return [Missing("collab-mcl-hexagon results", "no finished trials in a column")]
+    vals = {col: hexagon_values(*runs[col]) for col, _ in COLUMNS}
+    verdicts = _verdicts(claim, vals)
+    for col in (out or {}):
+        out[col]["hexagon-together"] = vals[col]
+    series, rows = [], []
+    for col, head in COLUMNS:
+        alone, team = runs[col]
+        for kind in ("sonar", "laser"):
+            series += _series(f"{kind} alone, {head}", alone, lambda d, k=kind: d["by_kind"].get(k))
+            series += _series(f"{kind} together, {head}", team, lambda d, k=kind: d["by_kind"].get(k))
+        for name, rs in (("alone", alone), ("together", team)):
+            for kind in ("sonar", "laser"):
+                rows.append([head, name, kind, len(rs), _ms(_metric(rs, f"loc_final_error_m_{kind}")),
+                             _ms(_metric(rs, f"loc_final_localized_fraction_{kind}")),
+                             _ms(_metric(rs, f"loc_time_to_localize_s_{kind}"))])
+
+    def ours(col: str) -> str:
+        v, (alone, team) = vals[col], runs[col]
+        return (f"{HEAD[col]}: localized at the end: alone sonar {v['frac_alone_sonar']:.0%}, laser "
+                f"{v['frac_alone_laser']:.0%}; together sonar {v['frac_together_sonar']:.0%}, laser "
+                f"{v['frac_together_laser']:.0%}; every robot localized in {int(v['alone_all_runs'])} / {len(alone)} "
+                f"runs alone, {int(v['together_all_runs'])} / {len(team)} together")
+
+    n_text = f"Seeds {seeds[0]}-{seeds[-1]}" + (" (quick: 2 + 2 robots, 1000 samples, 40 s)." if ctx.quick else ".")
     return [
         Comparison("§5.2.2: alone each sensor type stays ambiguous; together every robot localizes",
                    "Fig. 14: single-robot errors stay high (sonar: 3 modes, laser: 2); collaborative errors fall "
                    "for both types",
-                   f"localized at the end: alone sonar {frac[('alone', 'sonar')]:.0%}, laser "
-                   f"{frac[('alone', 'laser')]:.0%}; together sonar {frac[('together', 'sonar')]:.0%}, laser "
-                   f"{frac[('together', 'laser')]:.0%}; every robot localized in {full['alone']} / {len(alone)} "
-                   f"runs alone, {full['together']} / {len(team)} together",
-                   bool(together_all > alone_best and together_all >= 0.75
-                        and (ctx.quick or full["together"] >= 0.9 * len(team))),
+                   "; ".join(ours(col) for col, _ in COLUMNS),
+                   verdicts[claim.judged][0],
                    "Our hexagon's glass discs are 2-fold and foam discs 3-fold symmetric, so sonar robots keep 2 "
-                   "modes and laser robots 3 (the paper has them the other way round). Double counting guarded "
-                   "beyond §2.3's two rules: received trees are weighted by the chance the receiver is lost, the "
-                   "answer tree carries only the answering robot's own belief, and a tree holding the receiver's "
-                   "own recent information through a third robot is dropped (provenance)."),
+                   "modes and laser robots 3 (the paper has them the other way round). The teamnav column guards "
+                   "double counting beyond §2.3's two rules: received trees become draws weighted by the chance "
+                   "the receiver is lost, the answer tree carries only the answering robot's own belief, a tree "
+                   "holding the receiver's own recent information through a third robot is dropped (provenance), "
+                   "and the likelihoods are tempered (sonar 0.1, laser 0.01)." + _rule_text(claim, verdicts, n_text)),
         Plot("Fig. 14: error vs time by sensor kind", "time [s]", "mean distance of samples to the true pose [m]",
              series, hlines=[(1.5, "localized (1.5 m)")], caption="Bands: 95 % confidence interval over runs."),
         Table("Hexagon: by sensor kind (mean ± std over runs)",
-              ["setting", "sensor", "runs", "final error [m]", "localized at the end", "time to localize [s]"], rows),
+              ["column", "setting", "sensor", "runs", "final error [m]", "localized at the end",
+               "time to localize [s]"], rows),
     ]
 
 
 # ---------------------------------------------------------------------------- §5.1
-def _belief_views(ctx) -> list:
-    """Robin's samples just before and after the first detection of one run (Fig. 10)."""
+#: the run pictured in Fig. 10 (a report seed; both columns)
+PICTURED_SEED = 1
+
+
+def _pictured_run(col: str, seed: int = PICTURED_SEED, duration_s: float = 150.0):
+    """One collab-mcl-detection run of column ``col`` with 300 logged samples per record."""
+    from teamnav.experiments.report.sections._trails import paper_rules_spec
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
-    from teamnav.world import builtin_map
 
-    over = {"robots.1.params.log_points": 300}
-    res = run(load_scenario("collab-mcl-detection", overrides=over, seed=1, duration_s=150), progress=False)
-    logs = sorted((r for r in res.data.logs if r["robot"] == 1 and "pts" in r["values"]), key=lambda r: r["step"])
-    k = next((i for i, r in enumerate(logs) if r["values"].get("syncs", 0) > 0), None)
-    if k is None:
-        return [Missing("belief before/after the detection", "no detection was applied in the pictured run")]
-    grid = builtin_map("lab_and_corridor").grid
-    t_s = np.asarray(res.data.t_s)
+    over: dict = {"robots.1.params.log_points": 300}
+    if col == "paper_rules":
+        over = dict(paper_rules_spec("collab-mcl-detection").set)  # both robots' params, paper_rules: true
+        over["robots.1.params"] = {**over["robots.1.params"], "log_points": 300}
+    return run(load_scenario("collab-mcl-detection", overrides=over, seed=seed, duration_s=duration_s), progress=False)
+
+
+def detection_belief_rows(logs: list[dict], robot: int = 1) -> list[dict]:
+    """Every ``det_belief`` record (a detection tree that reached ``robot``, with the belief it met)
+    in a run's logs, in time order."""
     out = []
-    for title, rec in (("Fig. 10(a): Robin's belief as it passes Marian (before the detection)", logs[max(0, k - 1)]),
-                       ("Fig. 10(b): Robin's belief after integrating Marian's detection",
-                        logs[min(len(logs) - 1, k + 2)])):
-        j = int(np.argmin(np.abs(t_s - rec["t_s"])))
-        truth = res.data.true_pose[j]
-        out.append(MapView(title, grid, points=[("Robin's samples", np.asarray(rec["values"]["pts"]).reshape(-1, 2))],
-                           markers=[("Robin (true)", float(truth[1, 0]), float(truth[1, 1])),
-                                    ("Marian (true)", float(truth[0, 0]), float(truth[0, 1]))],
-                           caption=f"t = {rec['t_s']:.0f} s; 300 samples drawn by weight from the belief."))
+    for r in sorted((r for r in logs if r["robot"] == robot), key=lambda r: r["step"]):
+        out += list(r["values"].get("det_belief", []))
     return out
 
 
-def _detection(ctx) -> list:
-    kw = {"seeds": 1, "duration_s": 90, "set": QUICK_DETECTION} if ctx.quick else {}
-    rows = _ok(ctx.sweep("collab-mcl-detection", **kw))
-    alone = [r for r in rows if not _param(r, "robots.1.params.collaborate", True)]
-    team = [r for r in rows if _param(r, "robots.1.params.collaborate", False)]
-    if not alone or not team:
-        return [Missing("collab-mcl-detection results", "no finished trials")]
+def _belief_views(ctx) -> list:
+    """Robin's samples just before and after the first detection of one run per column (Fig. 10),
+    and Robin's sample count and spread at every detection tree it received (issue 26 §2)."""
+    from teamnav.world import builtin_map
+
+    grid = builtin_map("lab_and_corridor").grid
+    out, table = [], []
+    for col, head in COLUMNS:
+        res = _pictured_run(col)
+        for rec in detection_belief_rows(res.data.logs):
+            table.append([head, PICTURED_SEED, f"{rec['t_s']:.1f}", rec["n_particles"], f"{rec['spread_m']:.2f}",
+                          f"{rec['cluster_weight']:.2f}", "yes" if rec["applied"] else "no (gated)"])
+        logs = sorted((r for r in res.data.logs if r["robot"] == 1 and "pts" in r["values"]), key=lambda r: r["step"])
+        k = next((i for i, r in enumerate(logs) if r["values"].get("syncs", 0) > 0), None)
+        if k is None:
+            out.append(Missing(f"belief before/after the detection, {head}", "no detection was applied in the "
+                               "pictured run"))
+            continue
+        t_s = np.asarray(res.data.t_s)
+        for title, rec in ((f"Fig. 10(a): Robin's belief as it passes Marian (before the detection), {head}",
+                            logs[max(0, k - 1)]),
+                           (f"Fig. 10(b): Robin's belief after integrating Marian's detection, {head}",
+                            logs[min(len(logs) - 1, k + 2)])):
+            j = int(np.argmin(np.abs(t_s - rec["t_s"])))
+            truth = res.data.true_pose[j]
+            out.append(MapView(title, grid,
+                               points=[("Robin's samples", np.asarray(rec["values"]["pts"]).reshape(-1, 2))],
+                               markers=[("Robin (true)", float(truth[1, 0]), float(truth[1, 1])),
+                                        ("Marian (true)", float(truth[0, 0]), float(truth[0, 1]))],
+                               caption=f"t = {rec['t_s']:.0f} s; 300 samples drawn by weight from the belief; "
+                                       f"{rec['values'].get('n_particles', '?')} samples, spread "
+                                       f"{rec['values'].get('spread_m', float('nan')):.2f} m."))
+    out.insert(0, Table("Fig. 10(a)'s precondition: Robin's belief when Marian's tree arrives",
+                        ["column", "seed", "t [s]", "samples", "spread [m]", "heaviest cluster's weight", "applied"],
+                        table or [["(no tree reached Robin)", PICTURED_SEED, "", "", "", "", ""]],
+                        note="spread = sqrt(var x + var y) of Robin's weighted samples just before the tree; the "
+                             "paper's Fig. 10a shows a belief still spread along the corridor (metres), where eq. 14 "
+                             "can pick the right samples. A spread of a few decimetres with one heavy cluster is a "
+                             "belief that already collapsed, right or wrong."))
+    return out
+
+
+def detection_values(alone: list[dict], team: list[dict]) -> dict[str, float]:
+    """Claim ``single-detection``'s metrics from one column's §5.1 runs."""
+    nan = float("nan")
     ea = _metric(alone, "loc_final_error_m_g_robin")
     et = _metric(team, "loc_final_error_m_g_robin")
-    la = _metric(alone, "loc_time_to_localize_s_g_robin")
-    lt = _metric(team, "loc_time_to_localize_s_g_robin")
-    fa = float(np.mean(np.asarray(ea) < 1.5)) if ea else float("nan")
-    ft = float(np.mean(np.asarray(et) < 1.5)) if et else float("nan")
-    # Holds only when the detection collapses Robin's belief to the right place in (nearly) every
-    # run, the paper's "this single incident almost completely resolves the uncertainty": mean
-    # error < 1.5 m with detections (one run of 10 left on a wrong mode 20+ m off already breaks
-    # it), >= 90 % of runs localized with them (so many runs just under 1.5 m cannot pass on
-    # the mean), and ignoring them leaves the mean >= 1.5 m.
-    holds = bool(np.mean(et) < 1.5 <= np.mean(ea) and ft >= 0.9) if ea and et else None
+    return {"alone_final_error_mean_m": float(np.mean(ea)) if ea else nan,
+            "team_final_error_mean_m": float(np.mean(et)) if et else nan,
+            "alone_localized_frac": float(np.mean(np.asarray(ea) < 1.5)) if ea else nan,
+            "team_localized_frac": float(np.mean(np.asarray(et) < 1.5)) if et else nan}
+
+
+def _detection(ctx, out: dict | None = None) -> list:
+    """Blocks of claim ``single-detection``; its metrics per column go into ``out[column]["single-detection"]``."""
+    from teamnav.experiments.claims import load_claims
+
+    claim = load_claims("collab-mcl")["single-detection"]
+    seeds = _seeds(ctx, claim)
+    kw = {"seeds": seeds, "duration_s": 90, "set": QUICK_DETECTION} if ctx.quick else {"seeds": seeds}
+    split = {}
+    for col, _ in COLUMNS:
+        rows = _col_sweep(ctx, col, "collab-mcl-detection", **kw)
+        split[col] = ([r for r in rows if not _param(r, "robots.1.params.collaborate", True)],
+                      [r for r in rows if _param(r, "robots.1.params.collaborate", False)])
+    if not all(a and t for a, t in split.values()):
+        return [Missing("collab-mcl-detection results", "no finished trials in a column")]
+    vals = {col: detection_values(*split[col]) for col, _ in COLUMNS}
+    verdicts = _verdicts(claim, vals)
+    for col in (out or {}):
+        out[col]["single-detection"] = vals[col]
+
+    def ours(col: str) -> str:
+        alone, team = split[col]
+        v = vals[col]
+        return (f"{HEAD[col]}: Robin's final error {_ms(_metric(alone, 'loc_final_error_m_g_robin'))} m ignoring "
+                f"detections vs {_ms(_metric(team, 'loc_final_error_m_g_robin'))} m using them; localized at the "
+                f"end in {v['alone_localized_frac']:.0%} vs {v['team_localized_frac']:.0%} of runs; time to < 1.5 m "
+                f"{_ms(_metric(alone, 'loc_time_to_localize_s_g_robin'))} s vs "
+                f"{_ms(_metric(team, 'loc_time_to_localize_s_g_robin'))} s (n = {len(alone)} / {len(team)} runs)")
+
+    n_text = f"Seeds {seeds[0]}-{seeds[-1]}."
+    if ctx.quick:
+        n_text += (" Quick mode: one seed of 90 s per condition, so the verdict rests on Robin's final error alone "
+                   "(one run's time to < 1.5 m says nothing about a spread, and is often the same in both "
+                   "conditions).")
     blocks = [
         Comparison("§5.1 / Fig. 11: a single detection collapses the corridor robot's belief",
                    "error falls much faster with detections (10 runs, detection after 60-100 s)",
-                   f"Robin's final error {_ms(ea)} m ignoring detections vs {_ms(et)} m using them; "
-                   f"localized at the end in {fa:.0%} vs {ft:.0%} of runs; "
-                   f"time to < 1.5 m {_ms(la)} s vs {_ms(lt)} s (n = {len(alone)} / {len(team)} runs)",
-                   holds,
+                   "; ".join(ours(col) for col, _ in COLUMNS),
+                   verdicts[claim.judged][0],
                    "Our corridor robot starts 15-19 m west of the lab opening and passes it after about 60 s; "
-                   "Marian stands still, so the 2.5 m rule lets it use Robin once per run. Robin's sample set "
-                   "often collapses onto a wrong place before the detection (the paper's stays spread along the "
-                   "corridor), so the brain draws part of its samples from the received tree (sensor resetting, "
-                   "weighted by the posterior probability that Robin was lost) with headings from Robin's own "
-                   "belief (half of them; uniform for the rest)."),
+                   "Marian stands still, so the 2.5 m rule lets it use Robin once per run. The paper-as-written "
+                   "column applies eq. 14 alone: it can only reweight the samples Robin has. The teamnav column "
+                   "draws part of Robin's samples from the received tree (sensor resetting, weighted by the "
+                   "posterior probability that Robin was lost, lost prior 0.3) with headings from Robin's own "
+                   "belief (half of them; uniform for the rest), and tempers the likelihood (0.03)."
+                   + _rule_text(claim, verdicts, n_text)),
         Plot("Fig. 11: the corridor robot's error vs time", "time [s]", "mean distance of samples to the true pose [m]",
-             _series("single-robot MCL (ignores detections)", alone, lambda d: d["by_group"].get("robin"))
-             + _series("using Marian's detection", team, lambda d: d["by_group"].get("robin")),
+             [s for col, head in COLUMNS for s in
+              _series(f"single-robot MCL (ignores detections), {head}", split[col][0],
+                      lambda d: d["by_group"].get("robin"))
+              + _series(f"using Marian's detection, {head}", split[col][1], lambda d: d["by_group"].get("robin"))],
              hlines=[(1.5, "localized (1.5 m)")], caption="Bands: 95 % confidence interval over runs."),
     ]
-    if ctx.quick:
-        return blocks + [Missing("belief before/after the detection (Fig. 10)", "drawn in the full report only")]
     return blocks + _belief_views(ctx)
+
+
+def _claims_and_gap_fills(ctx, vals: dict) -> list:
+    """The claim table (both columns, rules and their history) and the gap-fill table."""
+    from teamnav.control.localizing import MCLWanderParams
+    from teamnav.experiments.claims import judge, load_claims
+    from teamnav.experiments.report.sections._trails import claim_rows, gap_fill_rows
+    from teamnav.experiments.spec import load_scenario
+
+    claims = load_claims("collab-mcl")
+    ran = [c for c in claims.claims if c.id in vals.get("teamnav", {})]
+    sub = claims.model_copy(update={"claims": ran})
+    verdicts = {col: {c.id: judge(c, vals[col][c.id]) for c in ran} for col, _ in COLUMNS}
+    blocks = [Table("Claims: the paper, the paper as written, teamnav",
+                    ["claim", "paper", "rule (claim file)", "paper as written", "teamnav", "rule history"],
+                    claim_rows(sub, vals, verdicts),
+                    note="verdicts judged on the column each claim names (claims/collab-mcl.yaml): the paper as "
+                         "written, except the two §7.2 extensions, which only teamnav has")]
+    for scen in ("collab-mcl-hallway", "collab-mcl-hexagon", "collab-mcl-detection"):
+        groups = load_scenario(scen).robots
+        rows = []
+        for g in groups:
+            rows += [[f"{g.name}: {r[0]}"] + r[1:] for r in gap_fill_rows(MCLWanderParams, g.params)
+                     if r[1] != r[2]]
+        blocks.append(Table(f"Gap-fills of {scen}: teamnav's value and the paper's (paper_rules: true sets the "
+                            "paper's)", ["parameter (mcl-wander-v1)", "teamnav", "paper as written",
+                                         "where the paper says so"], rows,
+                            note="kept in both columns (the paper gives no value): "
+                                 + "; ".join(f"{k}: {v}" for k, v in MCLWanderParams.GAP_FILLS_KEPT.items())))
+    return blocks
 
 
 def build(ctx) -> list:
@@ -236,11 +452,16 @@ def build(ctx) -> list:
     blocks: list = [Text("Every robot runs mcl-wander-v1: it wanders (wall following, random turns) while its own "
                          "MCL localizes it on the given map; with collaborate on, detections are turned into density "
                          "trees sent over the radio (eqs. 13-14, §2.3 rules). Error = mean distance of the belief's "
-                         "samples to the true position (64 samples drawn by weight per second and robot)."
+                         "samples to the true position (64 samples drawn by weight per second and robot). Two "
+                         "columns: \"paper as written\" (paper_rules: true: eq. 14 alone, untempered likelihood, "
+                         "resampling at every update, §2.3's two rules only, anonymous sights ignored) and "
+                         "\"teamnav\" (the scenarios' gap-fills); verdicts by the rules of "
+                         "experiments/claims/collab-mcl.yaml, on report seeds (tuning seeds are >= 1000)."
                          + (" Quick mode: few robots and samples, 1-2 seeds, short runs." if ctx.quick else ""))]
+    vals: dict = {col: {} for col, _ in COLUMNS}  # {column: {claim id: {metric: value}}}, filled by the parts
     for part in (_hallway, _hexagon, _detection, _beyond):
-        blocks += part(ctx)
-    return blocks
+        blocks += part(ctx, vals)
+    return blocks + _claims_and_gap_fills(ctx, vals)
 
 
 SECTION = SectionSpec(
