@@ -602,3 +602,39 @@ def test_visbug_resumes_with_step1_when_the_excursion_left_the_boundary_far_behi
     far = loop.to_own(np.array([9.5, 2.0]))
     nav.direction(np.array([*far, 0.0]), FREE_SCAN)
     assert nav.mode == MODE_TO_GOAL and nav.mline is mline and nav.hit_xy is hit and nav.hit_dist_m == d_hit
+
+
+# ---------------------------------------------------------------------------- paper rules (issue 21 §3)
+def test_visbug_as_written_reaches_the_goal_behind_the_u_cutting_across_the_boundary():
+    """``paper_rules``: turn left, and Step 2's Ti may be the farthest visible boundary point
+    (``boundary_shortcut``): Bug2 still arrives, on the left side, no slower than the follower."""
+    follower = Loop(u_trap(), nav_of("visbug21", {"turn": "left"}), U_START, U_GOAL)
+    base = follower.run(600)
+    nav = nav_of("visbug21", {"paper_rules": True})
+    assert nav.params.turn == "left" and nav.params.boundary_shortcut
+    loop = Loop(u_trap(), nav, U_START, U_GOAL)
+    steps = loop.run(600)
+    assert steps is not None and base is not None and loop.stalls == 0
+    assert min(p[0] for p in loop.path) < 3.3  # round the cup's west side
+    assert steps <= base
+
+
+def test_visbug_boundary_target_is_the_farthest_visible_point_ahead():
+    """A wall 0.6 m to the right (y = -0.6), the robot walking it with the wall on its right
+    (side +1): the target lies ahead (+x), stood back from the wall, and is seen free."""
+    nav = nav_of("visbug21", {"boundary_shortcut": True, "turn": "left"})
+    nav.side, nav._slack = 1, math.pi / 72
+    wall = np.column_stack((np.linspace(-2.0, 3.0, 51), np.full(51, -0.6)))
+    t = nav._boundary_target(np.zeros(2), wall, wall, 0.25, 0.33, 7.7)
+    assert t is not None and t[0] > 1.0 and abs(t[1] - (-0.6 + 0.33)) < 1e-9
+    nav.side = -1  # walking the other way: the target lies behind (-x)
+    t = nav._boundary_target(np.zeros(2), wall, wall, 0.25, 0.33, 7.7)
+    assert t is not None and t[0] < -1.0
+
+
+def test_avoid_past_as_written_keeps_one_memory():
+    nav = nav_of("avoid_past", {"paper_rules": True})
+    assert nav.params.memory_scope == "robot"
+    with pytest.raises(ValueError, match="memory_scope"):
+        nav_of("avoid_past", {"paper_rules": True, "memory_scope": "goal"})
+    assert nav_of("potential_field", {"paper_rules": True}).params.paper_rules

@@ -59,10 +59,10 @@ from __future__ import annotations
 
 import abc
 import math
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from teamnav.control.coop.los_help.goal_sharing import (
     GoalSharing,
@@ -82,10 +82,11 @@ from teamnav.control.coop.los_help.messages import (
 )
 from teamnav.control.coop.los_help.state_sharing import TroubleState
 from teamnav.control.nav.local.base import corridor_clear, wrap_scalar
+from teamnav.control.paper_rules import GapFill, apply_paper_rules, gap_fills
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, Message, Observation, RangeScan
 
-__all__ = ["make_navigator"]
+__all__ = ["los_gap_fills", "make_navigator"]
 
 NavigatorName = Literal["potential_field", "avoid_past", "visbug21"]
 XY = tuple[float, float]
@@ -222,7 +223,83 @@ class _CommonParams(BaseModel):
         5 tasks x 200 targets): silent R2 236 steps per target against 214 alone; helping R2
         225 with None and 226 with 1.0 on R1: the teammate's cost is not its body seen from afar
         (docs/report/los-help.md). Kept off; kept for the next trace.
+    relay_hop_limit : bool
+        Relay a goal only while its hop count ``Nr = Id − (k − 1)·M`` is above 1
+        (:func:`~.goal_sharing.can_relay`), so that a relayed Id never names the owner's previous
+        goal. Gap filled; False: §3.1 as written, every known goal is relayed with ``Id − 1``
+        (an Id of 0 names no goal and is not sent). In a team of M robots that accept a report only
+        with an Id at least the stored one, a goal relayed at ``Nr = 1`` reaches only robots that
+        already hold it first- or second-hand, so both values give the same runs there.
+    paper_rules : bool
+        Every gap-fill of :attr:`PAPER_RULES` at the paper's value, and ``navigator_params``
+        with ``paper_rules: true`` (the navigator's own, e.g. VisBug-21's ``turn="left"``);
+        setting one of them to another value as well is an error
+        (:mod:`teamnav.control.paper_rules`). The report's "paper as written" column.
     """
+
+    #: Gap-fills whose other value is Sgorbissa & Arkin's rule: {field: the paper's value}.
+    #: ``paper_rules: true`` sets them (and passes ``paper_rules`` to the navigator's params).
+    PAPER_RULES: ClassVar[dict[str, Any]] = {
+        # §3: "robots ... can obstruct the visibility of each other"; V(R) is the line of sight (§2)
+        "see_past_teammates": False,
+        # §2 point 4: one visibility test per step, no hysteresis
+        "keep_direct_view": False,
+        # §4.2: a report replaces the stored path when its D is shorter (strictly, no margin)
+        "report_margin_steps": 0.0,
+        # §2 point 4 / §3 rule 5: straight to a point in sight, otherwise A (no sliding)
+        "slide_when_blocked": False,
+        # §4.2: at a reached ghost "start again ... with A"; no lead-on along the light path
+        "lead_on": False,
+        # §4.4: a report is the pair (Id, D), no via point
+        "share_via": False,
+        # §3.1: relay every known goal with Id − 1
+        "relay_hop_limit": False,
+    }
+    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
+        "see_past_teammates": "Sgorbissa §2-§3: V(R) is line of sight; teammates occlude each other",
+        "keep_direct_view": "Sgorbissa §2 point 4: the goal is seen or not, one test per step",
+        "report_margin_steps": "Sgorbissa §4.2: a report replaces the stored D when strictly shorter",
+        "slide_when_blocked": "Sgorbissa §2 point 4: straight to a point in sight, else algorithm A",
+        "lead_on": "Sgorbissa §4.2: at a reached ghost the robot starts again with A",
+        "share_via": "Sgorbissa §4.4: a report is the pair (Id, D)",
+        "relay_hop_limit": "Sgorbissa §3.1: every known goal is relayed with Id - 1",
+    }
+    #: Gap-fills the paper gives no value for, kept in both columns (what the report says of each).
+    GAP_FILLS_KEPT: ClassVar[dict[str, str]] = {
+        "goal_tolerance_m": "ε of §2 has no value in the paper: 0.5 m (R1's targets)",
+        "ghost_tolerance_m": "when a ghost point counts as reached: 0.2 m (§4.2 gives no tolerance)",
+        "progress_min_fraction": "progress towards a point in sight (§5 rule 1 names no metric): a quarter step",
+        "trouble_cr": "Cr of §5 has no value in the paper: 50 steps",
+        "reset_trouble_on_target": "Pr, Tr, Nt restart at each new target (the paper has one goal per §5 example)",
+        "restart_navigator_on_give_up": "VisBug-21 declaring a reachable target unreachable (grid, robot radius) "
+                                        "starts over (the paper's VisBug never does)",
+        "via_in_sight": "moot without share_via",
+    }
+
+    @model_validator(mode="before")
+    @classmethod
+    def _paper_rules(cls, data: Any) -> Any:
+        """:func:`~teamnav.control.paper_rules.apply_paper_rules`, and ``paper_rules`` passed to
+        the navigator's params (their model, which depends on ``navigator``, applies its own
+        rules; a conflicting value there is an error here, not at the first step)."""
+        data = apply_paper_rules(cls, data)
+        if isinstance(data, dict) and data.get("paper_rules") is True:
+            nav = data.get("navigator_params", {})
+            if isinstance(nav, dict):
+                if nav.get("paper_rules", True) is not True:
+                    raise ValueError("paper_rules: true also applies to navigator_params; "
+                                     "navigator_params.paper_rules must not be false")
+                nav = {**nav, "paper_rules": True}
+                from teamnav.control.nav.local import NAVIGATORS
+
+                model = NAVIGATORS.get(str(data.get("navigator", "potential_field")))
+                if model is not None:
+                    try:
+                        model.Params(**nav)
+                    except ValidationError as e:
+                        raise ValueError(f"navigator_params: {e.errors()[0]['msg']}") from None
+                data["navigator_params"] = nav
+        return data
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
@@ -252,6 +329,22 @@ class _CommonParams(BaseModel):
     keep_direct_view: bool = True
     see_past_teammates: bool = True
     navigate_past_teammates_beyond_m: float | None = Field(None, gt=0.0, le=100.0)
+    relay_hop_limit: bool = True
+    paper_rules: bool = False
+
+
+def los_gap_fills(params_cls: type, navigator: str, ours: dict[str, Any] | None = None) -> list[GapFill]:
+    """The gap-fills of a LOS brain's params (``LosExplorerParams`` / ``LosHelperParams``) and of
+    its ``navigator``'s, the latter as ``navigator_params.<field>``, with our value (``ours``,
+    a scenario's params, over the defaults) and the paper's (:func:`~teamnav.control.paper_rules.gap_fills`)."""
+    from teamnav.control.nav.local import NAVIGATORS
+
+    given = dict(ours or {})
+    nav_given = given.pop("navigator_params", None) or {}
+    out = gap_fills(params_cls, given)
+    for g in gap_fills(NAVIGATORS[navigator].Params, nav_given):
+        out.append(g._replace(field=f"navigator_params.{g.field}"))
+    return out
 
 
 class _LosBrain(abc.ABC):
@@ -281,7 +374,7 @@ class _LosBrain(abc.ABC):
         self.sharing = GoalSharing(self.me, self.team_size, delayed=params.delayed_visibility,
                                    point_margin_m=2.5 * self.radius_m,
                                    report_margin_m=params.report_margin_steps * self.step_m,
-                                   lead_on=params.lead_on)
+                                   lead_on=params.lead_on, relay_hop_limit=params.relay_hop_limit)
         self.trouble = TroubleState(int(params.trouble_cr))
         self._history: dict[int, tuple[np.ndarray, dict[int, tuple[float, float]]]] = {}
         self._teammate_tr: dict[int, bool | None] = {}

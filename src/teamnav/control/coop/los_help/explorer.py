@@ -8,7 +8,7 @@ for the whole step and the scenario requirements).
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -203,7 +203,47 @@ class LosExplorerParams(_CommonParams):
     trouble_drop_after_steps : int
         Steps without progress towards a kept helper position out of sight after which
         ``trouble_drop_stalled_helper`` drops it (default 500, ten times ``trouble_cr``).
+    drop_stalled_ghost : bool
+        A teammate's point or ghost (§3 rule 5, §4.2) that R1 makes no progress towards for
+        ``trouble_cr`` steps (A trapped on the way, a teammate standing still in a doorway) is
+        given up like a reached one (``temp_dropped``), so that A, or §5 when in trouble, takes
+        over. Gap filled: §4.2 assumes the straight path to a ghost is free. False: §4.2 as
+        written, R1 heads to the ghost until it reaches it or a shorter D replaces it.
     """
+
+    #: The brain's gap-fills whose other value is the paper's rule (the common ones and R1's).
+    PAPER_RULES: ClassVar[dict[str, Any]] = {
+        **_CommonParams.PAPER_RULES,
+        # §3 rule 3: R1 heads to its goal once it perceives it from where R2 stood, not on trust
+        "trust_direct_promise": False,
+        # §5 rule 3: any teammate in sight that is not in trouble
+        "trouble_helper_towards_goal": False,
+        # §5 rule 3: followed "until it is no longer in trouble or ... perceive[s] its own goal"
+        "trouble_drop_stalled_helper": False,
+        # §5 rule 3: R_j in V(R_i) when R_i reads its Tr bit
+        "trouble_sighting_at_send": False,
+        # §4.2 / §6: VisBug-21's one local direction at a ghost too
+        "visbug_reverse_walk_factor": None,
+        # §4.2: R1 heads to the ghost that promised the shortest D until it reaches it
+        "drop_stalled_ghost": False,
+    }
+    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
+        **_CommonParams.PAPER_RULE_NOTES,
+        "trust_direct_promise": "Sgorbissa §3 rule 3: R1 heads to its goal once it perceives it itself",
+        "trouble_helper_towards_goal": "Sgorbissa §5 rule 3: any teammate in sight not in trouble",
+        "trouble_drop_stalled_helper": "Sgorbissa §5 rule 3: followed until not in trouble or the goal is seen",
+        "trouble_sighting_at_send": "Sgorbissa §5 rule 3: the teammate is in sight when its Tr bit is read",
+        "visbug_reverse_walk_factor": "Sgorbissa §6 / Lumelsky & Skewis: one local direction, at a ghost too",
+        "drop_stalled_ghost": "Sgorbissa §4.2: the ghost is headed for until reached or replaced by a shorter D",
+    }
+    GAP_FILLS_KEPT: ClassVar[dict[str, str]] = {
+        **_CommonParams.GAP_FILLS_KEPT,
+        "max_steps_per_target": "a step budget per target ends a hopeless task (§6 says the potential field "
+                                "alone fails, not after how long)",
+        "keep_trouble_helper": "a helper out of sight is still headed for (§5 names only two ends of following)",
+        "trouble_progress": "'helper': closing in on the followed teammate is progress (the paper's Fig. 10 reading)",
+        "restart_navigator_at_ghost": "§4.2's 'start again with A' at a reached ghost",
+    }
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
     restart_navigator_at_ghost: bool = True
@@ -222,6 +262,7 @@ class LosExplorerParams(_CommonParams):
     trouble_near_helper_m: float | None = Field(None, gt=0.0, le=100.0)
     trouble_drop_stalled_helper: bool = True
     trouble_drop_after_steps: int = Field(500, ge=1, le=10_000_000)
+    drop_stalled_ghost: bool = True
 
 
 
@@ -386,7 +427,7 @@ class LosExplorer(_LosBrain):
                 # that A, or §5 when in trouble, takes over (gap filled: §4.2 assumes the
                 # straight path to a ghost is free)
                 self._temp_stall = 0 if progressing else self._temp_stall + 1
-                if self._temp_stall >= p.trouble_cr:
+                if p.drop_stalled_ghost and self._temp_stall >= p.trouble_cr:
                     self._temp_stall = 0
                     self.temp_dropped += 1
                     self.sharing.mark_reached(self.me)

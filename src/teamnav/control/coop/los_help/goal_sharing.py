@@ -38,7 +38,8 @@ Gaps filled here (the paper is silent; written down as the style guide asks):
   owner of a goal does not substitute: it heads to its point (the brain drives there), and when
   it loses a direct view of its own goal it falls back to its navigator.
 - A relay is sent only while the hop count ``Nr = Id − (k − 1)·M`` is above 1, so a relayed Id
-  never falls into the range of the previous goal (§3.1: Nr = 1 when all robots handled it).
+  never falls into the range of the previous goal (§3.1: Nr = 1 when all robots handled it);
+  ``relay_hop_limit=False`` relays every known goal with ``Id − 1`` as §3.1 writes it.
 - A report is matched to a stored goal by goal index ``k = 1 + (Id − 1) // M``.
 - "Sees a point": within the visibility radius and the omnidirectional range reading along
   the point's bearing is at least the distance to it minus ``margin_m`` (0 for goals; a robot
@@ -419,6 +420,10 @@ class GoalSharing:
         strictly smaller distance, so the robot cannot loop. Gap filled: §4.2 only says the
         robot "will have to start again ... with A"; with the strict rule a chain of ghosts
         along a corridor was followed only to its first link (a tie). False: the paper's rule.
+    relay_hop_limit : bool
+        Relay a goal only while :func:`can_relay` (hop count above 1; gap filled, the default).
+        False: §3.1 as written, every known goal with ``Id − 1`` (not an Id of 0, which names
+        no goal).
 
     Examples
     --------
@@ -433,7 +438,7 @@ class GoalSharing:
     """
 
     def __init__(self, robot_id: int, team_size: int, *, delayed: bool = True, point_margin_m: float = 0.5,
-                 report_margin_m: float = 0.0, lead_on: bool = False) -> None:
+                 report_margin_m: float = 0.0, lead_on: bool = False, relay_hop_limit: bool = True) -> None:
         if team_size < 1:
             raise ValueError(f"team_size must be >= 1, got {team_size!r}")
         self.me = int(robot_id)
@@ -442,6 +447,7 @@ class GoalSharing:
         self.point_margin_m = float(point_margin_m)
         self.report_margin_m = float(report_margin_m)
         self.lead_on = bool(lead_on)
+        self.relay_hop_limit = bool(relay_hop_limit)
         self.own_k: int | None = None
         self.own_goal: tuple[float, float] | None = None
         self.known: dict[int, KnownGoal] = {}
@@ -643,9 +649,11 @@ class GoalSharing:
         if self.own_k is not None:
             out.append((self.me, self.own_id, self.own_goal[0], self.own_goal[1]))
         m = int(self.team_size)
+        limit = self.relay_hop_limit
         for g in self.known.values():
             gid = int(g.goal_id)
-            if gid - ((gid - 1) // m) * m > 1:  # can_relay: hops(gid) > 1, inline (speed)
+            # can_relay: hops(gid) > 1, inline (speed); without the limit (§3.1) any Id - 1 >= 1
+            if (gid - ((gid - 1) // m) * m > 1) if limit else gid > 1:
                 out.append((g.owner, gid - 1, g.gx_m, g.gy_m))
         return out
 

@@ -7,7 +7,7 @@ Helpers patrol the corridors and help by sharing only; the step shared with R1 i
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -36,6 +36,12 @@ class LosHelperParams(_CommonParams):
         measured on office_complex: R2 and R4 stood 2000 steps in room 5's doorway while R1
         waited, out of their sight, for help).
     """
+
+    GAP_FILLS_KEPT: ClassVar[dict[str, str]] = {
+        **_CommonParams.GAP_FILLS_KEPT,
+        "patrol_xy": "the helpers' routes (§6: they 'patrol the corridors'; the paper gives no route)",
+        "waypoint_timeout_steps": "a waypoint not reached in time is passed over (no paper rule)",
+    }
 
     patrol_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=10_000)
     patrol_mode: Literal["ping_pong", "cycle"] = "ping_pong"

@@ -79,7 +79,7 @@ steps). Not recording visits during excursions (R1+R2, seed 0): 234 -> 234: not 
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numba import njit
@@ -109,7 +109,18 @@ class AvoidPastParams(PotentialFieldParams):
     memory_scope : {"goal", "robot"}, default "goal"
         Lifetime of the memory: forgotten at each new goal of the robot's own (temporary goals
         keep it), or kept for the robot's life (the old default; see the module docstring).
+        ``"robot"`` is the paper's rule (``paper_rules``): neither Sgorbissa & Arkin nor Balch &
+        Arkin reset the spatial memory at a new goal, nor decay it.
     """
+
+    #: Avoid-Past as Sgorbissa & Arkin §6 and its source [17] (Balch & Arkin 1993) describe it.
+    PAPER_RULES: ClassVar[dict[str, Any]] = {
+        # §6 / Balch & Arkin 1993: a spatial memory of visited places, never reset at a new goal nor decayed
+        "memory_scope": "robot",
+    }
+    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
+        "memory_scope": "Sgorbissa §6, Balch & Arkin 1993: one lifelong memory of visited places, no reset, no decay",
+    }
 
     cell_m: float = Field(0.3, gt=0.0, le=10.0)
     memory_radius_m: float = Field(3.0, gt=0.0, le=50.0)

@@ -37,6 +37,7 @@ within the last ``progress_window_steps`` steps. In a local minimum it turns Fal
 from __future__ import annotations
 
 import math
+from typing import Any, ClassVar
 
 import numpy as np
 from numba import njit
@@ -51,6 +52,7 @@ from teamnav.control.nav.local.base import (
     safe_heading,
     scan_points,
 )
+from teamnav.control.paper_rules import paper_rules_validator
 from teamnav.control.types import RangeScan
 
 __all__ = ["INSIDE_GAIN", "PotentialField", "PotentialFieldParams", "field_vector"]
@@ -80,7 +82,15 @@ class PotentialFieldParams(BaseModel):
         Steps without beating the reference distance before ``progressing`` turns False.
     progress_fraction : float, default 0.5
         Least improvement of the reference distance that counts, as a fraction of a step.
+    paper_rules : bool, default False
+        Every gap-fill of :attr:`PAPER_RULES` at its paper value
+        (:mod:`teamnav.control.paper_rules`). The potential field has none (Arkin's schemas as
+        written); Avoid-Past's subclass adds its own.
     """
+
+    #: Gap-fills whose other value is the paper's rule: none here (see AvoidPastParams).
+    PAPER_RULES: ClassVar[dict[str, Any]] = {}
+    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {}
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
@@ -92,6 +102,9 @@ class PotentialFieldParams(BaseModel):
     perturbation: float = Field(1e-6, ge=0.0, le=0.1)
     progress_window_steps: int = Field(30, ge=1, le=100_000)
     progress_fraction: float = Field(0.5, gt=0.0, le=10.0)
+    paper_rules: bool = False
+
+    _paper_rules = paper_rules_validator()
 
 
 def field_vector(pose: np.ndarray, goal_xy: np.ndarray, points: np.ndarray, n_beams: int,

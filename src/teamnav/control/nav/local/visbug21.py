@@ -65,8 +65,9 @@ boundary walk ends at a leave point or back at H, whichever direction it takes.
 
 Where we deviate: Lumelsky & Skewis also let ``Ti`` be the farthest visible point of the
 obstacle boundary in the local direction (so a robot cuts across concave stretches of the
-boundary); we follow the boundary reactively at a constant offset instead, since the
-boundary is only known as scan points. The M-line shortcut above keeps VisBug's main gain
+boundary); by default we follow the boundary reactively at a constant offset instead, since
+the boundary is only known as scan points (``boundary_shortcut=True``, set by
+``paper_rules``, restores their rule on the sensed points, :meth:`VisBug21._boundary_target`). The M-line shortcut above keeps VisBug's main gain
 (leaving early for a visible M-line point). On a grid map and with fixed steps the
 convergence proof does not carry over exactly; the leave margin keeps every leave point
 strictly closer to T than its hit point, as in Bug2.
@@ -103,7 +104,7 @@ than expected is "trouble"); False once T is found unreachable.
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -128,6 +129,7 @@ from teamnav.control.nav.local.visbug21_geometry import (
     _leave_candidates,
     boundary_heading,
 )
+from teamnav.control.paper_rules import paper_rules_validator
 from teamnav.control.types import RangeScan
 
 __all__ = ["MODE_FOLLOW", "MODE_TO_GOAL", "MODE_UNREACHABLE", "VisBug21", "VisBugParams", "boundary_heading"]
@@ -193,7 +195,30 @@ class VisBugParams(BaseModel):
         only after a full lap in one direction. Meant for the trap that ``turn="nearer_end"``
         falls into in an office: T straight behind the side wall of a room whose door is the
         nearer sensed end (office_simple, S1 -> N5: a lap of every north room, ~1300 steps).
+    boundary_shortcut : bool, default False
+        Lumelsky & Skewis' second kind of Step 2 intermediate target, which our follower omits
+        (module docstring, "Where we deviate"): while walking the boundary with no leave point
+        in sight, head straight for the *farthest visible point of the followed obstacle's
+        boundary in the local direction* (:meth:`VisBug21._boundary_target`), so that concave
+        stretches are cut across; the constant-offset follower takes over when no such point is
+        at least a step away. True: VisBug-21 as its authors wrote it (``paper_rules``); False:
+        the reactive follower alone (our default, unchanged behaviour).
+    paper_rules : bool, default False
+        Every gap-fill of :attr:`PAPER_RULES` at its paper value (:mod:`teamnav.control.paper_rules`).
     """
+
+    #: VisBug-21 as Lumelsky & Skewis wrote it (Sgorbissa & Arkin §6 run "the VisBug21 algorithm
+    #: [7]"): {field: the paper's value}; ``paper_rules: true`` sets them.
+    PAPER_RULES: ClassVar[dict[str, Any]] = {
+        # Lumelsky & Skewis fix the local direction a priori ("left"); nearer_end is TangentBug's heuristic
+        "turn": "left",
+        # Lumelsky & Skewis: Ti is also the farthest visible boundary point in the local direction
+        "boundary_shortcut": True,
+    }
+    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
+        "turn": "VisBug-21 (Lumelsky & Skewis): one local direction fixed a priori, left",
+        "boundary_shortcut": "VisBug-21 (Lumelsky & Skewis): Step 2's Ti may be the farthest visible boundary point",
+    }
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
@@ -211,6 +236,10 @@ class VisBugParams(BaseModel):
     progress_window_steps: int = Field(30, ge=1, le=100_000)
     progress_fraction: float = Field(0.5, gt=0.0, le=10.0)
     reverse_walk_factor: float | None = Field(None, gt=0.0, le=1000.0)
+    boundary_shortcut: bool = False
+    paper_rules: bool = False
+
+    _paper_rules = paper_rules_validator()
 
     @model_validator(mode="after")
     def _hysteresis_below_follow(self) -> "VisBugParams":
@@ -431,8 +460,12 @@ class VisBug21:
                     self._reverse_reach_m *= 2.0
                     self._left_hit = False
                     self._returns = 0
-                heading = boundary_heading(xy, self._followed(pose, scan), r_safe + p.follow_margin_m, self.side,
-                                           p.follow_gain)
+                followed = self._followed(pose, scan)
+                heading = boundary_heading(xy, followed, r_safe + p.follow_margin_m, self.side, p.follow_gain)
+                if heading is not None and p.boundary_shortcut:
+                    bt = self._boundary_target(xy, followed, points, r_safe, r_safe + p.follow_margin_m, reach_m)
+                    if bt is not None:
+                        heading = math.atan2(bt[1] - xy[1], bt[0] - xy[0])
                 if heading is None:  # nothing sensed at all: the obstacle is gone
                     self.mode = MODE_TO_GOAL
         if self.mode == MODE_TO_GOAL and self._leave_target is not None:
@@ -491,6 +524,46 @@ class VisBug21:
             f = rf[1]  # set by start_again for this goal
         self._reverse_limit_m = math.inf if f is None else max(2.0, f * math.hypot(*(self.goal_xy - xy)))
         self._reverse_reach_m = self._reverse_limit_m
+
+    def _boundary_target(self, xy: np.ndarray, followed: np.ndarray, points: np.ndarray, r_safe: float,
+                         follow_m: float, reach_m: float) -> np.ndarray | None:
+        """Step 2's other intermediate target (``boundary_shortcut``, Lumelsky & Skewis): the
+        farthest visible point of the followed obstacle's boundary in the local direction.
+
+        The boundary is the followed obstacle's sensed points. Seen from the robot, the
+        nearest of them is at bearing φ; walking with the obstacle on the right (``side=+1``)
+        the boundary ahead lies at bearings ``φ + δ``, δ in (0, π) (on the left, ``φ − δ``).
+        Each point stands off the boundary by ``follow_m`` along its normal on the robot's
+        side (the normal of the chord through its two neighbours in beam order), so that the
+        robot keeps the follower's offset. The target is the stood-off point with the largest δ
+        that the robot reaches through a free corridor of half-width ``r_safe`` (Step 1's
+        test, which counts a point sensed at range ρ as ``ρ π / n_beams`` nearer, so along a
+        straight wall the target lies a metre or two ahead) and that lies at least one step
+        away; None when there is none (the reactive follower steers this step)."""
+        if followed.shape[0] < 3:
+            return None
+        rel = followed - xy
+        d = np.hypot(rel[:, 0], rel[:, 1])
+        i = int(np.argmin(d))
+        phi = math.atan2(rel[i, 1], rel[i, 0])
+        delta = self.side * (np.mod(np.arctan2(rel[:, 1], rel[:, 0]) - phi + math.pi, 2.0 * math.pi) - math.pi)
+        nxt = np.concatenate((followed[1:], followed[-1:]))
+        prv = np.concatenate((followed[:1], followed[:-1]))
+        tx, ty = nxt[:, 0] - prv[:, 0], nxt[:, 1] - prv[:, 1]
+        tn = np.maximum(np.hypot(tx, ty), 1e-12)
+        nx, ny = -ty / tn, tx / tn
+        flip = np.where(nx * rel[:, 0] + ny * rel[:, 1] > 0.0, -1.0, 1.0)  # the normal towards the robot
+        cand = followed + follow_m * np.column_stack((flip * nx, flip * ny))
+        far = np.hypot(cand[:, 0] - xy[0], cand[:, 1] - xy[1])
+        ok = (delta > 0.0) & (far >= self.step_length_m)
+        if not ok.any():
+            return None
+        idx = np.flatnonzero(ok)
+        idx = idx[np.argsort(-delta[idx], kind="stable")]
+        vis = self._visible(xy, points, cand[idx], r_safe, reach_m)
+        if not vis.any():
+            return None
+        return cand[idx[int(np.argmax(vis))]]
 
     def _followed(self, pose: np.ndarray, scan: RangeScan) -> np.ndarray:
         """Sensed points of the obstacle being followed (own frame), shape (K, 2).
