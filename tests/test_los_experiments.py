@@ -543,3 +543,21 @@ def test_legs_table_sets_the_finished_tasks_against_their_shortest_path():
     assert ap[9] == f"{190 / floor:.2f}" and ap[10] == "1/2"
     pf = next(r for r in tab.rows if r[1] == "Pot. Fields")
     assert pf[9] == "n/a (no task finished)" and pf[10] == "0/1"
+
+
+def test_verdict_rules_are_read_from_the_claim_file(monkeypatch):
+    """Issue 21 §3: the section's rules live in claims/los-help.yaml (judged on the paper-rules
+    column, report seeds < 1000); a stricter threshold there changes the verdict here."""
+    from teamnav.experiments.claims import load_claims
+    from teamnav.experiments.report.sections import _los_verdicts as V
+
+    cf = load_claims("los-help")
+    assert all(c.judged == "paper_rules" and max(c.seed_list) < 1000 for c in cf.claims)
+    by_team = _by_team(True)
+    means = S.table_block("simple", by_team)[1]
+    assert [c.holds for c in S.table_comparisons("simple", means, by_team)][:3] == [True, True, True]
+    strict = cf["table1-visbug21-falls"].model_copy(update={"rule": [
+        cf["table1-visbug21-falls"].rule[0].model_copy(update={"threshold": -1e6})]})
+    monkeypatch.setattr(V, "_claim", lambda cid: strict if cid == "table1-visbug21-falls" else cf[cid])
+    comps = S.table_comparisons("simple", means, by_team)
+    assert [c.holds for c in comps][:3] == [True, True, False]

@@ -1,17 +1,21 @@
 """The ``los-help`` section's verdicts: EXPERIMENTS.md's rows for Tables 1-2 and Figs. 16-17 as
 :class:`~teamnav.experiments.report.model.Comparison` blocks, paired by task (Sgorbissa & Arkin §6).
 
-Split from :mod:`.los_help` (no behaviour change).
+Split from :mod:`.los_help` (no behaviour change). The rules are read from the claim file
+``claims/los-help.yaml`` (:mod:`teamnav.experiments.claims`): each verdict computes the metrics
+its claim names and calls :func:`~teamnav.experiments.claims.judge`; no threshold lives here.
 """
 
 from __future__ import annotations
 
 import json
+import math
 from typing import Sequence
 
 import numpy as np
 
 from teamnav.experiments import los_tasks as L
+from teamnav.experiments.claims import judge, load_claims
 from teamnav.experiments.report.model import Comparison
 from teamnav.experiments.report.sections._los_common import (
     ERR_KEY, NAV_KEY, NAV_LABEL, PAPER_TABLES, TARGETS_KEY, TEAM_LABEL, _metric, finished_of, group, stats, steps_of,
@@ -74,6 +78,19 @@ def paired_rises(by_team: dict[int, list[dict]], nav: str, hs: Sequence[int]) ->
                    f"{int((d > 0).sum())} of {d.size} worse)")
     return out
 
+#: ``max_rise`` when no two team sizes have a finished mean (no added helper to rise at)
+NO_RISE = -1e9
+
+
+def _claim(claim_id: str):
+    return load_claims("los-help")[claim_id]
+
+
+def _judged(claim_id: str, values: dict[str, float]) -> bool | None:
+    """The claim's verdict on ``values`` (None: a metric not measured)."""
+    return judge(_claim(claim_id), values)[0]
+
+
 def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict[int, list[dict]]) -> list[Comparison]:
     tab = 1 if map_key == "simple" else 2
     paper = PAPER_TABLES[map_key]
@@ -94,12 +111,18 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
             note = f" (paired: the {k} of {n} tasks finished with every team that finished one)"
         p = [paper[nav][h][0] for h in hs if paper[nav][h] is not None]
         fails_first = not failing or not ok_hs or max(failing) < min(ok_hs)
+        cid = f"table{tab}-{nav.replace('_', '-')}-falls"
         if len(ms) < 2:
             # one team size with results: a trend only if teams with fewer helpers failed outright
-            holds = (fails_first and bool(ok_hs)) if failing else None
+            # (no added helper with a finished mean on either side: no rise, NO_RISE)
+            holds = None if not failing else (
+                False if not ok_hs else _judged(cid, {"max_rise": NO_RISE, "fails_first": float(fails_first)}))
+        elif all(np.isfinite(ms)):
+            holds = _judged(cid, {"max_rise": float(np.diff(np.asarray(ms, dtype=float)).max()),
+                                  "fails_first": float(fails_first)})
         else:
-            trend = strictly_falling(ms) if all(np.isfinite(ms)) else (False if any(np.isfinite(ms)) else None)
-            holds = None if trend is None else bool(trend and fails_first)
+            # some team between others has no paired mean: the trend cannot hold (None if none has one)
+            holds = False if any(np.isfinite(ms)) else None
         ours = " → ".join([f"fails ({int(fin[h].sum())}/{fin[h].size})" for h in failing if h < min(ok_hs, default=9)]
                           + ["n/a" if not np.isfinite(m) else f"{m:.0f}" for m in ms]
                           + [f"fails ({int(fin[h].sum())}/{fin[h].size})" for h in failing if h > min(ok_hs, default=9)])
@@ -115,7 +138,8 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
     pf_help = [r for h in teams if h > 0 for r in group(by_team[h], NAV_KEY).get("potential_field", [])]
     alone_fin, help_fin = finished_of(pf), finished_of(pf_help)
     if alone_fin.size and help_fin.size:
-        holds = bool(np.all(alone_fin < 0.5) and np.all(help_fin > 0.5))
+        holds = _judged(f"table{tab}-pf-alone-fails", {"pf_alone_finished": float(np.mean(alone_fin > 0.5)),
+                                                       "pf_helped_finished": float(np.mean(help_fin > 0.5))})
         per_team = ", ".join(f"{TEAM_LABEL[h]} {int(f.sum())}/{f.size}" for h in teams if h > 0
                              and (f := finished_of(group(by_team[h], NAV_KEY).get("potential_field", []))).size)
         ours = (f"alone: {int(alone_fin.sum())}/{alone_fin.size} finished; with helpers: "
@@ -130,7 +154,7 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         m3 = {nav: means[nav][3] for nav in L.NAVIGATORS if np.isfinite(means[nav][3])}
         if len(m3) >= 2:
             spread = max(m3.values()) / min(m3.values()) - 1.0
-            holds = spread > 0.10
+            holds = _judged("table2-algorithm-matters", {"best_to_worst_spread": spread})
             ours = ", ".join(f"{NAV_LABEL[k]} {v:.0f}" for k, v in m3.items()) + f" (best to worst +{100 * spread:.0f} %)"
         else:
             holds, ours = None, "not measured"
@@ -185,33 +209,36 @@ def noise_comparisons(map_key: str, means: dict[str, dict[float, float]], alone:
             pn = paired_noise(rows, nav, (0.0, 0.4)) if rows else None
             if pn is not None and pn[1] > 0:
                 (a, b), k = pn
-                grow.append(b > a)
+                grow.append(b - a)
                 text.append(f"{NAV_LABEL[nav]} {a:.0f} → {b:.0f} (paired, {k} tasks)")
             else:
-                grow.append(per[0.4] > per[0.0])
+                grow.append(per[0.4] - per[0.0])
                 text.append(f"{NAV_LABEL[nav]} {per[0.0]:.0f} → {per[0.4]:.0f}")
+    gholds = _judged(f"fig{fig}-noise-grows", {"min_growth": min(grow) if grow else math.nan}) if grow else None
     out.append(Comparison(f"Fig. {fig}: steps grow with err_max (0 → 0.4), R2..R4 present",
                           "performance decreases for every algorithm as err_max grows",
-                          "; ".join(text) or "not run", all(grow) if grow else None,
-                          "" if (not grow or all(grow)) else "some algorithms did not get slower with noise"))
+                          "; ".join(text) or "not run", gholds,
+                          "" if (not grow or gholds) else "some algorithms did not get slower with noise"))
     navs = [n for n in means if n in alone and np.isfinite(alone[n]) and 0.4 in means[n]]
     if map_key == "simple":
-        below = [means[n][0.4] < alone[n] for n in navs]
+        below = [means[n][0.4] / alone[n] for n in navs]
         ours = "; ".join(f"{NAV_LABEL[n]} {means[n][0.4]:.0f} vs alone {alone[n]:.0f}" for n in navs)
+        bholds = _judged("fig16-below-alone", {"max_ratio_to_alone": max(below)}) if below else None
         out.append(Comparison("Fig. 16: at err_max = 0.4 the steps stay below R1 alone",
                               "still lower than with no supporting robot (every algorithm)", ours or "not run",
-                              all(below) if below else None,
-                              "" if (not below or all(below)) else "help is gone at err_max = 0.4 for some algorithm"))
+                              bholds,
+                              "" if (not below or bholds) else "help is gone at err_max = 0.4 for some algorithm"))
     else:
         fade = []
         for n in navs:
             if 0.0 in means[n]:
                 gain0, gain4 = alone[n] - means[n][0.0], alone[n] - means[n][0.4]
                 fade.append((n, gain0, gain4))
-        holds = [g4 < 0.5 * g0 for _, g0, g4 in fade if g0 > 0]
+        ratios = [g4 / g0 for _, g0, g4 in fade if g0 > 0]
         ours = "; ".join(f"{NAV_LABEL[n]} gain over alone {g0:.0f} → {g4:.0f} steps" for n, g0, g4 in fade)
+        fholds = _judged("fig17-help-fades", {"max_gain_ratio": max(ratios)}) if ratios else None
         out.append(Comparison("Fig. 17: on the complex map help fades quickly with noise (gain at 0.4 < half the gain at 0)",
                               "support robots become almost useless; VisBug worse than R1 alone", ours or "not run",
-                              all(holds) if holds else None,
-                              "" if (not holds or all(holds)) else "our helpers keep more of their gain under noise"))
+                              fholds,
+                              "" if (not ratios or fholds) else "our helpers keep more of their gain under noise"))
     return out
