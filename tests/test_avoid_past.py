@@ -22,14 +22,15 @@ def _visited(nav: AvoidPast, steps: int) -> Loop:
     return loop
 
 
-def test_default_memory_is_the_trips():
-    assert AvoidPastParams().memory_scope == "goal" and AvoidPastParams().memory_radius_m == 3.0
+def test_default_memory_is_the_robots_lifelong_one():
+    """Issue 21 §1: the paper's rule (one memory, never reset, no decay) is the default."""
+    assert AvoidPastParams().memory_scope == "robot" and AvoidPastParams().memory_radius_m == 3.0
     with pytest.raises(ValueError):
         AvoidPastParams(memory_scope="task")
 
 
 def test_a_new_own_goal_forgets_the_visits_a_temporary_one_does_not():
-    nav = nav_of("avoid_past")
+    nav = nav_of("avoid_past", {"memory_scope": "goal"})
     loop = _visited(nav, 100)
     visits = dict(nav.visits)
     assert sum(visits.values()) == pytest.approx(100 * STEP_M)
@@ -48,7 +49,7 @@ def test_a_new_own_goal_forgets_the_visits_a_temporary_one_does_not():
 
 
 def test_robot_scope_keeps_one_memory():
-    nav = nav_of("avoid_past", {"memory_scope": "robot"})
+    nav = nav_of("avoid_past")
     loop = _visited(nav, 50)
     nav.set_goal(loop.to_own(np.array([1.0, 1.0])))
     assert sum(nav.visits.values()) == pytest.approx(50 * STEP_M)
@@ -57,10 +58,10 @@ def test_robot_scope_keeps_one_memory():
 def test_reset_memory_pushes_like_a_fresh_navigator():
     """After the reset the vector is the one of a navigator that never saw the old goal (the
     dense mirror of the visits is rebuilt, not left stale)."""
-    a = nav_of("avoid_past")
+    a = nav_of("avoid_past", {"memory_scope": "goal"})
     loop = _visited(a, 150)
     a.set_goal(loop.to_own(np.array([1.0, 1.0])))
-    b = nav_of("avoid_past")
+    b = nav_of("avoid_past", {"memory_scope": "goal"})
     b.set_goal(loop.to_own(np.array([1.0, 1.0])))
     pts = np.array([[0.0, 0.0]])
     for k in range(30):
@@ -89,8 +90,10 @@ def test_trip_memory_reaches_a_sequence_the_robot_memory_does_not():
     """Issue 7, R1 alone on office_simple (``los-help-simple``, task 1's first 12 targets, budget
     1500 steps each, pinned here: the scenario's own budget is 6000 since session 8, and with
     that much time even the saturated memory crawls through). With one memory for the robot's
-    life (the old default) the trodden corridor's visits saturate the push and R1 gives up on the
-    11th target (S4 from S5); with the trip's memory (the default) it reaches all 12."""
+    life (the old default, and again the default since issue 21 §1: the paper's rule) the trodden
+    corridor's visits saturate the push and R1 gives up on the 11th target (S4 from S5), at this
+    radius of 2 m and budget; with the trip's memory (``memory_scope="goal"``, the default of
+    sessions 6-13) it reaches all 12."""
     from teamnav import load_scenario, run
     from teamnav.experiments.los_tasks import task_targets_xy
 
@@ -103,6 +106,6 @@ def test_trip_memory_reaches_a_sequence_the_robot_memory_does_not():
         m = run(load_scenario("los-help-simple", overrides=ov, duration_s=0.1 * 1500 * 12), progress=False).metrics
         return int(m["los_targets_reached"]), bool(m["los_finished"])
 
-    assert reached({}) == (12, True)
+    assert reached({"memory_scope": "goal"}) == (12, True)
     n, finished = reached({"memory_scope": "robot", "memory_radius_m": 2.0})
     assert n < 12 and not finished

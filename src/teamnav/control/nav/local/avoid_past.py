@@ -16,11 +16,14 @@ Here:
   (a dict keyed by cell index, so it grows with the explored area); every :meth:`direction`
   call adds the step length to the cell under the robot (a visit weighs the path it stands
   for, so the law below does not change with the step length);
-- lifetime (``memory_scope``, our choice, a gap in the abstract): ``"goal"`` (default) forgets
+- lifetime (``memory_scope``): ``"robot"`` (the default since issue 21 §1, the paper's rule:
+  neither Sgorbissa & Arkin nor Balch & Arkin reset the memory at a new goal or decay it)
+  keeps one memory for the robot's whole life, with no decay. ``"goal"`` (the default from
+  session 6 to issue 21, a gap-fill measured only at the old 1500 / 2500-step budgets) forgets
   the visits when the robot is given a new goal of its own (not a temporary one: an
   excursion to a teammate or a ghost, Sgorbissa & Arkin §3-§5, keeps the memory, and so does
-  the way back to the same goal), so that the robot avoids *this* trip's past; ``"robot"``
-  keeps one memory for the robot's whole life. Why (issue 7, traced): with ``"robot"`` the
+  the way back to the same goal), so that the robot avoids *this* trip's past. Why it was
+  chosen then (issue 7, traced): with ``"robot"`` the
   counts of the corridors grow with every target of a 200-target task and the vector below
   is linear in the counts, so after a few targets any asymmetry of the well-trodden corridor
   saturates the push (office_simple, task 1: the unsaturated magnitude's median 1.4 over the
@@ -106,11 +109,12 @@ class AvoidPastParams(PotentialFieldParams):
         visit with 0.1 m steps).
     avoid_max : float, default 2.0
         Largest avoid-past magnitude (saturation; see the module docstring).
-    memory_scope : {"goal", "robot"}, default "goal"
-        Lifetime of the memory: forgotten at each new goal of the robot's own (temporary goals
-        keep it), or kept for the robot's life (the old default; see the module docstring).
-        ``"robot"`` is the paper's rule (``paper_rules``): neither Sgorbissa & Arkin nor Balch &
-        Arkin reset the spatial memory at a new goal, nor decay it.
+    memory_scope : {"robot", "goal"}, default "robot"
+        Lifetime of the memory: kept for the robot's life, no decay (the paper's rule, the
+        default since issue 21 §1: neither Sgorbissa & Arkin nor Balch & Arkin reset the
+        spatial memory at a new goal, nor decay it), or forgotten at each new goal of the
+        robot's own, temporary goals keeping it (a gap-fill, the default of sessions 6-13; see
+        the module docstring).
     """
 
     #: Avoid-Past as Sgorbissa & Arkin §6 and its source [17] (Balch & Arkin 1993) describe it.
@@ -126,7 +130,7 @@ class AvoidPastParams(PotentialFieldParams):
     memory_radius_m: float = Field(3.0, gt=0.0, le=50.0)
     avoid_gain_per_m: float = Field(1.0, ge=0.0, le=1000.0)
     avoid_max: float = Field(2.0, ge=0.0, le=1000.0)
-    memory_scope: Literal["goal", "robot"] = "goal"
+    memory_scope: Literal["goal", "robot"] = "robot"
 
 
 def avoid_past_vector(xy: np.ndarray, visits: dict[tuple[int, int], float], cell_m: float,
@@ -198,7 +202,8 @@ class AvoidPast(PotentialField):
 
     Same constructor and protocol as :class:`~teamnav.control.nav.local.potential_field.PotentialField`;
     ``visits`` is the robot's memory (cell index in the own frame -> metres of path in the cell);
-    with ``memory_scope="goal"`` a new goal of the robot's own (``temporary=False``, farther than
+    with ``memory_scope="robot"`` (the default) it is kept for the robot's life; with
+    ``memory_scope="goal"`` a new goal of the robot's own (``temporary=False``, farther than
     ``GOAL_SAME_TOL_M`` from the last one) starts an empty memory.
 
     Examples

@@ -232,7 +232,9 @@ class PotentialField:
         ``temporary`` is recorded (:attr:`temporary`) and otherwise changes nothing: the field
         has no memory of a goal to keep across an excursion (Sgorbissa & Arkin Fig. 9: back on
         its own goal the robot simply descends the field again from where it stands).
-        Avoid-Past's memory of visited places belongs to the robot and is kept either way.
+        Avoid-Past (a subclass) overrides ``_new_goal``: its memory of visited places is kept
+        for the robot's life with ``memory_scope="robot"`` (the default) and forgotten at a new
+        goal of the robot's own (not a temporary one) with ``memory_scope="goal"``.
         """
         g = check_goal(goal_xy)
         self.temporary = bool(temporary)
