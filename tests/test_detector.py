@@ -329,3 +329,25 @@ def test_small_team_kernel_equals_spatial_hash(seed, n, which):
         det_mod._BRUTE_MAX_ROBOTS = saved
     for a, b in zip(brute, hashed):
         assert a.dtype == b.dtype and np.array_equal(a, b)
+
+
+def test_occlusion_at_err_max_zero_is_perfect_sensing_and_keeps_the_stream():
+    """Issue 21 §2: Sgorbissa & Arkin's Tables 1-2 are "perfect sensing": the occlusion model at
+    err_max = 0 returns the exact range and bearing (eq. 2's bearing error only in the noise
+    figures, err_max > 0), and draws its uniforms all the same (the same random stream)."""
+    xs, ys, th = _ring(200, 3.0)
+    radii = np.full(xs.shape[0], 0.25)
+    clean = RobotDetector(DetectorConfig(max_range_m=50.0), empty(40, 40))
+    truth = run(clean, xs, ys, th, observers=[0], radii=radii)
+    zero = RobotDetector(DetectorConfig(max_range_m=50.0, noise_model="occlusion", err_max=0.0), empty(40, 40))
+    a = run(zero, xs, ys, th, observers=[0], radii=radii, seed=9)
+    assert np.array_equal(a.target, truth.target)
+    assert np.array_equal(a.range_m, truth.range_m) and np.array_equal(a.bearing_rad, truth.bearing_rad)
+    rng0, rng1 = np.random.default_rng(3), np.random.default_rng(3)
+    zero.detect_arrays(xs, ys, th, radii, [0], rng0, np.arange(xs.size))
+    RobotDetector(DetectorConfig(max_range_m=50.0, noise_model="occlusion", err_max=0.3), empty(40, 40)).detect_arrays(
+        xs, ys, th, radii, [0], rng1, np.arange(xs.size))
+    assert rng0.random() == rng1.random()
+    # err_max > 0: eq. 2 moves the bearing
+    noisy = RobotDetector(DetectorConfig(max_range_m=50.0, noise_model="occlusion", err_max=0.1), empty(40, 40))
+    assert not np.array_equal(run(noisy, xs, ys, th, observers=[0], radii=radii, seed=9).bearing_rad, truth.bearing_rad)
