@@ -35,6 +35,14 @@ team runs moved, as they must; a re-check reproduces the new file.
 come out differently already at the commit that recorded them: check against the file recorded
 on your kind of machine (issue 21 §5 held both: the file above's 8 VisBug-21 runs and all 24 of
 this one).
+
+Re-recorded (``los_fingerprints_epyc.json`` only) after two changes of behaviour meant to move
+runs (issue 21): Avoid-Past's lifelong memory as the default (§1, ``memory_scope="robot"``: all
+8 Avoid-Past runs moved, R1 alone included) and perfect sensing at ``err_max = 0`` (§2, the
+occlusion model returns exact range and bearing there: the 4 potential-field and VisBug-21
+team runs at err_max 0 moved). The other 12 (R1 alone and err_max 0.4 for those two
+algorithms) reproduced their hashes. ``los_fingerprints.json`` still holds the hashes of
+before these changes and needs re-recording on the machine that recorded it (not this one).
 """
 
 from __future__ import annotations
