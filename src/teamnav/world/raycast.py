@@ -231,6 +231,71 @@ def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
             n = m
 
 
+@njit(cache=True)
+def _cast_pose_capped(clear, fx, fy, res, ct, st, cb, sb, tmax, cap_m, use_cap, out, dxs, dys, idxs, idys, rs, cs, vs,
+                      qs, act):
+    """One pose of :func:`_cast_serial`, each ray ``b`` then cut to ``min(range, cap_m[b])``.
+
+    ``(fx, fy)``: the pose in grid cell units; ``out`` (R,) receives the ranges [m]; the
+    other arrays (R,) are scratch. With ``use_cap`` the answer is, bit for bit,
+    ``min(range of _cast_serial, cap_m[b])``, but a ray stops being traversed once it is past
+    its cap: it is cast with the limit ``cap_m[b] / res`` widened by a relative 2e-9 (so that
+    a ray stopped by that limit lies, after rounding, strictly beyond ``cap_m[b]``, and its
+    answer is the cap itself), and a ray that ends before the limit ends at the very jump
+    :func:`_cast_serial` ends it at (the jumps do not depend on the limit). ``cap_m`` >= 0,
+    ``inf`` for no cap; a cap of 0 costs no traversal.
+    """
+    nb = cb.shape[0]
+    r0, c0, ok = _start(clear, fx, fy)
+    if not ok:
+        for b in range(nb):
+            out[b] = 0.0  # min(0, cap) with cap >= 0
+        return
+    inv = 1.0 / res
+    n = 0
+    for b in range(nb):
+        dx, dy = _ray_dir(ct, st, cb[b], sb[b])
+        tm = tmax
+        if use_cap:
+            cap = cap_m[b] * inv * (1.0 + 2e-9)
+            if cap < tmax:
+                tm = cap
+                if cap == 0.0:
+                    out[b] = cap_m[b]
+                    continue
+        dxs[b] = dx
+        dys[b] = dy
+        idxs[b] = _inv(dx)
+        idys[b] = _inv(dy)
+        q = _quadrant(dx, dy)
+        qs[b] = q
+        rs[b] = r0
+        cs[b] = c0
+        vs[b] = clear[r0, c0, q]
+        out[b] = tm  # the ray's limit [cells] while it is traversed
+        act[n] = b
+        n += 1
+    while n > 0:
+        m = 0
+        for a in range(n):
+            b = act[a]
+            tm = out[b]
+            r, c, v, t, done = _jump(clear, qs[b], fx, fy, dxs[b], dys[b], idxs[b], idys[b], rs[b], cs[b], vs[b], tm)
+            if done:
+                if use_cap:
+                    # stopped by a cap below tmax: the map range lies beyond the cap
+                    out[b] = cap_m[b] if (t >= tm and tm < tmax) else min(t * res, cap_m[b])
+                else:
+                    out[b] = t * res
+            else:
+                rs[b] = r
+                cs[b] = c
+                vs[b] = v
+                act[m] = b
+                m += 1
+        n = m
+
+
 @njit(cache=True, parallel=True)
 def _cast_parallel(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, chunk):
     n = xs.shape[0]

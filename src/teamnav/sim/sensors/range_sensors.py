@@ -34,15 +34,17 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 from numba import njit, prange
 
 from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
 from teamnav.sim.config import LaserConfig, ProximityConfig, SonarConfig
-from teamnav.sim.sensors.robot_hits import PARALLEL_MIN_RAYS, beam_plan, check_bodies, robot_hits_unchecked
+from teamnav.sim.sensors.robot_hits import (PARALLEL_MIN_RAYS, _prepare, _robot_hits_row, beam_plan, check_bodies,
+                                              robot_hits_unchecked)
 from teamnav.world.grid import OccupancyGrid
-from teamnav.world.raycast import RayCaster
+from teamnav.world.raycast import RayCaster, _cast_pose_capped
 
 __all__ = ["RangeSensor", "apply_beam_noise", "beam_angles", "beam_noise_keyed", "build_range_sensor", "draw_noise_key"]
 
@@ -208,6 +210,20 @@ def _normal(s):
     return _normal_slow(s, rabs, idx, x)
 
 
+@njit(cache=True, inline="always")
+def _keyed_beam(t, s, use_u, use_z, sigma, p_max, p_short, max_range):
+    """One beam of the mixture from its true range ``t`` and its stream, whose state before
+    the first draw is ``s`` (beam ``c`` of a call keyed ``key``: ``key + 64 c * gamma``)."""
+    v = 0.0
+    if use_u:
+        s += _GAMMA
+        v = _unit(_mix64(s))
+    z = 0.0
+    if use_z and not (use_u and v < p_max + p_short):
+        z = _normal(s)
+    return _mixture_one(t, v, z, use_u, use_z, sigma, p_max, p_short, max_range)
+
+
 @njit(cache=True)
 def _counter_noise_rows(true, key, i0, i1, sigma, p_max, p_short, max_range, out):
     """Rows ``[i0, i1)`` of :func:`beam_noise_keyed` (``out`` may be ``true``)."""
@@ -218,16 +234,8 @@ def _counter_noise_rows(true, key, i0, i1, sigma, p_max, p_short, max_range, out
     s0 = key + np.uint64(i0 * nb * _SLOTS) * _GAMMA
     for i in range(i0, i1):
         for b in range(nb):
-            s = s0
+            out[i, b] = _keyed_beam(true[i, b], s0, use_u, use_z, sigma, p_max, p_short, max_range)
             s0 += block
-            v = 0.0
-            if use_u:
-                s += _GAMMA
-                v = _unit(_mix64(s))
-            z = 0.0
-            if use_z and not (use_u and v < p_max + p_short):
-                z = _normal(s)
-            out[i, b] = _mixture_one(true[i, b], v, z, use_u, use_z, sigma, p_max, p_short, max_range)
 
 
 @njit(cache=True, parallel=True)
@@ -249,6 +257,89 @@ def _counter_noise_blocks(true, keys, starts, sigma, p_max, p_short, max_range, 
         r0 = starts[g]
         r1 = starts[g + 1]
         _counter_noise_rows(true[r0:r1], keys[g], 0, r1 - r0, sigma, p_max, p_short, max_range, out[r0:r1])
+
+
+# ---------------------------------------------------------------------------- one pass per robot
+@njit(cache=True)
+def _hash_or_none(use_hits, all_x, all_y, all_r, max_range_m):
+    """:func:`~teamnav.sim.sensors.robot_hits._prepare` with the default cell, or an empty
+    hash of the same type when no bodies are tested."""
+    if use_hits and all_x.shape[0] > 0:
+        return _prepare(all_x, all_y, all_r, max_range_m, 0.0)
+    z = np.zeros(0)
+    return (z, z, z, np.zeros(0, np.int64), np.zeros(2, np.int64), 0.0, 0.0, 1.0, 1, 1, 0.0)
+
+
+@njit(cache=True)
+def _sense_rows(i0, i1, cast, hits, beams, even, hsh, noise, out):
+    """Rows ``[i0, i1)`` of :func:`_sense_serial`, robot by robot: other robots' discs first
+    (:func:`~teamnav.sim.sensors.robot_hits._robot_hits_row`, into the rays' caps), then
+    the map cast of the pose, each ray traversed only up to its cap
+    (:func:`~teamnav.world.raycast._cast_pose_capped`: ``min(map range, disc hit)`` bit for
+    bit), the nearest ray of each beam, then the beam's keyed noise (row ``i``'s streams of
+    :func:`_counter_noise_rows`)."""
+    clear, ox, oy, res, kxs, kys, kct, kst, cb, sb, tmax, rpb = cast
+    use_hits, xs, ys, ct, st, self_idx, reach = hits
+    use_noise, key, sigma, p_max, p_short, max_range = noise
+    nr = cb.shape[0]
+    nb = out.shape[1]
+    inv = 1.0 / res
+    cap = np.full(nr, np.inf)
+    rr = np.empty(nr)
+    rdx = np.empty(nr)
+    rdy = np.empty(nr)
+    dxs = np.empty(nr)
+    dys = np.empty(nr)
+    idxs = np.empty(nr)
+    idys = np.empty(nr)
+    rs = np.empty(nr, np.int64)
+    cs = np.empty(nr, np.int64)
+    vs = np.empty(nr, np.uint8)
+    qs = np.empty(nr, np.int64)
+    act = np.empty(nr, np.int64)
+    use_u = p_max + p_short > 0.0
+    use_z = sigma > 0.0
+    block = np.uint64(_SLOTS) * _GAMMA
+    for i in range(i0, i1):
+        if use_hits:
+            for b in range(nr):
+                cap[b] = np.inf
+            _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], reach, beams, even, hsh, cap, rdx, rdy)
+        _cast_pose_capped(clear, (kxs[i] - ox) * inv, (kys[i] - oy) * inv, res, kct[i], kst[i], cb, sb, tmax, cap,
+                          use_hits, rr, dxs, dys, idxs, idys, rs, cs, vs, qs, act)
+        s0 = key + np.uint64(i * nb * _SLOTS) * _GAMMA
+        for b in range(nb):
+            if rpb == 1:
+                t = rr[b]
+            else:
+                t = rr[b * rpb]
+                for k in range(b * rpb + 1, (b + 1) * rpb):
+                    t = min(t, rr[k])
+            if use_noise:
+                t = _keyed_beam(t, s0, use_u, use_z, sigma, p_max, p_short, max_range)
+                s0 += block
+            out[i, b] = t
+
+
+@njit(cache=True)
+def _sense_serial(cast, hits, beams, even, bodies, noise, out):
+    """Every robot's ranges (:func:`_sense_rows`) in this thread; ``bodies = (all_x, all_y,
+    all_r)`` are hashed once per call."""
+    all_x, all_y, all_r = bodies
+    hsh = _hash_or_none(hits[0], all_x, all_y, all_r, hits[6])
+    _sense_rows(0, out.shape[0], cast, hits, beams, even, hsh, noise, out)
+
+
+@njit(cache=True, parallel=True)
+def _sense_parallel(cast, hits, beams, even, bodies, noise, out, chunk):
+    """:func:`_sense_serial` with chunks of ``chunk`` robots spread over numba's threads (each
+    robot's result depends on nothing but its own pose: the same on any thread count)."""
+    all_x, all_y, all_r = bodies
+    hsh = _hash_or_none(hits[0], all_x, all_y, all_r, hits[6])
+    n = out.shape[0]
+    nchunks = (n + chunk - 1) // chunk
+    for c in prange(nchunks):
+        _sense_rows(c * chunk, min(n, (c + 1) * chunk), cast, hits, beams, even, hsh, noise, out)
 
 
 def _check_noise_args(true_m, noise_std_m, p_max, p_short, max_range_m, out):
@@ -375,6 +466,10 @@ def beam_noise_keyed(true_m, key, noise_std_m, p_max, p_short, max_range_m, out=
 
 
 # ---------------------------------------------------------------------------- the sensor
+_EMPTY_F = np.zeros(0)
+_EMPTY_I = np.zeros(0, np.int64)
+
+
 class RangeSensor:
     """One range sensor model, shared by every robot of a group that carries it.
 
@@ -483,19 +578,45 @@ class RangeSensor:
         """:meth:`true_ranges` without input checks (the engine's per-step path).
 
         ``xs, ys, thetas``: contiguous float64 (n,); ``bodies``: None or as returned by
-        :func:`~teamnav.sim.sensors.robot_hits.check_bodies`. Small calls run serially
-        (below ``PARALLEL_MIN_RAYS`` rays, waking numba's threads costs more than it saves).
+        :func:`~teamnav.sim.sensors.robot_hits.check_bodies`.
         """
+        return self._pass(xs, ys, thetas, bodies, None)
+
+    def _pass(self, xs, ys, thetas, bodies, key) -> np.ndarray:
+        """One kernel pass per robot (:func:`_sense_rows`): other robots' discs, the map cast
+        cut at them, each beam's nearest ray, then the keyed noise of ``key`` (None: no
+        noise), into a fresh (n, B) array. Calls of fewer than ``PARALLEL_MIN_RAYS`` rays,
+        and every call when numba runs one thread, stay in this thread (below that, waking
+        numba's threads costs more than it saves)."""
         n = xs.shape[0]
-        parallel = n * self.ray_angles_rad.shape[0] >= PARALLEL_MIN_RAYS
-        rays = self.caster._cast_cs(xs, ys, thetas, self._cos_rays, self._sin_rays, parallel)
-        if bodies is not None and self.sees_robots:
+        nr = self.ray_angles_rad.shape[0]
+        out = np.empty((n, self.angles_rad.shape[0]), dtype=np.float64)
+        if n == 0:
+            return out
+        grid = self.caster.grid
+        kxs, kys, ox, oy = grid.kernel_frame(xs, ys)
+        kth = grid.kernel_theta(thetas)
+        ct = np.cos(thetas)
+        st = np.sin(thetas)
+        kct, kst = (ct, st) if kth is thetas else (np.cos(kth), np.sin(kth))
+        res = self.caster._res
+        cast = (self.caster.clearance, float(ox), float(oy), res, kxs, kys, kct, kst, self._cos_rays, self._sin_rays,
+                self.max_range_m / res, self.rays_per_beam)
+        use_hits = bodies is not None and self.sees_robots and bodies[0].shape[0] > 0
+        if use_hits:
             all_x, all_y, all_r, self_idx = bodies
-            robot_hits_unchecked(xs, ys, thetas, self._plan, all_x, all_y, all_r, self_idx, rays, self.max_range_m, 0.0,
-                                 parallel)
-        if self.rays_per_beam == 1:
-            return rays
-        return rays.reshape(n, self.angles_rad.shape[0], self.rays_per_beam).min(axis=2)
+        else:
+            all_x = all_y = all_r = _EMPTY_F
+            self_idx = _EMPTY_I
+        hits = (use_hits, xs, ys, ct, st, self_idx, self.max_range_m)
+        noise = (key is not None, np.uint64(0 if key is None else key), self.noise_std_m, self.p_max, self.p_short,
+                 self.max_range_m)
+        if n * nr >= PARALLEL_MIN_RAYS and numba.get_num_threads() > 1:
+            chunk = min(256, max(1, n // (4 * numba.get_num_threads())))
+            _sense_parallel(cast, hits, self._plan.beams, self._plan.even, (all_x, all_y, all_r), noise, out, chunk)
+        else:
+            _sense_serial(cast, hits, self._plan.beams, self._plan.even, (all_x, all_y, all_r), noise, out)
+        return out
 
     # ------------------------------------------------------------------ observation
     def sense(self, xs, ys, thetas, rng: np.random.Generator, bodies=None, out: np.ndarray | None = None) -> np.ndarray:
@@ -533,9 +654,7 @@ class RangeSensor:
     def _sense(self, xs, ys, thetas, rng: np.random.Generator, bodies=None) -> np.ndarray:
         """:meth:`sense` without input checks, into a fresh array (the engine's per-step path;
         arrays as in :meth:`_true_ranges`)."""
-        true = self._true_ranges(xs, ys, thetas, bodies)
-        return _keyed_noise(true, draw_noise_key(rng), self.noise_std_m, self.p_max, self.p_short, self.max_range_m,
-                            true)
+        return self._pass(xs, ys, thetas, bodies, draw_noise_key(rng))
 
 
 def build_range_sensor(cfg: LaserConfig | SonarConfig | ProximityConfig, grid: OccupancyGrid) -> RangeSensor:

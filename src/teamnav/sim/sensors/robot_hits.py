@@ -192,6 +192,23 @@ def _build_hash(all_x, all_y, all_r, cell_m, max_cells):
 def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
     """Shorten row ``i`` of ``out`` (map ranges, modified in place) by other robots' discs.
 
+    A disc is skipped before any angle is computed when ``d - r`` is beyond the longest map
+    ray of robot ``i`` (no hit on it could shorten a ray); :func:`_robot_hits_row` does the rest.
+    """
+    nb = out.shape[1]
+    reach = 0.0
+    for b in range(nb):
+        reach = max(reach, out[i, b])
+    _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], reach, beams, even, hsh, out[i], np.empty(nb),
+                    np.empty(nb))
+
+
+@njit(cache=True)
+def _robot_hits_row(px, py, cti, sti, me, reach, beams, even, hsh, row, rdx, rdy):
+    """``row[b] = min(row[b], first hit of ray b on a disc other than ``me``)`` for a sensor
+    at ``(px, py)`` heading ``(cti, sti)`` (cos, sin); discs whose nearest point is ``reach``
+    or more away are skipped (``reach <= 0``: none is tested). ``rdx, rdy`` (R,): scratch.
+
     ``beams = (cb, sb, sorted_ang, ray_order)``: cos/sin of the ray directions, the
     directions wrapped to ``[-pi, pi)`` in ascending order and their ray indices.
     ``even = (is_even, first, inv_step)``: when the rays form an even fan (ray ``k`` at
@@ -203,29 +220,19 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
     by rays within ``asin(r / d)`` of ``phi``; the window used is the wider
     ``r / sqrt(d^2 - r^2)`` (``tan >= angle``, and no ``asin``) plus ``_ANGLE_MARGIN_RAD``,
     and every ray inside it is intersected exactly, so the result is that of testing every
-    ray. A disc is skipped before any angle is computed when ``d - r`` is beyond the longest
-    ray of robot ``i``.
+    ray. The ``min`` is order-free, so any ``reach`` at least the row's longest entry gives
+    the same row bit for bit.
     """
     cb, sb, sorted_ang, ray_order = beams
     is_even, first, inv_step, front, mid = even
     sx, sy, sr, sid, start, x0, y0, cell, nkx, nky, rmax = hsh
     nb = cb.shape[0]
     two_pi = 2.0 * math.pi
-    px = xs[i]
-    py = ys[i]
-    cti = ct[i]
-    sti = st[i]
-    me = self_idx[i]
     # rays of a fan no wider than a half-turn stay in the half-plane ahead of its middle
     # direction: a disc wholly behind that line is skipped before any angle is computed
     hx = math.cos(mid) * cti - math.sin(mid) * sti if front else 0.0
     hy = math.cos(mid) * sti + math.sin(mid) * cti if front else 0.0
-    reach = 0.0
-    for b in range(nb):
-        reach = max(reach, out[i, b])
-    rdx = np.empty(nb)  # world directions of the rays (the reference's arithmetic, once per robot)
-    rdy = np.empty(nb)
-    for b in range(nb):
+    for b in range(nb):  # world directions of the rays (the reference's arithmetic, once per robot)
         rdx[b] = cti * cb[b] - sti * sb[b]
         rdy[b] = sti * cb[b] + cti * sb[b]
     if reach <= 0.0:
@@ -251,9 +258,8 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
             r2 = r * r
             if d2 <= r2:  # sensor inside the disc: every ray stops at once
                 for b in range(nb):
-                    out[i, b] = 0.0
+                    row[b] = 0.0
                 continue
-            near = math.sqrt(d2) - r - _REACH_SLACK_M  # no hit is nearer
             # bearing of the centre in the body frame, in [-pi, pi]
             phi = _fast_atan2(cti * gy - sti * gx, cti * gx + sti * gy)
             beta = r / math.sqrt(d2 - r2) + _ANGLE_MARGIN_RAD
@@ -303,7 +309,7 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
                     disc = bb * bb - cc
                     t = -bb - math.sqrt(max(disc, 0.0))
                     t = t if (bb < 0.0 and disc >= 0.0) else np.inf
-                    out[i, b] = min(out[i, b], t)
+                    row[b] = min(row[b], t)
 
 
 @njit(cache=True)
