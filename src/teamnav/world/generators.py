@@ -432,8 +432,8 @@ def office_complex(resolution_m: float = 0.1, alleys: bool = True) -> Environmen
 
     Where we fill a gap: the paper gives Fig. 13 as a picture only (no sizes or coordinates).
 
-    ``alleys=False`` (builtin ``office_complex_closed``, session 7, H7trap; not used by any
-    scenario yet): the 1.6 m alleys between the backs of the U walls of rooms 1, 2 and 8 and the
+    ``alleys=False`` (builtin ``office_complex_closed``, session 7, H7trap; the map of
+    ``los-help-complex`` and of Table 2 / Fig. 17 since then): the 1.6 m alleys between the backs of the U walls of rooms 1, 2 and 8 and the
     room's wall are filled, so the U's back is flush with the wall. Why: Table 2's potential
     field with helpers finishes every task, so no trap of the paper's map was out of every
     helper's sight; on ``office_complex`` a potential field leaving the room's centre for the
@@ -443,8 +443,8 @@ def office_complex(resolution_m: float = 0.1, alleys: bool = True) -> Environmen
     prefixes of tasks 1-5, default brains, office_complex -> closed; tasks finished, targets
     reached): potential field alone 0/5 (4/200) -> 0/5 (4/200), R1+R2 2/5 (116/200) -> 4/5
     (168/200), R1..R4 (tasks 1-4) 1/4 (65/160) -> 3/4 (121/160); VisBug-21 alone 350 -> 321 steps
-    per target, R1..R4 286 -> 283; Avoid-Past alone 309 -> 345, R1..R4 -> 337. Switching
-    ``los-help-complex`` to it changes every Table 2 / Fig. 17 number: not done yet.
+    per target, R1..R4 286 -> 283; Avoid-Past alone 309 -> 345, R1..R4 -> 337 (measured before
+    ``los-help-complex`` switched to it).
 
     Places: ``room_1``..``room_8`` (targets), ``door_<k>`` (H doorways; ``door_6w`` room 6's
     west one) and ``door_<k>v`` (V doorways, 0.3 m into the room), ``base`` at the west end of H
