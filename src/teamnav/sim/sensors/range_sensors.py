@@ -260,12 +260,21 @@ def _counter_noise_blocks(true, keys, starts, sigma, p_max, p_short, max_range, 
 
 
 # ---------------------------------------------------------------------------- one pass per robot
+#: Robots' discs whose nearest point is within this distance [m] of a sensor are met before
+#: its map cast (their hits cap the rays' traversal), the rest after it, and only those
+#: nearer than the longest ray left (issue 27: at 1000 laser robots on the basement map 98 %
+#: of the beams end within 3 m, and 9 of the ~86 discs ahead of a robot shorten a ray).
+_NEAR_M: float = 4.0
+#: Side [m] of the hash cells of the one-pass sensing (its windows are a few metres).
+_HASH_CELL_M: float = 1.5
+
+
 @njit(cache=True)
 def _hash_or_none(use_hits, all_x, all_y, all_r, max_range_m):
     """:func:`~teamnav.sim.sensors.robot_hits._prepare` with the default cell, or an empty
     hash of the same type when no bodies are tested."""
     if use_hits and all_x.shape[0] > 0:
-        return _prepare(all_x, all_y, all_r, max_range_m, 0.0)
+        return _prepare(all_x, all_y, all_r, max_range_m, min(_HASH_CELL_M, max_range_m))
     z = np.zeros(0)
     return (z, z, z, np.zeros(0, np.int64), np.zeros(2, np.int64), 0.0, 0.0, 1.0, 1, 1, 0.0)
 
@@ -304,9 +313,16 @@ def _sense_rows(i0, i1, cast, hits, beams, even, hsh, noise, out):
         if use_hits:
             for b in range(nr):
                 cap[b] = np.inf
-            _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], reach, beams, even, hsh, cap, rdx, rdy)
+            near = min(reach, _NEAR_M)
+            _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], 0.0, near, beams, even, hsh, cap, rdx, rdy, True)
         _cast_pose_capped(clear, (kxs[i] - ox) * inv, (kys[i] - oy) * inv, res, kct[i], kst[i], cb, sb, tmax, cap,
                           use_hits, rr, dxs, dys, idxs, idys, rs, cs, vs, qs, act)
+        if use_hits:
+            # the discs beyond `near` that could still shorten a ray: nearer than the longest one
+            far = 0.0
+            for b in range(nr):
+                far = max(far, rr[b])
+            _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], near, far, beams, even, hsh, rr, rdx, rdy, False)
         s0 = key + np.uint64(i * nb * _SLOTS) * _GAMMA
         for b in range(nb):
             if rpb == 1:

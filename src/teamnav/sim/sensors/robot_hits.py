@@ -199,15 +199,18 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
     reach = 0.0
     for b in range(nb):
         reach = max(reach, out[i, b])
-    _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], reach, beams, even, hsh, out[i], np.empty(nb),
-                    np.empty(nb))
+    _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], 0.0, reach, beams, even, hsh, out[i], np.empty(nb),
+                    np.empty(nb), True)
 
 
 @njit(cache=True)
-def _robot_hits_row(px, py, cti, sti, me, reach, beams, even, hsh, row, rdx, rdy):
+def _robot_hits_row(px, py, cti, sti, me, inner, reach, beams, even, hsh, row, rdx, rdy, set_dirs):
     """``row[b] = min(row[b], first hit of ray b on a disc other than ``me``)`` for a sensor
     at ``(px, py)`` heading ``(cti, sti)`` (cos, sin); discs whose nearest point is ``reach``
-    or more away are skipped (``reach <= 0``: none is tested). ``rdx, rdy`` (R,): scratch.
+    or more away are skipped (``reach <= 0``: none is tested), and with ``inner > 0`` also
+    those a call of ``reach = inner`` tests (the same comparison, so two calls, ``reach = a``
+    then ``inner = a``, test every disc exactly once). ``rdx, rdy`` (R,): the rays' world
+    directions, filled when ``set_dirs`` (else as a previous call for this pose left them).
 
     ``beams = (cb, sb, sorted_ang, ray_order)``: cos/sin of the ray directions, the
     directions wrapped to ``[-pi, pi)`` in ascending order and their ray indices.
@@ -232,12 +235,15 @@ def _robot_hits_row(px, py, cti, sti, me, reach, beams, even, hsh, row, rdx, rdy
     # direction: a disc wholly behind that line is skipped before any angle is computed
     hx = math.cos(mid) * cti - math.sin(mid) * sti if front else 0.0
     hy = math.cos(mid) * sti + math.sin(mid) * cti if front else 0.0
-    for b in range(nb):  # world directions of the rays (the reference's arithmetic, once per robot)
-        rdx[b] = cti * cb[b] - sti * sb[b]
-        rdy[b] = sti * cb[b] + cti * sb[b]
-    if reach <= 0.0:
+    if set_dirs:
+        for b in range(nb):  # world directions of the rays (the reference's arithmetic, once per robot)
+            rdx[b] = cti * cb[b] - sti * sb[b]
+            rdy[b] = sti * cb[b] + cti * sb[b]
+    if reach <= 0.0 or reach <= inner:
         return
     reach += _REACH_SLACK_M
+    has_inner = inner > 0.0
+    inner += _REACH_SLACK_M
     half = reach + rmax
     kx0 = max(0, int(math.floor((px - half - x0) / cell)))
     kx1 = min(nkx - 1, int(math.floor((px + half - x0) / cell)))
@@ -255,6 +261,10 @@ def _robot_hits_row(px, py, cti, sti, me, reach, beams, even, hsh, row, rdx, rdy
             lim = reach + r
             if d2 >= lim * lim or sid[s] == me or gx * hx + gy * hy < -r - _REACH_SLACK_M:
                 continue
+            if has_inner:
+                lin = inner + r  # as `lim` of the call with reach = inner
+                if d2 < lin * lin:
+                    continue
             r2 = r * r
             if d2 <= r2:  # sensor inside the disc: every ray stops at once
                 for b in range(nb):

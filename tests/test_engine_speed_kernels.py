@@ -1,0 +1,243 @@
+"""The one-pass sensing kernel (issue 27 §2) against the former cast -> robot bodies -> noise path.
+
+``RangeSensor._pass`` casts each robot's rays only up to the nearest other robot's disc met
+first, in one numba loop per robot; everything here checks that it gives the former ranges
+bit for bit: the map cast of :func:`cast_rays`, cut by :func:`robot_hits_reference` (every
+ray against every disc), the nearest ray of each beam, then :func:`beam_noise_keyed`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from teamnav.sim.config import LaserConfig, ProximityConfig, SonarConfig
+from teamnav.sim.sensors import range_sensors as rs_mod
+from teamnav.sim.sensors import robot_hits as rh_mod
+from teamnav.sim.sensors.range_sensors import beam_noise_keyed, build_range_sensor
+from teamnav.sim.sensors.robot_hits import beam_plan, robot_hits_reference
+from teamnav.world import raycast as rc_mod
+from teamnav.world.grid import WALL, OccupancyGrid
+from teamnav.world.raycast import cast_rays
+
+
+def random_grid(rng, res, yaw=0.0):
+    h, w = int(rng.integers(20, 90)), int(rng.integers(20, 90))
+    cells = np.zeros((h, w), np.uint8)
+    for _ in range(int(rng.integers(0, 12))):  # walls and blocks
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        cells[r0:r0 + int(rng.integers(1, 15)), c0:c0 + int(rng.integers(1, 4))] = WALL
+        cells[r0:r0 + int(rng.integers(1, 3)), c0:c0 + int(rng.integers(1, 15))] = WALL
+    return OccupancyGrid(cells, res, (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3))), yaw_rad=yaw)
+
+
+def sensor_for(kind, rng, max_range, grid):
+    if kind == "laser":
+        cfg = LaserConfig(n_beams=int(rng.integers(1, 200)), fov_deg=float(rng.choice([90.0, 180.0, 270.0, 360.0])),
+                          max_range_m=max_range, noise_std_m=0.01, p_max=0.05, p_short=0.05, sees_robots=True)
+    elif kind == "sonar":
+        cfg = SonarConfig(n_transducers=int(rng.integers(1, 16)), rays_per_cone=int(rng.integers(1, 6)),
+                          max_range_m=max_range, sees_robots=True)
+    else:
+        cfg = ProximityConfig(angles_deg=tuple(float(a) for a in rng.uniform(-400, 400, int(rng.integers(1, 9)))),
+                              max_range_m=min(max_range, 10.0), sees_robots=True)
+    return build_range_sensor(cfg, grid)
+
+
+def former(sensor, xs, ys, th, bodies, key):
+    """The ranges the engine computed before the one-pass kernel: cast, bodies, nearest ray, noise."""
+    g = sensor.caster.grid
+    kx, ky, ox, oy = g.kernel_frame(xs, ys)
+    rays = cast_rays(sensor.caster.blocking, ox, oy, g.resolution_m, kx, ky, g.kernel_theta(th),
+                     sensor.ray_angles_rad, sensor.max_range_m, parallel=False)
+    if bodies is not None:
+        robot_hits_reference(xs, ys, th, sensor.ray_angles_rad, bodies, rays)
+    n, nb = xs.shape[0], sensor.angles_rad.shape[0]
+    true = rays if sensor.rays_per_beam == 1 else rays.reshape(n, nb, sensor.rays_per_beam).min(axis=2)
+    if key is None:
+        return true
+    return beam_noise_keyed(true, key, sensor.noise_std_m, sensor.p_max, sensor.p_short, sensor.max_range_m)
+
+
+def grazing_bodies(rng, sensor, xs, ys, th, n_extra):
+    """Random discs plus discs tangent to a ray (within a few ulps) and discs whose front is
+    at (about) the map range of a ray: the cases where the cap or the window could slip."""
+    g = sensor.caster.grid
+    kx, ky, ox, oy = g.kernel_frame(xs, ys)
+    maps = cast_rays(sensor.caster.blocking, ox, oy, g.resolution_m, kx, ky, g.kernel_theta(th),
+                     sensor.ray_angles_rad, sensor.max_range_m, parallel=False)
+    bx, by, br = [], [], []
+    for _ in range(n_extra):
+        i = int(rng.integers(0, xs.shape[0]))
+        b = int(rng.integers(0, sensor.ray_angles_rad.shape[0]))
+        a = th[i] + sensor.ray_angles_rad[b]
+        dx, dy = math.cos(a), math.sin(a)
+        r = float(rng.uniform(0.05, 0.4))
+        kind = int(rng.integers(0, 3))
+        if kind == 0:  # tangent to ray b at a random distance
+            t = float(rng.uniform(0.0, sensor.max_range_m))
+            side = 1.0 if rng.random() < 0.5 else -1.0
+            eps = float(rng.choice([0.0, 1e-15, -1e-15, 1e-12, -1e-12]))
+            cx = xs[i] + t * dx - side * (r + eps) * dy
+            cy = ys[i] + t * dy + side * (r + eps) * dx
+        elif kind == 1:  # front surface at the map range of ray b (a hit equal to the cap)
+            t = float(maps[i, b]) + float(rng.choice([0.0, 1e-13, -1e-13, 1e-9, -1e-9]))
+            t += int(rng.integers(-3, 4)) * float(np.spacing(t))
+            cx, cy = xs[i] + (t + r) * dx, ys[i] + (t + r) * dy
+        else:  # the sensor on the disc's rim, or just inside / outside it
+            e = float(rng.choice([0.0, 1e-12, -1e-12]))
+            cx, cy = xs[i] + (r + e) * dx, ys[i] + (r + e) * dy
+        bx.append(cx)
+        by.append(cy)
+        br.append(r)
+    return np.array(bx), np.array(by), np.array(br)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**32 - 1), st.sampled_from(["laser", "sonar", "proximity"]), st.booleans(),
+       st.sampled_from([0.05, 0.1, 0.25]), st.sampled_from([0.0, 0.0, 0.7]))
+def test_one_pass_matches_former_path_bit_for_bit(seed, kind, parallel, res, yaw):
+    rng = np.random.default_rng(seed)
+    grid = random_grid(rng, res, yaw)
+    max_range = float(rng.choice([0.5, 3.0, 10.0, 40.0]))
+    sensor = sensor_for(kind, rng, max_range, grid)
+    n_all = int(rng.integers(1, 80))
+    lo = grid.local_to_world(np.array([[-1.0, -1.0]]))[0]
+    span = max(grid.cells.shape) * res + 2.0
+    all_x = lo[0] + rng.uniform(0.0, span, n_all)
+    all_y = lo[1] + rng.uniform(0.0, span, n_all)
+    all_r = rng.uniform(0.0, 0.5, n_all)
+    sensing = np.sort(rng.choice(n_all, size=int(rng.integers(1, n_all + 1)), replace=False))
+    xs, ys = all_x[sensing].copy(), all_y[sensing].copy()
+    th = rng.uniform(-10.0, 10.0, sensing.shape[0])
+    if rng.random() < 0.3:  # axis-parallel and diagonal headings
+        th = rng.choice([0.0, math.pi / 2, -math.pi, math.pi / 4, 3 * math.pi / 4], sensing.shape[0])
+    gx, gy, gr = grazing_bodies(rng, sensor, xs, ys, th, int(rng.integers(0, 40)))
+    all_x, all_y, all_r = np.concatenate([all_x, gx]), np.concatenate([all_y, gy]), np.concatenate([all_r, gr])
+    bodies = (all_x, all_y, all_r, sensing.astype(np.int64))
+    key = int(rng.integers(0, 2**63))
+    old = rs_mod.PARALLEL_MIN_RAYS
+    try:
+        rs_mod.PARALLEL_MIN_RAYS = 0 if parallel else 10**12
+        got = sensor._pass(xs, ys, th, bodies, key)
+        got_true = sensor._pass(xs, ys, th, bodies, None)
+        got_map = sensor._pass(xs, ys, th, None, None)
+    finally:
+        rs_mod.PARALLEL_MIN_RAYS = old
+    np.testing.assert_array_equal(got_true, former(sensor, xs, ys, th, bodies, None))
+    np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, key))
+    np.testing.assert_array_equal(got_map, former(sensor, xs, ys, th, None, None))
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_capped_cast_is_min_of_cast_and_cap(seed):
+    """_cast_pose_capped == min(_cast_serial, cap), caps at, just below and above the map range."""
+    rng = np.random.default_rng(seed)
+    res = float(rng.choice([0.05, 0.1, 1.0]))
+    grid = random_grid(rng, res)
+    clear = rc_mod.clearance_map(grid.blocking(None))
+    n, nb = 20, int(rng.integers(1, 64))
+    xs = grid.origin_xy_m[0] + rng.uniform(-1.0, grid.cells.shape[1] * res + 1.0, n)
+    ys = grid.origin_xy_m[1] + rng.uniform(-1.0, grid.cells.shape[0] * res + 1.0, n)
+    th = rng.uniform(-4.0, 4.0, n)
+    ang = rng.uniform(-math.pi, math.pi, nb)
+    ct, st_, cb, sb = np.cos(th), np.sin(th), np.cos(ang), np.sin(ang)
+    tmax = float(rng.choice([0.3, 5.0, 50.0])) / res
+    full = np.empty((n, nb))
+    ox, oy = grid.origin_xy_m
+    rc_mod._cast_serial(clear, ox, oy, res, xs, ys, ct, st_, cb, sb, tmax, full, 0, n)
+    scratch = [np.empty(nb), np.empty(nb), np.empty(nb), np.empty(nb), np.empty(nb, np.int64), np.empty(nb, np.int64),
+               np.empty(nb, np.uint8), np.empty(nb, np.int64), np.empty(nb, np.int64)]
+    for p in range(n):
+        m = full[p]
+        cap = np.where(rng.random(nb) < 0.5, m, rng.uniform(0.0, tmax * res * 1.2, nb))
+        cap = cap * rng.choice([1.0, 1.0 + 1e-10, 1.0 - 1e-10, 1.5, 0.5], nb)
+        ulps = rng.choice([0, 0, 1, -1, 2, -2, 5, -5], nb)  # caps a few ulps from the map range
+        cap = np.maximum(0.0, cap + ulps * np.spacing(cap))
+        cap[rng.random(nb) < 0.1] = np.inf
+        cap[rng.random(nb) < 0.1] = 0.0
+        out = np.empty(nb)
+        inv = 1.0 / res
+        rc_mod._cast_pose_capped(clear, (xs[p] - ox) * inv, (ys[p] - oy) * inv, res, ct[p], st_[p], cb, sb, tmax, cap,
+                                 True, out, *scratch)
+        np.testing.assert_array_equal(out, np.minimum(m, cap))
+        rc_mod._cast_pose_capped(clear, (xs[p] - ox) * inv, (ys[p] - oy) * inv, res, ct[p], st_[p], cb, sb, tmax, cap,
+                                 False, out, *scratch)
+        np.testing.assert_array_equal(out, m)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 6.0), st.floats(0.0, 12.0))
+def test_two_reaches_test_every_disc_once(seed, inner, reach):
+    """Discs within `inner`, then those beyond it up to `reach`: the same rows as one call
+    (and as every ray against every disc, for the discs that matter)."""
+    rng = np.random.default_rng(seed)
+    n_all = int(rng.integers(1, 150))
+    all_x = rng.uniform(0.0, 12.0, n_all)
+    all_y = rng.uniform(0.0, 12.0, n_all)
+    all_r = rng.uniform(0.0, 0.5, n_all)
+    angles = np.linspace(-math.pi / 2, math.pi / 2, 181) if seed % 2 else rng.uniform(-4.0, 4.0, 40)
+    plan = beam_plan(angles)
+    hsh = rh_mod._prepare(all_x, all_y, all_r, 10.0, float(rng.choice([0.0, 0.7, 1.5])))
+    nb = angles.shape[0]
+    for i in range(min(n_all, 10)):
+        th = float(rng.uniform(-7.0, 7.0))
+        ct, st_ = math.cos(th), math.sin(th)
+        base = rng.uniform(0.0, reach, nb) if rng.random() < 0.5 else np.full(nb, reach)
+        one = base.copy()
+        rh_mod._robot_hits_row(all_x[i], all_y[i], ct, st_, i, 0.0, reach, plan.beams, plan.even, hsh, one,
+                               np.empty(nb), np.empty(nb), True)
+        two = base.copy()
+        rdx, rdy = np.empty(nb), np.empty(nb)
+        rh_mod._robot_hits_row(all_x[i], all_y[i], ct, st_, i, 0.0, min(inner, reach), plan.beams, plan.even, hsh, two,
+                               rdx, rdy, True)
+        rh_mod._robot_hits_row(all_x[i], all_y[i], ct, st_, i, min(inner, reach), reach, plan.beams, plan.even, hsh,
+                               two, rdx, rdy, False)
+        np.testing.assert_array_equal(two, one)
+        if reach >= base.max():
+            ref = base[None, :].copy()
+            robot_hits_reference(all_x[i:i + 1], all_y[i:i + 1], np.array([th]), angles,
+                                 (all_x, all_y, all_r, np.array([i])), ref)
+            np.testing.assert_array_equal(one, ref[0])
+
+
+def test_basement_team_matches_former_path():
+    """1000 robots on the MIT basement map, as bench_engine's laser case: bit for bit, serial and parallel."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from bench_engine import build_sim
+
+    sim = build_sim("laser", "batched", 1000, seed=4)
+    for _ in range(3):
+        sim.step()
+    grp = sim._groups[0]
+    sensor, bodies = grp.sensors[0], grp.bodies[0]
+    s = sim.state
+    xs, ys, th = s.x_m.copy(), s.y_m.copy(), s.theta_rad.copy()
+    want = former(sensor, xs, ys, th, bodies, 12345)
+    threads = numba.get_num_threads()
+    try:
+        for t in sorted({1, threads}):
+            numba.set_num_threads(t)
+            np.testing.assert_array_equal(sensor._pass(xs, ys, th, bodies, 12345), want)
+    finally:
+        numba.set_num_threads(threads)
+
+
+@pytest.mark.parametrize("mod", [rs_mod, rh_mod, rc_mod])
+def test_every_kernel_is_cached(mod):
+    from numba.core.caching import NullCache
+    from numba.core.registry import CPUDispatcher
+
+    kernels = [v for v in vars(mod).values() if isinstance(v, CPUDispatcher) and v.__module__ == mod.__name__]
+    assert kernels
+    for k in kernels:
+        assert not isinstance(k._cache, NullCache), f"{mod.__name__}.{k.__name__} lacks cache=True"
