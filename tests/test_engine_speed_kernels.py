@@ -192,13 +192,13 @@ def test_two_reaches_test_every_disc_once(seed, inner, reach):
         base = rng.uniform(0.0, reach, nb) if rng.random() < 0.5 else np.full(nb, reach)
         one = base.copy()
         rh_mod._robot_hits_row(all_x[i], all_y[i], ct, st_, i, 0.0, reach, plan.beams, plan.even, hsh, one,
-                               np.empty(nb), np.empty(nb), True)
+                               np.empty(nb), np.empty(nb), True, rh_mod._ALL)
         two = base.copy()
         rdx, rdy = np.empty(nb), np.empty(nb)
         rh_mod._robot_hits_row(all_x[i], all_y[i], ct, st_, i, 0.0, min(inner, reach), plan.beams, plan.even, hsh, two,
-                               rdx, rdy, True)
+                               rdx, rdy, True, rh_mod._ALL)
         rh_mod._robot_hits_row(all_x[i], all_y[i], ct, st_, i, min(inner, reach), reach, plan.beams, plan.even, hsh,
-                               two, rdx, rdy, False)
+                               two, rdx, rdy, False, rh_mod._ALL)
         np.testing.assert_array_equal(two, one)
         if reach >= base.max():
             ref = base[None, :].copy()
@@ -241,3 +241,21 @@ def test_every_kernel_is_cached(mod):
     assert kernels
     for k in kernels:
         assert not isinstance(k._cache, NullCache), f"{mod.__name__}.{k.__name__} lacks cache=True"
+
+
+@pytest.mark.parametrize("heading", [0.0, 0.3, math.pi / 2, -2.5, math.pi])
+@pytest.mark.parametrize("gap", [2e-9, 1e-7, 1e-3, 0.2])
+def test_disc_just_beyond_the_near_ring_on_a_lone_long_ray(heading, gap):
+    """A disc met after the cast (just beyond ``_NEAR_M``) on the only ray that runs far: the
+    box of long rays must hold it, however thin (one beam, small radii)."""
+    grid = OccupancyGrid.empty(40.0, 40.0, 0.05, origin_xy_m=(-20.0, -20.0))
+    sensor = build_range_sensor(LaserConfig(n_beams=1, fov_deg=1.0, max_range_m=10.0, noise_std_m=0.0,
+                                            sees_robots=True), grid)
+    r = 0.02
+    t = rs_mod._NEAR_M + gap
+    cx, cy = (t + r) * math.cos(heading), (t + r) * math.sin(heading)
+    bodies = (np.array([0.0, cx, 9.0]), np.array([0.0, cy, 9.0]), np.array([0.01, r, 0.01]), np.array([0]))
+    xs, ys, th = np.zeros(1), np.zeros(1), np.array([heading])
+    got = sensor._pass(xs, ys, th, bodies, None)
+    np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, None))
+    assert got[0, 0] < t + 1e-6

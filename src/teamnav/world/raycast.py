@@ -242,8 +242,10 @@ def _cast_pose_capped(clear, fx, fy, res, ct, st, cb, sb, tmax, cap_m, use_cap, 
     its cap: it is cast with the limit ``cap_m[b] / res`` widened by a relative 2e-9 (so that
     a ray stopped by that limit lies, after rounding, strictly beyond ``cap_m[b]``, and its
     answer is the cap itself), and a ray that ends before the limit ends at the very jump
-    :func:`_cast_serial` ends it at (the jumps do not depend on the limit). ``cap_m`` >= 0,
-    ``inf`` for no cap; a cap of 0 costs no traversal.
+    :func:`_cast_serial` ends it at (the jumps do not depend on the limit). A ray whose
+    widened limit lies within the free square centred on the start cell (whose half-side the
+    four quadrant codes give) is not traversed at all: its answer is its cap. ``cap_m`` >= 0,
+    ``inf`` for no cap.
     """
     nb = cb.shape[0]
     r0, c0, ok = _start(clear, fx, fy)
@@ -252,17 +254,21 @@ def _cast_pose_capped(clear, fx, fy, res, ct, st, cb, sb, tmax, cap_m, use_cap, 
             out[b] = 0.0  # min(0, cap) with cap >= 0
         return
     inv = 1.0 / res
+    # every ray runs free for more than `free` cells: the four quadrant squares of the start
+    # cell hold the centred square of half-side min(codes) - 1 around it
+    free = float(min(min(clear[r0, c0, 0], clear[r0, c0, 1]), min(clear[r0, c0, 2], clear[r0, c0, 3])) - 1)
+    free = min(free, tmax)
     n = 0
     for b in range(nb):
-        dx, dy = _ray_dir(ct, st, cb[b], sb[b])
         tm = tmax
         if use_cap:
             cap = cap_m[b] * inv * (1.0 + 2e-9)
             if cap < tmax:
                 tm = cap
-                if cap == 0.0:
+                if cap <= free or cap == 0.0:  # the map range lies beyond the cap: no traversal
                     out[b] = cap_m[b]
                     continue
+        dx, dy = _ray_dir(ct, st, cb[b], sb[b])
         dxs[b] = dx
         dys[b] = dy
         idxs[b] = _inv(dx)

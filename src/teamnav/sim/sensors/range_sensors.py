@@ -41,8 +41,8 @@ from numba import njit, prange
 from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
 from teamnav.sim.config import LaserConfig, ProximityConfig, SonarConfig
-from teamnav.sim.sensors.robot_hits import (PARALLEL_MIN_RAYS, _prepare, _robot_hits_row, beam_plan, check_bodies,
-                                              robot_hits_unchecked)
+from teamnav.sim.sensors.robot_hits import (_ALL, PARALLEL_MIN_RAYS, _prepare, _robot_hits_row, beam_plan,
+                                              check_bodies, robot_hits_unchecked)
 from teamnav.world.grid import OccupancyGrid
 from teamnav.world.raycast import RayCaster, _cast_pose_capped
 
@@ -314,15 +314,38 @@ def _sense_rows(i0, i1, cast, hits, beams, even, hsh, noise, out):
             for b in range(nr):
                 cap[b] = np.inf
             near = min(reach, _NEAR_M)
-            _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], 0.0, near, beams, even, hsh, cap, rdx, rdy, True)
+            _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], 0.0, near, beams, even, hsh, cap, rdx, rdy, True,
+                            _ALL)
         _cast_pose_capped(clear, (kxs[i] - ox) * inv, (kys[i] - oy) * inv, res, kct[i], kst[i], cb, sb, tmax, cap,
                           use_hits, rr, dxs, dys, idxs, idys, rs, cs, vs, qs, act)
         if use_hits:
-            # the discs beyond `near` that could still shorten a ray: nearer than the longest one
+            # the discs beyond `near` that could still shorten a ray: nearer than the longest
+            # one, and centred within rmax of the part beyond `near` of a ray longer than that
+            # (a hit at t >= near on ray b lies on [near, rr[b]] of it): their bounding box
             far = 0.0
+            px = xs[i]
+            py = ys[i]
+            bx0 = np.inf
+            bx1 = -np.inf
+            by0 = np.inf
+            by1 = -np.inf
+            t0 = near - 1e-6  # a hit beyond `near` (to within rounding)
             for b in range(nr):
-                far = max(far, rr[b])
-            _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], near, far, beams, even, hsh, rr, rdx, rdy, False)
+                t1 = rr[b]
+                if t1 > near:
+                    far = max(far, t1)
+                    ax = px + t0 * rdx[b]
+                    bx = px + t1 * rdx[b]
+                    ay = py + t0 * rdy[b]
+                    by = py + t1 * rdy[b]
+                    bx0 = min(bx0, min(ax, bx))
+                    bx1 = max(bx1, max(ax, bx))
+                    by0 = min(by0, min(ay, by))
+                    by1 = max(by1, max(ay, by))
+            if far > near:
+                m = hsh[10] + 1e-6  # largest radius, and rounding
+                _robot_hits_row(px, py, ct[i], st[i], self_idx[i], near, far, beams, even, hsh, rr, rdx, rdy, False,
+                                (bx0 - m, bx1 + m, by0 - m, by1 + m))
         s0 = key + np.uint64(i * nb * _SLOTS) * _GAMMA
         for b in range(nb):
             if rpb == 1:

@@ -67,6 +67,8 @@ _REACH_SLACK_M: float = 1e-9
 #: Largest deviation [rad] of a ray from the even fan ``first + k * step`` for the fan to
 #: be indexed by arithmetic (far below ``_ANGLE_MARGIN_RAD``).
 _EVEN_TOL_RAD: float = 1e-12
+#: The ``box`` of :func:`_robot_hits_row` that holds every disc.
+_ALL = (-np.inf, np.inf, -np.inf, np.inf)
 #: Hash cells per robot at most (the cell side grows beyond that: sparse, huge worlds).
 _CELLS_PER_ROBOT: int = 4
 
@@ -200,17 +202,18 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
     for b in range(nb):
         reach = max(reach, out[i, b])
     _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], 0.0, reach, beams, even, hsh, out[i], np.empty(nb),
-                    np.empty(nb), True)
+                    np.empty(nb), True, _ALL)
 
 
 @njit(cache=True)
-def _robot_hits_row(px, py, cti, sti, me, inner, reach, beams, even, hsh, row, rdx, rdy, set_dirs):
+def _robot_hits_row(px, py, cti, sti, me, inner, reach, beams, even, hsh, row, rdx, rdy, set_dirs, box):
     """``row[b] = min(row[b], first hit of ray b on a disc other than ``me``)`` for a sensor
     at ``(px, py)`` heading ``(cti, sti)`` (cos, sin); discs whose nearest point is ``reach``
     or more away are skipped (``reach <= 0``: none is tested), and with ``inner > 0`` also
     those a call of ``reach = inner`` tests (the same comparison, so two calls, ``reach = a``
     then ``inner = a``, test every disc exactly once). ``rdx, rdy`` (R,): the rays' world
     directions, filled when ``set_dirs`` (else as a previous call for this pose left them).
+    ``box = (x0, x1, y0, y1)`` [m]: only discs centred in it are tested (infinite: all).
 
     ``beams = (cb, sb, sorted_ang, ray_order)``: cos/sin of the ray directions, the
     directions wrapped to ``[-pi, pi)`` in ascending order and their ray indices.
@@ -245,10 +248,11 @@ def _robot_hits_row(px, py, cti, sti, me, inner, reach, beams, even, hsh, row, r
     has_inner = inner > 0.0
     inner += _REACH_SLACK_M
     half = reach + rmax
-    kx0 = max(0, int(math.floor((px - half - x0) / cell)))
-    kx1 = min(nkx - 1, int(math.floor((px + half - x0) / cell)))
-    ky0 = max(0, int(math.floor((py - half - y0) / cell)))
-    ky1 = min(nky - 1, int(math.floor((py + half - y0) / cell)))
+    bx0, bx1, by0, by1 = box
+    kx0 = max(0, int(math.floor((max(px - half, bx0) - x0) / cell)))
+    kx1 = min(nkx - 1, int(math.floor((min(px + half, bx1) - x0) / cell)))
+    ky0 = max(0, int(math.floor((max(py - half, by0) - y0) / cell)))
+    ky1 = min(nky - 1, int(math.floor((min(py + half, by1) - y0) / cell)))
     for kx in range(kx0, kx1 + 1):
         # cells (kx, ky0..ky1) are contiguous
         s0 = start[kx * nky + ky0]
