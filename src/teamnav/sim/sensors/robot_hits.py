@@ -314,6 +314,20 @@ def _robot_hits_row(px, py, cti, sti, me, inner, reach, beams, even, hsh, row, r
             for part in range(2):
                 k0 = ka0 if part == 0 else kb0
                 k1 = ka1 if part == 0 else kb1
+                if is_even:  # ray k is ray k: unit-stride loads, which the compiler vectorizes
+                    if k1 <= k0:
+                        continue
+                    wx = rdx[k0:k1]
+                    wy = rdy[k0:k1]
+                    wr = row[k0:k1]
+                    for j in range(k1 - k0):
+                        bb = fx * wx[j] + fy * wy[j]
+                        disc = bb * bb - cc
+                        t = -bb - math.sqrt(disc if disc > 0.0 else 0.0)
+                        t = t if (bb < 0.0) & (disc >= 0.0) else np.inf
+                        o = wr[j]
+                        wr[j] = t if t < o else o
+                    continue
                 for k in range(k0, k1):
                     # _disc_hit's arithmetic with selects for branches (short spans mispredict)
                     b = ray_order[k]
