@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/bench_engine.py [--quick] [--cases laser,swarm] [--robots 10,100,1000]
                                       [--irsim-python PATH] [--enki-python PATH] [--threads N]
-                                      [--profile CASE]
+                                      [--profile CASE] [--baseline-src DIR [--rounds K]]
 
 (a) ``laser``: N robots with a 180-beam, 10 m laser on the MIT basement map (0.05 m/px),
     wandering: teamnav's per-robot ``wander-v1`` (a Python Controller per robot) and batched
@@ -21,6 +21,13 @@ with how to install it and marked "not measured". teamnav runs in this interpret
 simulation is built, stepped ``warmup`` times (JIT compilation excluded), then timed over a
 fixed number of steps, best of ``repeats``. ``--profile laser-batched-1000`` (any
 case-form-N) prints a cProfile of that run's timed steps instead.
+
+``--baseline-src DIR`` also times another tree's engine (``DIR`` is its ``src`` folder, e.g.
+``git archive HEAD~1 src | tar -x -C /tmp/base`` then ``/tmp/base/src``) on the same cells in
+the same run: each round times the baseline and this tree, each in a fresh subprocess
+(``--measure-one``), ``--rounds`` times alternating, and prints the best of each with the ratio
+and the CPU time per step (the fair reading on a shared machine; with ``--threads 1`` CPU
+time is the step's own).
 """
 
 from __future__ import annotations
@@ -118,6 +125,61 @@ def measure_teamnav(case: str, form: str, n: int, steps: int, warmup: int, repea
     return {"robot_steps_per_s": n * steps / best, "seconds": best, "steps": steps, "mean_displacement_m": moved}
 
 
+def measure_cpu(case: str, form: str, n: int, steps: int, warmup: int, repeats: int) -> dict:
+    """:func:`measure_teamnav` plus the best CPU seconds per step (``time.process_time``)."""
+    sim = build_sim(case, form, n)
+    for _ in range(warmup):
+        sim.step()
+    wall = cpu = math.inf
+    for _ in range(repeats):
+        t0, c0 = time.perf_counter(), time.process_time()
+        sim.run(steps)
+        wall = min(wall, time.perf_counter() - t0)
+        cpu = min(cpu, time.process_time() - c0)
+    return {"robot_steps_per_s": n * steps / wall, "wall_ms_per_step": wall / steps * 1e3,
+            "cpu_ms_per_step": cpu / steps * 1e3, "steps": steps}
+
+
+def compare_baseline(src: str, cells: list[tuple[str, str, int]], plan: Plan, threads: int | None, rounds: int) -> None:
+    """Time ``cells`` with the engine of source folder ``src`` and with this tree, alternating,
+    each round in fresh subprocesses; print the best of each and the ratio."""
+    src_dir = Path(src).resolve()
+    if not (src_dir / "teamnav" / "__init__.py").exists():
+        raise SystemExit(f"--baseline-src must be a folder holding teamnav/ (a tree's src), got {src!r}")
+    here = ROOT / "src"
+
+    def one(path: Path, spec: str) -> dict:
+        env = dict(os.environ, PYTHONPATH=str(path) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+        cmd = [sys.executable, str(Path(__file__).resolve()), "--measure-one", spec]
+        if threads is not None:
+            cmd += ["--threads", str(threads)]
+        if plan is QUICK:
+            cmd.append("--quick")
+        r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=1800)
+        if r.returncode != 0:
+            raise SystemExit(f"--measure-one {spec} under {path} failed:\n{r.stderr[-2000:]}")
+        return json.loads(r.stdout.strip().splitlines()[-1])
+
+    print(f"\n### this tree ({here}) against the baseline ({src_dir}), same run, {rounds} rounds alternating\n")
+    print("| cell | baseline cpu ms/step | this tree cpu ms/step | speed-up (cpu) | baseline robot-steps/s | "
+          "this tree robot-steps/s | speed-up (wall) |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
+    for case, form, n in cells:
+        spec = f"{case}-{form}-{n}"
+        best = {"base": None, "new": None}
+        for _ in range(rounds):
+            for tag, path in (("base", src_dir), ("new", here)):
+                res = one(path, spec)
+                cur = best[tag]
+                best[tag] = res if cur is None else {
+                    "cpu_ms_per_step": min(cur["cpu_ms_per_step"], res["cpu_ms_per_step"]),
+                    "robot_steps_per_s": max(cur["robot_steps_per_s"], res["robot_steps_per_s"])}
+        b, w = best["base"], best["new"]
+        print(f"| {spec} | {b['cpu_ms_per_step']:.2f} | {w['cpu_ms_per_step']:.2f} | "
+              f"{b['cpu_ms_per_step'] / w['cpu_ms_per_step']:.2f}× | {b['robot_steps_per_s']:,.0f} | "
+              f"{w['robot_steps_per_s']:,.0f} | {w['robot_steps_per_s'] / b['robot_steps_per_s']:.2f}× |", flush=True)
+
+
 def profile_teamnav(spec: str, steps: int) -> None:
     case, form, n = spec.split("-")
     sim = build_sim(case, form, int(n))
@@ -194,6 +256,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--threads", type=int, default=None,
                     help="numba threads for teamnav's parallel kernels (default: numba's, all cores)")
     ap.add_argument("--profile", metavar="CASE-FORM-N", help="cProfile one teamnav cell, e.g. swarm-batched-1000")
+    ap.add_argument("--baseline-src", metavar="DIR",
+                    help="also time the engine of this src folder (another commit's tree) on the same cells, alternating")
+    ap.add_argument("--rounds", type=int, default=3, help="alternating rounds of --baseline-src (default 3)")
+    ap.add_argument("--measure-one", metavar="CASE-FORM-N", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     plan = QUICK if a.quick else FULL
     sizes = [int(s) for s in a.robots.split(",") if s]
@@ -216,6 +282,11 @@ def main(argv: list[str] | None = None) -> int:
     if a.profile:
         n = int(a.profile.rsplit("-", 1)[1])
         profile_teamnav(a.profile, _steps(plan.teamnav_steps, n))
+        return 0
+    if a.measure_one:
+        case, form, n = a.measure_one.split("-")
+        print(json.dumps(measure_cpu(case, form, int(n), _steps(plan.teamnav_steps, int(n)), plan.warmup,
+                                     plan.teamnav_repeats)))
         return 0
 
     peers = {
@@ -254,6 +325,11 @@ def main(argv: list[str] | None = None) -> int:
         title = ("(a) laser robots, 180 beams / 10 m, MIT basement map" if case == "laser"
                  else "(b) swarm, 7 proximity rays / 14 cm, walled arena of side √N m")
         print_table(title, label, rows, targets)
+    if a.baseline_src:
+        if a.rounds < 1:
+            raise SystemExit(f"--rounds must be >= 1, got {a.rounds}")
+        compare_baseline(a.baseline_src, [(c, f, n) for c in cases for n in sizes for f in forms], plan, a.threads,
+                         a.rounds)
     return 0
 
 

@@ -205,7 +205,7 @@ def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
                     np.empty(nb), True, _ALL)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _robot_hits_row(px, py, cti, sti, me, inner, reach, beams, even, hsh, row, rdx, rdy, set_dirs, box):
     """``row[b] = min(row[b], first hit of ray b on a disc other than ``me``)`` for a sensor
     at ``(px, py)`` heading ``(cti, sti)`` (cos, sin); discs whose nearest point is ``reach``
