@@ -257,7 +257,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="numba threads for teamnav's parallel kernels (default: numba's, all cores)")
     ap.add_argument("--profile", metavar="CASE-FORM-N", help="cProfile one teamnav cell, e.g. swarm-batched-1000")
     ap.add_argument("--baseline-src", metavar="DIR",
-                    help="also time the engine of this src folder (another commit's tree) on the same cells, alternating")
+                    help="also time the engine of this src folder (another commit's tree) on the same cells, "
+                         "alternating")
     ap.add_argument("--rounds", type=int, default=3, help="alternating rounds of --baseline-src (default 3)")
     ap.add_argument("--measure-one", metavar="CASE-FORM-N", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)

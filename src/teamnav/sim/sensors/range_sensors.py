@@ -28,6 +28,14 @@ draws are made and a run is deterministic given the ``Generator``, on any number
 and one ``random((n, B))``), kept as the readable reference. Either way the short reading
 reuses the beam's uniform (``(u - p_max) / p_short`` is again uniform on ``[0, 1)`` given the
 beam is short).
+
+One pass per robot. The engine's sensing (:meth:`RangeSensor._pass`) runs one numba loop over
+the robots that, for each, intersects the other robots' discs within ``_NEAR_M`` first, casts
+the map only up to those hits (:func:`~teamnav.world.raycast._cast_pose_capped`), tests the
+farther discs that could still shorten a ray, takes each beam's nearest ray and adds its keyed
+noise: the ranges of cast -> robot bodies -> noise, bit for bit, for a third of the work at
+1000 laser robots (``benchmarks/README.md``, issue 27). Sensors of fewer than
+``ONE_PASS_MIN_RAYS`` rays a robot run those three passes as such.
 """
 
 from __future__ import annotations
