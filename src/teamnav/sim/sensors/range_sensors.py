@@ -682,6 +682,21 @@ class RangeSensor:
         numba's threads costs more than it saves)."""
         n = xs.shape[0]
         nr = self.ray_angles_rad.shape[0]
+        use_hits = bodies is not None and self.sees_robots and bodies[0].shape[0] > 0
+        if nr < ONE_PASS_MIN_RAYS:
+            # few rays a robot (proximity rings): a fixed cost per robot of the one pass
+            # outweighs what it saves; three passes over all robots give the same bits
+            parallel = n * nr >= PARALLEL_MIN_RAYS
+            true = self.caster._cast_cs(xs, ys, thetas, self._cos_rays, self._sin_rays, parallel)
+            if use_hits:
+                all_x, all_y, all_r, self_idx = bodies
+                robot_hits_unchecked(xs, ys, thetas, self._plan, all_x, all_y, all_r, self_idx, true, self.max_range_m,
+                                     0.0, parallel)
+            if self.rays_per_beam > 1:
+                true = true.reshape(n, self.angles_rad.shape[0], self.rays_per_beam).min(axis=2)
+            if key is None:
+                return true
+            return _keyed_noise(true, key, self.noise_std_m, self.p_max, self.p_short, self.max_range_m, true)
         out = np.empty((n, self.angles_rad.shape[0]), dtype=np.float64)
         if n == 0:
             return out
@@ -694,7 +709,6 @@ class RangeSensor:
         res = self.caster._res
         cast = (self.caster.clearance, float(ox), float(oy), res, kxs, kys, kct, kst, self._cos_rays, self._sin_rays,
                 self.max_range_m / res, self.rays_per_beam)
-        use_hits = bodies is not None and self.sees_robots and bodies[0].shape[0] > 0
         if use_hits:
             all_x, all_y, all_r, self_idx = bodies
         else:
@@ -703,19 +717,6 @@ class RangeSensor:
         hits = (use_hits, xs, ys, ct, st, self_idx, self.max_range_m)
         noise = (key is not None, np.uint64(0 if key is None else key), self.noise_std_m, self.p_max, self.p_short,
                  self.max_range_m)
-        if nr < ONE_PASS_MIN_RAYS:
-            # few rays a robot (proximity rings): a fixed cost per robot of the one pass
-            # outweighs what it saves; three passes over all robots give the same bits
-            true = self.caster._cast_cs(xs, ys, thetas, self._cos_rays, self._sin_rays,
-                                        n * nr >= PARALLEL_MIN_RAYS and numba.get_num_threads() > 1)
-            if use_hits:
-                robot_hits_unchecked(xs, ys, thetas, self._plan, all_x, all_y, all_r, self_idx, true, self.max_range_m,
-                                     0.0, n * nr >= PARALLEL_MIN_RAYS)
-            if self.rays_per_beam > 1:
-                true = true.reshape(n, self.angles_rad.shape[0], self.rays_per_beam).min(axis=2)
-            if key is None:
-                return true
-            return _keyed_noise(true, key, self.noise_std_m, self.p_max, self.p_short, self.max_range_m, true)
         if n * nr >= PARALLEL_MIN_RAYS and numba.get_num_threads() > 1:
             chunk = min(256, max(1, n // (4 * numba.get_num_threads())))
             _sense_parallel(cast, hits, self._plan.beams, self._plan.even, (all_x, all_y, all_r), noise, out, chunk)
