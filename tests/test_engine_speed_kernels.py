@@ -261,23 +261,3 @@ def test_disc_just_beyond_the_near_ring_on_a_lone_long_ray(heading, gap):
     got = sensor._pass(xs, ys, th, bodies, None)
     np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, None))
     assert got[0, 0] < t + 1e-6
-
-
-@pytest.mark.parametrize("sigma,p_max,p_short", [(0.01, 0.0, 0.0), (0.5, 0.05, 0.1), (0.0, 0.2, 0.0), (0.0, 0.0, 0.3),
-                                                 (2.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.1, 0.5, 0.5)])
-def test_noise_row_matches_keyed_rows(sigma, p_max, p_short):
-    """The two-loop noise of a row (fast ziggurat path vectorized, slow beams redone) against
-    _counter_noise_rows, over enough beams to meet the slow path and the tail many times."""
-    rng = np.random.default_rng(7)
-    n, nb = 40, 3000
-    true = rng.uniform(0.0, 12.0, (n, nb))
-    true[:, ::7] = 0.0
-    key = np.uint64(rng.integers(0, 2**63))
-    want = np.empty_like(true)
-    rs_mod._counter_noise_rows(true, key, 0, n, sigma, p_max, p_short, 10.0, want)
-    got = true.copy()
-    slow = np.empty(nb, np.bool_)
-    for i in range(n):
-        s0 = np.uint64((int(key) + i * nb * 64 * int(rs_mod._GAMMA)) % 2**64)  # row i's first stream state
-        rs_mod._noise_row(got[i], s0, p_max + p_short > 0.0, sigma > 0.0, sigma, p_max, p_short, 10.0, slow)
-    np.testing.assert_array_equal(got, want)

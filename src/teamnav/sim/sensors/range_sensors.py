@@ -232,44 +232,6 @@ def _keyed_beam(t, s, use_u, use_z, sigma, p_max, p_short, max_range):
     return _mixture_one(t, v, z, use_u, use_z, sigma, p_max, p_short, max_range)
 
 
-@njit(cache=True, error_model="numpy")  # no zero-division branch: the loop vectorizes
-def _noise_row(row, s0, use_u, use_z, sigma, p_max, p_short, max_range, slow):
-    """``row[b] = _keyed_beam(row[b], s0 + 64 b * gamma, ...)`` for every beam ``b``, in place.
-
-    Two loops, same numbers: the first takes every beam through the ziggurat's fast path
-    with no call and no early exit (so the compiler vectorizes it: 64-bit multiplies, table
-    gathers) and marks the ~1 % of beams that need its slow path; the second redoes just
-    those with :func:`_keyed_beam`. ``slow`` (B,): scratch."""
-    nb = row.shape[0]
-    block = np.uint64(_SLOTS) * _GAMMA
-    any_slow = False
-    for b in range(nb):
-        s = s0 + np.uint64(b) * block
-        t = row[b]
-        v = 0.0
-        if use_u:
-            s += _GAMMA
-            v = _unit(_mix64(s))
-        s += _GAMMA
-        r = _mix64(s)
-        idx = r & np.uint64(0xFF)
-        r >>= np.uint64(8)
-        rabs = (r >> np.uint64(1)) & np.uint64(0x000FFFFFFFFFFFFF)
-        fr = float(np.int64(rabs))
-        x = fr * _ZIG_WI[idx]
-        x = -x if r & np.uint64(1) else x
-        need = use_z and not (use_u and v < p_max + p_short)
-        sl = need and not (fr < _ZIG_KI[idx])
-        slow[b] = sl
-        any_slow |= sl
-        m = _mixture_one(t, v, x if need else 0.0, use_u, use_z, sigma, p_max, p_short, max_range)
-        row[b] = t if sl else m  # a slow beam is redone below from its true range
-    if any_slow:
-        for b in range(nb):
-            if slow[b]:
-                row[b] = _keyed_beam(row[b], s0 + np.uint64(b) * block, use_u, use_z, sigma, p_max, p_short, max_range)
-
-
 @njit(cache=True)
 def _counter_noise_rows(true, key, i0, i1, sigma, p_max, p_short, max_range, out):
     """Rows ``[i0, i1)`` of :func:`beam_noise_keyed` (``out`` may be ``true``)."""
@@ -358,9 +320,9 @@ def _sense_rows(i0, i1, cast, hits, beams, even, hsh, noise, out):
     vs = np.empty(nr, np.uint8)
     qs = np.empty(nr, np.int64)
     act = np.empty(nr, np.int64)
-    slow = np.empty(nb, np.bool_)
     use_u = p_max + p_short > 0.0
     use_z = sigma > 0.0
+    block = np.uint64(_SLOTS) * _GAMMA
     for i in range(i0, i1):
         if use_hits:
             for b in range(nr):
@@ -398,19 +360,18 @@ def _sense_rows(i0, i1, cast, hits, beams, even, hsh, noise, out):
                 m = hsh[10] + 1e-6  # largest radius, and rounding
                 _robot_hits_row(px, py, ct[i], st[i], self_idx[i], near, far, beams, even, hsh, rr, rdx, rdy, False,
                                 (bx0 - m, bx1 + m, by0 - m, by1 + m))
-        row = out[i]
-        if rpb == 1:
-            for b in range(nb):
-                row[b] = rr[b]
-        else:
-            for b in range(nb):
+        s0 = key + np.uint64(i * nb * _SLOTS) * _GAMMA
+        for b in range(nb):
+            if rpb == 1:
+                t = rr[b]
+            else:
                 t = rr[b * rpb]
                 for k in range(b * rpb + 1, (b + 1) * rpb):
                     t = min(t, rr[k])
-                row[b] = t
-        if use_noise:
-            _noise_row(row, key + np.uint64(i * nb * _SLOTS) * _GAMMA, use_u, use_z, sigma, p_max, p_short, max_range,
-                       slow)
+            if use_noise:
+                t = _keyed_beam(t, s0, use_u, use_z, sigma, p_max, p_short, max_range)
+                s0 += block
+            out[i, b] = t
 
 
 @njit(cache=True)
