@@ -100,8 +100,8 @@ def grazing_bodies(rng, sensor, xs, ys, th, n_extra):
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.integers(0, 2**32 - 1), st.sampled_from(["laser", "sonar", "proximity"]), st.booleans(),
-       st.sampled_from([0.05, 0.1, 0.25]), st.sampled_from([0.0, 0.0, 0.7]), st.booleans())
-def test_one_pass_matches_former_path_bit_for_bit(seed, kind, parallel, res, yaw, always_one_pass):
+       st.sampled_from([0.05, 0.1, 0.25]), st.sampled_from([0.0, 0.0, 0.7]))
+def test_one_pass_matches_former_path_bit_for_bit(seed, kind, parallel, res, yaw):
     rng = np.random.default_rng(seed)
     grid = random_grid(rng, res, yaw)
     max_range = float(rng.choice([0.5, 3.0, 10.0, 40.0]))
@@ -121,16 +121,14 @@ def test_one_pass_matches_former_path_bit_for_bit(seed, kind, parallel, res, yaw
     all_x, all_y, all_r = np.concatenate([all_x, gx]), np.concatenate([all_y, gy]), np.concatenate([all_r, gr])
     bodies = (all_x, all_y, all_r, sensing.astype(np.int64))
     key = int(rng.integers(0, 2**63))
-    old = rs_mod.PARALLEL_MIN_RAYS, rs_mod.ONE_PASS_MIN_RAYS
+    old = rs_mod.PARALLEL_MIN_RAYS
     try:
         rs_mod.PARALLEL_MIN_RAYS = 0 if parallel else 10**12
-        if always_one_pass:  # also the few-ray sensors through the one-pass kernel
-            rs_mod.ONE_PASS_MIN_RAYS = 0
         got = sensor._pass(xs, ys, th, bodies, key)
         got_true = sensor._pass(xs, ys, th, bodies, None)
         got_map = sensor._pass(xs, ys, th, None, None)
     finally:
-        rs_mod.PARALLEL_MIN_RAYS, rs_mod.ONE_PASS_MIN_RAYS = old
+        rs_mod.PARALLEL_MIN_RAYS = old
     np.testing.assert_array_equal(got_true, former(sensor, xs, ys, th, bodies, None))
     np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, key))
     np.testing.assert_array_equal(got_map, former(sensor, xs, ys, th, None, None))

@@ -28,14 +28,6 @@ draws are made and a run is deterministic given the ``Generator``, on any number
 and one ``random((n, B))``), kept as the readable reference. Either way the short reading
 reuses the beam's uniform (``(u - p_max) / p_short`` is again uniform on ``[0, 1)`` given the
 beam is short).
-
-One pass per robot. The engine's sensing (:meth:`RangeSensor._pass`) runs one numba loop over
-the robots that, for each, intersects the other robots' discs within ``_NEAR_M`` first, casts
-the map only up to those hits (:func:`~teamnav.world.raycast._cast_pose_capped`), tests the
-farther discs that could still shorten a ray, takes each beam's nearest ray and adds its keyed
-noise: the ranges of cast -> robot bodies -> noise, bit for bit, for a third of the work at
-1000 laser robots (``benchmarks/README.md``, issue 27). Sensors of fewer than
-``ONE_PASS_MIN_RAYS`` rays a robot run those three passes as such.
 """
 
 from __future__ import annotations
@@ -273,11 +265,7 @@ def _counter_noise_blocks(true, keys, starts, sigma, p_max, p_short, max_range, 
 #: nearer than the longest ray left (issue 27: at 1000 laser robots on the basement map 98 %
 #: of the beams end within 3 m, and 9 of the ~86 discs ahead of a robot shorten a ray).
 _NEAR_M: float = 4.0
-#: Fewest rays a robot for :meth:`RangeSensor._pass` to sense robot by robot in one kernel
-#: (below, e.g. 7 proximity rays, three passes over all robots are faster: 0.55 against
-#: 0.68 ms a step for 1000 swarm robots).
-ONE_PASS_MIN_RAYS: int = 24
-#: Largest side [m] of the hash cells of the one-pass sensing (its windows are a few metres).
+#: Side [m] of the hash cells of the one-pass sensing (its windows are a few metres).
 _HASH_CELL_M: float = 1.5
 
 
@@ -286,9 +274,7 @@ def _hash_or_none(use_hits, all_x, all_y, all_r, max_range_m):
     """:func:`~teamnav.sim.sensors.robot_hits._prepare` with the default cell, or an empty
     hash of the same type when no bodies are tested."""
     if use_hits and all_x.shape[0] > 0:
-        # the default cell (half the reach) for short sensors, at most _HASH_CELL_M
-        cell = min(_HASH_CELL_M, max(1e-3, 0.5 * (max_range_m + all_r.max())))
-        return _prepare(all_x, all_y, all_r, max_range_m, cell)
+        return _prepare(all_x, all_y, all_r, max_range_m, min(_HASH_CELL_M, max_range_m))
     z = np.zeros(0)
     return (z, z, z, np.zeros(0, np.int64), np.zeros(2, np.int64), 0.0, 0.0, 1.0, 1, 1, 0.0)
 
@@ -643,21 +629,6 @@ class RangeSensor:
         numba's threads costs more than it saves)."""
         n = xs.shape[0]
         nr = self.ray_angles_rad.shape[0]
-        use_hits = bodies is not None and self.sees_robots and bodies[0].shape[0] > 0
-        if nr < ONE_PASS_MIN_RAYS:
-            # few rays a robot (proximity rings): a fixed cost per robot of the one pass
-            # outweighs what it saves; three passes over all robots give the same bits
-            parallel = n * nr >= PARALLEL_MIN_RAYS
-            true = self.caster._cast_cs(xs, ys, thetas, self._cos_rays, self._sin_rays, parallel)
-            if use_hits:
-                all_x, all_y, all_r, self_idx = bodies
-                robot_hits_unchecked(xs, ys, thetas, self._plan, all_x, all_y, all_r, self_idx, true, self.max_range_m,
-                                     0.0, parallel)
-            if self.rays_per_beam > 1:
-                true = true.reshape(n, self.angles_rad.shape[0], self.rays_per_beam).min(axis=2)
-            if key is None:
-                return true
-            return _keyed_noise(true, key, self.noise_std_m, self.p_max, self.p_short, self.max_range_m, true)
         out = np.empty((n, self.angles_rad.shape[0]), dtype=np.float64)
         if n == 0:
             return out
@@ -670,6 +641,7 @@ class RangeSensor:
         res = self.caster._res
         cast = (self.caster.clearance, float(ox), float(oy), res, kxs, kys, kct, kst, self._cos_rays, self._sin_rays,
                 self.max_range_m / res, self.rays_per_beam)
+        use_hits = bodies is not None and self.sees_robots and bodies[0].shape[0] > 0
         if use_hits:
             all_x, all_y, all_r, self_idx = bodies
         else:
