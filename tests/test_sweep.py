@@ -308,6 +308,10 @@ def test_a_worker_that_dies_fails_its_trial_and_the_sweep_goes_on(tmp_path, log)
     assert (res.done, res.failed) == (2, 1)
     (bad,) = [r for r in res.rows() if r["status"] == "failed"]
     assert bad["params"]["robots.0.count"] == 3 and bad["error"].startswith("WorkerDied")
+    # a lost start is run again (LOCAL_MAX_RETRIES times) before the trial counts as failed
+    from teamnav.experiments.executors import LOCAL_MAX_RETRIES
+
+    assert bad["retries"] == LOCAL_MAX_RETRIES and bad["retry_errors"].count("WorkerDied") == LOCAL_MAX_RETRIES + 1
 
 
 def test_each_result_is_committed_before_its_slot_runs_the_next_trial(tmp_path, log, monkeypatch):

@@ -283,14 +283,40 @@ class LocalExecutor:
         n = self.workers or default_workers()
         pending: Iterator[TrialTask] = iter(tasks)
         in_flight: dict[Future, tuple[TrialTask, str]] = {}
+        again: list[tuple[TrialTask, str]] = []  # trials lost with a dead worker, to start first
+        lost: dict[str, list[str]] = {}  # trial id -> errors of its lost starts
         pool = self._pool(n)
+
+        def renew() -> None:
+            nonlocal pool
+            pool.shutdown(wait=True, cancel_futures=True)
+            pool = self._pool(n)
+
+        def lose(task: TrialTask, started: str) -> None:
+            """A start lost with its worker: run it again (up to LOCAL_MAX_RETRIES times), or
+            report it failed with what each start ended with."""
+            errors = lost.setdefault(task.trial.trial_id, [])
+            errors.append(_DIED)
+            if len(errors) <= LOCAL_MAX_RETRIES:
+                again.append((task, started))
+                return
+            on_result(dataclasses.replace(_lost(task, _DIED, started), retries=len(errors) - 1,
+                                          retry_errors=tuple(lost.pop(task.trial.trial_id))))
 
         def fill() -> None:
             while len(in_flight) < n:
-                task = next(pending, None)
-                if task is None:
-                    return
-                in_flight[pool.submit(execute, task)] = (task, _now())
+                if again:
+                    task, started = again.pop(0)
+                else:
+                    task = next(pending, None)
+                    if task is None:
+                        return
+                    started = _now()
+                try:
+                    in_flight[pool.submit(execute, task)] = (task, started)
+                except BrokenProcessPool:  # the pool broke since the last result: a fresh one
+                    again.insert(0, (task, started))
+                    renew()
 
         try:
             fill()
@@ -303,17 +329,20 @@ class LocalExecutor:
                         res = fut.result()
                     except BrokenProcessPool:
                         broken = True
-                        res = _lost(task, _DIED, started)
+                        lose(task, started)
+                        continue
                     except Exception as exc:  # noqa: BLE001 - e.g. a trial_fn that cannot be pickled
                         res = _lost(task, f"{type(exc).__name__}: {exc}", started)
+                    if task.trial.trial_id in lost:  # finished after earlier starts were lost
+                        errors = lost.pop(task.trial.trial_id)
+                        res = dataclasses.replace(res, retries=len(errors), retry_errors=tuple(errors))
                     on_result(res)
                 if broken:
-                    # every trial still in flight went down with the pool; report them, start afresh
+                    # every trial still in flight went down with the pool: start them again afresh
                     for task, started in in_flight.values():
-                        on_result(_lost(task, _DIED, started))
+                        lose(task, started)
                     in_flight.clear()
-                    pool.shutdown(wait=True, cancel_futures=True)
-                    pool = self._pool(n)
+                    renew()
                 fill()
         except BaseException:  # Ctrl-C, SIGTERM (signals.Terminated), a failing on_result
             _stop_workers(pool)  # stop the trials in flight: nothing keeps running behind us
@@ -321,9 +350,12 @@ class LocalExecutor:
         pool.shutdown(wait=True)
 
 
+#: Times a local trial whose worker process died is started again before it counts as failed.
+LOCAL_MAX_RETRIES = 2
+
 _DIED = (
     "WorkerDied: a worker process ended abruptly (crash, os._exit, out of memory or killed) while this "
-    "trial was running; the sweep went on, rerun it to retry"
+    "trial was running (it was started again up to LOCAL_MAX_RETRIES times); the sweep went on"
 )
 
 
