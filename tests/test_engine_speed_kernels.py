@@ -259,3 +259,55 @@ def test_disc_just_beyond_the_near_ring_on_a_lone_long_ray(heading, gap):
     got = sensor._pass(xs, ys, th, bodies, None)
     np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, None))
     assert got[0, 0] < t + 1e-6
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(-30.0, 30.0), st.floats(-30.0, 30.0), st.floats(0.1, 20.0))
+def test_a_far_box_anywhere_reads_only_the_hash_grid(seed, bx, by, side):
+    """A box that misses the hash grid (beyond every disc: the far box of a long free ray)
+    tests nothing and reads nothing past the grid's cell table; any box gives rows between
+    "every disc" and "only the discs centred in the box" (cells are coarser than the box).
+
+    Runs the kernel as plain Python (``py_func``), where an index past an array raises:
+    compiled, the read past ``start`` was silent or, now and then, a segfault that killed
+    sweep workers (issue 27's "sporadic worker deaths")."""
+    rng = np.random.default_rng(seed)
+    n_all = int(rng.integers(1, 40))
+    all_x = rng.uniform(0.0, 12.0, n_all)
+    all_y = rng.uniform(0.0, 12.0, n_all)
+    all_r = rng.uniform(0.0, 0.5, n_all)
+    angles = np.linspace(-math.pi / 2, math.pi / 2, 61) if seed % 2 else rng.uniform(-4.0, 4.0, 20)
+    plan = beam_plan(angles)
+    hsh = rh_mod._prepare(all_x, all_y, all_r, 10.0, float(rng.choice([0.0, 0.7, 1.5])))
+    nb = angles.shape[0]
+    box = (bx, bx + side, by, by + side)
+    i = int(rng.integers(0, n_all))
+    th = float(rng.uniform(-4.0, 4.0))
+    base = np.full(nb, 30.0)
+    got = base.copy()
+    rh_mod._robot_hits_row.py_func(all_x[i], all_y[i], math.cos(th), math.sin(th), i, 0.0, 30.0, plan.beams,
+                                   plan.even, hsh, got, np.empty(nb), np.empty(nb), True, box)
+    every = base[None, :].copy()
+    robot_hits_reference(all_x[i:i + 1], all_y[i:i + 1], np.array([th]), angles, (all_x, all_y, all_r, np.array([i])),
+                         every)
+    inside = (all_x >= box[0]) & (all_x <= box[1]) & (all_y >= box[2]) & (all_y <= box[3])
+    boxed = base[None, :].copy()
+    me = int(np.cumsum(inside)[i] - 1) if inside[i] else -1
+    robot_hits_reference(all_x[i:i + 1], all_y[i:i + 1], np.array([th]), angles,
+                         (all_x[inside], all_y[inside], all_r[inside], np.array([me])), boxed)
+    assert np.all(every[0] <= got) and np.all(got <= boxed[0])
+
+
+def test_a_box_above_the_last_cell_column_regression():
+    """The case that crashed: the sensing robot in the grid's last column, its far box wholly
+    above the grid (ky0 > nky - 1 made ``start[kx * nky + ky0]`` read past the table)."""
+    all_x = np.array([0.0, 5.0])
+    all_y = np.array([0.0, 5.0])
+    all_r = np.array([0.25, 0.25])
+    hsh = rh_mod._prepare(all_x, all_y, all_r, 10.0, 1.0)
+    assert (hsh[7], hsh[8], hsh[9]) == (1.5, 4, 4)  # cell, nkx, nky: a 4 x 4 table of 17 entries
+    plan = beam_plan(np.linspace(-math.pi / 2, math.pi / 2, 31))
+    row = np.full(31, 9.0)
+    rh_mod._robot_hits_row.py_func(5.0, 5.0, 1.0, 0.0, 1, 0.0, 9.0, plan.beams, plan.even, hsh, row, np.empty(31),
+                                   np.empty(31), True, (4.0, 6.0, 10.0, 12.0))
+    assert np.all(row == 9.0)  # the box holds no disc: nothing shortened

@@ -139,7 +139,11 @@ def _start_sweep(tmp_path: Path) -> tuple[subprocess.Popen, Path, Path, dict[int
     _wait_for(lambda: len(_partials(out / "trials")) >= 2, proc, log, "two trials stepping")
     procs = _descendants(proc.pid)
     workers = [p for p in procs if "multiprocessing" in _cmdline(p) and "resource_tracker" not in _cmdline(p)]
-    assert len(workers) >= 2, {p: _cmdline(p) for p in procs}
+    if len(workers) < 2:  # a worker died: say how, with what the sweep printed (faulthandler's dump)
+        states = {p: ((_stat(p) or ["gone"])[0], _cmdline(p)) for p in procs}
+        proc.kill()
+        proc.wait(timeout=10)
+        pytest.fail(f"expected 2 live workers, found {states}; the sweep's stderr:\n{log.read_text()[-4000:]}")
     return proc, out, log, procs
 
 

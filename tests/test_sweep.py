@@ -312,6 +312,8 @@ def test_a_worker_that_dies_fails_its_trial_and_the_sweep_goes_on(tmp_path, log)
     from teamnav.experiments.executors import LOCAL_MAX_RETRIES
 
     assert bad["retries"] == LOCAL_MAX_RETRIES and bad["retry_errors"].count("WorkerDied") == LOCAL_MAX_RETRIES + 1
+    # each lost start says how the pool's workers ended (crash_trial leaves by os._exit(3))
+    assert "pid " in bad["error"] and "exit status 3" in bad["error"]
 
 
 def test_each_result_is_committed_before_its_slot_runs_the_next_trial(tmp_path, log, monkeypatch):

@@ -27,6 +27,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import re
+import signal
 
 import datetime as _dt
 import importlib.util
@@ -225,6 +226,9 @@ def _init_worker(threads: int, parent_pid: int | None) -> None:
     numba threads."""
     from teamnav.experiments.signals import die_with_parent
 
+    import faulthandler
+
+    faulthandler.enable()  # a worker that crashes (SIGSEGV, SIGABRT, ...) prints where, on the sweep's stderr
     die_with_parent(parent_pid)
     _limit_numba_threads(threads)
 
@@ -246,6 +250,25 @@ def _stop_workers(pool: ProcessPoolExecutor, grace_s: float = 5.0) -> None:
             if p.is_alive():
                 p.kill()
                 p.join(1.0)
+
+
+def _exit_status(code: int | None) -> str:
+    if code is None:
+        return "still running"
+    if code < 0:
+        try:
+            return f"killed by {signal.Signals(-code).name}"
+        except ValueError:
+            return f"killed by signal {-code}"
+    return f"exit status {code}"
+
+
+def _how_workers_ended(pool: ProcessPoolExecutor) -> str:
+    """``"pid 12: exit status 1; pid 13: killed by SIGTERM"`` for the processes of a broken pool
+    (the pool SIGTERMs the survivors after the first death, so the first death is the one not
+    ended by SIGTERM, unless SIGTERM was what killed it)."""
+    procs = getattr(pool, "_processes", None) or {}
+    return "; ".join(f"pid {pid}: {_exit_status(p.exitcode)}" for pid, p in sorted(procs.items())) or "none left"
 
 
 def _execute_one_thread(task: TrialTask) -> TrialResult:
@@ -292,15 +315,15 @@ class LocalExecutor:
             pool.shutdown(wait=True, cancel_futures=True)
             pool = self._pool(n)
 
-        def lose(task: TrialTask, started: str) -> None:
+        def lose(task: TrialTask, started: str, how: str) -> None:
             """A start lost with its worker: run it again (up to LOCAL_MAX_RETRIES times), or
             report it failed with what each start ended with."""
             errors = lost.setdefault(task.trial.trial_id, [])
-            errors.append(_DIED)
+            errors.append(f"{_DIED} (workers: {how})")
             if len(errors) <= LOCAL_MAX_RETRIES:
                 again.append((task, started))
                 return
-            on_result(dataclasses.replace(_lost(task, _DIED, started), retries=len(errors) - 1,
+            on_result(dataclasses.replace(_lost(task, errors[-1], started), retries=len(errors) - 1,
                                           retry_errors=tuple(lost.pop(task.trial.trial_id))))
 
         def fill() -> None:
@@ -322,14 +345,14 @@ class LocalExecutor:
             fill()
             while in_flight:
                 done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
-                broken = False
+                broken = ""
                 for fut in done:
                     task, started = in_flight.pop(fut)
                     try:
                         res = fut.result()
                     except BrokenProcessPool:
-                        broken = True
-                        lose(task, started)
+                        broken = broken or _how_workers_ended(pool)
+                        lose(task, started, broken)
                         continue
                     except Exception as exc:  # noqa: BLE001 - e.g. a trial_fn that cannot be pickled
                         res = _lost(task, f"{type(exc).__name__}: {exc}", started)
@@ -340,7 +363,7 @@ class LocalExecutor:
                 if broken:
                     # every trial still in flight went down with the pool: start them again afresh
                     for task, started in in_flight.values():
-                        lose(task, started)
+                        lose(task, started, broken)
                     in_flight.clear()
                     renew()
                 fill()

@@ -253,6 +253,8 @@ def _robot_hits_row(px, py, cti, sti, me, inner, reach, beams, even, hsh, row, r
     kx1 = min(nkx - 1, int(math.floor((min(px + half, bx1) - x0) / cell)))
     ky0 = max(0, int(math.floor((max(py - half, by0) - y0) / cell)))
     ky1 = min(nky - 1, int(math.floor((min(py + half, by1) - y0) / cell)))
+    if ky0 > ky1:  # the window misses the hash grid (a far box beyond every disc): nothing to test,
+        return     # and start[kx * nky + ky0] could lie past the end of `start` (read out of bounds)
     for kx in range(kx0, kx1 + 1):
         # cells (kx, ky0..ky1) are contiguous
         s0 = start[kx * nky + ky0]
