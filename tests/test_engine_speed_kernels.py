@@ -100,8 +100,8 @@ def grazing_bodies(rng, sensor, xs, ys, th, n_extra):
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.integers(0, 2**32 - 1), st.sampled_from(["laser", "sonar", "proximity"]), st.booleans(),
-       st.sampled_from([0.05, 0.1, 0.25]), st.sampled_from([0.0, 0.0, 0.7]))
-def test_one_pass_matches_former_path_bit_for_bit(seed, kind, parallel, res, yaw):
+       st.sampled_from([0.05, 0.1, 0.25]), st.sampled_from([0.0, 0.0, 0.7]), st.booleans())
+def test_one_pass_matches_former_path_bit_for_bit(seed, kind, parallel, res, yaw, always_one_pass):
     rng = np.random.default_rng(seed)
     grid = random_grid(rng, res, yaw)
     max_range = float(rng.choice([0.5, 3.0, 10.0, 40.0]))
@@ -121,14 +121,16 @@ def test_one_pass_matches_former_path_bit_for_bit(seed, kind, parallel, res, yaw
     all_x, all_y, all_r = np.concatenate([all_x, gx]), np.concatenate([all_y, gy]), np.concatenate([all_r, gr])
     bodies = (all_x, all_y, all_r, sensing.astype(np.int64))
     key = int(rng.integers(0, 2**63))
-    old = rs_mod.PARALLEL_MIN_RAYS
+    old = rs_mod.PARALLEL_MIN_RAYS, rs_mod.ONE_PASS_MIN_RAYS
     try:
         rs_mod.PARALLEL_MIN_RAYS = 0 if parallel else 10**12
+        if always_one_pass:  # also the few-ray sensors through the one-pass kernel
+            rs_mod.ONE_PASS_MIN_RAYS = 0
         got = sensor._pass(xs, ys, th, bodies, key)
         got_true = sensor._pass(xs, ys, th, bodies, None)
         got_map = sensor._pass(xs, ys, th, None, None)
     finally:
-        rs_mod.PARALLEL_MIN_RAYS = old
+        rs_mod.PARALLEL_MIN_RAYS, rs_mod.ONE_PASS_MIN_RAYS = old
     np.testing.assert_array_equal(got_true, former(sensor, xs, ys, th, bodies, None))
     np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, key))
     np.testing.assert_array_equal(got_map, former(sensor, xs, ys, th, None, None))
@@ -311,3 +313,23 @@ def test_a_box_above_the_last_cell_column_regression():
     rh_mod._robot_hits_row.py_func(5.0, 5.0, 1.0, 0.0, 1, 0.0, 9.0, plan.beams, plan.even, hsh, row, np.empty(31),
                                    np.empty(31), True, (4.0, 6.0, 10.0, 12.0))
     assert np.all(row == 9.0)  # the box holds no disc: nothing shortened
+
+
+@pytest.mark.parametrize("sigma,p_max,p_short", [(0.01, 0.0, 0.0), (0.5, 0.05, 0.1), (0.0, 0.2, 0.0), (0.0, 0.0, 0.3),
+                                                 (2.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.1, 0.5, 0.5)])
+def test_noise_row_matches_keyed_rows(sigma, p_max, p_short):
+    """The two-loop noise of a row (fast ziggurat path vectorized, slow beams redone) against
+    _counter_noise_rows, over enough beams to meet the slow path and the tail many times."""
+    rng = np.random.default_rng(7)
+    n, nb = 40, 3000
+    true = rng.uniform(0.0, 12.0, (n, nb))
+    true[:, ::7] = 0.0
+    key = np.uint64(rng.integers(0, 2**63))
+    want = np.empty_like(true)
+    rs_mod._counter_noise_rows(true, key, 0, n, sigma, p_max, p_short, 10.0, want)
+    got = true.copy()
+    slow = np.empty(nb, np.bool_)
+    for i in range(n):
+        s0 = np.uint64((int(key) + i * nb * 64 * int(rs_mod._GAMMA)) % 2**64)  # row i's first stream state
+        rs_mod._noise_row(got[i], s0, p_max + p_short > 0.0, sigma > 0.0, sigma, p_max, p_short, 10.0, slow)
+    np.testing.assert_array_equal(got, want)

@@ -28,6 +28,14 @@ draws are made and a run is deterministic given the ``Generator``, on any number
 and one ``random((n, B))``), kept as the readable reference. Either way the short reading
 reuses the beam's uniform (``(u - p_max) / p_short`` is again uniform on ``[0, 1)`` given the
 beam is short).
+
+One pass per robot. The engine's sensing (:meth:`RangeSensor._pass`) runs one numba loop over
+the robots that, for each, intersects the other robots' discs within ``_NEAR_M`` first, casts
+the map only up to those hits (:func:`~teamnav.world.raycast._cast_pose_capped`), tests the
+farther discs that could still shorten a ray, takes each beam's nearest ray and adds its keyed
+noise: the ranges of cast -> robot bodies -> noise, bit for bit, for a third of the work at
+1000 laser robots (``benchmarks/README.md``, issue 27). Sensors of fewer than
+``ONE_PASS_MIN_RAYS`` rays a robot run those three passes as such.
 """
 
 from __future__ import annotations
@@ -224,6 +232,44 @@ def _keyed_beam(t, s, use_u, use_z, sigma, p_max, p_short, max_range):
     return _mixture_one(t, v, z, use_u, use_z, sigma, p_max, p_short, max_range)
 
 
+@njit(cache=True, error_model="numpy")  # no zero-division branch: the loop vectorizes
+def _noise_row(row, s0, use_u, use_z, sigma, p_max, p_short, max_range, slow):
+    """``row[b] = _keyed_beam(row[b], s0 + 64 b * gamma, ...)`` for every beam ``b``, in place.
+
+    Two loops, same numbers: the first takes every beam through the ziggurat's fast path
+    with no call and no early exit (so the compiler vectorizes it: 64-bit multiplies, table
+    gathers) and marks the ~1 % of beams that need its slow path; the second redoes just
+    those with :func:`_keyed_beam`. ``slow`` (B,): scratch."""
+    nb = row.shape[0]
+    block = np.uint64(_SLOTS) * _GAMMA
+    any_slow = False
+    for b in range(nb):
+        s = s0 + np.uint64(b) * block
+        t = row[b]
+        v = 0.0
+        if use_u:
+            s += _GAMMA
+            v = _unit(_mix64(s))
+        s += _GAMMA
+        r = _mix64(s)
+        idx = r & np.uint64(0xFF)
+        r >>= np.uint64(8)
+        rabs = (r >> np.uint64(1)) & np.uint64(0x000FFFFFFFFFFFFF)
+        fr = float(np.int64(rabs))
+        x = fr * _ZIG_WI[idx]
+        x = -x if r & np.uint64(1) else x
+        need = use_z and not (use_u and v < p_max + p_short)
+        sl = need and not (fr < _ZIG_KI[idx])
+        slow[b] = sl
+        any_slow |= sl
+        m = _mixture_one(t, v, x if need else 0.0, use_u, use_z, sigma, p_max, p_short, max_range)
+        row[b] = t if sl else m  # a slow beam is redone below from its true range
+    if any_slow:
+        for b in range(nb):
+            if slow[b]:
+                row[b] = _keyed_beam(row[b], s0 + np.uint64(b) * block, use_u, use_z, sigma, p_max, p_short, max_range)
+
+
 @njit(cache=True)
 def _counter_noise_rows(true, key, i0, i1, sigma, p_max, p_short, max_range, out):
     """Rows ``[i0, i1)`` of :func:`beam_noise_keyed` (``out`` may be ``true``)."""
@@ -265,7 +311,11 @@ def _counter_noise_blocks(true, keys, starts, sigma, p_max, p_short, max_range, 
 #: nearer than the longest ray left (issue 27: at 1000 laser robots on the basement map 98 %
 #: of the beams end within 3 m, and 9 of the ~86 discs ahead of a robot shorten a ray).
 _NEAR_M: float = 4.0
-#: Side [m] of the hash cells of the one-pass sensing (its windows are a few metres).
+#: Fewest rays a robot for :meth:`RangeSensor._pass` to sense robot by robot in one kernel
+#: (below, e.g. 7 proximity rays, three passes over all robots are faster: 0.55 against
+#: 0.68 ms a step for 1000 swarm robots).
+ONE_PASS_MIN_RAYS: int = 24
+#: Largest side [m] of the hash cells of the one-pass sensing (its windows are a few metres).
 _HASH_CELL_M: float = 1.5
 
 
@@ -274,7 +324,9 @@ def _hash_or_none(use_hits, all_x, all_y, all_r, max_range_m):
     """:func:`~teamnav.sim.sensors.robot_hits._prepare` with the default cell, or an empty
     hash of the same type when no bodies are tested."""
     if use_hits and all_x.shape[0] > 0:
-        return _prepare(all_x, all_y, all_r, max_range_m, min(_HASH_CELL_M, max_range_m))
+        # the default cell (half the reach) for short sensors, at most _HASH_CELL_M
+        cell = min(_HASH_CELL_M, max(1e-3, 0.5 * (max_range_m + all_r.max())))
+        return _prepare(all_x, all_y, all_r, max_range_m, cell)
     z = np.zeros(0)
     return (z, z, z, np.zeros(0, np.int64), np.zeros(2, np.int64), 0.0, 0.0, 1.0, 1, 1, 0.0)
 
@@ -306,9 +358,9 @@ def _sense_rows(i0, i1, cast, hits, beams, even, hsh, noise, out):
     vs = np.empty(nr, np.uint8)
     qs = np.empty(nr, np.int64)
     act = np.empty(nr, np.int64)
+    slow = np.empty(nb, np.bool_)
     use_u = p_max + p_short > 0.0
     use_z = sigma > 0.0
-    block = np.uint64(_SLOTS) * _GAMMA
     for i in range(i0, i1):
         if use_hits:
             for b in range(nr):
@@ -346,18 +398,19 @@ def _sense_rows(i0, i1, cast, hits, beams, even, hsh, noise, out):
                 m = hsh[10] + 1e-6  # largest radius, and rounding
                 _robot_hits_row(px, py, ct[i], st[i], self_idx[i], near, far, beams, even, hsh, rr, rdx, rdy, False,
                                 (bx0 - m, bx1 + m, by0 - m, by1 + m))
-        s0 = key + np.uint64(i * nb * _SLOTS) * _GAMMA
-        for b in range(nb):
-            if rpb == 1:
-                t = rr[b]
-            else:
+        row = out[i]
+        if rpb == 1:
+            for b in range(nb):
+                row[b] = rr[b]
+        else:
+            for b in range(nb):
                 t = rr[b * rpb]
                 for k in range(b * rpb + 1, (b + 1) * rpb):
                     t = min(t, rr[k])
-            if use_noise:
-                t = _keyed_beam(t, s0, use_u, use_z, sigma, p_max, p_short, max_range)
-                s0 += block
-            out[i, b] = t
+                row[b] = t
+        if use_noise:
+            _noise_row(row, key + np.uint64(i * nb * _SLOTS) * _GAMMA, use_u, use_z, sigma, p_max, p_short, max_range,
+                       slow)
 
 
 @njit(cache=True)
@@ -629,6 +682,21 @@ class RangeSensor:
         numba's threads costs more than it saves)."""
         n = xs.shape[0]
         nr = self.ray_angles_rad.shape[0]
+        use_hits = bodies is not None and self.sees_robots and bodies[0].shape[0] > 0
+        if nr < ONE_PASS_MIN_RAYS:
+            # few rays a robot (proximity rings): a fixed cost per robot of the one pass
+            # outweighs what it saves; three passes over all robots give the same bits
+            parallel = n * nr >= PARALLEL_MIN_RAYS
+            true = self.caster._cast_cs(xs, ys, thetas, self._cos_rays, self._sin_rays, parallel)
+            if use_hits:
+                all_x, all_y, all_r, self_idx = bodies
+                robot_hits_unchecked(xs, ys, thetas, self._plan, all_x, all_y, all_r, self_idx, true, self.max_range_m,
+                                     0.0, parallel)
+            if self.rays_per_beam > 1:
+                true = true.reshape(n, self.angles_rad.shape[0], self.rays_per_beam).min(axis=2)
+            if key is None:
+                return true
+            return _keyed_noise(true, key, self.noise_std_m, self.p_max, self.p_short, self.max_range_m, true)
         out = np.empty((n, self.angles_rad.shape[0]), dtype=np.float64)
         if n == 0:
             return out
@@ -641,7 +709,6 @@ class RangeSensor:
         res = self.caster._res
         cast = (self.caster.clearance, float(ox), float(oy), res, kxs, kys, kct, kst, self._cos_rays, self._sin_rays,
                 self.max_range_m / res, self.rays_per_beam)
-        use_hits = bodies is not None and self.sees_robots and bodies[0].shape[0] > 0
         if use_hits:
             all_x, all_y, all_r, self_idx = bodies
         else:
