@@ -101,6 +101,17 @@ def test_distance_per_robot_is_the_true_path():
     assert m["distance_m.robot0"] == pytest.approx(5.0) and m["distance_m.robot1"] == pytest.approx(1.0)
 
 
+def test_lifetime_distance_stops_at_each_robots_last_place_event():
+    # samples at 0, 1800, 3600 s; robot 0 drives 5 m then 3 m, its last place event at 1800 s;
+    # robot 1 drives 1 m then 1 m, its last at 3600 s (issue 25 §5: one window for both)
+    xy = np.array([[[0.0, 0.0], [1.0, 1.0]], [[3.0, 4.0], [1.0, 2.0]], [[3.0, 7.0], [1.0, 3.0]]])
+    log = [_ev(900, 0, "source"), _ev(1800, 0, "home"), _ev(900, 1, "source"), _ev(3600, 1, "home")]
+    m = M.trail_metrics(_data(log, xy=xy))
+    assert m["distance_m_total"] == pytest.approx(10.0)
+    assert m["distance_m_lifetime_total"] == pytest.approx(5.0 + 2.0)
+    assert m["lifetime_min_total"] == pytest.approx(30.0 + 60.0)
+
+
 def test_efficiency_and_table1_on_the_papers_own_numbers():
     # Try §3.6 / Table 1: trips 36, 59, 78, 86 over lifetimes 81.3, 138.1, 176.6, 188.4 min;
     # "average time between Places was (9h43m40s / 262) = 2m13s ... 0.23 m/s" (31 m; ours 31.5 m)
@@ -444,7 +455,7 @@ def test_try_efficiency_is_split_into_detours_and_time_moving():
     from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
 
     def table(key, kw):
-        extra = {"trips_total": 40, "distance_m_total": 1800.0, "lifetime_min_total": 100.0,
+        extra = {"trips_total": 40, "distance_m_lifetime_total": 1800.0, "lifetime_min_total": 100.0,
                  "place_speed_mps": 31.5 * 40 / 6000.0}  # 150 s between places: 0.21 m/s, 52.5 % of cruise
         return [_row(20, 100.0, d, extra) for d in (0.0, 2.0)]
 

@@ -165,11 +165,17 @@ def _windows(times: list[float], duration_s: float) -> np.ndarray:
     return counts
 
 
-def _distance_m(data: RunData) -> np.ndarray:
+def _distance_m(data: RunData, until_s: np.ndarray | None = None) -> np.ndarray:
+    """Distance each robot drove [m] over the run, or, with ``until_s`` (N,), up to its own
+    time ``until_s[i]`` (the samples at or before it)."""
     if data.true_pose.shape[0] < 2:
         return np.zeros(data.n_robots)
     d = np.diff(data.true_pose[:, :, :2], axis=0)
-    return np.hypot(d[..., 0], d[..., 1]).sum(axis=0)
+    step = np.hypot(d[..., 0], d[..., 1])  # (T-1, N): from sample k to k+1
+    if until_s is None:
+        return step.sum(axis=0)
+    keep = data.t_s[1:, None] <= np.asarray(until_s, dtype=float)[None, :]
+    return np.where(keep, step, 0.0).sum(axis=0)
 
 
 def _crumbs(data: RunData, duration_s: float) -> dict[str, float]:
@@ -216,6 +222,9 @@ def trail_metrics(data: RunData) -> dict[str, Any]:
     out["trips_total"] = int(per_trips.sum())
     out["distance_m_total"] = float(dist.sum())
     out["lifetime_min_total"] = float(life.sum() / 60.0)
+    # distance over the same window as the lifetime (each robot up to its last place event):
+    # the mean speed over the lifetime is this over lifetime_min_total (issue 25 §5)
+    out["distance_m_lifetime_total"] = float(_distance_m(data, life).sum())
     out["units_per_robot_min"] = int(per_units.min())
     out["units_per_robot_max"] = int(per_units.max())
     if dl:  # keys left out when there is nothing to time (NaN would not compare equal to itself)
