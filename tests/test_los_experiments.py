@@ -3,6 +3,7 @@ metrics and the report section's verdicts on hand-made rows."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -423,10 +424,12 @@ def test_noise_growth_is_judged_on_the_tasks_finished_at_both_noise_levels():
 
 
 class _FakeCtx:
-    """A ctx whose sweeps return hand-made rows (no simulation)."""
+    """A ctx whose sweeps return hand-made rows (no simulation); ``paper_falling``: whether the
+    paper-rules column's table rows fall with helpers (the teamnav column's always do)."""
 
-    def __init__(self, quick):
+    def __init__(self, quick, paper_falling=True):
         self.quick = quick
+        self.paper_falling = paper_falling
         self.calls = []
 
     def sweep(self, sweep_name, **kw):
@@ -434,7 +437,8 @@ class _FakeCtx:
         self.calls.append((name, kw, sweep_name))
         teams = ([S.team_of({"params": {k: v for k, v in c.items()}}) for c in sweep_name.cases]
                  if not isinstance(sweep_name, str) else [])
-        rows = [r for h in sorted(set(teams)) for r in _by_team(True)[h]] if "table" in name else [
+        falling = self.paper_falling or not name.endswith("-paper-rules")
+        rows = [r for h in sorted(set(teams)) for r in _by_team(falling)[h]] if "table" in name else [
             _row(nav, 300 + 100 * e, **{S.ERR_KEY: e, S.DELAYED_KEY: True, S.STATE_KEY: True})
             for nav in L.NAVIGATORS for e in (0.0, 0.4)]
 
@@ -456,11 +460,28 @@ def test_full_build_asks_for_nested_teams_and_every_sweep_and_returns_every_bloc
     spec = [c[2] for c in ctx.calls if c[0] == "los-table1"][0]
     assert len(spec.cases) == 12 and [c for c in ctx.calls if c[0] == "los-table1"][0][1] == {"name": "los-table1"}
     tab = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Table 1")][0]
-    assert tab.rows[2][2:] == ["502 (0.7 %) 2/2", "252 (1.4 %) 2/2", "169 (2.1 %) 2/2", "128 (2.8 %) 2/2"]
+    # per algorithm: paper as written, teamnav, the paper's row (issue 21 §3)
+    assert [r[1] for r in tab.rows] == ["paper as written", "teamnav", "paper"] * 3
+    assert tab.rows[3][0] == "Av. Past" and tab.rows[4][0] == ""
+    assert tab.rows[3][2:] == tab.rows[4][2:] == ["502 (0.7 %) 2/2", "252 (1.4 %) 2/2", "169 (2.1 %) 2/2", "128 (2.8 %) 2/2"]
+    assert tab.rows[5][2:] == ["554.2 (11.7 %)", "426.2 (8.1 %)", "302.0 (14.2 %)", "257.2 (5.6 %)"]
     assert "20 targets per task" in tab.note
     noise = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Fig. 16")][0]
-    assert noise.columns[-1] == "R1 alone" and noise.rows[0][-1].startswith("fails") and noise.rows[1][-1] == "502 (0.7 %) 2/2"
-    assert noise.columns[1:3] == ["err_max 0", "err_max 0.4"]
+    assert noise.columns[-1] == "R1 alone" and noise.rows[0][-1].startswith("fails") and noise.rows[2][-1] == "502 (0.7 %) 2/2"
+    assert noise.columns[1:4] == ["column", "err_max 0", "err_max 0.4"]
+    assert [r[1] for r in noise.rows] == ["paper as written", "teamnav"] * 3
+    # every table and noise sweep is asked for in both columns; Table 2 also over route plans B and C
+    assert {"los-table1-paper-rules", "los-table2-paper-rules", "los-noise-simple-paper-rules",
+            "los-noise-complex-paper-rules", "los-table2-plan-b", "los-table2-plan-c-paper-rules"} <= set(names)
+    plan_b = [c for c in ctx.calls if c[0] == "los-table2-plan-b"][0]
+    assert plan_b[2].scenario == "los-help-complex-plan-b" and len(plan_b[2].cases) == 9  # no R1-alone cases
+    plans = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Table 2 over route plans")][0]
+    assert {r[2] for r in plans.rows} == {"plan A", "plan B", "plan C", "mean over 3 plans"}
+    texts = " ".join(b.text for b in blocks if hasattr(b, "text"))
+    assert "Table 2's map is ours" in texts and "los-help-complex-plan-b" in texts
+    claims = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Claims:")][0]
+    assert claims.columns[3:5] == ["paper as written", "teamnav"]
+    assert all("(holds)" in r[3] and "(holds)" in r[4] for r in claims.rows if r[0].startswith("Table 1"))
     assert {Table, Plot, Comparison} <= {type(b) for b in blocks}
     assert not any(isinstance(b, Missing) for b in blocks)
     verdicts = {b.claim: b.holds for b in blocks if isinstance(b, Comparison)}
@@ -476,7 +497,11 @@ def test_quick_build_runs_short_tasks_and_says_what_it_left_out():
     assert sorted(c["case"] for c in spec.cases) == sorted(f"{a}/{t}" for a in ("pot-field", "avoid-past", "visbug21")
                                                            for t in ("R1", "R1-4"))
     assert all(c[1]["set"][S.BUDGET_KEY] == S.QUICK_BUDGET_STEPS_PER_TARGET for c in ctx.calls)
-    assert {b.what.split(" (")[0] for b in blocks if isinstance(b, Missing)} >= {"Table 2 / Fig. 14", "Fig. 17"}
+    # quick mode runs the complex map too (both columns, route plans B and C with R1..R4 only)
+    assert not {b.what.split(" (")[0] for b in blocks if isinstance(b, Missing)} & {"Table 2 / Fig. 14", "Fig. 17"}
+    plan_c = [c for c in ctx.calls if c[0] == "los-table2-plan-c-paper-rules"][0]
+    assert plan_c[1]["name"] == "los-table2-plan-c-quick-paper-rules"
+    assert sorted(c["case"] for c in plan_c[2].cases) == ["avoid-past/R1-4", "pot-field/R1-4", "visbug21/R1-4"]
     assert all("quick mode" in b.differs for b in blocks if isinstance(b, Comparison) and b.holds is not None)
 
 
@@ -561,3 +586,137 @@ def test_verdict_rules_are_read_from_the_claim_file(monkeypatch):
     monkeypatch.setattr(V, "_claim", lambda cid: strict if cid == "table1-visbug21-falls" else cf[cid])
     comps = S.table_comparisons("simple", means, by_team)
     assert [c.holds for c in comps][:3] == [True, True, False]
+
+
+# ---------------------------------------------------------------------------- two columns, route plans (issue 21 §3-§4)
+@needs_brains
+def test_verdicts_are_the_paper_as_written_columns_and_the_teamnav_column_says_what_gap_fills_add():
+    # the paper-rules runs rise with helpers, the teamnav runs fall: the verdict follows the paper's column
+    blocks = S.build(_FakeCtx(quick=False, paper_falling=False))
+    comps = {b.claim: b for b in blocks if isinstance(b, Comparison)}
+    ap = comps["Table 1: Av. Past steps fall as helpers are added (R1, R1,2, R1,2,3, R1,2,3,4)"]
+    assert ap.holds is False
+    assert ap.ours.startswith("paper as written: 502 → 552 → 602 → 652") and "| teamnav: 502 → 252 → 169 → 128" in ap.ours
+    assert "teamnav (our gap-fills): holds" in ap.differs
+    claims = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Claims:")][0]
+    row = next(r for r in claims.rows if r[0].startswith("Table 1: Av. Past"))
+    assert "(does not hold)" in row[3] and "(holds)" in row[4]
+    # and the other way round: a paper column that falls holds whatever teamnav does
+    assert comps["Table 1: the potential field alone fails, and finishes with helpers (state + goal sharing)"].holds is True
+
+
+@needs_brains
+def test_the_paper_rules_column_runs_every_robot_at_paper_rules_with_the_cases_plan_and_quick_budget():
+    from teamnav.control import registry
+    from teamnav.experiments.report.sections._trails import paper_rules_spec
+    from teamnav.experiments.spec import load_scenario
+    from teamnav.experiments.sweep import expand, resolve_spec
+
+    base = S.table_spec("complex", [0, 3]).model_copy(update={"scenario": "los-help-complex-plan-b"})
+    spec = resolve_spec(paper_rules_spec(base), set=S._quick_set(), grid={S.TARGETS_KEY: S._tasks("complex", True)},
+                        duration_s=S._budget_s("complex", True))
+    trials = expand(spec)
+    assert len(trials) == 6
+    t = next(x for x in trials if x.params["case"] == "avoid-past/R1-4")
+    scn = load_scenario(spec.scenario, overrides={k: v for k, v in t.params.items() if k not in ("case", "duration_s")})
+    assert [g.params.get("paper_rules") for g in scn.robots] == [True] * 4
+    r1 = scn.robots[0].params
+    assert r1["navigator"] == "avoid_past" and r1["max_steps_per_target"] == S.QUICK_BUDGET_STEPS_PER_TARGET
+    assert len(r1["targets_xy"]) == S.QUICK_TARGETS
+    plan_b = load_scenario("los-help-complex-plan-b")
+    assert scn.robots[2].params["patrol_xy"] == plan_b.robots[2].params["patrol_xy"]
+    p = registry.lookup("los-explorer-v1").Params(**r1)
+    assert p.see_past_teammates is False and p.report_margin_steps == 0.0 and p.navigator_params["paper_rules"] is True
+    # the teamnav column keeps our gap-fills
+    ours = load_scenario(base.scenario).robots[0].params
+    assert "paper_rules" not in ours and registry.lookup("los-explorer-v1").Params(**ours).see_past_teammates is True
+
+
+def _plan(steps_by_team, alone=None):
+    """One route plan's rows of Av. Past: {team: [steps of task 0, task 1]}."""
+    out = {h: [_row("avoid_past", s, **{f"robots.{k + 1}.count": int(k < h) for k in range(3)},
+                    **{S.TARGETS_KEY: [[float(task), 0.0]] * 20}) for task, s in enumerate(v)]
+           for h, v in steps_by_team.items()}
+    if alone is not None:
+        out[0] = alone[0]
+    return out
+
+
+def test_table2_verdicts_read_the_mean_over_route_plans():
+    a = _plan({0: [500, 500], 1: [400, 400], 2: [300, 300], 3: [200, 200]})
+    b = _plan({1: [600, 600], 2: [300, 300], 3: [200, 200]}, alone=a)  # plan B alone rises at R2
+    c = _plan({1: [450, 450], 2: [310, 310], 3: [210, 210]}, alone=a)
+    means = S.table_block("complex", a)[1]
+    record: dict = {}
+    comps = S.table_comparisons("complex", means, a, plans=[a, b, c], record=record)
+    ap = next(x for x in comps if "Av. Past" in x.claim)
+    # the means over the plans: 500, 483, 303, 203: falling although plan B rises
+    assert ap.holds is True and ap.ours.startswith("500 → 483 → 303 → 203")
+    assert "mean over 3 route plans" in ap.ours and "plan B: 500 → 600 → 300 → 200" in ap.ours
+    assert record["table2-avoid-past-falls"][0]["max_rise"] == pytest.approx(-16.67, abs=0.01)  # 500 -> 483.3
+    # plan B's rise large enough to lift the mean above R1 alone: fails, though plan A alone falls
+    b2 = _plan({1: [800, 800], 2: [300, 300], 3: [200, 200]}, alone=a)
+    ap2 = next(x for x in S.table_comparisons("complex", means, a, plans=[a, b2, c]) if "Av. Past" in x.claim)
+    assert ap2.holds is False and ap2.ours.startswith("500 → 550")
+    assert next(x for x in S.table_comparisons("complex", means, a) if "Av. Past" in x.claim).holds is True
+    tab = S.route_plans_block({"paper_rules": [a, b2, c], "teamnav": [a, b, c]}, ("plan A", "plan B", "plan C"))
+    mean_rows = [r for r in tab.rows if r[0] == "Av. Past" and r[2] == "mean over 3 plans"]
+    assert [r[1] for r in mean_rows] == ["paper as written", "teamnav"]
+    assert mean_rows[0][3:] == ["500", "550", "303", "203"] and mean_rows[1][4] == "483"
+
+
+def test_route_plan_files_are_what_the_generator_writes_and_differ_only_in_the_helpers_routes(tmp_path):
+    from teamnav.experiments.registry import SCENARIO_DIR
+    from teamnav.experiments.report.sections import _los_common as C
+
+    for p in C.write_route_plan_files(tmp_path):
+        assert (SCENARIO_DIR / p.name).read_text(encoding="utf-8") == p.read_text(encoding="utf-8"), (
+            f"{p.name} is stale: run python -m teamnav.experiments.report.sections._los_common")
+    a = L.scenario_data("complex")
+    routes = {}
+    for plan in ("B", "C"):
+        d = C.route_plan_scenario(plan)
+        assert d["robots"][0] == a["robots"][0] and d["map"] == a["map"]
+        for k in (1, 2, 3):
+            assert {x: v for x, v in d["robots"][k]["params"].items() if x != "patrol_xy"} == \
+                {x: v for x, v in a["robots"][k]["params"].items() if x != "patrol_xy"}
+        routes[plan] = [g["params"]["patrol_xy"] for g in d["robots"][1:]]
+    routes["A"] = [g["params"]["patrol_xy"] for g in a["robots"][1:]]
+    assert len({json.dumps(v) for v in routes.values()}) == 3  # three different plans
+    with pytest.raises(ValueError, match="plan must be one of"):
+        C.route_plan_scenario("A")
+
+
+def test_route_plans_lie_in_the_corridors_with_clearance_and_see_every_room_together():
+    from teamnav.experiments.report.sections._los_common import ROUTE_PLANS
+
+    env = builtin_map(L.MAPS["complex"])
+    clear = distance_field(env.grid)
+    occ, res = np.asarray(env.grid.occupied()), env.grid.resolution_m
+    corridors = [v for k, v in env.regions.items() if k.startswith("corridor")]
+    centres = L.room_centres("complex")
+    assert ROUTE_PLANS["A"][1] == L.LAYOUTS["complex"].helpers
+    for plan, (_text, helpers) in ROUTE_PLANS.items():
+        seen = set()
+        for start, route in helpers:
+            pts = [start[:2], *route]
+            for x, y in pts:
+                r, c = env.grid.world_to_cell((x, y))
+                assert clear[r, c] >= L.RADIUS_M + 0.3, (plan, x, y)
+                assert any(x0 <= x <= x1 and y0 - 0.4 <= y <= y1 + 0.4 for x0, y0, x1, y1 in corridors), (plan, x, y)
+            seen |= {name for a, b in zip(pts, pts[1:]) for t in np.linspace(0.0, 1.0, 150)
+                     for name, c in centres.items()
+                     if (p := (a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t))
+                     and math.hypot(c[0] - p[0], c[1] - p[1]) <= L.VISIBILITY_M and _sees(occ, res, p, c)}
+        assert seen == set(centres), (plan, sorted(set(centres) - seen))  # R2..R4 together see every room
+
+
+def test_table2_claims_are_judged_on_the_mean_over_route_plans_fixed_before_the_data():
+    from teamnav.experiments.claims import load_claims
+
+    cf = load_claims("los-help")
+    t2 = [c for c in cf.claims if c.id.startswith("table2-")]
+    assert len(t2) == 5
+    for c in t2:
+        last = c.history[-1]
+        assert "route plans" in last.change and last.before_data and "route plans" in c.note

@@ -231,3 +231,125 @@ def legs_block(tables: dict[str, dict[int, list[dict]]]) -> Table:
                       "path through the task's targets for R1's body, less ε at each end of a leg (grid estimate within "
                       "3 %; teamnav.world.shortest_path). Means over the finished tasks, as in Tables 1-2; a cell that "
                       "finished none shows the legs of the targets it reached.")
+
+
+# ---------------------------------------------------------------------------- two columns (issue 21 §3-§4)
+#: the section's two columns: (key, heading); the trail and collab-mcl sections use the same
+COLUMNS = (("paper_rules", "paper as written"), ("teamnav", "teamnav"))
+HEAD = dict(COLUMNS)
+
+
+def table_block_cols(map_key: str, by_col: dict[str, dict[int, list[dict]]]) -> tuple[Table, dict[str, dict[str, list[float]]]]:
+    """Table 1 or 2 with both columns beside the paper's: per algorithm a row "paper as written"
+    (``paper_rules: true``), a row "teamnav" (our gap-fills) and the paper's row; and each
+    column's mean steps per algorithm and team size (:func:`table_block`)."""
+    per = {col: table_block(map_key, by_col.get(col, {})) for col, _ in COLUMNS}
+    rows: list[list[str]] = []
+    for i, nav in enumerate(L.NAVIGATORS):
+        for col, head in COLUMNS:
+            rows.append([NAV_LABEL[nav] if col == COLUMNS[0][0] else "", head, *per[col][0].rows[2 * i][2:]])
+        rows.append(["", "paper", *per[COLUMNS[0][0]][0].rows[2 * i + 1][2:]])
+    first = per[COLUMNS[0][0]][0]
+    note = (first.note + " Rows: 'paper as written' runs both brains with paper_rules: true (every gap-fill whose "
+            "other value is the paper's rule at the paper's value, the gap-fill table below); 'teamnav' runs our "
+            "gap-fills; verdicts are judged on the paper-as-written rows.")
+    return Table(first.title, first.columns, rows, note), {col: per[col][1] for col, _ in COLUMNS}
+
+
+def robots_plot_cols(map_key: str, by_col: dict[str, dict[int, list[dict]]]) -> Plot:
+    """Fig. 12 or 14 with a curve per algorithm and column."""
+    plots = {col: robots_plot(map_key, by_col.get(col, {})) for col, _ in COLUMNS}
+    first = plots[COLUMNS[0][0]]
+    series = [Series(f"{s.label} ({head})", s.x, s.y, s.lo, s.hi, style=("line+points" if col == "paper_rules" else "points"))
+              for col, head in COLUMNS for s in plots[col].series]
+    return Plot(first.title, first.xlabel, first.ylabel, series,
+                caption=first.caption + " Lines with points: paper as written; points only: teamnav.")
+
+
+def noise_plot_cols(map_key: str, rows_by_col: dict[str, list[dict]], alone_by_col: dict[str, dict[str, float]]
+                    ) -> tuple[Plot, dict[str, dict[str, dict[float, float]]]]:
+    """Fig. 16 or 17 with a curve per algorithm and column; R1 alone's lines of the paper-as-written
+    column (R1 alone runs the same rules as its column; both levels are in the table)."""
+    got = {col: noise_plot(map_key, rows_by_col.get(col, []), alone_by_col.get(col, {})) for col, _ in COLUMNS}
+    first = got[COLUMNS[0][0]][0]
+    series = [Series(f"{s.label} ({head})", s.x, s.y, s.lo, s.hi, style=("line+points" if col == "paper_rules" else "points"))
+              for col, head in COLUMNS for s in got[col][0].series]
+    hl = [(y, f"{lab} ({HEAD[col]})") for col, _ in COLUMNS for y, lab in got[col][0].hlines]
+    cap = " ".join(f"{HEAD[col]}: {got[col][0].caption}" for col, _ in COLUMNS)
+    return (Plot(first.title, first.xlabel, first.ylabel, series, hlines=hl,
+                 caption="Lines with points: paper as written; points only: teamnav. " + cap),
+            {col: got[col][1] for col, _ in COLUMNS})
+
+
+def noise_table_cols(map_key: str, rows_by_col: dict[str, list[dict]], alone_by_col: dict[str, list[dict]]) -> Table:
+    """Figs. 16-17 as a table, a row per algorithm and column (:func:`noise_table`)."""
+    per = {col: noise_table(map_key, rows_by_col.get(col, []), alone_by_col.get(col, [])) for col, _ in COLUMNS}
+    cols = max((t.columns for t in per.values()), key=len)
+    rows = [[r[0], HEAD[col], *r[1:]] for i in range(max(len(t.rows) for t in per.values()))
+            for col, _ in COLUMNS if i < len(per[col].rows) for r in [per[col].rows[i]]]
+    first = per[COLUMNS[0][0]]
+    return Table(first.title, [cols[0], "column", *cols[1:]], rows, first.note)
+
+
+def route_plans_block(plans_by_col: dict[str, list[dict[int, list[dict]]]], labels: tuple[str, ...]) -> Table:
+    """Table 2's robustness column (issue 21 §4): R1's steps per target per algorithm, column and
+    route plan for R2..R4, and the mean over the plans that the Table 2 verdicts read
+    (claims/los-help.yaml; per plan the tasks finished, unpaired here: the verdicts pair by task)."""
+    from teamnav.experiments.report.sections._los_verdicts import _team_mean
+
+    rows: list[list[str]] = []
+    for nav in L.NAVIGATORS:
+        for col, head in COLUMNS:
+            plans = plans_by_col.get(col, [])
+            for label, p in zip(labels, plans):
+                cells = []
+                for h in range(4):
+                    rs = group(p.get(h, []), NAV_KEY).get(nav, [])
+                    cells.append(cell(steps_of(rs), finished_of(rs)) if h in p else "not run")
+                rows.append([NAV_LABEL[nav], head, label, *cells])
+            if plans:
+                ms = [[_team_mean(p, nav, h) for p in plans] for h in range(4)]
+                rows.append([NAV_LABEL[nav], head, f"mean over {len(plans)} plans",
+                             *("n/a" if not np.isfinite(m).all() else f"{np.mean(m):.0f}" for m in ms)])
+    return Table("Table 2 over route plans for R2..R4 (robustness column, issue 21 §4): R1's motion steps per target, "
+                 "mean (std %) tasks finished / run",
+                 ["algorithm", "column", "route plan", *TEAM_LABEL.values()], rows,
+                 "Plans chosen before their runs (report/sections/_los_common.ROUTE_PLANS; scenarios los-help-complex, "
+                 "-plan-b, -plan-c); R1 alone is the same run in every plan. 'mean over plans': the mean of the plans' "
+                 "means over finished tasks (n/a when a plan finished none); the Table 2 verdicts read the mean over "
+                 "the plans of the paired-by-task means (claims/los-help.yaml).")
+
+
+def gap_fill_blocks() -> list[Table]:
+    """The gap-fills of both brains with teamnav's value and the paper's (``paper_rules: true``
+    sets the paper's), and the rules the paper leaves unspecified with how each is filled (kept in
+    both columns)."""
+    from teamnav.control import registry
+    from teamnav.control.coop.los_help.brain import los_gap_fills
+    from teamnav.experiments.spec import load_scenario
+
+    scn = load_scenario("los-help-simple")
+    rows, seen = [], set()
+    for brain, group_i, navs in (("los-explorer-v1", 0, L.NAVIGATORS), ("los-helper-v1", 1, ("visbug21",))):
+        cls = registry.lookup(brain).Params
+        ours = {k: v for k, v in scn.robots[group_i].params.items() if k not in ("targets_xy", "patrol_xy")}
+        for nav in navs:
+            for g in los_gap_fills(cls, nav, {**ours, "navigator": nav}):
+                key = (brain, g.field if not g.field.startswith("navigator_params") else f"{g.field} ({nav})")
+                if key in seen:
+                    continue
+                seen.add(key)
+                rows.append([brain, key[1], repr(g.teamnav_value), repr(g.paper_value), g.note])
+    kept = []
+    for brain in ("los-explorer-v1", "los-helper-v1"):
+        for k, v in registry.lookup(brain).Params.GAP_FILLS_KEPT.items():
+            kept.append([brain, k, v])
+    return [Table("Gap-fills of the two brains: teamnav's value and the paper's (paper_rules: true sets the paper's)",
+                  ["brain", "parameter", "teamnav", "paper as written", "where the paper says so"], rows,
+                  "Each a flag of the brain's Params (PAPER_RULES); the 'paper as written' column of Tables 1-2 and "
+                  "Figs. 16-17 runs every one at the paper's value."),
+            Table("What the paper leaves unspecified, and how we fill it (the same in both columns)",
+                  ["brain", "parameter", "the gap and our value"], kept,
+                  "GAP_FILLS_KEPT of the brains: the paper gives no value, so both columns use ours. The maps' room "
+                  "layouts beyond Figs. 11 and 13, the targets and the helpers' routes are ours too "
+                  "(teamnav.experiments.los_tasks).")]

@@ -21,6 +21,24 @@ What it runs (sweeps ``los-table1``, ``los-table2``, ``los-noise-simple``,
   (:func:`~teamnav.experiments.los_tasks.shortest_steps_for_targets`), so that a reader sees
   which part of the path the helpers shorten for each algorithm.
 
+Two columns (issue 21 §3), drawn through the shared paper-rules mechanism of the trail and
+collab-mcl sections (:func:`._trails.paper_rules_spec`): "paper as written" runs every robot
+group (both brains) at ``paper_rules: true`` (each gap-fill whose other value is the paper's rule
+at the paper's value: ``PAPER_RULES`` of ``los-explorer-v1`` / ``los-helper-v1`` and of their
+navigators), in sweeps named ``<sweep>-paper-rules``; "teamnav" runs the scenarios as they are
+(our gap-fills). Tables 1-2, Figs. 12, 14, 16 and 17 show both beside the paper's numbers; every
+verdict is judged on the paper-as-written column by the rules of ``claims/los-help.yaml``
+(:func:`._los_verdicts.column_comparisons`), the teamnav column saying what our gap-fills add; a
+claim table shows both columns' metrics, and two tables list the gap-fills (both values) and the
+rules the paper leaves unspecified with how each is filled (``GAP_FILLS_KEPT``, both columns).
+The ablation, the legs and the traffic tables are the teamnav column's.
+
+Table 2's map and routes are ours (issue 21 §4; the paper gives no layout for Fig. 13): the
+section says so above Table 2 and runs Table 2 over three route plans for R2..R4
+(:data:`._los_common.ROUTE_PLANS`: A the scenario ``los-help-complex``, B and C the scenarios
+``los-help-complex-plan-b`` / ``-plan-c``; R1 alone is plan A's run in every plan), a robustness
+table per plan and column, and the Table 2 verdicts read the mean over the plans.
+
 EXPERIMENTS.md rows become :class:`Comparison` blocks: steps fall monotonically as helpers are
 added, for every algorithm (Tables 1-2; a verdict that fails names each rise with its paired
 mean ± s.e. over the tasks, so that a rise within the noise reads as such); the potential field alone never finishes and
@@ -39,16 +57,20 @@ Budget: R1 abandons its task when a target is not reached within
 complex); the run then ends and counts as failed (not in the means). A trapped run so ends
 at its first trap instead of burning a whole task's budget.
 
-Running it: ``teamnav report los-help --out DIR`` (full) runs 2 x 60 table trials (3
-algorithms x 4 teams x 5 tasks; ``teamnav sweep los-table1 --out DIR`` runs the same 60), 2 x 75
-noise trials and 60 ablation trials; :data:`FULL_CPU_NOTE` says what it costs here. Set
+Running it: ``teamnav report los-help --out DIR`` (full) runs, per column, 2 x 60 table trials
+(3 algorithms x 4 teams x 5 tasks; ``teamnav sweep los-table1 --out DIR`` runs the same 60), 2 x 45
+route-plan trials (plans B and C, teams R1,2..R1..R4) and 2 x 75 noise trials, and 60 ablation
+trials (teamnav only); :data:`FULL_CPU_NOTE` says what one column cost here (the paper-rules
+column and the route plans have not been run in full yet: about 2.2x the note's CPU time in all,
+by trial counts). Set
 ``NUMBA_NUM_THREADS=1`` for sweeps on a small box: the
 line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread launch
 costs more than the work for four robots.
 
-Quick mode (CI): the simple map only, the first target of task 1 with an 800-step budget,
-teams {R1, R1..R4}, err_max 0.4 (err_max 0 is the tables' R1..R4 run), no ablation: 9 short
-runs.
+Quick mode (CI): both maps, the first target of task 1 with an 800-step budget, teams {R1,
+R1..R4} (route plans B and C: R1..R4 only), err_max 0.4 (err_max 0 is the tables' R1..R4 run),
+no ablation: 24 short runs per column, 48 in all (about 30 CPU-s here; the simple map alone in
+one column was 9 runs and 5 s).
 
 Files: the row helpers and the paper's Tables 1-2 in :mod:`._los_common`, the tables and figures
 in :mod:`._los_tables`, the verdicts (:class:`Comparison` blocks) in :mod:`._los_verdicts`;
@@ -65,15 +87,16 @@ from teamnav.experiments.report.model import Comparison, Missing, SectionSpec, T
 
 # the helpers this section is built from, importable from here as before the split
 from teamnav.experiments.report.sections._los_common import (  # noqa: F401
-    BUDGET_KEY, DELAYED_KEY, ERR_KEY, NAV_KEY, NAV_LABEL, PAPER_TABLES, STATE_KEY, TARGETS_KEY, TEAM_LABEL, _mean,
+    PLAN_SCENARIOS, ROUTE_PLANS, BUDGET_KEY, DELAYED_KEY, ERR_KEY, NAV_KEY, NAV_LABEL, PAPER_TABLES, STATE_KEY, TARGETS_KEY, TEAM_LABEL, _mean,
     _metric, _paper_cell, cell, finished_of, group, ok_rows, stats, steps_of, strictly_falling, targets_per_task,
 )
 from teamnav.experiments.report.sections._los_tables import (  # noqa: F401
-    FRACTIONS, ablation_block, legs_block, noise_plot, noise_table, robots_plot, table_block, traffic_block,
+    COLUMNS, FRACTIONS, gap_fill_blocks, noise_plot_cols, noise_table_cols, robots_plot_cols, route_plans_block,
+    table_block_cols, ablation_block, legs_block, noise_plot, noise_table, robots_plot, table_block, traffic_block,
     where_steps_go_block,
 )
 from teamnav.experiments.report.sections._los_verdicts import (  # noqa: F401
-    alone_levels, noise_comparisons, paired_means, paired_noise, table_comparisons,
+    column_comparisons, alone_levels, noise_comparisons, paired_means, paired_noise, table_comparisons,
 )
 
 PAPER = "sgorbissa-arkin-local-navigation-strategies-for-a-team-of-robots.txt"
@@ -131,7 +154,7 @@ GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on t
 QUICK_TARGETS = 1
 QUICK_BUDGET_STEPS_PER_TARGET = 800
 #: Maps run in quick mode (the complex map's runs are the longest).
-QUICK_MAPS = ("simple",)
+QUICK_MAPS = ("simple", "complex")
 
 
 def _n_targets(quick: bool) -> int:
@@ -180,34 +203,72 @@ def _quick_set(team: dict[str, int] | None = None) -> dict[str, Any]:
     return {**(team or {}), BUDGET_KEY: QUICK_BUDGET_STEPS_PER_TARGET}
 
 
-def run_tables(ctx, map_key: str) -> dict[int, list[dict]]:
-    """Rows of the table sweep per team size (0..3 helpers, nested): one sweep call, whose cases
-    are algorithm x team (quick mode: the teams R1 and R1..R4 only, short tasks)."""
+def _col_rows(ctx, col: str, spec_or_name: Any, name: str, **kw: Any) -> list[dict]:
+    """Finished rows of a sweep in column ``col``: ``"teamnav"`` as the scenario is, ``"paper_rules"``
+    with both brains at ``paper_rules: true`` (the params those rules set dropped from the scenario;
+    :func:`._trails.paper_rules_spec`, as the trail and collab-mcl sections do), named ``<name>-paper-rules``."""
+    if col == "paper_rules":
+        from teamnav.experiments.report.sections._trails import paper_rules_spec
+
+        return ok_rows(ctx.sweep(paper_rules_spec(spec_or_name), name=f"{name}-paper-rules", **kw))
+    return ok_rows(ctx.sweep(spec_or_name, name=name, **kw))
+
+
+def run_tables(ctx, map_key: str, col: str = "teamnav", plan: str = "A",
+               alone: list[dict] | None = None) -> dict[int, list[dict]]:
+    """Rows of the table sweep per team size (0..3 helpers, nested) in column ``col``: one sweep
+    call, whose cases are algorithm x team (quick mode: the teams R1 and R1..R4 only, short tasks).
+
+    ``plan``: a route plan of Table 2's robustness column (:data:`._los_common.ROUTE_PLANS`; B, C run
+    the plan's scenario without the R1-alone cases, whose rows ``alone`` stand in: R1 alone meets
+    no helper, whatever their routes)."""
     quick = bool(ctx.quick)
     teams = _teams(map_key, quick)
     kw: dict[str, Any] = {}
     if quick:
         kw = {"set": _quick_set(), "grid": {TARGETS_KEY: _tasks(map_key, True)}, "duration_s": _budget_s(map_key, True)}
-    name = TABLE_SWEEP[map_key] + ("-quick" if quick else "")
-    rows = ok_rows(ctx.sweep(table_spec(map_key, teams), name=name, **kw))
+    spec = table_spec(map_key, teams)
+    name = TABLE_SWEEP[map_key]
+    if plan != "A":
+        name = f"{name}-plan-{plan.lower()}"
+        spec = spec.model_copy(update={"scenario": PLAN_SCENARIOS[plan], "name": name,
+                                       "cases": [c for c in spec.cases if not c["case"].endswith("/R1")]})
+    name += "-quick" if quick else ""
     out: dict[int, list[dict]] = {h: [] for h in teams}
-    for r in rows:
+    for r in _col_rows(ctx, col, spec, name, **kw):
         out.setdefault(team_of(r), []).append(r)
+    if plan != "A":
+        out[0] = list(alone or [])
     return out
 
 
-def run_noise(ctx, map_key: str, all_helpers: list[dict]) -> list[dict]:
-    """Rows of the noise sweeps; in quick mode only err_max = 0.4 runs, and the tables' R1..R4
-    rows (the same configuration at err_max = 0) stand for err_max = 0."""
+def run_noise(ctx, map_key: str, all_helpers: list[dict], col: str = "teamnav") -> list[dict]:
+    """Rows of the noise sweeps in column ``col``; in quick mode only err_max = 0.4 runs, and the
+    tables' R1..R4 rows (the same configuration at err_max = 0) stand for err_max = 0."""
     if not ctx.quick:
-        return _rows(ctx, NOISE_SWEEP[map_key], "")
+        return _col_rows(ctx, col, NOISE_SWEEP[map_key], NOISE_SWEEP[map_key])
     kw = {"grid": {TARGETS_KEY: _tasks(map_key, True), ERR_KEY: [0.4]}, "duration_s": _budget_s(map_key, True),
           "set": _quick_set()}
     zero = [{**r, "params": {**r["params"], ERR_KEY: 0.0}} for r in all_helpers]
-    return zero + _rows(ctx, NOISE_SWEEP[map_key], "-quick", **kw)
+    return zero + _col_rows(ctx, col, NOISE_SWEEP[map_key], NOISE_SWEEP[map_key] + "-quick", **kw)
+
+
+#: Above Table 2 (issue 21 §4): the complex map and the helpers' routes are ours.
+COMPLEX_MAP_NOTE = ("Table 2's map is ours. The paper gives no layout for Fig. 13: office_complex_closed (teamnav.world."
+                    "generators), its rooms, their U-shaped walls (the potential field's trap) and the helpers' routes are "
+                    "our interpretation of the figure, not the paper's map. So Table 2 is also run over three route plans "
+                    "for R2..R4, chosen before their runs and listed in the scenarios los-help-complex (plan A), "
+                    "los-help-complex-plan-b and -plan-c, and each Table 2 verdict is judged on the mean over the plans "
+                    "(claims/los-help.yaml): " + " | ".join(f"{k}: {v[0]}" for k, v in ROUTE_PLANS.items()) + ".")
+
+COLS = tuple(c for c, _ in COLUMNS)
+
 
 def build(ctx) -> list:
     from teamnav.control import registry
+    from teamnav.experiments.claims import load_claims
+    from teamnav.experiments.report.model import Table
+    from teamnav.experiments.report.sections._trails import claim_rows
 
     lacking = [n for n in ("los-explorer-v1", "los-helper-v1") if n not in registry.names()]
     if lacking:
@@ -224,10 +285,18 @@ def build(ctx) -> list:
         f"{QUICK_BUDGET_STEPS_PER_TARGET if quick else ' / '.join(map(str, L.BUDGET_STEPS_PER_TARGET.values()))} "
         f"steps{'' if quick else ' (simple / complex map)'}: R1 then gives up and the run ends. As in §6, state "
         "sharing is used with the potential field only; the ablation shows what it does to the others. "
+        "Two columns (issue 21 §3), as in the trail and collab-mcl sections: \"paper as written\" runs both brains "
+        "with paper_rules: true (every gap-fill whose other value is the paper's rule at the paper's value: the "
+        "gap-fill table below) and \"teamnav\" our gap-fills; Tables 1-2 and Figs. 16-17 show both beside the "
+        "paper's numbers. Every verdict is judged on the paper-as-written column by the rules of "
+        "claims/los-help.yaml; the teamnav column says what our gap-fills add. Where the paper gives no rule at "
+        "all, both columns use the same value (the second gap-fill table). Measured effects of the gap-fills: "
         + GAP_FILLS_NOTE + " " + FULL_CPU_NOTE)]
-    tables: dict[str, dict[int, list[dict]]] = {}
+    blocks += gap_fill_blocks()
+    tables: dict[str, dict[str, dict[int, list[dict]]]] = {col: {} for col in COLS}
     comps: list[Comparison] = []
-    alone: dict[str, dict[str, float]] = {}
+    record: dict[str, dict] = {col: {} for col in COLS}
+    alone: dict[str, dict[str, dict[str, float]]] = {col: {} for col in COLS}
     maps = [m for m in L.MAPS if not quick or m in QUICK_MAPS]
     for m in L.MAPS:
         if m not in maps:
@@ -235,27 +304,49 @@ def build(ctx) -> list:
             comps.append(Comparison("Table 2 (complex map): same trends; the algorithm still matters with 3 helpers",
                                     "see Table 2", "not measured in quick mode", None))
             continue
-        by_team = run_tables(ctx, m)
-        tables[m] = by_team
-        tab, means = table_block(m, by_team)
-        blocks += [tab, robots_plot(m, by_team)]
-        comps += table_comparisons(m, means, by_team)
-        alone[m] = alone_levels(by_team.get(0, []))
+        by_col = {col: run_tables(ctx, m, col) for col in COLS}
+        plans = None
+        if m == "complex":
+            blocks.append(Text(COMPLEX_MAP_NOTE))
+            plans = {col: [by_col[col]] + [run_tables(ctx, m, col, p, alone=by_col[col].get(0, []))
+                                           for p in ROUTE_PLANS if p != "A"] for col in COLS}
+        for col in COLS:
+            tables[col][m] = by_col[col]
+            alone[col][m] = alone_levels(by_col[col].get(0, []))
+        tab, means = table_block_cols(m, by_col)
+        blocks += [tab, robots_plot_cols(m, by_col)]
+        if plans is not None:
+            blocks.append(route_plans_block(plans, tuple(f"plan {p}" for p in ROUTE_PLANS)))
+        comps += column_comparisons({col: table_comparisons(m, means[col], by_col[col],
+                                                            plans=plans[col] if plans else None, record=record[col])
+                                     for col in COLS})
     for m in L.MAPS:
         if m not in maps:
             blocks.append(Missing(f"Fig. 17 ({L.MAPS[m]}, noise)", "full mode only (teamnav report los-help)"))
             continue
-        rows = run_noise(ctx, m, tables[m].get(3, []))
-        plot, nmeans = noise_plot(m, rows, alone[m])
-        blocks += [noise_table(m, rows, tables[m].get(0, [])), plot]
-        comps += noise_comparisons(m, nmeans, alone[m], rows)
+        rows = {col: run_noise(ctx, m, tables[col][m].get(3, []), col) for col in COLS}
+        plot, nmeans = noise_plot_cols(m, rows, {col: alone[col][m] for col in COLS})
+        blocks += [noise_table_cols(m, rows, {col: tables[col][m].get(0, []) for col in COLS}), plot]
+        comps += column_comparisons({col: noise_comparisons(m, nmeans[col], alone[col][m], rows[col], record=record[col])
+                                     for col in COLS})
+    claims = load_claims("los-help")
+    vals = {col: {cid: v for cid, (v, _j) in record[col].items()} for col in COLS}
+    verdicts = {col: {cid: j for cid, (_v, j) in record[col].items()} for col in COLS}
+    blocks.append(Table("Claims: the paper, the paper as written, teamnav",
+                        ["claim", "paper", "rule (claim file)", "paper as written", "teamnav", "rule history"],
+                        claim_rows(claims, vals, verdicts),
+                        note="verdicts judged on the paper-as-written column (claims/los-help.yaml); the teamnav column "
+                             "is what the gap-fills buy; Table 2's claims read the mean over the route plans"
+                             + ("; quick mode: indicative only" if quick else "")))
+    blocks.append(Text("The tables below are the teamnav column's runs (our gap-fills): the ablation, where R1's "
+                       "steps and path go, and the traffic."))
     if quick:
         blocks.append(Missing("the ablation (reflected only / + ghosts / + state sharing)", "full mode only (teamnav report los-help)"))
     else:
         blocks.append(ablation_block(ok_rows(ctx.sweep("los-ablation"))))
-    blocks.append(where_steps_go_block(tables))
-    blocks.append(legs_block(tables))
-    blocks.append(traffic_block({m: tables[m].get(3, []) for m in maps}))
+    blocks.append(where_steps_go_block(tables["teamnav"]))
+    blocks.append(legs_block(tables["teamnav"]))
+    blocks.append(traffic_block({m: tables["teamnav"][m].get(3, []) for m in maps}))
     if quick:
         note = "quick mode: one target per cell, not 5 tasks of 200; the verdict is indicative only"
         comps = [Comparison(c.claim, c.paper, c.ours, c.holds, "; ".join(x for x in (c.differs, note) if x))
