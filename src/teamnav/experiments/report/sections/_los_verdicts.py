@@ -4,6 +4,12 @@
 Split from :mod:`.los_help` (no behaviour change). The rules are read from the claim file
 ``claims/los-help.yaml`` (:mod:`teamnav.experiments.claims`): each verdict computes the metrics
 its claim names and calls :func:`~teamnav.experiments.claims.judge`; no threshold lives here.
+
+Two columns (issue 21 §3): the verdicts are computed on each column's rows and merged by
+:func:`column_comparisons`, which keeps the paper-as-written column's verdict (every claim is
+``judged: paper_rules``) and reports the teamnav one beside it. Table 2's verdicts read the mean
+over the route plans of :data:`._los_common.ROUTE_PLANS` (issue 21 §4; ``plans`` of
+:func:`table_comparisons`, :func:`_plan_means`).
 """
 
 from __future__ import annotations

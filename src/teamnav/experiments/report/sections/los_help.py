@@ -113,7 +113,9 @@ FULL_CPU_NOTE = ("Cost of the full reproduction here, measured (2026-11-26, sess
                  "`los-noise-complex` (75) in 1305 s and `los-ablation` (60) in 686 s on 2 workers (the first shared "
                  "its cores with other work for a while). All five: about 84 min of wall time on 2 cores, about 2.7 "
                  "CPU-hours. A failing trial ends at its first target over budget; wall time is about the CPU time "
-                 "over the number of workers (`-j`).")
+                 "over the number of workers (`-j`). That was one column (teamnav) of 330 trials; with the paper-as-written "
+                 "column and Table 2's route plans B and C (issue 21 §3-§4) the section runs 780 trials, about 6 CPU-hours "
+                 "here by trial counts (estimated, not yet measured).")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
 GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
