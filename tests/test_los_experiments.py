@@ -720,3 +720,12 @@ def test_table2_claims_are_judged_on_the_mean_over_route_plans_fixed_before_the_
     for c in t2:
         last = c.history[-1]
         assert "route plans" in last.change and last.before_data and "route plans" in c.note
+
+
+def test_noise_table_pairs_each_algorithms_rows_across_columns_when_one_column_lacks_an_algorithm():
+    from teamnav.experiments.report.sections._los_tables import noise_table_cols
+
+    rows = [_row(nav, s, **{S.ERR_KEY: e}) for nav, s in (("avoid_past", 200), ("visbug21", 300)) for e in (0.0, 0.4)]
+    tab = noise_table_cols("simple", {"paper_rules": rows[2:], "teamnav": rows}, {"paper_rules": [], "teamnav": []})
+    assert [r[:2] for r in tab.rows] == [["Av. Past", "teamnav"], ["VisBug", "paper as written"], ["VisBug", "teamnav"]]
+    assert tab.rows[1][2] == tab.rows[2][2] == "300 (0.0 %) 1/1"

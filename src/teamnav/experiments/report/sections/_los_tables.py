@@ -285,8 +285,9 @@ def noise_table_cols(map_key: str, rows_by_col: dict[str, list[dict]], alone_by_
     """Figs. 16-17 as a table, a row per algorithm and column (:func:`noise_table`)."""
     per = {col: noise_table(map_key, rows_by_col.get(col, []), alone_by_col.get(col, [])) for col, _ in COLUMNS}
     cols = max((t.columns for t in per.values()), key=len)
-    rows = [[r[0], HEAD[col], *r[1:]] for i in range(max(len(t.rows) for t in per.values()))
-            for col, _ in COLUMNS if i < len(per[col].rows) for r in [per[col].rows[i]]]
+    by_label = {col: {r[0]: r for r in per[col].rows} for col, _ in COLUMNS}
+    rows = [[NAV_LABEL[nav], HEAD[col], *by_label[col][NAV_LABEL[nav]][1:]] for nav in L.NAVIGATORS
+            for col, _ in COLUMNS if NAV_LABEL[nav] in by_label[col]]
     first = per[COLUMNS[0][0]]
     return Table(first.title, [cols[0], "column", *cols[1:]], rows, first.note)
 
