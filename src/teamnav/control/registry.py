@@ -186,3 +186,6 @@ register("los-helper-v1", "teamnav.control.coop.los_help.helper:LosHelper")
 # Vaughan et al. trail papers: Blazing a trail (2000) and Try to see it my way (2002) (helper H4)
 register("blazing-trail-v1", "teamnav.control.coop.blazing_trail:BlazingTrail")
 register("trail-share-v1", "teamnav.control.coop.trail_share:TrailShare")
+
+# Beyond the papers (issue 22): the systems combined
+register("localized-v1", "teamnav.control.beyond.localized:Localized")
