@@ -174,19 +174,26 @@ def test_capped_cast_is_min_of_cast_and_cap(seed):
         np.testing.assert_array_equal(out, m)
 
 
+def _random_discs_and_fan(rng, seed, max_discs, fan_rays, random_rays):
+    """1..max_discs discs in a 12 m square (radii up to 0.5 m), an even half-turn fan of
+    ``fan_rays`` rays (odd seeds) or ``random_rays`` random directions, the fan's plan and
+    the discs' hash (cell side default, 0.7 or 1.5 m)."""
+    n_all = int(rng.integers(1, max_discs))
+    all_x = rng.uniform(0.0, 12.0, n_all)
+    all_y = rng.uniform(0.0, 12.0, n_all)
+    all_r = rng.uniform(0.0, 0.5, n_all)
+    angles = np.linspace(-math.pi / 2, math.pi / 2, fan_rays) if seed % 2 else rng.uniform(-4.0, 4.0, random_rays)
+    hsh = rh_mod._prepare(all_x, all_y, all_r, 10.0, float(rng.choice([0.0, 0.7, 1.5])))
+    return n_all, all_x, all_y, all_r, angles, beam_plan(angles), hsh
+
+
 @settings(max_examples=60, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.floats(0.0, 6.0), st.floats(0.0, 12.0))
 def test_two_reaches_test_every_disc_once(seed, inner, reach):
     """Discs within `inner`, then those beyond it up to `reach`: the same rows as one call
     (and as every ray against every disc, for the discs that matter)."""
     rng = np.random.default_rng(seed)
-    n_all = int(rng.integers(1, 150))
-    all_x = rng.uniform(0.0, 12.0, n_all)
-    all_y = rng.uniform(0.0, 12.0, n_all)
-    all_r = rng.uniform(0.0, 0.5, n_all)
-    angles = np.linspace(-math.pi / 2, math.pi / 2, 181) if seed % 2 else rng.uniform(-4.0, 4.0, 40)
-    plan = beam_plan(angles)
-    hsh = rh_mod._prepare(all_x, all_y, all_r, 10.0, float(rng.choice([0.0, 0.7, 1.5])))
+    n_all, all_x, all_y, all_r, angles, plan, hsh = _random_discs_and_fan(rng, seed, 150, 181, 40)
     nb = angles.shape[0]
     for i in range(min(n_all, 10)):
         th = float(rng.uniform(-7.0, 7.0))
@@ -274,13 +281,7 @@ def test_a_far_box_anywhere_reads_only_the_hash_grid(seed, bx, by, side):
     compiled, the read past ``start`` was silent or, now and then, a segfault that killed
     sweep workers (issue 27's "sporadic worker deaths")."""
     rng = np.random.default_rng(seed)
-    n_all = int(rng.integers(1, 40))
-    all_x = rng.uniform(0.0, 12.0, n_all)
-    all_y = rng.uniform(0.0, 12.0, n_all)
-    all_r = rng.uniform(0.0, 0.5, n_all)
-    angles = np.linspace(-math.pi / 2, math.pi / 2, 61) if seed % 2 else rng.uniform(-4.0, 4.0, 20)
-    plan = beam_plan(angles)
-    hsh = rh_mod._prepare(all_x, all_y, all_r, 10.0, float(rng.choice([0.0, 0.7, 1.5])))
+    n_all, all_x, all_y, all_r, angles, plan, hsh = _random_discs_and_fan(rng, seed, 40, 61, 20)
     nb = angles.shape[0]
     box = (bx, bx + side, by, by + side)
     i = int(rng.integers(0, n_all))
