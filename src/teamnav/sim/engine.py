@@ -113,6 +113,7 @@ class _Group:
     detector: Any = None
     detector_rng: Any = None
     has_log: bool = False
+    whole: bool = False  # its controller reads Simulation.observed instead of per-robot observations
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -267,6 +268,7 @@ class Simulation:
             else:
                 grp.sensors, grp.rngs, cfgs = sensors, sens_rngs, list(g.sensors)
                 grp.has_log = callable(getattr(brain[0], "log", None)) if brain else False
+                grp.whole = bool(getattr(cls, "observes_whole_group", False))
                 if g.detector is not None:
                     grp.detector = factories[1](g.detector, grid)
                     grp.detector_rng = np.random.default_rng(det_group_ss[gi])
@@ -299,6 +301,18 @@ class Simulation:
         self._y0 = np.empty(n)
         self._th0 = np.empty(n)
         self._decided = False
+        #: what the latest observations were built from, for readers of whole groups at once
+        #: (:mod:`teamnav.env`): ``(step, odometry poses (n, 3), odometry deltas (n, 3) or None,
+        #: {group index: [(sensor name, ranges (count, B), beam angles, max range)]}, inboxes,
+        #: events, {group index: per robot, a tuple of Detection} or None)`` for the per-robot
+        #: groups, after faults (inboxes and events: per robot, or None when no message / no
+        #: event this step; detections before faults); the very arrays whose rows the
+        #: per-robot observations view, so read them, never write them. None before the first
+        #: observation. A controller class with ``observes_whole_group = True`` (the
+        #: environment's agents) is handed no per-robot observation in a run without faults:
+        #: its ``step`` is not called, its robots keep the commands last stored
+        #: (:meth:`set_commands`), and it reads this instead.
+        self.observed: tuple | None = None
         self._pre_hooks: list[Callable] = []
         self._post_hooks: list[Callable] = []
 
@@ -601,6 +615,8 @@ class Simulation:
         shared = self._shared_readings() if self._scan_sets else None
         dets_of = self._shared_detections() if self._det_sets else None
         delta = self.odometry.delta.copy() if self._any_per_robot else None  # fresh, one copy for all groups
+        scans_of: dict[int, list] = {}
+        self.observed = (step, odom, delta, scans_of, inboxes, events, dets_of)
         fx = self.faults
         omit = None
         for grp in self._groups:
@@ -633,8 +649,11 @@ class Simulation:
                 readings, omit = fx.readings(grp.index, sl.start, readings)
                 if dets is not None:
                     dets = fx.detections(grp.index, sl.start, dets, grp.detector)
+            scans_of[grp.index] = readings
             if self._rec_sensing and self.recorder.wants(step):
                 self._record_sensing(grp, [(r[0], r[1]) for r in readings], dets)
+            if grp.whole and fx is None:
+                continue  # its controller reads self.observed
             stalled = s.stalled[sl].tolist()
             for k, brain in enumerate(grp.brain):
                 i = sl.start + k
