@@ -38,6 +38,8 @@ engine no longer steps (the environment then ends that agent's episode). The min
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 _NEEDED = ("_observe_and_decide", "_decided", "_v_cmd", "_w_cmd", "_dir_cmd")
@@ -78,6 +80,14 @@ def set_commands(sim, ids, v_mps, omega_radps, direction_rad) -> None:
     sim._w_cmd[ids] = omega_radps
     if direction_rad is not None:
         sim._dir_cmd[ids] = direction_rad
+
+
+def command_writer(sim):
+    """:func:`set_commands` for ``sim``, resolved once (an environment calls it every step)."""
+    hook = getattr(sim, "set_commands", None)
+    if callable(hook):
+        return functools.partial(hook, check=False)  # the environment checked its actions
+    return lambda ids, v_mps, omega_radps, direction_rad: set_commands(sim, ids, v_mps, omega_radps, direction_rad)
 
 
 def send_messages(sim, outgoing) -> None:

@@ -110,7 +110,7 @@ class RobotPort:
     def observation(self) -> Observation | None:
         """This step's :class:`~teamnav.control.types.Observation`, the very object a built-in
         brain would be handed (scans, odometry, detections, inbox with message bodies, events)."""
-        return self._proxy.obs
+        return self._core.observation(self.robot_id)
 
     # ---------------------------------------------------------------- writing
     def send(self, messages) -> None:
@@ -121,6 +121,7 @@ class RobotPort:
             if not isinstance(m, Message):
                 raise ValueError(f"agent {self.name!r}: send() takes teamnav.control.Message objects, got {type(m).__name__}")
             self._outbox.append(m)
+        self._core._ports_dirty = True  # the next step puts it on the radio
 
     def log(self, values: dict[str, Any]) -> None:
         """Values the recorder keeps for this robot at this step, as a brain's ``log()`` returns
@@ -130,6 +131,7 @@ class RobotPort:
         if not isinstance(values, dict):
             raise ValueError(f"agent {self.name!r}: log() takes a dict, got {type(values).__name__}")
         self._log = values
+        self._core._ports_dirty = True
 
     @property
     def finished(self) -> bool | None:
@@ -178,6 +180,10 @@ class AgentProxy:
     __slots__ = ("rng", "info", "obs", "port_finished")
 
     brain = None
+    #: the engine hands this group no per-robot observation in a run without faults (its
+    #: ``step`` is not called); the environment reads ``Simulation.observed`` and builds an
+    #: agent's observation object only when asked (``RobotPort.observation``)
+    observes_whole_group = True
 
     def __init__(self, params: Any, rng: np.random.Generator, info: RobotInfo) -> None:
         self.rng = rng

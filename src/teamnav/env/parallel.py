@@ -115,6 +115,8 @@ class ParallelEnv(_PZParallelEnv):
         self.observation_spaces = {a: copy.deepcopy(st.obs_spaces[a]) for a in self.possible_agents}
         self.action_spaces = {a: copy.deepcopy(st.act_spaces[a]) for a in self.possible_agents}
         self._core = EnvCore(st)
+        self._core.flat_single = True  # a one-agent block is handed out as that agent's dict
+        self._flat = [b.n == 1 for b in st.blocks]
         self._seeds = Seeds(st.scenario.seed)
         self._row = {a: j for j, a in enumerate(self.possible_agents)}
         # (block, row in block) of every agent
@@ -157,24 +159,39 @@ class ParallelEnv(_PZParallelEnv):
             extra = [ag for ag in actions if ag not in row]
             if extra:
                 raise ValueError(f"unknown agents {extra[:5]} in actions (agents: {', '.join(self.possible_agents[:8])} ...)")
-        res = self._core.step(a)
-        obs = self._split(res.obs, live)
-        reward = res.reward.tolist()
-        terminated = res.terminated.tolist()
+        core = self._core
+        res = core.step(a)
+        step = core.sim.step_index
         trunc = bool(res.truncated)
-        step = self._core.sim.step_index
-        terms = {n: v.tolist() for n, v in res.terms.items()}
         events = res.events
-        rew, term, truncs, infos = {}, {}, {}, {}
-        for ag in live:
-            j = row[ag]
-            rew[ag] = reward[j]
-            term[ag] = terminated[j]
-            truncs[ag] = trunc
-            infos[ag] = {"step": step, "events": events[j], "reward_terms": {n: v[j] for n, v in terms.items()}}
-        if trunc or self._core.episode_over:
+        if len(live) == st.n_agents:  # every agent live: rows are the agents' order
+            obs = self._split_all(res.obs)
+            rew = dict(zip(live, res.reward.tolist()))
+            term = dict(zip(live, res.terminated.tolist()))
+            truncs = dict.fromkeys(live, trunc)
+            if len(res.terms) == 1:
+                (name, v), = res.terms.items()
+                infos = {ag: {"step": step, "events": ev, "reward_terms": {name: x}}
+                         for ag, ev, x in zip(live, events, v.tolist())}
+            else:
+                names = list(res.terms)
+                infos = {ag: {"step": step, "events": ev, "reward_terms": dict(zip(names, xs))}
+                         for ag, ev, *xs in zip(live, events, *[v.tolist() for v in res.terms.values()])}
+        else:
+            obs = self._split(res.obs, live)
+            reward = res.reward.tolist()
+            terminated = res.terminated.tolist()
+            terms = {n: v.tolist() for n, v in res.terms.items()}
+            rew, term, truncs, infos = {}, {}, {}, {}
+            for ag in live:
+                j = row[ag]
+                rew[ag] = reward[j]
+                term[ag] = terminated[j]
+                truncs[ag] = trunc
+                infos[ag] = {"step": step, "events": events[j], "reward_terms": {n: v[j] for n, v in terms.items()}}
+        if trunc or core.episode_over:
             self.agents = []
-        elif any(terminated):
+        elif True in term.values():
             self.agents = [ag for ag in live if not term[ag]]
         if not self.agents and self.record_dir is not None and not self._saved:
             self.save_run(self.record_dir / f"episode-{self._episodes - 1:04d}", force=True)
@@ -182,10 +199,23 @@ class ParallelEnv(_PZParallelEnv):
 
     def _split(self, blocks: list[dict[str, np.ndarray]], agents: list[str]) -> dict[str, dict[str, np.ndarray]]:
         out = {}
-        where, row = self._where, self._row
+        where, row, flat = self._where, self._row, self._flat
         for ag in agents:
             b, k = where[row[ag]]
-            out[ag] = {key: arr[k] for key, arr in blocks[b].items()}
+            out[ag] = blocks[b] if flat[b] else {key: arr[k] for key, arr in blocks[b].items()}
+        return out
+
+    def _split_all(self, blocks: list[dict[str, np.ndarray]]) -> dict[str, dict[str, np.ndarray]]:
+        """:meth:`_split` for every agent: the rows of each block's arrays, block after block."""
+        out = {}
+        names = iter(self.possible_agents)
+        for d, flat in zip(blocks, self._flat):
+            if flat:  # one agent: already its own dict
+                out[next(names)] = d
+                continue
+            keys = list(d)
+            for vals, ag in zip(zip(*d.values()), names):  # iterating an array yields its rows (views)
+                out[ag] = dict(zip(keys, vals))
         return out
 
     def render(self):

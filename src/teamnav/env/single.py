@@ -57,6 +57,7 @@ class SingleRobotEnv(gym.Env):
         self.render_mode = render_mode
         self.record_dir = Path(record_dir) if record_dir is not None else None
         self._core = EnvCore(st)
+        self._core.flat_single = True  # its one agent's block is its observation, in its own shapes
         self._episodes = 0
         self._done = True
 
@@ -75,7 +76,7 @@ class SingleRobotEnv(gym.Env):
                              "there is nothing to drive")
         self._episodes += 1
         self._done = False
-        return {k: v[0] for k, v in obs[0].items()}, {"step": 0, "events": (), "seed": int(seed)}
+        return obs[0], {"step": 0, "events": (), "seed": int(seed)}
 
     def step(self, action):
         """Returns ``(observation, reward, terminated, truncated, info)``."""
@@ -93,7 +94,7 @@ class SingleRobotEnv(gym.Env):
             self._done = True
             if self.record_dir is not None:
                 self.save_run(self.record_dir / f"episode-{self._episodes - 1:04d}", force=True)
-        return {k: v[0] for k, v in res.obs[0].items()}, float(res.reward[0]), terminated, truncated, info
+        return res.obs[0], float(res.reward[0]), terminated, truncated, info
 
     def render(self):
         if self.render_mode is None:
