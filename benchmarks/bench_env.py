@@ -2,8 +2,8 @@
 
 Usage::
 
-    python benchmarks/bench_env.py [--quick] [--agents 1,10,100] [--steps N] [--repeats R]
-                                   [--threads N] [--batched] [--vmas-python PATH]
+    python benchmarks/bench_env.py [--quick] [--agents 1,10,100] [--swarm 1000] [--steps N] [--repeats R]
+                                   [--threads N] [--batched] [--copies C] [--vmas-python PATH]
 
 For N agents (robots of radius 0.2 m, unicycle, 180-beam 180° 8 m laser, σ = 1 cm) on the MIT
 basement map (``mit/basement_hallways_5cm.yaml``, 60 m x 60 m at 5 cm), started at random over
@@ -21,6 +21,12 @@ the whole map, every robot drives a constant (v, ω) of its own. Measured, in th
   ``benchmarks/peers/vmas_peer.py``): N agents with a 180-ray 8 m lidar in a 60 m square with
   40 boxes (VMAS has no grid maps), one environment, torch on the CPU with 1 thread. A missing
   peer is reported with its install command and marked "not measured".
+
+**Swarm** (``--swarm N``, default 1000, 0 to skip): N robots of the built-in ``swarm`` scenario
+(r = 0.08 m, 7-beam 0.14 m infrared proximity sensors, the 30 m walled arena), each driving a
+constant (v, ω) within its limits: the engine with ``ConstantDrive`` per robot, the engine with
+the scenario's own batched brain (``wander-batched-v1``, the engine's fastest path for these
+robots: one array brain, no per-robot observation), and the ParallelEnv.
 
 Each is built, stepped ``warmup`` times (numba kernels loaded, caches warm), then timed over
 ``steps`` steps, best of ``repeats`` (``time.perf_counter``). Recording is left as the
@@ -75,10 +81,20 @@ class ConstantDrive:
         return self.out
 
 
-def _constant(i: int) -> tuple[float, float]:
-    """Robot i's constant command (the same in the engine and the env runs)."""
+def _constant(i: int, arena: str = "basement") -> tuple[float, float]:
+    """Robot i's constant command (the same in the engine and the env runs), within its limits."""
     rng = np.random.default_rng(1000 + i)
-    return float(rng.uniform(0.1, 0.4)), float(rng.uniform(-0.5, 0.5))
+    v, w = float(rng.uniform(0.1, 0.4)), float(rng.uniform(-0.5, 0.5))
+    return (v / 2, w) if arena == "swarm" else (v, w)  # swarm robots: max_v 0.2 m/s
+
+
+class ConstantDriveSwarm(ConstantDrive):
+    """:class:`ConstantDrive` with the swarm robots' commands."""
+
+    def __init__(self, params, rng, info) -> None:
+        from teamnav.control.types import Action
+
+        self.out = (Action(*_constant(info.robot_id, "swarm")), [])
 
 
 def _overrides(n: int, controller: str) -> dict:
@@ -96,29 +112,32 @@ def _overrides(n: int, controller: str) -> dict:
     }
 
 
-def _scenario(n: int, controller: str, seed: int = 1):
+def _scenario(n: int, controller: str, seed: int = 1, arena: str = "basement"):
     from teamnav import load_scenario
 
+    if arena == "swarm":  # the built-in swarm, n robots, a brain of our choice
+        return load_scenario("swarm", overrides={"robots.0.count": n, "robots.0.controller": controller,
+                                                 "robots.0.params": {}}, seed=seed, duration_s=1e6)
     return load_scenario("demo", overrides=_overrides(n, controller), seed=seed, duration_s=1e6)
 
 
-def _build_engine(n: int, controller: str, warmup: int):
+def _build_engine(n: int, controller: str, warmup: int, arena: str = "basement"):
     from teamnav.experiments.spec import build_grid
     from teamnav.sim.engine import Simulation
 
-    scn = _scenario(n, controller)
+    scn = _scenario(n, controller, arena=arena)
     sim = Simulation(build_grid(scn), scn)
     for _ in range(warmup):
         sim.step()
     return sim.step
 
 
-def _build_parallel(n: int, warmup: int):
+def _build_parallel(n: int, warmup: int, arena: str = "basement"):
     from teamnav.env import ParallelEnv
 
-    env = ParallelEnv(_scenario(n, "idle-v1"))
+    env = ParallelEnv(_scenario(n, "idle-v1", arena=arena))
     env.reset(seed=1)
-    actions = {a: np.array(_constant(i)) for a, i in env.robot_ids.items()}
+    actions = {a: np.array(_constant(i, arena)) for a, i in env.robot_ids.items()}
     for _ in range(warmup):
         env.step(actions)
     return lambda: env.step(actions)
@@ -136,21 +155,35 @@ def _build_batched(n: int, copies: int, warmup: int):
     return lambda: env.step(actions)
 
 
+#: the clock of the timings: wall (``time.perf_counter``) or the process's CPU time
+#: (``time.process_time``, every thread's; ``--clock cpu``: on a shared, loaded machine a step
+#: is not charged for the time the process waits for a core)
+CLOCK = {"wall": time.perf_counter, "cpu": time.process_time}
+_clock = time.perf_counter
+
+
 def _time(fn, steps: int) -> float:
-    t0 = time.perf_counter()
+    t0 = _clock()
     for _ in range(steps):
         fn()
-    return (time.perf_counter() - t0) / steps
+    return (_clock() - t0) / steps
 
 
-def measure(n: int, steps: int, repeats: int, warmup: int, batched: int = 0) -> dict[str, float]:
+def measure(n: int, steps: int, repeats: int, warmup: int, batched: int = 0, arena: str = "basement") -> dict[str, float]:
     """Best seconds per step of each variant; the variants take turns, round after round, so
     a change of load on the machine hits them alike."""
-    fns = {
-        "engine": _build_engine(n, "bench_env:ConstantDrive", warmup),
-        "wander": _build_engine(n, "wander-v1", warmup),
-        "env": _build_parallel(n, warmup),
-    }
+    if arena == "swarm":
+        fns = {
+            "engine": _build_engine(n, "bench_env:ConstantDriveSwarm", warmup, arena),
+            "wander": _build_engine(n, "wander-batched-v1", warmup, arena),
+            "env": _build_parallel(n, warmup, arena),
+        }
+    else:
+        fns = {
+            "engine": _build_engine(n, "bench_env:ConstantDrive", warmup),
+            "wander": _build_engine(n, "wander-v1", warmup),
+            "env": _build_parallel(n, warmup),
+        }
     if batched:
         fns["batched"] = _build_batched(n, batched, warmup)
     best = {k: float("inf") for k in fns}
@@ -164,25 +197,30 @@ def measure(n: int, steps: int, repeats: int, warmup: int, batched: int = 0) -> 
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="fewer steps and repeats")
-    ap.add_argument("--agents", default="1,10,100", help="comma-separated agent counts")
+    ap.add_argument("--agents", default="1,10,100", help="comma-separated agent counts (basement, lasers); '' for none")
+    ap.add_argument("--swarm", type=int, default=1000, help="robots in the swarm arena row (0: no swarm row)")
     ap.add_argument("--steps", type=int, help="timed steps per repeat (default: per size)")
     ap.add_argument("--repeats", type=int, help="timings per cell, best kept (default 5, quick 2)")
+    ap.add_argument("--clock", choices=sorted(CLOCK), default="wall",
+                    help="wall: perf_counter (default); cpu: the process's CPU time (all threads), for a loaded machine")
     ap.add_argument("--threads", type=int, help="numba threads (NUMBA_NUM_THREADS must be set before import)")
     ap.add_argument("--batched", action="store_true", help="also time BatchedEnv (--copies copies) beside VMAS with as many environments")
     ap.add_argument("--copies", type=int, default=4, help="copies of the batched env and VMAS environments (default 4)")
     ap.add_argument("--vmas-python", default=os.environ.get("TEAMNAV_BENCH_VMAS_PYTHON", "/tmp/vmas-venv/bin/python"),
                     help="interpreter with vmas installed (the peer)")
     args = ap.parse_args(argv)
+    global _clock
+    _clock = CLOCK[args.clock]
     if args.threads:
         import numba
 
         numba.set_num_threads(args.threads)
     sys.path.insert(0, str(HERE.parent))  # so `bench_env:ConstantDrive` imports as a module
-    sizes = [int(x) for x in args.agents.split(",")]
+    sizes = [int(x) for x in args.agents.split(",") if x.strip()]
     repeats = args.repeats or (3 if args.quick else 9)
     warmup = 20
     print(f"teamnav.env benchmark: basement map, 180-beam laser, constant actions; best of {repeats}; "
-          f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}")
+          f"{args.clock} clock; {os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}")
     head = "| agents | engine steps/s | engine + wander-v1 steps/s | env steps/s | env agent-steps/s | env / engine (time per step) | env / engine + wander-v1 |"
     if args.batched:
         head += f" batched env agent-steps/s ({args.copies} copies) |"
@@ -207,6 +245,14 @@ def main(argv: list[str] | None = None) -> None:
             if vb:
                 print(f"  batched, {n} agents x {args.copies} copies: teamnav {n / t['batched']:,.0f} agent-steps/s, "
                       f"VMAS ({args.copies} envs, CPU) {vb:,.0f}: {n / t['batched'] / vb:,.1f}x", flush=True)
+    if args.swarm:
+        n = args.swarm
+        t = measure(n, args.steps or (20 if args.quick else 60), repeats, warmup, arena="swarm")
+        print(f"\nswarm arena, {n} robots (7-beam infrared proximity), load average {os.getloadavg()[0]:.2f}:\n"
+              f"| robots | engine steps/s | engine + wander-batched-v1 steps/s | env steps/s | env agent-steps/s | "
+              f"env / engine (time per step) | env / engine + wander-batched-v1 |\n|---:|---:|---:|---:|---:|---:|---:|\n"
+              f"| {n} | {1 / t['engine']:,.1f} | {1 / t['wander']:,.1f} | {1 / t['env']:,.1f} | {n / t['env']:,.0f} | "
+              f"{t['env'] / t['engine']:.2f}x | {t['env'] / t['wander']:.2f}x |", flush=True)
 
 
 if __name__ == "__main__":
