@@ -1,0 +1,80 @@
+"""scripts/collab_mcl_collapse.py (issue 26 §2/§3): one factor at a time on top of the paper's
+rules, tuning seeds only, and the measures it reports (Fox, Burgard, Kruppa & Thrun §5.1, Fig. 10a)."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+from teamnav.control.localizing import MCLWanderParams
+from teamnav.experiments.spec import load_scenario
+
+_PATH = Path(__file__).resolve().parents[1] / "scripts" / "collab_mcl_collapse.py"
+_spec = importlib.util.spec_from_file_location("collab_mcl_collapse", _PATH)
+cc = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(cc)
+
+
+def test_report_seeds_are_refused():
+    assert cc.parse_seeds("1000-1002,1010") == [1000, 1001, 1002, 1010]
+    with pytest.raises(ValueError, match="report seeds"):
+        cc.parse_seeds("7")
+    with pytest.raises(ValueError, match="report seeds"):
+        cc.parse_seeds("998-1001")
+
+
+def test_paper_baseline_is_paper_rules_on_robin_and_keeps_marian():
+    over = cc.overrides("detection", "paper", collaborate=False)
+    robin, marian = over["robots.1.params"], over["robots.0.params"]
+    assert robin["paper_rules"] is True and robin["collaborate"] is False
+    # Marian keeps sending in both conditions: only Robin's use of detections is switched
+    assert marian["collaborate"] is True and marian["paper_rules"] is True
+    load_scenario("collab-mcl-detection", overrides=over, seed=1000, duration_s=1.0)
+
+
+def test_a_factor_changes_only_its_own_setting():
+    over = cc.overrides("detection", "sigma", collaborate=True)
+    beam = over["robots.1.params"].get("beam", {})
+    assert beam["sigma_hit_m"] == 1.0
+    # the factor is on Robin only; Marian's filter is the paper-rules one
+    assert "beam" not in over["robots.0.params"] or over["robots.0.params"]["beam"].get("sigma_hit_m") != 1.0
+    hall = cc.overrides("hallway", "sigma", collaborate=False)["robots.0.params"]
+    # the scenario's other beam-mixture weights stay (a nested merge, not a replacement)
+    assert hall["beam"]["sigma_hit_m"] == 1.0 and hall["beam"]["z_hit"] == 0.7
+    assert hall["paper_rules"] is True and hall["collaborate"] is False
+
+
+@pytest.mark.parametrize("factor, field, value", [("temper", "likelihood_exponent", 0.03),
+                                                  ("ess", "resample_ess_fraction", 0.5)])
+def test_a_factor_that_is_a_paper_rule_writes_the_other_rules_out(factor, field, value):
+    p = cc.overrides("detection", factor, collaborate=True)["robots.1.params"]
+    assert "paper_rules" not in p and p[field] == value
+    for k, v in MCLWanderParams.PAPER_RULES.items():
+        if k != field:
+            assert p[k] == v, k
+    load_scenario("collab-mcl-detection", overrides=cc.overrides("detection", factor, True), seed=1000,
+                  duration_s=1.0)
+
+
+def test_one_short_run_measures_the_belief_and_a_flatter_likelihood_keeps_it_wider():
+    """At 6 s Robin's paper-rules belief is already within a metre on seed 1000 (the collapse the
+    script measures); the tempered likelihood (teamnav's 0.03) keeps it spread over metres."""
+    paper = cc.one_run(("detection", "paper_rules", "paper", 1000, True, 6.0))
+    temper = cc.one_run(("detection", "paper_rules", "temper", 1000, True, 6.0))
+    for r in (paper, temper):
+        assert {"n_5s", "spread_5s_m", "final_error_m", "det_n"} <= set(r)
+        assert r["det_n"] is None  # no detection in 6 s
+    assert paper["spread_5s_m"] < 1.0
+    assert temper["spread_5s_m"] > 3.0 * paper["spread_5s_m"]
+
+
+def test_teamnav_checks_load():
+    for name, (scen, _, _) in cc.TEAMNAV_CHECKS.items():
+        part = next(k for k, v in cc.PART_SCENARIO.items() if v == scen)
+        over = cc.overrides(part, name, collaborate=True, column="teamnav")
+        assert all("paper_rules" not in p for p in over.values())
+        load_scenario(scen, overrides=over, seed=1000, duration_s=1.0)
+    p = cc.overrides("detection", "detection-prior0.6", True, "teamnav")["robots.1.params"]
+    assert p["inject_lost_prior"] == 0.6 and p["inject_fraction"] == 0.2
