@@ -662,3 +662,19 @@ def test_try_section_judges_the_drift_claim_at_the_highest_k_both_ran():
     assert "at k = 6 the 2002 team keeps 44 %" in claim.ours and "the 2000 team 44 %" in claim.ours
     assert "k = 4: " in claim.ours  # every k is shown
     assert claim.holds is False
+
+
+def test_a_report_trial_reproduces_from_its_stored_scenario(tmp_path):
+    """Issue 25 §5: a sweep trial (as the report runs it, in a worker process) and a rerun of the
+    scenario file it stored give the same metrics, every one (wall times aside)."""
+    from teamnav.experiments.sweep import sweep
+
+    res = sweep("try-paper", seeds=[3], duration_s=600.0, out_dir=tmp_path / "sw", workers=1, artifacts=True,
+                progress=False)
+    assert res.done == 1
+    (trial,) = [p for p in (tmp_path / "sw" / "trials").iterdir() if p.is_dir()]
+    stored = json.loads((trial / "metrics.json").read_text())
+    again = run(load_scenario(trial / "scenario.yaml"), out_dir=tmp_path / "again", progress=False).metrics
+    skip = {k for k in stored if k.startswith("wall") or "warmup" in k}
+    assert {k: v for k, v in stored.items() if k not in skip} == {k: v for k, v in again.items() if k not in skip}
+    assert stored["trips_total"] > 0  # the runs did something worth comparing
