@@ -69,3 +69,15 @@ def test_beyond_claim_values_and_verdict():
     worse = localized_values({0.0: rows(20, 22), 4.0: rows(15, 16)}, {4.0: rows(8, 10)}, 3600.0)
     assert judge(claim, worse, 3600.0)[0] is False  # 15.5 < 0.9 x 21
     assert judge(claim, vals, 300.0)[0] is None  # 5-min runs are not judged
+
+
+def test_cheapest_particle_count_without_breakdown():
+    from teamnav.experiments.report.sections.beyond import cheapest_without_breakdown, particle_count
+
+    def row(n, censored):
+        return {"params": {"case": f"p{n}"}, "breakdown_censored": censored}
+
+    rows = [row(25, 0), row(25, 1), row(50, 1), row(50, 1), row(100, 1), row(500, 0)]
+    assert particle_count(rows[0]) == 25 and particle_count({"params": {"case": "x4"}}) is None
+    assert cheapest_without_breakdown(rows) == 50
+    assert cheapest_without_breakdown([row(25, 0), row(50, 0)]) is None

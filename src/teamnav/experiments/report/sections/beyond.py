@@ -19,10 +19,13 @@ two, and the section measures what the second buys against the systems it is bui
 Quick mode (CI): k = 0 and 4, the claim's two quick seeds, 5-min runs (the trail sections'
 quick drift runs, so ``report all --quick`` reuses the odometric ones): the pipeline works;
 no verdict (the rule needs 1-h runs). Full mode: k = 0, 1, 4, seeds 0-9, 1 h each
-(30 localized runs, about 35 CPU-s each on this machine).
+(30 localized runs, about 35 CPU-s each on this machine), and the particle counts (50 runs).
 
-Left for later (issue 22): the particle count that removes the 2000 algorithm's breakdown,
-localized LOS help, detections for the trail team, trails as LOS memory, and the papers' own
+Full mode also runs ``beyond-localized-particles``: the localized team at k = 4 with 25, 50,
+100, 200 and 500 samples per robot, and names the cheapest count none of whose runs broke
+down (issue 22: "the cheapest particle count that removes the 2000 algorithm's breakdown").
+
+Left for later (issue 22): localized LOS help, detections for the trail team, trails as LOS memory, and the papers' own
 future work.
 """
 
@@ -38,6 +41,30 @@ LOCALIZED_SWEEP = "beyond-localized-trails"
 #: the parts, by column label: odometry-only sweeps with the same drift cases
 PARTS = (("blazing-trail-v1, odometry", "blazing-drift"), ("trail-share-v1, odometry", "try-drift"))
 LOCALIZED_LABEL = "localized-v1 (MCL) + blazing-trail-v1"
+PARTICLES_SWEEP = "beyond-localized-particles"
+
+
+def particle_count(row: dict) -> int | None:
+    """Samples per robot of a ``beyond-localized-particles`` row (its case ``p<n>``), or None."""
+    label = (row.get("params") or {}).get("case", row.get("case"))
+    if isinstance(label, str) and label.startswith("p") and label[1:].isdigit():
+        return int(label[1:])
+    return None
+
+
+def cheapest_without_breakdown(rows: list[dict]) -> int | None:
+    """The smallest particle count none of whose runs broke down (every run still delivering in
+    its last 10 min: ``breakdown_censored`` = 1), or None when every count has a breakdown."""
+    by: dict[int, list[dict]] = {}
+    for r in rows:
+        n = particle_count(r)
+        if n is not None:
+            by.setdefault(n, []).append(r)
+    for n in sorted(by):
+        cens = T.values(by[n], "breakdown_censored")
+        if cens.size and bool((cens == 1).all()):
+            return n
+    return None
 
 
 def _settings(quick: bool) -> tuple[list[int], float, list[float]]:
@@ -113,6 +140,8 @@ def _localized_trails(ctx) -> list:
              ("localization does not help there (odometry is exact), and it costs the CPU in the table."
               if not helps0 > 0 else "a gain without drift, from the filter's pose being sharper than odometry's "
                                      "start-region error, or from the seeds."))
+    if not quick:
+        blocks += _particles(ctx, seeds, dur)
     blocks.append(Comparison(
         f"{claim.title} ({rule_text(claim)})",
         f"{claim.paper_number} ({claim.statement.section}: \u201c{claim.statement.quote}\u201d)",
@@ -120,6 +149,26 @@ def _localized_trails(ctx) -> list:
         holds,
         where + " History of the rule: " + history_text(claim)))
     return blocks
+
+
+def _particles(ctx, seeds: list[int], dur: float) -> list:
+    """Full mode: the localized team at k = 4 with 25 .. 500 samples per robot."""
+    rows = T.ok(ctx.sweep(PARTICLES_SWEEP, seeds=seeds, duration_s=dur))
+    by: dict[int, list[dict]] = {}
+    for r in rows:
+        n = particle_count(r)
+        if n is not None:
+            by.setdefault(n, []).append(r)
+    table = [[str(n), T.msd(_units_per_hour(by[n], dur), "{:.1f}"), _broke(by[n]),
+              T.msd(T.values(by[n], "loc_mean_error_m"), "{:.2f}", "m"), T.msd(_cpu_per_sim_hour(by[n], dur), "{:.0f}", "s")]
+             for n in sorted(by)]
+    cheapest = cheapest_without_breakdown(rows)
+    return [Table(
+        "The cheapest particle count that removes the breakdown (k = 4)",
+        ["samples per robot", "units per hour", "broke down", "MCL pose error", "CPU s per simulated hour"], table,
+        note=("cheapest count with no breakdown in any run: "
+              + (f"{cheapest}" if cheapest is not None else "none of those tried")
+              + f"; sweep {PARTICLES_SWEEP}, seeds {seeds[0]}-{seeds[-1]}, {dur / 60:g} min per run"))]
 
 
 def build(ctx) -> list:
