@@ -729,3 +729,18 @@ def test_noise_table_pairs_each_algorithms_rows_across_columns_when_one_column_l
     tab = noise_table_cols("simple", {"paper_rules": rows[2:], "teamnav": rows}, {"paper_rules": [], "teamnav": []})
     assert [r[:2] for r in tab.rows] == [["Av. Past", "teamnav"], ["VisBug", "paper as written"], ["VisBug", "teamnav"]]
     assert tab.rows[1][2] == tab.rows[2][2] == "300 (0.0 %) 1/1"
+
+
+def test_a_route_plan_without_a_paired_mean_at_a_team_fails_the_table2_trend():
+    # claims/los-help.yaml: plan C finished nothing with R1..3 while A and B did: the trend fails,
+    # it is not left unjudged (and a single plan with the same gap is judged as before)
+    a = _plan({0: [500, 500], 1: [400, 400], 2: [300, 300], 3: [200, 200]})
+    b = _plan({1: [420, 420], 2: [310, 310], 3: [210, 210]}, alone=a)
+    c = _plan({1: [450, 450], 2: [9999, 9999], 3: [220, 220]}, alone=a)
+    for r in c[2]:
+        r["metrics"]["los_finished"] = 0
+    ap = next(x for x in S.table_comparisons("complex", S.table_block("complex", a)[1], a, plans=[a, b, c])
+              if "Av. Past" in x.claim)
+    assert ap.holds is False and "route plan has no paired mean" in ap.differs and "plan C: n/a → n/a → n/a → n/a, 0 of 2 tasks" in ap.ours
+    assert next(x for x in S.table_comparisons("complex", S.table_block("complex", a)[1], a, plans=[a, b])
+                if "Av. Past" in x.claim).holds is True

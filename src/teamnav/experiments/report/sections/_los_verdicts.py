@@ -166,7 +166,12 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         p = [paper[nav][h][0] for h in hs if paper[nav][h] is not None]
         fails_first = not failing or not ok_hs or max(failing) < min(ok_hs)
         cid = f"table{tab}-{nav.replace('_', '-')}-falls"
-        if len(ms) < 2:
+        plan_gap = multi and bool(ok_hs) and not all(np.isfinite(ms))
+        if plan_gap:
+            # claims/los-help.yaml's plan rule: a plan without a paired mean at a team (it finished no
+            # task common to the teams that finished one) makes the trend fail
+            holds = False
+        elif len(ms) < 2:
             # one team size with results: a trend only if teams with fewer helpers failed outright
             # (no added helper with a finished mean on either side: no rise, NO_RISE)
             holds = None if not failing else (
@@ -185,7 +190,10 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         out.append(Comparison(
             f"Table {tab}: {NAV_LABEL[nav]} steps fall as helpers are added ({', '.join(TEAM_LABEL[h] for h in hs)})",
             " → ".join(f"{v:.1f}" for v in p), ours + ratio + note, holds,
-            "" if holds or holds is None else "not strictly falling at every added helper in our runs"
+            "" if holds or holds is None else
+            "a route plan has no paired mean at some team (no task finished by every team that finished one in "
+            "that plan), which fails the trend (claims/los-help.yaml)" if plan_gap else
+            "not strictly falling at every added helper in our runs"
             + (f" (each rise paired by task, {'; '.join(rises)})" if not multi and (rises := paired_rises(by_team, nav, ok_hs))
                else " (see the table)")))
     pf = group(by_team.get(0, []), NAV_KEY).get("potential_field", [])
