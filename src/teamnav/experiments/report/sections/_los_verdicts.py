@@ -101,6 +101,14 @@ def _judged(claim_id: str, values: dict[str, float], record: dict | None = None)
     return got[0]
 
 
+def _failed(claim_id: str, why: str, record: dict | None = None) -> bool:
+    """A verdict that fails before any metric can be read (its metric is not defined): False,
+    recorded with a NaN metric and ``why`` so that the claim table says "does not hold" too."""
+    if record is not None:
+        record[claim_id] = ({_claim(claim_id).metric: float("nan")}, (False, f"{why}: does not hold"))
+    return False
+
+
 def _team_mean(by_team: dict[int, list[dict]], nav: str, h: int) -> float:
     """Mean steps per target of ``nav`` with team ``h`` over its finished tasks (NaN: none)."""
     rs = group(by_team.get(h, []), NAV_KEY).get(nav, [])
@@ -170,18 +178,19 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         if plan_gap:
             # claims/los-help.yaml's plan rule: a plan without a paired mean at a team (it finished no
             # task common to the teams that finished one) makes the trend fail
-            holds = False
+            holds = _failed(cid, "a route plan has no paired mean at some team", record)
         elif len(ms) < 2:
             # one team size with results: a trend only if teams with fewer helpers failed outright
             # (no added helper with a finished mean on either side: no rise, NO_RISE)
             holds = None if not failing else (
-                False if not ok_hs else _judged(cid, {"max_rise": NO_RISE, "fails_first": float(fails_first)}, record))
+                _failed(cid, "no team finished a task", record) if not ok_hs
+                else _judged(cid, {"max_rise": NO_RISE, "fails_first": float(fails_first)}, record))
         elif all(np.isfinite(ms)):
             holds = _judged(cid, {"max_rise": float(np.diff(np.asarray(ms, dtype=float)).max()),
                                   "fails_first": float(fails_first)}, record)
         else:
             # some team between others has no paired mean: the trend cannot hold (None if none has one)
-            holds = False if any(np.isfinite(ms)) else None
+            holds = _failed(cid, "a team between others has no paired mean", record) if any(np.isfinite(ms)) else None
         ours = " → ".join([f"fails ({int(fin[h].sum())}/{fin[h].size})" for h in failing if h < min(ok_hs, default=9)]
                           + ["n/a" if not np.isfinite(m) else f"{m:.0f}" for m in ms]
                           + [f"fails ({int(fin[h].sum())}/{fin[h].size})" for h in failing if h > min(ok_hs, default=9)])
