@@ -4,6 +4,7 @@ Usage::
 
     python benchmarks/bench_env.py [--quick] [--agents 1,10,100] [--swarm 1000] [--steps N] [--repeats R]
                                    [--threads N] [--batched] [--copies C] [--vmas-python PATH]
+                                   [--clock wall|cpu] [--env-from REV]
 
 For N agents (robots of radius 0.2 m, unicycle, 180-beam 180° 8 m laser, σ = 1 cm) on the MIT
 basement map (``mit/basement_hallways_5cm.yaml``, 60 m x 60 m at 5 cm), started at random over
@@ -27,6 +28,11 @@ the whole map, every robot drives a constant (v, ω) of its own. Measured, in th
 constant (v, ω) within its limits: the engine with ``ConstantDrive`` per robot, the engine with
 the scenario's own batched brain (``wander-batched-v1``, the engine's fastest path for these
 robots: one array brain, no per-robot observation), and the ParallelEnv.
+
+**Before / after** (``--env-from REV``): ``src/teamnav/env`` of git revision ``REV`` is copied
+under another package name (``teamnav_env_<rev>``, its own imports rewritten) into a temporary
+folder and timed as one more ParallelEnv variant, "env @ REV", beside today's, on the same
+engine, in the same rounds.
 
 Each is built, stepped ``warmup`` times (numba kernels loaded, caches warm), then timed over
 ``steps`` steps, best of ``repeats`` (``time.perf_counter``). Recording is left as the
@@ -132,10 +138,32 @@ def _build_engine(n: int, controller: str, warmup: int, arena: str = "basement")
     return sim.step
 
 
-def _build_parallel(n: int, warmup: int, arena: str = "basement"):
+def _env_from(rev: str):
+    """The ParallelEnv class of ``src/teamnav/env`` at git revision ``rev``, as its own package."""
+    import importlib
+    import re
+    import tempfile
+
+    root = HERE.parents[1]
+    sha = subprocess.run(["git", "-C", str(root), "rev-parse", "--short", rev], capture_output=True, text=True,
+                         check=True).stdout.strip()
+    name = f"teamnav_env_{sha}"
+    folder = Path(tempfile.mkdtemp(prefix="bench_env_")) / name
+    folder.mkdir()
+    files = subprocess.run(["git", "-C", str(root), "ls-tree", "--name-only", sha, "src/teamnav/env/"],
+                           capture_output=True, text=True, check=True).stdout.split()
+    for f in files:
+        text = subprocess.run(["git", "-C", str(root), "show", f"{sha}:{f}"], capture_output=True, text=True,
+                              check=True).stdout
+        (folder / Path(f).name).write_text(re.sub(r"teamnav\.env\b", name, text))
+    sys.path.insert(0, str(folder.parent))
+    return importlib.import_module(name).ParallelEnv
+
+
+def _build_parallel(n: int, warmup: int, arena: str = "basement", cls=None):
     from teamnav.env import ParallelEnv
 
-    env = ParallelEnv(_scenario(n, "idle-v1", arena=arena))
+    env = (cls or ParallelEnv)(_scenario(n, "idle-v1", arena=arena))
     env.reset(seed=1)
     actions = {a: np.array(_constant(i, arena)) for a, i in env.robot_ids.items()}
     for _ in range(warmup):
@@ -169,7 +197,8 @@ def _time(fn, steps: int) -> float:
     return (_clock() - t0) / steps
 
 
-def measure(n: int, steps: int, repeats: int, warmup: int, batched: int = 0, arena: str = "basement") -> dict[str, float]:
+def measure(n: int, steps: int, repeats: int, warmup: int, batched: int = 0, arena: str = "basement",
+            before=None) -> dict[str, float]:
     """Best seconds per step of each variant; the variants take turns, round after round, so
     a change of load on the machine hits them alike."""
     if arena == "swarm":
@@ -186,6 +215,8 @@ def measure(n: int, steps: int, repeats: int, warmup: int, batched: int = 0, are
         }
     if batched:
         fns["batched"] = _build_batched(n, batched, warmup)
+    if before is not None:
+        fns["before"] = _build_parallel(n, warmup, arena, before)
     best = {k: float("inf") for k in fns}
     for _ in range(repeats):
         for k, fn in fns.items():
@@ -203,6 +234,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--repeats", type=int, help="timings per cell, best kept (default 5, quick 2)")
     ap.add_argument("--clock", choices=sorted(CLOCK), default="wall",
                     help="wall: perf_counter (default); cpu: the process's CPU time (all threads), for a loaded machine")
+    ap.add_argument("--env-from", metavar="REV", help="also time the ParallelEnv of git revision REV (before / after)")
     ap.add_argument("--threads", type=int, help="numba threads (NUMBA_NUM_THREADS must be set before import)")
     ap.add_argument("--batched", action="store_true", help="also time BatchedEnv (--copies copies) beside VMAS with as many environments")
     ap.add_argument("--copies", type=int, default=4, help="copies of the batched env and VMAS environments (default 4)")
@@ -217,6 +249,7 @@ def main(argv: list[str] | None = None) -> None:
         numba.set_num_threads(args.threads)
     sys.path.insert(0, str(HERE.parent))  # so `bench_env:ConstantDrive` imports as a module
     sizes = [int(x) for x in args.agents.split(",") if x.strip()]
+    before = _env_from(args.env_from) if args.env_from else None
     repeats = args.repeats or (3 if args.quick else 9)
     warmup = 20
     print(f"teamnav.env benchmark: basement map, 180-beam laser, constant actions; best of {repeats}; "
@@ -232,7 +265,7 @@ def main(argv: list[str] | None = None) -> None:
     print("|" + "---:|" * (head.count("|") - 1))
     for n in sizes:
         steps = args.steps or max(20, int((300 if args.quick else 1000) / max(1.0, n ** 0.8)))
-        t = measure(n, steps, repeats, warmup, args.copies if args.batched else 0)
+        t = measure(n, steps, repeats, warmup, args.copies if args.batched else 0, before=before)
         row = (f"| {n} | {1 / t['engine']:,.0f} | {1 / t['wander']:,.0f} | {1 / t['env']:,.0f} | {n / t['env']:,.0f} | "
                f"{t['env'] / t['engine']:.2f}x | {t['env'] / t['wander']:.2f}x |")
         if args.batched:
@@ -240,6 +273,9 @@ def main(argv: list[str] | None = None) -> None:
         v = vmas(args.vmas_python, n, max(3, min(50, 300 // n)), 2 if args.quick else 3) if have_vmas else None
         row += f" {v:,.0f} | {n / t['env'] / v:,.0f}x |" if v else " not measured | — |"
         print(row, flush=True)
+        if before is not None:
+            print(f"  env @ {args.env_from}: {t['before'] * 1e6:,.1f} us/step, {t['before'] / t['engine']:.2f}x the engine; "
+                  f"now {t['env'] * 1e6:,.1f} us/step, {t['env'] / t['engine']:.2f}x", flush=True)
         if args.batched and have_vmas:
             vb = vmas(args.vmas_python, n, max(3, min(20, 60 // n)), 2 if args.quick else 3, args.copies)
             if vb:
@@ -247,12 +283,15 @@ def main(argv: list[str] | None = None) -> None:
                       f"VMAS ({args.copies} envs, CPU) {vb:,.0f}: {n / t['batched'] / vb:,.1f}x", flush=True)
     if args.swarm:
         n = args.swarm
-        t = measure(n, args.steps or (20 if args.quick else 60), repeats, warmup, arena="swarm")
+        t = measure(n, args.steps or (20 if args.quick else 60), repeats, warmup, arena="swarm", before=before)
         print(f"\nswarm arena, {n} robots (7-beam infrared proximity), load average {os.getloadavg()[0]:.2f}:\n"
               f"| robots | engine steps/s | engine + wander-batched-v1 steps/s | env steps/s | env agent-steps/s | "
               f"env / engine (time per step) | env / engine + wander-batched-v1 |\n|---:|---:|---:|---:|---:|---:|---:|\n"
               f"| {n} | {1 / t['engine']:,.1f} | {1 / t['wander']:,.1f} | {1 / t['env']:,.1f} | {n / t['env']:,.0f} | "
               f"{t['env'] / t['engine']:.2f}x | {t['env'] / t['wander']:.2f}x |", flush=True)
+        if before is not None:
+            print(f"  env @ {args.env_from}: {t['before'] * 1e3:,.2f} ms/step, {t['before'] / t['engine']:.2f}x the engine; "
+                  f"now {t['env'] * 1e3:,.2f} ms/step, {t['env'] / t['engine']:.2f}x", flush=True)
 
 
 if __name__ == "__main__":
