@@ -13,7 +13,9 @@ the motion of step k + 1, no extra step of latency), the environment
 1. takes the first decision of an episode at reset, which ``step()`` otherwise does lazily
    (:func:`decide_first`), so reset can return the observation of step 0 before any motion;
 2. overwrites the agents' stored commands after they decided and before the next motion
-   (:func:`set_commands`); their proxy brains returned a placeholder ``Action.stop()``.
+   (:func:`set_commands`); their proxy brains returned a placeholder ``Action.stop()`` (or,
+   for a group of agents only, were not stepped: ``observes_whole_group``, and the
+   environment reads ``Simulation.observed``).
 
 Both write engine internals (``_observe_and_decide``, ``_decided``, ``_v_cmd``, ``_w_cmd``,
 ``_dir_cmd``). Two more helpers keep agents under the scenario's ``faults`` as the engine keeps

@@ -6,7 +6,11 @@ its :class:`~teamnav.control.protocol.RobotInfo`). A proxy either
 
 - *stands in for an agent*: ``step(obs)`` keeps the observation for the environment and
   returns ``Action.stop()``, a placeholder the environment replaces by the agent's action
-  before the next motion (:mod:`teamnav.env._engine`); or
+  before the next motion (:mod:`teamnav.env._engine`); or, for a group whose robots are all
+  agents (:class:`AgentProxy`, ``observes_whole_group``) in a run without faults, is not
+  stepped at all: the engine builds no per-robot observation, the environment reads the
+  group's arrays (``Simulation.observed``) and builds an agent's observation object only
+  when :attr:`RobotPort.observation` asks for it, as the engine would have built it; or
 - *wraps the scenario's own brain* for a robot of that group that is not an agent (a
   teammate of :class:`~teamnav.env.SingleRobotEnv`'s robot in the same group): that brain is
   built with the same parameters, random stream and ``RobotInfo`` as the engine would build
@@ -108,8 +112,9 @@ class RobotPort:
 
     @property
     def observation(self) -> Observation | None:
-        """This step's :class:`~teamnav.control.types.Observation`, the very object a built-in
-        brain would be handed (scans, odometry, detections, inbox with message bodies, events)."""
+        """This step's :class:`~teamnav.control.types.Observation`, the object a built-in brain
+        would be handed (scans, odometry, detections, inbox with message bodies, events): the
+        engine's, or built from the same arrays as the engine builds it (one object per step)."""
         return self._core.observation(self.robot_id)
 
     # ---------------------------------------------------------------- writing
