@@ -2,7 +2,8 @@
 cell's "mean (std %) finished/run" (Sgorbissa & Arkin §6).
 
 Split from :mod:`.los_help` (no behaviour change); what the section measured over time is in
-``docs/report/los-help.md``.
+``docs/report/los-help.md``. Also the route plans of Table 2's robustness column (issue 21 §4,
+:data:`ROUTE_PLANS`) and the scenario files of plans B and C (:func:`write_route_plan_files`).
 """
 
 from __future__ import annotations
