@@ -20,7 +20,9 @@ A scenario is a YAML file validated by :class:`Scenario`, which extends the simu
 With a ``builtin`` map, named places of that environment can stand in for coordinates: a
 ``places`` entry ``{place: home, radius_m: 1.5, event: took_resource}`` takes its name and
 position from the map's place ``home``, and a group's ``start: {near: home, spread_m: 1.0}``
-becomes the square ``region`` of half-side ``spread_m`` around it. Both are replaced by plain
+becomes the square ``region`` of half-side ``spread_m`` around it; a moving place's waypoint
+``{t_s: 600, place: c3_east_end}`` takes that place's position (``motion``:
+:class:`~teamnav.sim.config.PlaceMotion`). All are replaced by plain
 numbers when the scenario is validated, so the resolved scenario that a run writes needs no
 map lookup to reproduce.
 
@@ -236,6 +238,14 @@ class MapSpec(Model):
 
 
 # ---------------------------------------------------------------------------- scenario
+def _named_waypoints(place: Any) -> bool:
+    """Whether a raw ``places`` entry has a moving ``motion.path`` waypoint given by name
+    (``{t_s: 600, place: c3_east_end}``: a built-in map's place stands in for ``x_m``/``y_m``)."""
+    motion = place.get("motion") if isinstance(place, dict) else None
+    path = motion.get("path") if isinstance(motion, dict) else None
+    return isinstance(path, (list, tuple)) and any(isinstance(w, dict) and "place" in w for w in path)
+
+
 class Scenario(SimConfig):
     """A complete experiment: the simulation (:class:`SimConfig`) plus map, duration, metrics.
 
@@ -282,7 +292,7 @@ class Scenario(SimConfig):
         places, robots = data.get("places"), data.get("robots")
         places = places if isinstance(places, (list, tuple)) else ()  # anything else is the field validators' to report
         robots = robots if isinstance(robots, (list, tuple)) else ()
-        uses_places = any(isinstance(p, dict) and "place" in p for p in places) or any(
+        uses_places = any(isinstance(p, dict) and ("place" in p or _named_waypoints(p)) for p in places) or any(
             isinstance(g, dict) and isinstance(g.get("start"), dict) and "near" in g["start"] for g in robots
         )
         if not uses_places:
@@ -323,6 +333,19 @@ class Scenario(SimConfig):
                         raise ValueError(f"places[{i}]: give either 'place' or 'x_m'/'y_m', not both")
                     p["x_m"], p["y_m"] = where(f"places[{i}].place", ref)
                     p.setdefault("name", ref)
+                if isinstance(p, dict) and _named_waypoints(p):
+                    p = dict(p)
+                    p["motion"] = motion = dict(p["motion"])
+                    path = []
+                    for j, w in enumerate(motion["path"]):
+                        if isinstance(w, dict) and "place" in w:
+                            w = dict(w)
+                            ref = w.pop("place")
+                            if "x_m" in w or "y_m" in w:
+                                raise ValueError(f"places[{i}].motion.path[{j}]: give either 'place' or 'x_m'/'y_m', not both")
+                            w["x_m"], w["y_m"] = where(f"places[{i}].motion.path[{j}].place", ref)
+                        path.append(w)
+                    motion["path"] = path
                 places.append(p)
             data["places"] = places
         if isinstance(data.get("robots"), (list, tuple)):

@@ -242,10 +242,58 @@ class RadioConfig(Model):
 
 
 # ---------------------------------------------------------------------------- places / events
+#: a place coordinate or waypoint time: finite and bounded, like the faults' [m], [s]
+PlaceCoord = Annotated[float, Field(ge=-1e6, le=1e6)]
+
+
+class PlaceWaypoint(Model):
+    """Where a moving place is at time ``t_s`` [s] (world metres ``x_m``, ``y_m``)."""
+
+    t_s: float = Field(gt=0.0, le=1e7)
+    x_m: PlaceCoord
+    y_m: PlaceCoord
+
+
+class PlaceMotion(Model):
+    """How a place moves (beyond the papers: Vaughan et al. 2000 §6 names a moving resource as
+    future work and gives no motion; this is ours). The place is at its own ``x_m``, ``y_m`` at
+    t = 0 and at each waypoint of ``path`` at that waypoint's ``t_s`` (strictly increasing).
+
+    - ``mode="linear"``: straight-line, constant-speed motion between consecutive positions
+      (slow motion); after the last waypoint the place stays there.
+    - ``mode="jump"``: the place stays where it is until the next waypoint's time, then is there
+      at once (it is at waypoint k from ``t_s[k]`` inclusive).
+    - ``period_s`` (optional, > the last ``t_s``): the motion repeats with this period; from the
+      last waypoint the place goes back to its start, moving in ``linear`` mode, jumping at
+      ``period_s`` in ``jump`` mode.
+
+    :func:`teamnav.sim.events.place_positions` evaluates it.
+    """
+
+    mode: Literal["linear", "jump"] = "linear"
+    path: tuple[PlaceWaypoint, ...] = Field(min_length=1, max_length=10_000)
+    period_s: float | None = Field(None, gt=0.0, le=1e7)
+
+    @model_validator(mode="after")
+    def _times_increase(self) -> "PlaceMotion":
+        ts = [w.t_s for w in self.path]
+        for j in range(1, len(ts)):
+            if not ts[j] > ts[j - 1]:
+                raise ValueError(f"path[{j}].t_s: waypoint times must increase strictly; expected > "
+                                 f"{ts[j - 1]} (path[{j - 1}].t_s), got {ts[j]}")
+        if self.period_s is not None and not self.period_s > ts[-1]:
+            raise ValueError(f"period_s: expected more than the last waypoint time {ts[-1]} s, got {self.period_s}")
+        return self
+
+
 class PlaceConfig(Model):
     """A named disc region. A robot entering it (centre within ``radius_m``) fires ``event``
     for that robot (the trail scenarios: "took_resource" at the source, "given_resource" at
-    home); with ``on="inside"`` it fires every step the robot is inside instead of on entry."""
+    home); with ``on="inside"`` it fires every step the robot is inside instead of on entry.
+
+    ``motion`` (:class:`PlaceMotion`, optional; beyond the papers) moves the disc over time from
+    ``x_m``, ``y_m`` (its position at t = 0). Without it the place is static and the field is left
+    out of the resolved scenario (config hashes unchanged)."""
 
     name: str
     x_m: float
@@ -253,6 +301,14 @@ class PlaceConfig(Model):
     radius_m: float = Field(1.0, gt=0.0)
     event: str | None = None
     on: Literal["enter", "inside"] = "enter"
+    motion: PlaceMotion | None = None
+
+    @model_serializer(mode="wrap")
+    def _without_static_motion(self, handler):
+        data = handler(self)
+        if isinstance(data, dict) and self.motion is None:
+            data.pop("motion", None)
+        return data
 
 
 # ---------------------------------------------------------------------------- faults
