@@ -250,3 +250,31 @@ def test_robot_driving_through_gets_the_event_at_the_moved_place_not_the_old_spo
         ]
     seen = sim.brains[0][0].seen
     assert [o.step for o in seen if o.events] == [e[0] for e in fired]
+
+
+# ------------------------------------------------------------------------ the report block (section beyond)
+def test_motion_speed_counts_the_cycle_distance_over_its_duration():
+    from teamnav.experiments.report.sections.beyond import motion_speed_mps
+
+    far = {"t_s": 600.0, "x_m": 24.4, "y_m": 15.9}
+    assert motion_speed_mps((5.4, 15.9), None) == 0.0
+    jump = motion_speed_mps((5.4, 15.9), {"mode": "jump", "path": [far], "period_s": 1200.0})
+    glide = motion_speed_mps((5.4, 15.9), {"mode": "linear", "path": [far], "period_s": 1200.0})
+    assert jump == pytest.approx(38.0 / 1200.0) and glide == jump
+    assert motion_speed_mps((0.0, 0.0), {"path": [{"t_s": 10.0, "x_m": 3.0, "y_m": 4.0}]}) == pytest.approx(0.5)
+
+
+def test_moving_resource_block_quick_runs_its_two_cases(tmp_path):
+    from teamnav.experiments.report.context import SweepContext
+    from teamnav.experiments.report.model import Plot, Table
+    from teamnav.experiments.report.sections.beyond import MOVING_QUICK_CASES, _moving_resource
+
+    ctx = SweepContext(tmp_path, quick=True, workers=1, section="beyond")
+    blocks = _moving_resource(ctx)
+    (table,) = [b for b in blocks if isinstance(b, Table)]
+    assert [r[0] for r in table.rows] == list(MOVING_QUICK_CASES)
+    assert table.rows[0][1] == "0.0000" and float(table.rows[1][1]) == pytest.approx(0.05, rel=1e-9)
+    assert all("(n = 1)" in r[2] for r in table.rows), table.rows  # one seed each, and it finished
+    (plot,) = [b for b in blocks if isinstance(b, Plot)]
+    assert [s.x for s in plot.series] == [[0.0, pytest.approx(0.05)]]
+    assert "no verdict" in plot.caption

@@ -25,7 +25,14 @@ Full mode also runs ``beyond-localized-particles``: the localized team at k = 4 
 100, 200 and 500 samples per robot, and names the cheapest count none of whose runs broke
 down (issue 22: "the cheapest particle count that removes the 2000 algorithm's breakdown").
 
-Left for later (issue 22): localized LOS help, detections for the trail team, trails as LOS memory, and the papers' own
+The papers' future work, **a moving resource** (Vaughan et al. 2000 §6; the motion is ours,
+:class:`~teamnav.sim.config.PlaceMotion`; scenario and sweep ``beyond-moving-resource``):
+trail-share-v1 while the source stays, jumps every 30-5 min or glides at 0.01-0.05 m/s between
+two spots of C3; units per hour against the source's mean speed, no claim (the paper gives no
+number). Quick mode: the static and the fastest gliding case, seed 0, 5 min (two runs); full
+mode: the 8 cases x seeds 0-9 x 1 h (about 9 CPU-s per run here).
+
+Left for later (issue 22): localized LOS help, detections for the trail team, trails as LOS memory, and the papers' other
 future work.
 """
 
@@ -33,7 +40,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from teamnav.experiments.report.model import Comparison, Missing, SectionSpec, Table, Text
+from teamnav.experiments.report.model import Comparison, Missing, Plot, SectionSpec, Series, Table, Text
 from teamnav.experiments.report.sections import _trails as T
 
 PAPER = "vaughan-stoy-sukhatme-mataric-blazing-a-trail.txt"
@@ -171,6 +178,85 @@ def _particles(ctx, seeds: list[int], dur: float) -> list:
               + f"; sweep {PARTICLES_SWEEP}, seeds {seeds[0]}-{seeds[-1]}, {dur / 60:g} min per run"))]
 
 
+# ---------------------------------------------------------------------------- a moving resource
+MOVING_SWEEP = "beyond-moving-resource"
+#: quick mode: the static source and the fastest glide (5-min runs: a jump every 5 min would not show)
+MOVING_QUICK_CASES = ("static", "glide-0.05")
+
+
+def motion_speed_mps(start_xy: tuple[float, float], motion: dict | None) -> float:
+    """Mean speed [m/s] of a place moving per ``motion`` (a ``PlaceMotion`` dict) from ``start_xy``:
+    the distance of one cycle (start, waypoints, and back to the start when periodic) over its
+    duration; 0 for a static place. Jumps count the distance jumped, so a jump every T between two
+    spots d apart is d / T, comparable with a glide at that speed."""
+    if not motion:
+        return 0.0
+    from teamnav.sim.config import PlaceMotion
+
+    m = PlaceMotion.model_validate(motion)
+    pts = [start_xy] + [(w.x_m, w.y_m) for w in m.path]
+    if m.period_s is not None:
+        pts.append(start_xy)
+    dist = sum(float(np.hypot(b[0] - a[0], b[1] - a[1])) for a, b in zip(pts, pts[1:]))
+    span = m.period_s if m.period_s is not None else m.path[-1].t_s
+    return dist / span
+
+
+def _moving_resource(ctx) -> list:
+    """Issue 22, the papers' future work: a moving resource (Vaughan et al. 2000 §6; the motion is ours).
+
+    trail-share-v1 (the 2002 algorithm: Places updated on task events, crumbs expire after 4 min,
+    Try §3) forages while the source stays, jumps or glides between two spots of C3; units per hour
+    against the source's mean speed. No claim (the papers give no number): the curve, no verdict."""
+    from teamnav.experiments.spec import load_scenario
+    from teamnav.experiments.sweep import load_sweep
+
+    quick = bool(ctx.quick)
+    missing = T.brains_missing(["trail-share-v1"])
+    if missing is not None:
+        return [missing]
+    spec = load_sweep(MOVING_SWEEP)
+    labels = list(MOVING_QUICK_CASES) if quick else [str(c.get("case")) for c in spec.cases]
+    seeds, dur = ([0], 300.0) if quick else (list(range(10)), 3600.0)
+    src = next(p for p in load_scenario(spec.scenario).places if p.event == "took_resource")
+    cases = {str(c.get("case")): c for c in spec.cases}
+    speed = {lab: motion_speed_mps((src.x_m, src.y_m), cases[lab].get("places.1.motion")) for lab in labels}
+    data = T.by_case(T.ok(ctx.sweep(T.case_spec(MOVING_SWEEP, labels), seeds=seeds, duration_s=dur)))
+    rows, curves = [], {"jump": [], "glide": []}
+    for lab in labels:
+        r = data.get(lab, [])
+        u = _units_per_hour(r, dur)
+        kind = lab.split("-")[0]
+        rows.append([lab, f"{speed[lab]:.4f}", T.msd(u, "{:.1f}"), _broke(r), T.msd(T.values(r, "trip_time_s_after_mean"), "{:.0f}", "s")])
+        for k in (("jump", "glide") if kind == "static" else (kind,)):
+            if k in curves and u.size:
+                curves[k].append((speed[lab], float(u.mean()), float(np.percentile(u, 25)), float(np.percentile(u, 75))))
+    series = []
+    for k, pts in curves.items():
+        if len(pts) > 1:
+            pts.sort()
+            series.append(Series(f"source {'jumps' if k == 'jump' else 'glides'} (static at 0)", [p[0] for p in pts],
+                                 [p[1] for p in pts], [p[2] for p in pts], [p[3] for p in pts], style="line+points"))
+    far = next(c["places.1.motion"]["path"][0] for c in spec.cases if c.get("places.1.motion"))
+    d = float(np.hypot(far["x_m"] - src.x_m, far["y_m"] - src.y_m))
+    blocks: list = [Text(
+        f"The papers' future work, a moving resource (Vaughan et al. 2000 §6; the motion is ours): trail-share-v1 "
+        f"(scenario {spec.scenario}: try-to-see-it-my-way's four robots and drift) while the source moves along the "
+        f"north corridor between x {src.x_m:g} m and a spot {d:.0f} m east of it, the same route length from home "
+        "either side of corner 2. It jumps there and back every T, or glides there and back at v; its mean speed is "
+        f"the distance it covers per cycle over the cycle. Seeds {seeds[0]}-{seeds[-1]}, {dur / 60:g} min per run"
+        + (" (quick mode: two cases, one seed; the pipeline works, the numbers are not the result)." if quick else "."))]
+    blocks.append(Table(
+        "Units per hour against the source's speed",
+        ["case", "source mean speed [m/s]", "units per hour", "broke down (no unit in the last 10 min)",
+         "trip time after the first trail"],
+        rows, note=f"mean ± std over runs (n = runs); sweep {MOVING_SWEEP}."))
+    if series:
+        blocks.append(Plot("Delivery rate against resource speed", "source mean speed [m/s]", "units per hour", series,
+                           caption="mean over seeds, band 25-75 %; no paper number to compare (no verdict)."))
+    return blocks
+
+
 def build(ctx) -> list:
     """The section's blocks (one combination so far)."""
     blocks: list = [Text(
@@ -178,9 +264,9 @@ def build(ctx) -> list:
         "built from. Every combination is a registered brain composing the papers' rules (no copies); its module "
         "docstring says which. Only combination 1 is built so far; the others of issue 22 are listed as missing.")]
     blocks += _localized_trails(ctx)
+    blocks += _moving_resource(ctx)
     for what in ("localized LOS help (frames from MCL poses)", "detections help the trail team (eqs. 13-14)",
-                 "trails as LOS memory", "the papers' future work (negative detections, data association, a moving "
-                 "resource, restricted radio, N places)"):
+                 "trails as LOS memory", "the papers' future work (negative detections, data association, restricted radio, N places)"):
         blocks.append(Missing(what=what, why="not built yet (issue 22)"))
     return blocks
 
