@@ -50,13 +50,14 @@ TUNING_SEED_MIN = 1000
 #: name -> (what changes, params merged into the robots' params on top of ``paper_rules: true``,
 #: the paper's status of the changed setting). One factor each against ``paper``.
 FACTORS: dict[str, tuple[str, dict, str]] = {
-    "paper": ("paper_rules: true as the report runs it (KLD floor 500, beam sigma_hit 0.2 m, 90 beams, "
-              "motion alpha (0.1, 0.05, 0.05, 0.05), exponent 1, resampling every update)", {}, "baseline"),
+    "paper": ("paper_rules: true as the report runs it (KLD floor 500; Robin: 90 laser beams, sigma_hit 0.2 m; "
+              "hallway: 16 sonar cones, 0.3 m; motion alpha (0.1, 0.05, 0.05, 0.05); exponent 1; resampling "
+              "every update)", {}, "baseline"),
     "floor": ("KLD floor 500 -> 5000 samples", {"min_particles": 5000}, "unspecified (gap-fill)"),
     "fixed": ("fixed 10000 samples (no KLD adaptation)", {"adaptive": False}, "unspecified (gap-fill)"),
     "motion": ("motion noise x3: alpha (0.3, 0.15, 0.15, 0.15)", {"motion": {"alpha": [0.3, 0.15, 0.15, 0.15]}},
                "unspecified (gap-fill)"),
-    "sigma": ("beam model sigma_hit 0.2 -> 1.0 m", {"beam": {"sigma_hit_m": 1.0}}, "unspecified (gap-fill)"),
+    "sigma": ("beam model sigma_hit 0.2 m (laser) or 0.3 m (sonar) -> 1.0 m", {"beam": {"sigma_hit_m": 1.0}}, "unspecified (gap-fill)"),
     "beams": ("every 10th beam (9 of 90 laser beams; 2 of 16 sonar cones)", {"beam_stride": 10},
               "unspecified (gap-fill)"),
     "sigma+beams": ("sigma_hit 1.0 m and every 10th beam (both unspecified values at once)",
@@ -261,6 +262,56 @@ def paired(rows: list[dict], key: str = "ttl_s") -> list[str]:
     return lines
 
 
+def _mean(v) -> float | None:
+    v = [x for x in v if x is not None and math.isfinite(x)]
+    return round(float(np.mean(v)), 2) if v else None
+
+
+def table_rows(rows: list[dict]) -> list[dict]:
+    """The numbers the report section and docs/report/collab-mcl.md quote, one dict per (part,
+    column, factor), rounded to cm / 0.01 s: means over runs (``runs`` seeds), counts of runs."""
+    out = []
+    keys = sorted({(r["part"], r["column"], r["factor"]) for r in rows})
+    for part, column, factor in keys:
+        rs = [r for r in rows if (r["part"], r["column"], r["factor"]) == (part, column, factor)]
+        a = {r["seed"]: r for r in rs if not r["collaborate"]}
+        t = {r["seed"]: r for r in rs if r["collaborate"]}
+        d = {"part": part, "column": column, "factor": factor, "seeds": sorted(set(a) | set(t))}
+        if part == "detection":
+            both = list(a.values()) or list(t.values())
+            d.update({"spread_5s_m": _mean(r["spread_5s_m"] for r in both),
+                      "spread_5s_median_m": round(float(np.median([r["spread_5s_m"] for r in both])), 2),
+                      "spread_30s_m": _mean(r["spread_30s_m"] for r in both),
+                      "det_n": _mean(r["det_n"] for r in t.values()),
+                      "det_spread_m": _mean(r["det_spread_m"] for r in t.values()),
+                      "det_error_m": _mean(r["det_error_m"] for r in t.values()),
+                      "det_right": sum(1 for r in t.values() if r["det_error_m"] is not None and r["det_error_m"] < 1.5),
+                      "alone_final_m": _mean(r["final_error_m"] for r in a.values()),
+                      "alone_localized": sum(r["final_error_m"] < 1.5 for r in a.values()),
+                      "team_final_m": _mean(r["final_error_m"] for r in t.values()),
+                      "team_localized": sum(r["final_error_m"] < 1.5 for r in t.values()),
+                      "alone_runs": len(a), "team_runs": len(t)})
+        else:
+            diffs = [t[s]["ttl_s"] - a[s]["ttl_s"] for s in sorted(set(a) & set(t))]
+            d.update({"alone_ttl_s": _mean(r["ttl_s"] for r in a.values()),
+                      "team_ttl_s": _mean(r["ttl_s"] for r in t.values()),
+                      "paired_s": _mean(diffs),
+                      "paired_se_s": round(float(np.std(diffs, ddof=1) / math.sqrt(len(diffs))), 2)
+                      if len(diffs) > 1 else None,
+                      "faster": sum(x < 0 for x in diffs), "pairs": len(diffs),
+                      "alone_final_localized": _mean(r["final_localized"] for r in a.values()),
+                      "team_final_localized": _mean(r["final_localized"] for r in t.values()),
+                      "team_all_localized": sum(bool(r.get("all_localized")) for r in t.values()),
+                      "alone_all_localized": sum(bool(r.get("all_localized")) for r in a.values()),
+                      "alone_runs": len(a), "team_runs": len(t)})
+            for k in ("sonar", "laser"):
+                if any(f"final_localized_{k}" in r for r in rs):
+                    d[f"alone_localized_{k}"] = _mean(r.get(f"final_localized_{k}") for r in a.values())
+                    d[f"team_localized_{k}"] = _mean(r.get(f"final_localized_{k}") for r in t.values())
+        out.append(d)
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("part", choices=sorted(PART_SCENARIO) + ["summary"],
@@ -278,6 +329,8 @@ def main(argv: list[str] | None = None) -> int:
         for part in sorted({r["part"] for r in rows}):
             rs = [r for r in rows if r["part"] == part]
             print("\n".join(summarize(rs) + paired(rs, "ttl_s") + paired(rs, "final_error_m")))
+        for d in table_rows(rows):
+            print(json.dumps(d))
         return 0
     names = FACTORS if a.column == "paper_rules" else [k for k, v in TEAMNAV_CHECKS.items()
                                                         if v[0] == PART_SCENARIO[a.part]]
