@@ -78,3 +78,56 @@ def test_teamnav_checks_load():
         load_scenario(scen, overrides=over, seed=1000, duration_s=1.0)
     p = cc.overrides("detection", "detection-prior0.6", True, "teamnav")["robots.1.params"]
     assert p["inject_lost_prior"] == 0.6 and p["inject_fraction"] == 0.2
+
+
+# ---------------------------------------------------------------------------- the section's copy of the results
+_DATA = Path(__file__).resolve().parents[1] / "docs" / "report" / "collab-mcl-collapse.jsonl"
+
+
+def test_section_numbers_are_the_committed_runs():
+    """The report section quotes TUNING_RUNS; they must be the script's summary of the committed runs."""
+    import json
+
+    from teamnav.experiments.report.sections import collab_mcl as sec
+
+    rows = [json.loads(x) for x in _DATA.read_text().splitlines() if x.strip()]
+    assert all(r["seed"] >= cc.TUNING_SEED_MIN for r in rows)
+    assert list(sec.TUNING_RUNS) == cc.table_rows(rows)
+    assert sec.COLLAPSE_FACTORS == {k: (w, st) for k, (w, _, st) in cc.FACTORS.items()}
+
+
+def _det_row(team_final_m, team_localized, alone_final_m=6.9):
+    return {"part": "detection", "column": "teamnav", "factor": "detection", "seeds": list(range(1000, 1020)),
+            "alone_final_m": alone_final_m, "alone_localized": 10, "alone_runs": 20,
+            "team_final_m": team_final_m, "team_localized": team_localized, "team_runs": 20}
+
+
+@pytest.mark.parametrize("row, holds", [(_det_row(1.2, 19), True), (_det_row(2.49, 18), False),
+                                        (_det_row(1.2, 17), False), (_det_row(1.2, 19, alone_final_m=0.2), False)])
+def test_tuning_rows_are_judged_by_the_claim_files_rule(row, holds):
+    from teamnav.experiments.claims import judge, load_claims
+    from teamnav.experiments.report.sections.collab_mcl import tuning_claim_values
+
+    assert judge(load_claims("collab-mcl")["single-detection"], tuning_claim_values(row))[0] is holds
+
+
+def test_hallway_tuning_row_needs_the_paired_reduction():
+    from teamnav.experiments.claims import judge, load_claims
+    from teamnav.experiments.report.sections.collab_mcl import tuning_claim_values
+
+    row = {"part": "hallway", "alone_ttl_s": 150.0, "team_ttl_s": 139.0, "alone_final_localized": 0.78,
+           "team_final_localized": 0.91, "paired_s": -11.0, "paired_se_s": 33.0}
+    claim = load_claims("collab-mcl")["hallway-faster"]
+    assert judge(claim, tuning_claim_values(row))[0] is False  # -11 + 2 x 33 > 0
+    assert judge(claim, tuning_claim_values({**row, "paired_se_s": 5.0}))[0] is True
+
+
+def test_the_tuning_blocks_have_rows():
+    from teamnav.experiments.report.model import Table
+    from teamnav.experiments.report.sections.collab_mcl import _tuning_blocks
+
+    blocks = _tuning_blocks()
+    assert [type(b) for b in blocks] == [Table, Table, Table]
+    factors = {row[0] for row in blocks[0].rows}
+    assert {"paper", "floor", "motion", "sigma", "beams", "temper", "ess"} <= factors
+    assert {row[0] for row in blocks[2].rows} == {"hallway-faster", "hexagon-together", "single-detection"}
