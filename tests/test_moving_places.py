@@ -278,3 +278,42 @@ def test_moving_resource_block_quick_runs_its_two_cases(tmp_path):
     (plot,) = [b for b in blocks if isinstance(b, Plot)]
     assert [s.x for s in plot.series] == [[0.0, pytest.approx(0.05)]]
     assert "no verdict" in plot.caption
+
+
+# ------------------------------------------------------------------------ blazing-trail-v1's optional crumb expiry
+def _blaze(**params):
+    from teamnav.control.check import synthetic_infos
+    from teamnav.control.coop.blazing_trail import BlazingTrail
+
+    return BlazingTrail(BlazingTrail.Params(**params), np.random.default_rng(0), synthetic_infos(1)[0])
+
+
+def _batch(n, x0):
+    from teamnav.control.coop.crumbs import CrumbBatch
+
+    return CrumbBatch(np.column_stack([x0 + np.arange(n, dtype=float), np.zeros(n)]), np.zeros(n))
+
+
+def test_global_crumbs_never_expire_by_default_the_papers_rule():
+    b = _blaze()
+    assert b.params.global_crumb_ttl_s is None
+    b._add_global(_batch(3, 0.0), 0.0)
+    b._add_global(_batch(2, 10.0), 100.0)
+    assert len(b.global_crumbs) == 5 and not b._added  # no bookkeeping without a ttl
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.integers(1, 6), st.floats(0.0, 50.0)), min_size=1, max_size=8),
+       st.floats(1.0, 100.0), st.sampled_from([None, 4, 9]))
+def test_global_crumbs_expire_ttl_after_they_were_added(batches, ttl, cap):
+    b = _blaze(global_crumb_ttl_s=ttl, max_global_crumbs=cap)
+    t, kept = 0.0, []  # (time added, x) of every crumb the list should hold
+    for i, (n, gap) in enumerate(batches):
+        t += gap
+        b._add_global(_batch(n, 100.0 * i), t)
+        kept += [(t, 100.0 * i + j) for j in range(n)]
+        if cap is not None:
+            kept = kept[-cap:]
+        b._expire(t - ttl)
+        kept = [(ta, x) for ta, x in kept if not ta < t - ttl]
+        assert b.global_crumbs.xy_m[:, 0].tolist() == [x for _, x in kept]

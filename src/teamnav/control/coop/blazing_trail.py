@@ -70,11 +70,19 @@ Choices where the paper is silent: crumb interval 1 s and radius 2 m (the paper 
 1.8 m corridors, a radius about a corridor wide, reaches the crumbs of the corridor the robot is
 in and the corner it approaches); the global list is unbounded as in the paper unless
 ``max_global_crumbs`` caps it (oldest dropped).
+
+``global_crumb_ttl_s`` (None by default: the paper's rule, crumbs never expire; beyond the paper,
+issue 22's moving resource, Blazing §6 future work): a crumb leaves the global list this long
+after the robot *added* it (its own batch at its waggle dance, a teammate's on receipt; the
+batches carry no drop times, so a crumb may be up to one trip older than its receipt). Without
+it a trail to a source that has moved stays for ever, beside the new one. The 2002 algorithm's
+crumbs expire 4 min after dropping (Try §2.3 step 2); this is the nearest rule the 2000 message allows.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 from typing import Any, ClassVar
 
 import numpy as np
@@ -151,6 +159,9 @@ class BlazingTrailParams(BaseModel):
         Navigate's forward speed [m/s].
     max_global_crumbs : int or None
         Cap on the global list (None: unbounded, as in the paper).
+    global_crumb_ttl_s : float or None
+        A global crumb expires this long [s] after it was added (None: never, the paper; beyond
+        the paper, for a moving resource; module docstring).
     prune_loops : bool
         Cut loops out of the private list (module docstring; False: the paper as written).
     prune_radius_m, prune_min_loop_m : float
@@ -225,6 +236,7 @@ class BlazingTrailParams(BaseModel):
     radius_m: float = Field(2.0, gt=0.0, le=100.0)
     cruise_speed_mps: float = Field(0.25, gt=0.0, le=10.0)
     max_global_crumbs: int | None = Field(None, ge=1, le=10_000_000)
+    global_crumb_ttl_s: float | None = Field(None, gt=0.0, le=1e7)
     prune_loops: bool = True
     crumb_min_move_m: float = Field(0.1, ge=0.0, le=100.0)
     turn_at_place: bool = True
@@ -273,6 +285,8 @@ class BlazingTrail:
         self.round = PlaceRound([params.home_event, params.source_event], start_index=0)
         self.private = CrumbList()
         self.global_crumbs = CrumbList(max_crumbs=params.max_global_crumbs)
+        #: (time added [s], crumbs) per batch of the global list, oldest first (only with a ttl)
+        self._added: deque[list] = deque()
         self.deliveries = 0
         self.broadcasts = 0
         self._next_crumb_s = 0.0
@@ -294,11 +308,35 @@ class BlazingTrail:
         """Broadcast the private list, append it to the own global list, clear it (§4.1)."""
         body = self.private.to_batch()
         self.private.clear()
-        self.global_crumbs.extend(body)
+        self._add_global(body, float(obs.time_s))
         self.broadcasts += 1
         if not self.params.communicate:
             return []
         return [Message(self.info.robot_id, float(obs.time_s), body, kind="crumbs")]
+
+    def _add_global(self, batch: CrumbBatch, t: float) -> None:
+        """Append ``batch`` to the global list, remembering when (for ``global_crumb_ttl_s``)."""
+        self.global_crumbs.extend(batch)
+        if self.params.global_crumb_ttl_s is None or len(batch) == 0:
+            return
+        self._added.append([t, len(batch)])
+        excess = sum(n for _, n in self._added) - len(self.global_crumbs)  # the cap dropped the oldest
+        while excess > 0:
+            k = min(excess, self._added[0][1])
+            self._added[0][1] -= k
+            excess -= k
+            if self._added[0][1] == 0:
+                self._added.popleft()
+
+    def _expire(self, before_s: float) -> None:
+        """Drop the global crumbs added before ``before_s`` (they are the list's first ones)."""
+        drop = 0
+        while self._added and self._added[0][0] < before_s:
+            drop += self._added.popleft()[1]
+        if drop:
+            keep = CrumbBatch(self.global_crumbs.xy_m[drop:].copy(), self.global_crumbs.heading_rad[drop:].copy())
+            self.global_crumbs = CrumbList(max_crumbs=self.params.max_global_crumbs)
+            self.global_crumbs.extend(keep)
 
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
         """One control step: task events, the inbox, crumb dropping, the preferred heading, Navigate."""
@@ -330,7 +368,9 @@ class BlazingTrail:
         if p.communicate:
             for msg in obs.inbox:
                 if msg.kind == "crumbs" and isinstance(msg.body, CrumbBatch) and msg.sender != self.info.robot_id:
-                    self.global_crumbs.extend(msg.body)
+                    self._add_global(msg.body, t)
+        if p.global_crumb_ttl_s is not None:
+            self._expire(t - p.global_crumb_ttl_s)
         qx, qy = x + p.lookahead_m * math.cos(th), y + p.lookahead_m * math.sin(th)
         mean = self.global_crumbs.average_heading(qx, qy, p.radius_m)
         pref = preferred_heading(mean, self.carrying)
