@@ -317,3 +317,52 @@ def test_global_crumbs_expire_ttl_after_they_were_added(batches, ttl, cap):
         b._expire(t - ttl)
         kept = [(ta, x) for ta, x in kept if not ta < t - ttl]
         assert b.global_crumbs.xy_m[:, 0].tolist() == [x for _, x in kept]
+
+
+class _FakeResult:
+    def __init__(self, rows):
+        self._rows = rows
+
+    def rows(self):
+        return self._rows
+
+
+class _FakeFullContext:
+    """Full mode without running: every case of the asked sweep gets one row per seed, its units
+    falling with the case's position in the sweep (so the table's order and numbers can be read back)."""
+
+    quick = False
+    progress = False
+
+    def __init__(self):
+        self.asked = []
+
+    def sweep(self, name_or_spec, *, seeds, duration_s):
+        from teamnav.experiments.sweep import load_sweep
+
+        spec = load_sweep(name_or_spec) if isinstance(name_or_spec, str) else name_or_spec
+        self.asked.append((spec.sweep_name if hasattr(spec, "sweep_name") else spec.name, list(seeds), duration_s))
+        return _FakeResult([{"status": "ok", "params": {"case": c["case"]}, "units_total": 60 - 5 * i + s,
+                             "breakdown_censored": int(i < 4), "trip_time_s_after_mean": 100.0, "crumbs_max": 500 + i}
+                            for i, c in enumerate(spec.cases) for s in seeds])
+
+
+def test_moving_resource_block_full_mode_reads_every_case_and_the_blazing_sweep():
+    from teamnav.experiments.report.model import Plot, Table
+    from teamnav.experiments.report.sections.beyond import _moving_resource
+
+    ctx = _FakeFullContext()
+    blocks = _moving_resource(ctx)
+    assert [(seeds, d) for _, seeds, d in ctx.asked] == [(list(range(10)), 3600.0)] * 2
+    main, blaze = [b for b in blocks if isinstance(b, Table)]
+    assert [r[0] for r in main.rows] == ["static", "jump-30min", "jump-15min", "jump-10min", "jump-5min",
+                                         "glide-0.01", "glide-0.02", "glide-0.05"]
+    assert main.rows[0][2].startswith("64.5 ± 3.0 (n = 10)") and main.rows[0][3] == "0 of 10"
+    assert main.rows[4][3] == "10 of 10"
+    speeds = [float(r[1]) for r in main.rows]
+    assert speeds[1:5] == pytest.approx([38 / 3600, 38 / 1800, 38 / 1200, 38 / 600], abs=5e-5)  # printed to 4 places
+    (plot,) = [b for b in blocks if isinstance(b, Plot)]
+    jumps, glides = plot.series
+    assert jumps.x == sorted(jumps.x) and len(jumps.x) == 5 and len(glides.x) == 4
+    assert [r[2] for r in blaze.rows[:2]] == ["never (the paper)", "300 s after added"]
+    assert {r[0] for r in blaze.rows} == {"static", "jump-10min", "glide-0.02"}

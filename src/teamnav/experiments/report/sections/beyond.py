@@ -30,7 +30,9 @@ The papers' future work, **a moving resource** (Vaughan et al. 2000 §6; the mot
 trail-share-v1 while the source stays, jumps every 30-5 min or glides at 0.01-0.05 m/s between
 two spots of C3; units per hour against the source's mean speed, no claim (the paper gives no
 number). Quick mode: the static and the fastest gliding case, seed 0, 5 min (two runs); full
-mode: the 8 cases x seeds 0-9 x 1 h (about 9 CPU-s per run here).
+mode: the 8 cases x seeds 0-9 x 1 h (about 9 CPU-s per run here), and blazing-trail-v1 (sweep
+``beyond-moving-resource-blazing``: 3 motions x crumbs that never expire, the paper, or expire
+after 300 s, ``global_crumb_ttl_s``, beyond it; 60 runs).
 
 Left for later (issue 22): localized LOS help, detections for the trail team, trails as LOS memory, and the papers' other
 future work.
@@ -182,6 +184,8 @@ def _particles(ctx, seeds: list[int], dur: float) -> list:
 MOVING_SWEEP = "beyond-moving-resource"
 #: quick mode: the static source and the fastest glide (5-min runs: a jump every 5 min would not show)
 MOVING_QUICK_CASES = ("static", "glide-0.05")
+#: the 2000 algorithm under the same motion, with and without crumb expiry (full mode only)
+MOVING_BLAZING_SWEEP = "beyond-moving-resource-blazing"
 
 
 def motion_speed_mps(start_xy: tuple[float, float], motion: dict | None) -> float:
@@ -254,7 +258,30 @@ def _moving_resource(ctx) -> list:
     if series:
         blocks.append(Plot("Delivery rate against resource speed", "source mean speed [m/s]", "units per hour", series,
                            caption="mean over seeds, band 25-75 %; no paper number to compare (no verdict)."))
+    if not quick:
+        blocks += _moving_blazing(ctx, seeds, dur, speed)
     return blocks
+
+
+def _moving_blazing(ctx, seeds: list[int], dur: float, speed: dict[str, float]) -> list:
+    """Full mode: blazing-trail-v1 with the moving source, its never-expiring global crumb list (the
+    2000 paper) beside ``global_crumb_ttl_s`` = 300 s (beyond the paper)."""
+    missing = T.brains_missing(["blazing-trail-v1"])
+    if missing is not None:
+        return [missing]
+    data = T.by_case(T.ok(ctx.sweep(MOVING_BLAZING_SWEEP, seeds=seeds, duration_s=dur)))
+    rows = []
+    for lab in sorted(data, key=lambda c: (speed.get(c.removesuffix("-ttl300"), 0.0), c)):
+        base = lab.removesuffix("-ttl300")
+        r = data[lab]
+        rows.append([base, f"{speed[base]:.4f}" if base in speed else "?",
+                     "300 s after added" if lab.endswith("-ttl300") else "never (the paper)",
+                     T.msd(_units_per_hour(r, dur), "{:.1f}"), _broke(r), T.msd(T.values(r, "crumbs_max"), "{:.0f}")])
+    return [Table(
+        "The 2000 algorithm with a moving source: global crumbs that never expire, and that expire",
+        ["case", "source mean speed [m/s]", "global crumbs expire", "units per hour", "broke down", "global crumbs (max)"],
+        rows, note=f"mean ± std over runs (n = runs); sweep {MOVING_BLAZING_SWEEP}, seeds {seeds[0]}-{seeds[-1]}, "
+                   f"{dur / 60:g} min per run; global_crumb_ttl_s is beyond the paper (blazing_trail's docstring).")]
 
 
 def build(ctx) -> list:
