@@ -81,3 +81,15 @@ def test_cheapest_particle_count_without_breakdown():
     assert particle_count(rows[0]) == 25 and particle_count({"params": {"case": "x4"}}) is None
     assert cheapest_without_breakdown(rows) == 50
     assert cheapest_without_breakdown([row(25, 0), row(50, 0)]) is None
+
+
+def test_paired_gain_says_when_there_is_no_difference():
+    from teamnav.experiments.report.sections.beyond import paired_gain_text
+
+    ours = [{"seed": s, "units_total": u} for s, u in enumerate([10, 12, 11, 13])]
+    same = [{"seed": s, "units_total": u} for s, u in enumerate([11, 11, 12, 12])]
+    worse = [{"seed": s, "units_total": u} for s, u in enumerate([5, 6, 5, 7])]
+    assert "no difference beyond the seeds' spread" in paired_gain_text(ours, same, 3600.0)
+    text = paired_gain_text(ours, worse, 1800.0)  # units per hour: twice the units of a 30-min run
+    assert text.startswith("+11.5 ± ") and "delivers more" in text and "4 paired seeds" in text
+    assert paired_gain_text(ours[:1], same, 3600.0) == "too few paired seeds to compare"
