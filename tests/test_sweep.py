@@ -532,3 +532,19 @@ def test_trials_are_scheduled_longest_first_from_recorded_times_or_robot_steps()
     first = longest_first(trials, trials, rows)
     assert [t.params["robots.0.count"] for t in first] == [4, 4, 2, 2, 8, 8]
     assert [t.seed for t in first[2:4]] == [by_count[2][0].seed, by_count[2][1].seed]
+
+
+def test_a_case_key_into_a_dict_of_set_does_not_leak_into_other_cases():
+    """A case's dotted key (robots.0.params.x) into a dict that ``set`` gives whole
+    (robots.0.params: {...}) changes that case only: overrides are copied, not shared (the
+    trials of a sweep hold the same ``set`` objects)."""
+    from teamnav.experiments.sweep import SweepSpec
+
+    spec = SweepSpec(scenario="demo", seeds=1,
+                     set={"robots.0.params": {"cruise_speed_mps": 0.3}},
+                     cases=[{"case": "a", "robots.0.params.turn_rate_radps": 0.5}, {"case": "b", "robots.0.count": 2}])
+    a, b = expand(spec)
+    sa, sb = a.load(), b.load()
+    assert sa.robots[0].params["turn_rate_radps"] == 0.5
+    assert "turn_rate_radps" not in sb.robots[0].params and sb.robots[0].params["cruise_speed_mps"] == 0.3
+    assert spec.set["robots.0.params"] == {"cruise_speed_mps": 0.3}

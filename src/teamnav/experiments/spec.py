@@ -571,6 +571,9 @@ def apply_overrides(data: dict, overrides: Mapping[str, Any] | Sequence[str] | N
                 raise ScenarioError.one(file, f"--set {key}", f"expected a YAML value ({first})", text) from None
             items.append((key, value, item))
     for key, value, shown in items:
+        # a copy: a later dotted key writes into what this one set, never into the caller's object
+        # (a sweep's `set` dict shared by all its cases leaked one case's value into every case)
+        value = copy.deepcopy(value)
         parts = key.split(".")
         if not key or any(not p for p in parts):
             raise ScenarioError.one(file, "--set", "expected a dotted key such as robots.0.count", key)
