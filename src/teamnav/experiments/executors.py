@@ -268,6 +268,11 @@ def _how_workers_ended(pool: ProcessPoolExecutor) -> str:
     (the pool SIGTERMs the survivors after the first death, so the first death is the one not
     ended by SIGTERM, unless SIGTERM was what killed it)."""
     procs = getattr(pool, "_processes", None) or {}
+    deadline = time.monotonic() + 2.0  # the pool may not have reaped the dead one yet
+    for p in list(procs.values()):
+        with contextlib.suppress(Exception):
+            if p.exitcode is None:
+                p.join(max(0.0, deadline - time.monotonic()))
     return "; ".join(f"pid {pid}: {_exit_status(p.exitcode)}" for pid, p in sorted(procs.items())) or "none left"
 
 
