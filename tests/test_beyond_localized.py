@@ -93,3 +93,52 @@ def test_paired_gain_says_when_there_is_no_difference():
     text = paired_gain_text(ours, worse, 1800.0)  # units per hour: twice the units of a 30-min run
     assert text.startswith("+11.5 ± ") and "delivers more" in text and "4 paired seeds" in text
     assert paired_gain_text(ours[:1], same, 3600.0) == "too few paired seeds to compare"
+
+
+class _Rows:
+    def __init__(self, rows):
+        self._rows = rows
+
+    def rows(self):
+        return self._rows
+
+
+class _FakeFull:
+    """Full mode without running: each asked sweep gets one row per case and seed; the
+    localized team keeps 68 units/h at every k, the odometric ones lose 8 per unit of k."""
+
+    quick = False
+    progress = False
+
+    def __init__(self):
+        self.asked = []
+
+    def sweep(self, name_or_spec, *, seeds, duration_s):
+        from teamnav.experiments.sweep import load_sweep
+
+        spec = load_sweep(name_or_spec) if isinstance(name_or_spec, str) else name_or_spec
+        self.asked.append(spec.sweep_name)
+        local = spec.sweep_name.startswith("beyond-")
+
+        def units(case):
+            k = float(case[1:]) if case.startswith("x") else 4.0
+            return 68 if local else 68 - 8 * k
+
+        return _Rows([{"status": "ok", "seed": s, "params": {"case": c["case"]}, "units_total": units(c["case"]) + s % 2,
+                       "breakdown_censored": 1, "loc_mean_error_m": 0.07 if local else None, "wall_time_s": 20.0}
+                      for c in spec.cases for s in seeds])
+
+
+def test_full_mode_draws_the_parts_the_particle_counts_and_the_verdict():
+    from teamnav.experiments.report.model import Comparison, Table
+    from teamnav.experiments.report.sections.beyond import _localized_trails
+
+    ctx = _FakeFull()
+    blocks = _localized_trails(ctx)
+    assert ctx.asked == ["beyond-localized-trails", "blazing-drift", "try-drift", "beyond-localized-particles"]
+    main, parts = [b for b in blocks if isinstance(b, Table)]
+    assert [r[0] for r in main.rows] == ["0", "0", "0", "1", "1", "1", "4", "4", "4"]
+    assert [r[0] for r in parts.rows] == ["25", "50", "100", "200", "500"]
+    assert "cheapest count with no breakdown in any run: 25" in parts.note and "odometric blazing team at k = 4" in parts.note
+    (cmp,) = [b for b in blocks if isinstance(b, Comparison)]
+    assert cmp.holds is True and "no difference beyond the seeds' spread" in cmp.differs  # k = 0: equal units

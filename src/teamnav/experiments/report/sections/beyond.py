@@ -162,6 +162,8 @@ def _localized_trails(ctx) -> list:
     claim = load_claims("beyond")["localized-trails-drift"]
     vals = localized_values(loc, parts[PARTS[0][0]], dur)
     holds, how = judge(claim, vals, dur)
+    if not quick:
+        blocks += _particles(ctx, seeds, dur, parts[PARTS[0][0]].get(4.0, []))
     where = "Without drift (k = 0): " + paired_gain_text(loc.get(0.0, []), parts[PARTS[0][0]].get(0.0, []), dur) + "."
     blocks.append(Comparison(
         f"{claim.title} ({rule_text(claim)})",
@@ -172,8 +174,9 @@ def _localized_trails(ctx) -> list:
     return blocks
 
 
-def _particles(ctx, seeds: list[int], dur: float) -> list:
-    """Full mode: the localized team at k = 4 with 25 .. 500 samples per robot."""
+def _particles(ctx, seeds: list[int], dur: float, odometric_k4: list[dict]) -> list:
+    """Full mode: the localized team at k = 4 with 25 .. 500 samples per robot, beside how many
+    runs of the odometric team broke down at k = 4 (``odometric_k4``: its rows)."""
     rows = T.ok(ctx.sweep(PARTICLES_SWEEP, seeds=seeds, duration_s=dur))
     by: dict[int, list[dict]] = {}
     for r in rows:
@@ -189,6 +192,8 @@ def _particles(ctx, seeds: list[int], dur: float) -> list:
         ["samples per robot", "units per hour", "broke down", "MCL pose error", "stepping s per simulated hour"], table,
         note=("cheapest count with no breakdown in any run: "
               + (f"{cheapest}" if cheapest is not None else "none of those tried")
+              + f" (the odometric blazing team at k = 4: {_broke(odometric_k4)} broke down, "
+              + f"{T.msd(_units_per_hour(odometric_k4, dur), '{:.1f}')} units per hour)"
               + f"; sweep {PARTICLES_SWEEP}, seeds {seeds[0]}-{seeds[-1]}, {dur / 60:g} min per run"))]
 
 
