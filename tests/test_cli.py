@@ -198,6 +198,9 @@ def test_quick_report_says_its_claims_are_indicative_on_the_same_line(tmp_path):
     s = SimpleNamespace(key="k", status="error", wall_s=1.0, comparisons=claims, error="RuntimeError: x")
     assert section_line(s, quick=True).endswith("(quick mode: indicative only, small sample; run without --quick "
                                                  "for the verdicts)  (RuntimeError: x)")
+    unjudged = SimpleNamespace(key="k", status="ok", wall_s=1.0, comparisons=[*claims, Comparison("c", "4", "-", None)],
+                               error="")
+    assert "1/3 claims hold, 1 not judged (quick mode" in section_line(unjudged, quick=True)
 
 
 def test_out_dir_not_empty_needs_force(tmp_path):
