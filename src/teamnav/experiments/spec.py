@@ -323,29 +323,27 @@ class Scenario(SimConfig):
                 )
             return named[ref]
 
+        def located(d: dict, field: str) -> tuple[dict, Any]:
+            """``d`` with its ``place`` key turned into ``x_m``, ``y_m`` (a copy), and the name."""
+            d = dict(d)
+            ref = d.pop("place")
+            if "x_m" in d or "y_m" in d:
+                raise ValueError(f"{field}: give either 'place' or 'x_m'/'y_m', not both")
+            d["x_m"], d["y_m"] = where(f"{field}.place", ref)
+            return d, ref
+
         if isinstance(data.get("places"), (list, tuple)):
             places = []
             for i, p in enumerate(data["places"]):
                 if isinstance(p, dict) and "place" in p:
-                    p = dict(p)
-                    ref = p.pop("place")
-                    if "x_m" in p or "y_m" in p:
-                        raise ValueError(f"places[{i}]: give either 'place' or 'x_m'/'y_m', not both")
-                    p["x_m"], p["y_m"] = where(f"places[{i}].place", ref)
+                    p, ref = located(p, f"places[{i}]")
                     p.setdefault("name", ref)
                 if isinstance(p, dict) and _named_waypoints(p):
                     p = dict(p)
                     p["motion"] = motion = dict(p["motion"])
-                    path = []
-                    for j, w in enumerate(motion["path"]):
-                        if isinstance(w, dict) and "place" in w:
-                            w = dict(w)
-                            ref = w.pop("place")
-                            if "x_m" in w or "y_m" in w:
-                                raise ValueError(f"places[{i}].motion.path[{j}]: give either 'place' or 'x_m'/'y_m', not both")
-                            w["x_m"], w["y_m"] = where(f"places[{i}].motion.path[{j}].place", ref)
-                        path.append(w)
-                    motion["path"] = path
+                    motion["path"] = [located(w, f"places[{i}].motion.path[{j}]")[0]
+                                      if isinstance(w, dict) and "place" in w else w
+                                      for j, w in enumerate(motion["path"])]
                 places.append(p)
             data["places"] = places
         if isinstance(data.get("robots"), (list, tuple)):
