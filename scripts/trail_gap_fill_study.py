@@ -1,0 +1,241 @@
+"""What each gap-fill of ``blazing-trail-v1`` buys, and what keeps the 2000 team from breaking down (issue 25 §4).
+
+Vaughan, Støy, Sukhatme & Matarić (2000) §5.1: the four robots carried 28 units in 30 min, then
+"the unbounded odometry error causes the system to break down completely at around 27 minutes".
+teamnav's report has two columns: ``paper_rules: true`` (every gap-fill at the paper's value,
+cruise 0.25 m/s; :mod:`teamnav.control.paper_rules`) and ours. This script takes them apart with
+paired seeds (the same seed gives the same start spots, drift and noise draws in every
+configuration), in two parts:
+
+``gapfills``
+    The ``blazing-a-trail`` trial (30 min, the scenario's per-robot heading drift). Configurations:
+    ``paper`` (every gap-fill at the paper's value), ``teamnav`` (every one at ours, cruise 0.4 m/s),
+    ``paper+G`` (the paper's rules with gap-fill G alone at our value: what G buys on its own) and
+    ``teamnav-G`` (ours with G alone at the paper's value: what G is worth among the others).
+``drift``
+    One hour at the drift cases of ``blazing-drift`` (k x the 2002 paper's per-robot rates, Try
+    §3.6: Bug -1, Ant +1, Fly +2, Tanis +0.35 deg/min; ``x1-slip``: wheel slip 0.01 m/sqrt(m) and
+    1 deg/sqrt(m) on top of k = 1, a heading random walk; ``x1-scale5``: wheel-diameter errors of
+    +-3-5 % on top of k = 1; :mod:`teamnav.sim.odometry`), for ``paper``, ``paper+reverse``
+    (the paper's rules with homebound crumbs stored reversed), ``teamnav@0.25`` (our gap-fills
+    at the paper's cruise speed) and ``teamnav``: which part of the difference between the columns
+    is the speed and which the gap-fills, and whether a drift model with a random walk or a
+    scale error breaks the team where a constant heading bias does not.
+
+The breakdown is the report's: the last delivery, when the run ends at least
+``BREAKDOWN_GAP_S`` (180 s) after it; otherwise none (censored at the run's end).
+
+The seeds are neither the report's (0-9) nor used to choose anything: nothing is tuned here.
+
+Usage::
+
+    nice -n 10 python scripts/trail_gap_fill_study.py gapfills --seeds 100-109 --workers 2 --out F.jsonl
+    nice -n 10 python scripts/trail_gap_fill_study.py drift --seeds 100-109 --workers 2 --out F.jsonl
+    python scripts/trail_gap_fill_study.py summary --out F.jsonl
+
+Results (JSON lines, one per run) are appended to ``--out``; ``summary`` prints the tables that
+``docs/report/blazing-a-trail.md`` shows (mean ± std over runs, and the paired difference against
+``paper`` as mean ± standard error with the count of seeds better).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+import numpy as np
+
+SCENARIO = "blazing-a-trail"
+#: the scenario's own params (besides the gap-fills): as blazing-paper-rules.yaml
+BASE_PARAMS = {"communicate": True, "layer_every_steps": 6000}
+TEAMNAV_CRUISE = 0.4
+#: Try §3.6's per-robot rates [deg/min] in robot order (Bug, Ant, Fly, Tanis), as blazing-drift.yaml
+RATES = (-1.0, 1.0, 2.0, 0.35)
+SCALE5 = (0.05, -0.05, 0.03, -0.03)
+DRIFT_CASES = ("x0", "x1", "x4", "x1-slip", "x1-scale5")
+DRIFT_CONFIGS = ("paper", "paper+reverse_carried_crumbs", "teamnav@0.25", "teamnav")
+
+
+def gap_fill_table() -> list:
+    """The gap-fills of ``blazing-trail-v1`` (Navigate's included), ours at cruise 0.4 m/s."""
+    from teamnav.control.coop.blazing_trail import BlazingTrailParams
+    from teamnav.control.paper_rules import gap_fills
+
+    return gap_fills(BlazingTrailParams, {"cruise_speed_mps": TEAMNAV_CRUISE})
+
+
+def params_for(config: str) -> dict:
+    """The robots' params of a configuration (see the module docstring).
+
+    Raises
+    ------
+    ValueError
+        An unknown configuration or gap-fill name (the message lists the known ones).
+    """
+    fills = gap_fill_table()
+    names = [g.field for g in fills]
+    paper = {g.field: g.paper_value for g in fills}
+    ours = {g.field: g.teamnav_value for g in fills}
+    if config == "paper":
+        chosen = paper
+    elif config == "teamnav":
+        chosen = ours
+    elif config == "teamnav@0.25":
+        chosen = {**ours, "cruise_speed_mps": 0.25}
+    elif config.startswith("paper+") and config[6:] in names:
+        chosen = {**paper, config[6:]: ours[config[6:]]}
+    elif config.startswith("teamnav-") and config[8:] in names:
+        chosen = {**ours, config[8:]: paper[config[8:]]}
+    else:
+        raise ValueError(f"unknown configuration {config!r}: expected paper, teamnav, teamnav@0.25, "
+                         f"paper+G or teamnav-G with G one of {', '.join(names)}")
+    out: dict = dict(BASE_PARAMS)
+    for key, value in chosen.items():
+        head, _, tail = key.partition(".")
+        if tail:
+            out.setdefault(head, {})[tail] = value
+        else:
+            out[head] = value
+    return out
+
+
+def drift_overrides(case: str) -> dict:
+    """The odometry overrides of a ``blazing-drift`` case (``x<k>``, ``x1-slip``, ``x1-scale5``)."""
+    base, _, extra = case.partition("-")
+    if not base.startswith("x"):
+        raise ValueError(f"unknown drift case {case!r}: expected one of {', '.join(DRIFT_CASES)}")
+    k = float(base[1:])
+    out = {f"robots.{i}.odometry.heading_drift_deg_per_min": k * r for i, r in enumerate(RATES)}
+    if extra == "slip":
+        for i in range(4):
+            out[f"robots.{i}.odometry.slip_std_m_per_sqrt_m"] = 0.01
+            out[f"robots.{i}.odometry.heading_slip_deg_per_sqrt_m"] = 1.0
+    elif extra == "scale5":
+        for i, s in enumerate(SCALE5):
+            out[f"robots.{i}.odometry.scale_error"] = s
+    elif extra:
+        raise ValueError(f"unknown drift case {case!r}: expected one of {', '.join(DRIFT_CASES)}")
+    return out
+
+
+def one_run(job: tuple[str, str, str, int, float]) -> dict:
+    """One run of ``(part, config, case, seed, duration_s)``: units, breakdown, trips, CPU."""
+    from teamnav.experiments.metric_sets.trails import BREAKDOWN_GAP_S, deliveries
+    from teamnav.experiments.runner import run
+    from teamnav.experiments.spec import load_scenario
+
+    part, config, case, seed, duration = job
+    params = params_for(config)
+    ov = {f"robots.{i}.params": params for i in range(4)}
+    if case:
+        ov.update(drift_overrides(case))
+    t0 = time.process_time()
+    res = run(load_scenario(SCENARIO, overrides=ov, seed=seed, duration_s=duration), progress=False)
+    times = sorted(t for t, _ in deliveries(res.data.event_log))
+    if times and duration - times[-1] >= BREAKDOWN_GAP_S:
+        bd, cens = times[-1], False
+    elif not times:
+        bd, cens = 0.0, False
+    else:
+        bd, cens = duration, True
+    half = [t for t in times if t > duration / 2]
+    return {"part": part, "config": config, "case": case, "seed": seed, "duration_s": duration,
+            "units": len(times), "units_second_half": len(half), "first_delivery_s": times[0] if times else None,
+            "breakdown_s": bd, "breakdown_censored": cens, "cpu_s": round(time.process_time() - t0, 2)}
+
+
+def parse_seeds(text: str) -> list[int]:
+    """``"100-109"`` or ``"100,105"`` -> seeds; the report's seeds 0-9 are refused."""
+    out: list[int] = []
+    for part in text.split(","):
+        a, _, b = part.partition("-")
+        out.extend(range(int(a), int(b or a) + 1))
+    if any(s < 100 for s in out):
+        raise SystemExit(f"--seeds: {text!r} includes seeds below 100; 0-29 belong to the report")
+    return out
+
+
+def _ms(v: list[float]) -> str:
+    return f"{np.mean(v):.1f} ± {np.std(v, ddof=1):.1f}" if len(v) > 1 else (f"{v[0]:.1f}" if v else "-")
+
+
+def _paired(rows: list[dict], base: dict, key: str) -> str:
+    d = [r[key] - base[r["seed"]][key] for r in rows if r["seed"] in base]
+    if len(d) < 2:
+        return "-"
+    se = np.std(d, ddof=1) / math.sqrt(len(d))
+    better = sum(x > 0 for x in d)
+    return f"{np.mean(d):+.1f} ± {se:.1f} ({better}/{len(d)} more)"
+
+
+def summarize(rows: list[dict]) -> list[str]:
+    out: list[str] = []
+    for part in ("gapfills", "drift"):
+        prt = [r for r in rows if r["part"] == part]
+        if not prt:
+            continue
+        cases = sorted({r["case"] for r in prt}, key=lambda c: (len(c), c))
+        for case in cases:
+            rs = [r for r in prt if r["case"] == case]
+            base = {r["seed"]: r for r in rs if r["config"] == "paper"}
+            dur = rs[0]["duration_s"]
+            out.append(f"\n## {part} {case or '(scenario drift)'}, {dur / 60:.0f} min, seeds "
+                       f"{min(r['seed'] for r in rs)}-{max(r['seed'] for r in rs)}")
+            out.append("| configuration | units | paired vs paper | 2nd-half units | broke down | "
+                       "median breakdown (min) | CPU s/run |")
+            out.append("|---|---|---|---|---|---|---|")
+            configs = sorted({r["config"] for r in rs}, key=lambda c: (c != "paper", c != "teamnav", c))
+            for c in configs:
+                g = [r for r in rs if r["config"] == c]
+                broke = [r for r in g if not r["breakdown_censored"]]
+                med = np.median([r["breakdown_s"] if not r["breakdown_censored"] else r["duration_s"] for r in g])
+                out.append(f"| {c} | {_ms([r['units'] for r in g])} | {_paired(g, base, 'units') if c != 'paper' else ''} | "
+                           f"{_ms([r['units_second_half'] for r in g])} | {len(broke)}/{len(g)} | "
+                           f"{med / 60:.0f}{'+' if med >= dur else ''} | {np.mean([r['cpu_s'] for r in g]):.1f} |")
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("part", choices=["gapfills", "drift", "summary"])
+    ap.add_argument("--seeds", default="100-109")
+    ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--out", required=True, type=Path)
+    ap.add_argument("--configs", default=None, help="comma-separated configurations (default: all of the part)")
+    ap.add_argument("--cases", default=",".join(DRIFT_CASES), help="drift cases (part drift)")
+    ap.add_argument("--duration", type=float, default=None, help="run length [s] (30 min / 1 h by part)")
+    a = ap.parse_args(argv)
+    if a.part == "summary":
+        rows = [json.loads(line) for line in a.out.read_text().splitlines() if line.strip()]
+        print("\n".join(summarize(rows)))
+        return 0
+    seeds = parse_seeds(a.seeds)
+    names = [g.field for g in gap_fill_table()]
+    if a.part == "gapfills":
+        configs = a.configs.split(",") if a.configs else (
+            ["paper", "teamnav"] + [f"paper+{n}" for n in names] + [f"teamnav-{n}" for n in names])
+        jobs = [("gapfills", c, "", s, a.duration or 1800.0) for c in configs for s in seeds]
+    else:
+        configs = a.configs.split(",") if a.configs else list(DRIFT_CONFIGS)
+        jobs = [("drift", c, k, s, a.duration or 3600.0) for k in a.cases.split(",") for c in configs for s in seeds]
+    for c in configs:
+        params_for(c)  # fail before any run
+    a.out.parent.mkdir(parents=True, exist_ok=True)
+    done = 0
+    with ProcessPoolExecutor(a.workers) as ex, a.out.open("a") as fh:
+        for fut in as_completed([ex.submit(one_run, j) for j in jobs]):
+            fh.write(json.dumps(fut.result()) + "\n")
+            fh.flush()
+            done += 1
+            print(f"\r{done}/{len(jobs)}", end="", file=sys.stderr, flush=True)
+    print(file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,82 @@
+"""scripts/trail_gap_fill_study.py (issue 25 §4): its configurations are the report's two columns
+and single gap-fills between them (Vaughan et al. 2000 §4), and its drift cases are blazing-drift's."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+from teamnav.control.coop.blazing_trail import BlazingTrailParams, navigate_params
+from teamnav.experiments.spec import load_scenario
+from teamnav.experiments.sweep import load_sweep
+
+_PATH = Path(__file__).resolve().parents[1] / "scripts" / "trail_gap_fill_study.py"
+_spec = importlib.util.spec_from_file_location("trail_gap_fill_study", _PATH)
+gs = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(gs)
+
+
+def _dump(params: dict) -> dict:
+    """The brain's parameters, its nested Navigate dict resolved as the brain resolves it
+    (as the brain builds it; its cruise speed is the brain's own), ``paper_rules`` itself left out."""
+    p = BlazingTrailParams(**params)
+    out = p.model_dump(exclude={"paper_rules"})
+    out["navigate"] = navigate_params(p.navigate, p.cruise_speed_mps).model_dump(exclude={"paper_rules", "cruise_speed_mps"})
+    return out
+
+
+def test_paper_config_is_paper_rules_true():
+    """The study's "paper" configuration, written out field by field, validates to the same
+    brain parameters as the report's ``paper_rules: true`` column."""
+    assert _dump(gs.params_for("paper")) == _dump({**gs.BASE_PARAMS, "paper_rules": True})
+
+
+def test_teamnav_config_is_the_scenario_column():
+    assert _dump(gs.params_for("teamnav")) == _dump({**gs.BASE_PARAMS, "cruise_speed_mps": 0.4})
+
+
+@pytest.mark.parametrize("field", [g.field for g in gs.gap_fill_table()])
+def test_one_gap_fill_differs_from_its_column(field):
+    """``paper+G`` differs from ``paper`` in G alone; ``teamnav-G`` from ``teamnav`` in G alone."""
+    head, _, tail = field.partition(".")
+
+    def get(d):
+        return d[head][tail] if tail else d[head]
+
+    for base, config in (("paper", f"paper+{field}"), ("teamnav", f"teamnav-{field}")):
+        a, b = _dump(gs.params_for(base)), _dump(gs.params_for(config))
+        assert get(a) != get(b)
+        diff = {k for k in a if a[k] != b[k]}
+        assert diff == {head}
+        if tail:
+            assert {k for k in a[head] if a[head][k] != b[head][k]} == {tail}
+
+
+def test_unknown_configuration_names_the_known_ones():
+    with pytest.raises(ValueError, match="reverse_carried_crumbs"):
+        gs.params_for("paper+no_such_fill")
+
+
+def test_drift_cases_match_the_blazing_drift_sweep():
+    """The study's drift cases set the same non-zero odometry errors as ``blazing-drift``'s cases."""
+    sweep = load_sweep("blazing-drift")
+    cases = {c["case"]: c for c in sweep.cases}
+
+    def nonzero(d):
+        return {k: float(v) for k, v in d.items() if k != "case" and float(v) != 0.0}
+
+    for case in gs.DRIFT_CASES:
+        mine = nonzero(gs.drift_overrides(case))
+        assert mine == pytest.approx(nonzero(cases[case]))
+        assert set(mine) == set(nonzero(cases[case]))
+    load_scenario("blazing-a-trail", overrides=gs.drift_overrides("x1-slip"), seed=100, duration_s=1.0)
+    with pytest.raises(ValueError, match="x1-slip"):
+        gs.drift_overrides("x1-wobble")
+
+
+def test_report_seeds_are_refused():
+    assert gs.parse_seeds("100-102,110") == [100, 101, 102, 110]
+    with pytest.raises(SystemExit, match="report"):
+        gs.parse_seeds("5-105")
