@@ -366,3 +366,29 @@ def test_moving_resource_block_full_mode_reads_every_case_and_the_blazing_sweep(
     assert jumps.x == sorted(jumps.x) and len(jumps.x) == 5 and len(glides.x) == 4
     assert [r[2] for r in blaze.rows[:2]] == ["never (the paper)", "300 s after added"]
     assert {r[0] for r in blaze.rows} == {"static", "jump-10min", "glide-0.02"}
+
+
+def test_moving_places_are_recorded_as_a_layer_where_they_are(_drive_registered, tmp_path):
+    """A run with a moving place writes its positions (Places.track) as the ``moving_places`` layer,
+    so replays and exports draw it where it is; a run without one writes no such layer."""
+    from teamnav.sim.recorder import load as load_run
+
+    def run(motion):
+        place = {"name": "src", "x_m": 2.0, "y_m": 1.0, "radius_m": 0.5, "event": "took_resource"}
+        if motion is not None:
+            place["motion"] = motion
+        cfg = SimConfig(robots=(RobotGroupConfig(count=1, controller="drive-test-v1", sensors=(),
+                                                 start=StartConfig(poses=((1.0, 1.0, 0.0),))),),
+                        places=(PlaceConfig.model_validate(place),))
+        sim = Simulation(_room(), cfg)
+        sim.run(30)
+        return sim
+
+    sim = run({"mode": "jump", "path": [{"t_s": 0.5, "x_m": 4.0, "y_m": 1.0}, {"t_s": 2.0, "x_m": 3.0, "y_m": 2.0}]})
+    sim.recorder.save(tmp_path / "moving")
+    layer = load_run(tmp_path / "moving").layers["moving_places"]
+    assert layer.kind == "markers" and layer.frame == "world" and layer.hold
+    assert layer.step.tolist() == [0, 5, 20] and set(layer.robot.tolist()) == {-1}
+    rows = [layer.data[layer.offset[k]:layer.offset[k + 1]].tolist() for k in range(len(layer.step))]
+    assert rows == [[[2.0, 1.0]], [[4.0, 1.0]], [[3.0, 2.0]]]
+    assert "moving_places" not in run(None).recorder.layer_names

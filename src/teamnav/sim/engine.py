@@ -332,10 +332,25 @@ class Simulation:
         if self.radio is not None:
             self.recorder.comm_counts = self.radio.counts
         self._rec_sensing = bool(config.record_scans)
+        self._n_track = 0
+        if self.places.moving:  # replays and exports draw moving places where they are, not at their start
+            self.recorder.declare_layer("moving_places", "markers", hold=True,
+                                        description="moving places (Places.track: t = 0, every jump, every "
+                                                    "0.25 m of glide); static places are in the scenario")
+            self._record_moving_places()
         if self._rec_sensing:
             self.recorder.declare_layer("detections", "segments", description="robot detector: observer to detected robot")
             self.recorder.declare_layer("messages", "segments", description="radio message delivered: sender to receiver")
         self._record()
+
+    def _record_moving_places(self) -> None:
+        """One ``moving_places`` sample (robot -1) with every moving place where
+        :attr:`Places.track` last put it, at the step of its newest record."""
+        last: dict[str, tuple[float, float]] = {}
+        for rec in self.places.track:
+            last[rec["place"]] = (rec["x_m"], rec["y_m"])
+        self.recorder.add_layer_sample("moving_places", int(self.places.track[-1]["step"]), -1, list(last.values()))
+        self._n_track = len(self.places.track)
 
     # ------------------------------------------------------------------ public
     @property
@@ -460,6 +475,8 @@ class Simulation:
         if fx is not None and fx.kidnap_due:
             fx.kidnap(s)  # after the odometry step: odometry never feels the jump
         events = self.places.update(self.step_index, self.time_s, s.x_m, s.y_m) if self.places.active else None
+        if len(self.places.track) != self._n_track:
+            self._record_moving_places()
         if fx is None:
             inboxes = self.radio.collect() if self.radio is not None and self.radio.has_pending else None
         else:
