@@ -44,6 +44,7 @@ import numpy as np
 
 from teamnav.experiments.report.model import Comparison, Missing, Plot, SectionSpec, Series, Table, Text
 from teamnav.experiments.report.sections import _trails as T
+from teamnav.experiments.report.sections._beyond_mail_round import mail_round as _mail_round
 
 PAPER = "vaughan-stoy-sukhatme-mataric-blazing-a-trail.txt"
 LOCALIZED_SWEEP = "beyond-localized-trails"
@@ -310,6 +311,7 @@ def build(ctx) -> list:
         "docstring says which. Only combination 1 is built so far; the others of issue 22 are listed as missing.")]
     blocks += _localized_trails(ctx)
     blocks += _moving_resource(ctx)
+    blocks += _mail_round(ctx)  # N places, a mail round (Try §2.1, §4): _beyond_mail_round.py
     for what in ("localized LOS help (frames from MCL poses)", "detections help the trail team (eqs. 13-14)",
                  "trails as LOS memory", "the papers' future work (negative detections, data association, restricted radio, N places)"):
         blocks.append(Missing(what=what, why="not built yet (issue 22)"))
