@@ -148,6 +148,26 @@ def test_mail_round_block_full_mode_reads_every_case_for_ten_seeds():
     assert all("(n = 10)" in r[3] for r in table.rows)
     # 2 legs in 30 min: 4 legs per hour for the team, whatever N
     assert {r[3] for r in table.rows} == {"4.0 ± 0.0 (n = 10)"}
-    eff, mem = [b for b in blocks if isinstance(b, Plot)]
+    eff, thr, mem = [b for b in blocks if isinstance(b, Plot)]
     assert [s.x for s in eff.series] == [[2.0, 3.0, 4.0, 5.0], [3.0, 4.0, 5.0], [2.0, 3.0, 4.0, 5.0]]
     assert "no verdict" in eff.caption and mem.series[0].lo[0] == 100.0
+    # 2 legs in 30 min shared by 4 robots against 2 legs by one robot alone: 1 against 4 legs per robot-hour
+    assert thr.series[0].y == [1.0] * 4 and thr.series[2].y == [4.0] * 4
+    assert "N = 2: -3.0 ± 0.0 legs/robot/h (s.e., 10 seeds): the team's robots make fewer legs each" in thr.caption
+
+
+def test_sharing_text_says_when_there_is_no_difference():
+    team_setup, solo_setup = _setup(n_robots=2), _setup(n_robots=1)
+
+    def rows(legs_by_seed):
+        return [{"seed": s, "arrivals_series": json.dumps([[10.0 * (k + 1), 0, "ba"[k % 2]] for k in range(n)])}
+                for s, n in legs_by_seed.items()]
+
+    # team: 2 robots share the legs; solo: one robot. Per robot per hour (a 3600-s run): team n/2, solo n
+    same = M.sharing_text(rows({0: 4, 1: 6, 2: 2}), rows({0: 2, 1: 3, 2: 1}), team_setup, solo_setup, 3600.0)
+    assert same.startswith("+0.0 ± 0.0") and "no difference" in same
+    noisy = M.sharing_text(rows({0: 6, 1: 2, 2: 4}), rows({0: 1, 1: 3, 2: 2}), team_setup, solo_setup, 3600.0)
+    assert "no difference beyond the seeds' spread" in noisy  # +2, -2, 0: mean 0
+    more = M.sharing_text(rows({0: 10, 1: 12, 2: 10}), rows({0: 2, 1: 3, 2: 1}), team_setup, solo_setup, 3600.0)
+    assert "more legs each" in more
+    assert M.sharing_text(rows({0: 2}), rows({0: 1}), team_setup, solo_setup, 3600.0) == "too few paired seeds to compare"
