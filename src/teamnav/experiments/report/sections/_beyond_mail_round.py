@@ -248,7 +248,8 @@ def mail_round(ctx) -> list:
         f"in a fixed cyclic order (scenario {spec.scenario}: the MIT basement hallways, a real map whose corridors form "
         f"one loop of about 139 m; places {', '.join(setups[max(labels, key=lambda x: setups[x].n_places)].round)} "
         "in that order, the round of N using the first N). The 2002 team's per-robot drift, cruise "
-        f"{first.cruise_mps:g} m/s. Seeds {seeds[0]}-{seeds[-1]}, {dur / 60:g} min per run"
+        f"{first.cruise_mps:g} m/s. "
+        + (f"Seeds {seeds[0]}-{seeds[-1]}" if len(seeds) > 1 else f"Seed {seeds[0]}") + f", {dur / 60:g} min per run"
         + (" (quick mode: N = 2 and 3, one seed; the pipeline works, the numbers are not the result)." if quick else "."))]
     blocks.append(Table(
         "Mail round: units, efficiency and memory against N",
