@@ -33,7 +33,8 @@ Usage::
     nice -n 10 python scripts/trail_gap_fill_study.py drift --seeds 100-109 --workers 2 --out F.jsonl
     python scripts/trail_gap_fill_study.py summary --out F.jsonl
 
-Results (JSON lines, one per run) are appended to ``--out``; ``summary`` prints the tables that
+Results (JSON lines, one per run) are appended to ``--out`` (a run already there is skipped,
+so an interrupted study resumes); ``summary`` prints the tables that
 ``docs/report/blazing-a-trail.md`` shows (mean ± std over runs, and the paired difference against
 ``paper`` as mean ± standard error with the count of seeds better).
 """
@@ -42,13 +43,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
-import numpy as np
 
 SCENARIO = "blazing-a-trail"
 #: the scenario's own params (besides the gap-fills): as blazing-paper-rules.yaml
@@ -160,43 +159,17 @@ def parse_seeds(text: str) -> list[int]:
     return out
 
 
-def _ms(v: list[float]) -> str:
-    return f"{np.mean(v):.1f} ± {np.std(v, ddof=1):.1f}" if len(v) > 1 else (f"{v[0]:.1f}" if v else "-")
-
-
-def _paired(rows: list[dict], base: dict, key: str) -> str:
-    d = [r[key] - base[r["seed"]][key] for r in rows if r["seed"] in base]
-    if len(d) < 2:
-        return "-"
-    se = np.std(d, ddof=1) / math.sqrt(len(d))
-    better = sum(x > 0 for x in d)
-    return f"{np.mean(d):+.1f} ± {se:.1f} ({better}/{len(d)} more)"
-
-
 def summarize(rows: list[dict]) -> list[str]:
+    """Markdown tables of the runs, as the report section shows them
+    (:mod:`teamnav.experiments.report.sections._trails_gap_fills`)."""
+    from teamnav.experiments.report.sections._trails_gap_fills import HEADER, cases, table_rows
+
     out: list[str] = []
     for part in ("gapfills", "drift"):
-        prt = [r for r in rows if r["part"] == part]
-        if not prt:
-            continue
-        cases = sorted({r["case"] for r in prt}, key=lambda c: (len(c), c))
-        for case in cases:
-            rs = [r for r in prt if r["case"] == case]
-            base = {r["seed"]: r for r in rs if r["config"] == "paper"}
-            dur = rs[0]["duration_s"]
-            out.append(f"\n## {part} {case or '(scenario drift)'}, {dur / 60:.0f} min, seeds "
-                       f"{min(r['seed'] for r in rs)}-{max(r['seed'] for r in rs)}")
-            out.append("| configuration | units | paired vs paper | 2nd-half units | broke down | "
-                       "median breakdown (min) | CPU s/run |")
-            out.append("|---|---|---|---|---|---|---|")
-            configs = sorted({r["config"] for r in rs}, key=lambda c: (c != "paper", c != "teamnav", c))
-            for c in configs:
-                g = [r for r in rs if r["config"] == c]
-                broke = [r for r in g if not r["breakdown_censored"]]
-                med = np.median([r["breakdown_s"] if not r["breakdown_censored"] else r["duration_s"] for r in g])
-                out.append(f"| {c} | {_ms([r['units'] for r in g])} | {_paired(g, base, 'units') if c != 'paper' else ''} | "
-                           f"{_ms([r['units_second_half'] for r in g])} | {len(broke)}/{len(g)} | "
-                           f"{med / 60:.0f}{'+' if med >= dur else ''} | {np.mean([r['cpu_s'] for r in g]):.1f} |")
+        for case in cases(rows, part):
+            out += [f"\n## {part} {case or '(the scenario drift)'}", "| " + " | ".join(HEADER) + " |",
+                    "|" + "---|" * len(HEADER)]
+            out += ["| " + " | ".join(r) + " |" for r in table_rows(rows, part, case)]
     return out
 
 
@@ -225,6 +198,10 @@ def main(argv: list[str] | None = None) -> int:
         jobs = [("drift", c, k, s, a.duration or 3600.0) for k in a.cases.split(",") for c in configs for s in seeds]
     for c in configs:
         params_for(c)  # fail before any run
+    if a.out.exists():  # resume: a run already in --out is not run again
+        done_keys = {(r["part"], r["config"], r["case"], r["seed"])
+                     for r in map(json.loads, filter(str.strip, a.out.read_text().splitlines()))}
+        jobs = [j for j in jobs if j[:4] not in done_keys]
     a.out.parent.mkdir(parents=True, exist_ok=True)
     done = 0
     with ProcessPoolExecutor(a.workers) as ex, a.out.open("a") as fh:

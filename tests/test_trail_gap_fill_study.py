@@ -4,6 +4,7 @@ and single gap-fills between them (Vaughan et al. 2000 §4), and its drift cases
 from __future__ import annotations
 
 import importlib.util
+import json
 from pathlib import Path
 
 import pytest
@@ -80,3 +81,45 @@ def test_report_seeds_are_refused():
     assert gs.parse_seeds("100-102,110") == [100, 101, 102, 110]
     with pytest.raises(SystemExit, match="report"):
         gs.parse_seeds("5-105")
+
+
+def test_study_tables_pair_by_seed():
+    """The paired column is the mean over seeds of (config - paper) on the same seed, with its
+    standard error and the count of seeds where the config delivered more."""
+    from teamnav.experiments.report.sections._trails_gap_fills import table_rows
+
+    def run(config, seed, units, bd=None):
+        return {"part": "gapfills", "case": "", "config": config, "seed": seed, "duration_s": 1800.0,
+                "units": units, "units_second_half": units // 2, "breakdown_s": bd or 1800.0,
+                "breakdown_censored": bd is None, "cpu_s": 1.0}
+
+    runs = [run("paper", 1, 2, 600.0), run("paper", 2, 4, 1200.0), run("paper", 3, 6),
+            run("paper+x", 1, 12), run("paper+x", 2, 10), run("paper+x", 3, 6),
+            run("teamnav", 1, 30), run("teamnav", 2, 30), run("teamnav", 3, 30),
+            run("teamnav-x", 1, 20), run("teamnav-x", 2, 24), run("teamnav-x", 3, 30)]
+    rows = {r[0]: r for r in table_rows(runs, "gapfills", "")}
+    # differences 10, 6, 0: mean 5.3, std 5.03, s.e. 2.9; 2 of 3 seeds more
+    assert rows["paper+x"][2] == "+5.3 ± 2.9 (2/3)"
+    assert rows["paper"][2] == "reference"
+    assert rows["paper"][1] == "4.0 ± 2.0" and rows["paper"][4] == "2/3"
+    assert rows["paper"][5] == "20"  # median of 10, 20 and 30+ (censored at the run's end) min
+    assert rows["paper+x"][5] == "30+"
+    # leaving a gap-fill out of ours is paired with ours: -10, -6, 0
+    assert rows["teamnav-x"][2] == "-5.3 ± 2.9 (0/3)"
+
+
+def test_stored_study_runs_are_the_docs_jsonl():
+    """The section's package data holds exactly the runs recorded in docs/report/ (both parts)."""
+    from teamnav.experiments.report.sections._trails_gap_fills import STUDY_RUNS
+
+    docs = Path(__file__).resolve().parents[1] / "docs" / "report"
+    lines = []
+    for name in ("blazing-gap-fill-study.jsonl", "blazing-drift-study.jsonl"):
+        path = docs / name
+        if path.exists():
+            lines += [json.loads(x) for x in path.read_text().splitlines() if x.strip()]
+
+    def key(r):
+        return (r["part"], r["case"], r["config"], r["seed"])
+
+    assert sorted(STUDY_RUNS, key=key) == sorted(lines, key=key)

@@ -43,7 +43,9 @@ k = 0, 1, 2, 3, 4, 6 for 1 h, 10 seeds (the sweep's k = 0.5 case is there for ``
 the drift sweep is shared with the try-to-see-it-my-way section).
 
 What the section measured (the final drift sweep, the paper's conditions, one robot alone,
-the full mode's cost, with commits): ``docs/report/blazing-a-trail.md``.
+the full mode's cost, with commits): ``docs/report/blazing-a-trail.md``. Why the two columns
+differ, each gap-fill alone and the drift models on paired seeds (issue 25 §4), is shown from the
+stored runs of ``scripts/trail_gap_fill_study.py`` (:mod:`._trails_gap_fills`), not re-run.
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ import numpy as np
 from teamnav.experiments.claims import judge, load_claims, rule_text
 from teamnav.experiments.report.model import Comparison, Missing, Plot, SectionSpec, Series, Table, Text
 from teamnav.experiments.report.sections import _trails as T
+from teamnav.experiments.report.sections import _trails_gap_fills as GF
 
 PAPER = "vaughan-stoy-sukhatme-mataric-blazing-a-trail.txt"
 #: §5.1 units per robot (Tanis, Ant, Bee, Punky) and total
@@ -222,6 +225,7 @@ def build(ctx) -> list:
                         note="kept in both columns (the papers give no value): crumb interval 1 s and radius 2 m, "
                              "the sliding box's 2.0 m reach (lanes), trail_rule 'side' (§5.1's own wording), the "
                              "180° rule's 150° threshold for 'approximately opposite'"))
+    blocks += GF.blocks()  # issue 25 §4: each gap-fill alone, and the drift models (stored runs, not re-run)
 
     # 1. first trail, trip times after it vs the optimal robot
     c1 = claims["first-trail"]
