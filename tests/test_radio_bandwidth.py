@@ -177,3 +177,14 @@ def test_a_capped_scenario_runs_and_its_counts_show_what_the_cap_dropped(tmp_pat
     assert oc["messages"] > 0 and oc["burst_bytes"] == 100.0
     for s, sent in enumerate(capped["per_robot"]["bytes_sent"]):  # 100 B burst + 20 B/s x 30 s
         assert sent <= 100.0 + 20.0 * dur
+
+
+def test_faults_come_first_what_they_stop_takes_nothing_from_the_bucket():
+    r = _radio(100.0)  # 100-B bucket, 26-B messages
+    m = _msg(0, 2)
+    r.send([(0, m)] * 3, XS, YS, blocked=True, step=0)  # a blackout: not sent, bucket untouched
+    r.send([(0, m)] * 3, XS, YS, muted=np.array([True, False, False]), step=0)  # sender muted: the same
+    r.send([(0, m)] * 3, XS, YS, step=0)
+    assert [len(b) for b in r.collect()] == [0, 3, 3]
+    c = r.counts()
+    assert c["faults"]["messages_not_sent"] == 6 and c["over_cap"]["messages"] == 0
