@@ -36,8 +36,9 @@ along p_loss 0, 0.3, 0.6, 0.9, 1 no more lossy case is better than the one befor
 than 2 standard errors of the per-seed paired difference (:func:`loss_reversals`).
 
 Quick mode (CI): cases p0 and p0.9 of each system, seed 0, 3 LOS targets, 60-s MCL and 5-min
-trail runs (eight short runs): the pipeline works; no verdict. Full mode: the sweep files, seeds
-0-9 (the CPU cost of each sweep is stated in docs/report/beyond.md, session 15).
+trail runs (eight short runs, about 1 CPU-min): the pipeline works; no verdict. Full mode: the
+sweep files, seeds 0-9, 350 runs: about 1500 CPU-s on a 2-core EPYC (try 401, blazing 390,
+collab-mcl 562, los 169; docs/report/beyond.md, session 15, has the numbers).
 """
 
 from __future__ import annotations
