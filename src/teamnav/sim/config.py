@@ -233,12 +233,39 @@ class RadioConfig(Model):
     """Who hears a message: everyone (``broadcast``), robots within ``range_m`` (``range``),
     or robots within ``range_m`` *and* in line of sight (``line_of_sight``: Sgorbissa & Arkin's
     robots talk only while they see each other). Each delivery is lost with ``p_loss``; a
-    message sent at step k is delivered at step k+1."""
+    message sent at step k is delivered at step k+1.
+
+    ``bandwidth_bps`` (bytes per second per sender; None, the default, is unlimited: every
+    paper's rule, none of the four papers caps its radio) is ours (issue 22, "restricted radio
+    for every system"): a token bucket per sender, full at the start, refilled every step by
+    ``bandwidth_bps * dt_s`` up to a burst of ``bandwidth_burst_s`` seconds of the cap
+    (default 1 s; it must hold the largest message a system sends, or that message never
+    goes out: a trail robot's 100-B crumb needs ``bandwidth_bps * bandwidth_burst_s >= 100``). Each
+    message the sender sends (in outbox order, sized by :meth:`Message.size_bytes`) goes out when
+    it fits in the bucket, and takes its bytes out; one that does not fit is **dropped** at the
+    sender (not sent, counted under ``over_cap`` in the radio's counts), not queued: every
+    system here broadcasts its latest state (poses, goals, trees, crumbs), which a later message
+    replaces, so a queue would deliver stale news late and break the one-step delay. A message
+    larger than the burst can never go out. The cap counts transmissions, not receivers (one
+    broadcast costs its size once). Without the cap the radio is unchanged, bit for bit.
+    """
 
     mode: Literal["broadcast", "range", "line_of_sight"] = "broadcast"
     range_m: float = Field(1e9, gt=0.0)
     p_loss: Prob = 0.0
     sees: tuple[str, ...] = DEFAULT_SEES["vision"]
+    bandwidth_bps: float | None = Field(None, gt=0.0, le=1e12)
+    bandwidth_burst_s: float = Field(1.0, gt=0.0, le=86400.0)
+
+    @model_serializer(mode="wrap")
+    def _without_unlimited_bandwidth(self, handler):
+        # an uncapped radio dumps as before the cap existed (config hashes and stored trials stay)
+        data = handler(self)
+        if isinstance(data, dict) and self.bandwidth_bps is None:
+            data.pop("bandwidth_bps", None)
+            if self.bandwidth_burst_s == 1.0:
+                data.pop("bandwidth_burst_s", None)
+        return data
 
 
 # ---------------------------------------------------------------------------- places / events

@@ -286,7 +286,7 @@ class Simulation:
 
         self._plan_shared_sensing()
         self._any_per_robot = any(not grp.batched for grp in self._groups)
-        self.radio = Radio(config.radio, grid, n, np.random.default_rng(radio_ss)) if self._any_per_robot else None
+        self.radio = Radio(config.radio, grid, n, np.random.default_rng(radio_ss), dt_s=self.dt_s) if self._any_per_robot else None
         self.places = Places(config.places, self.state.x_m, self.state.y_m)
         self._ids_all = np.arange(n, dtype=np.int64)
 
@@ -714,9 +714,10 @@ class Simulation:
             )
         if outgoing:
             if fx is None:
-                self.radio.send(outgoing, xs, ys)
+                self.radio.send(outgoing, xs, ys, step=step)
             else:
-                self.radio.send(outgoing, xs, ys, muted=fx.radio_off if fx.any_radio_off else None, blocked=fx.blackout)
+                self.radio.send(outgoing, xs, ys, muted=fx.radio_off if fx.any_radio_off else None, blocked=fx.blackout,
+                                step=step)
 
     def _apply_batch(self, grp: _Group, act) -> None:
         n = grp.cfg.count

@@ -29,10 +29,21 @@ nothing (its messages are not counted as sent) and hears nothing; a blocked radi
 carries nothing: what is sent then is not sent, what is due then is not delivered. The counts
 of what faults stopped appear under ``"faults"`` in :meth:`Radio.counts` once a fault has
 touched the radio, and never otherwise.
+
+Bandwidth cap (``RadioConfig.bandwidth_bps``, ours: no paper caps its radio; None, unlimited,
+is the papers' rule): each sender has a token bucket of bytes, full (``bandwidth_bps *
+bandwidth_burst_s``) at the start and refilled at each step ``k`` by ``bandwidth_bps * dt_s``
+per step since its last refill, never above the burst. A message that fits goes out and takes
+its ``size_bytes`` from the bucket; one that does not is dropped at the sender: not sent, no
+loss drawn for it, counted under ``"over_cap"`` (messages and bytes, per robot) in
+:meth:`Radio.counts` (present only when a cap is set). So over any window of steps ``a..b`` a
+sender transmits at most ``burst + bandwidth_bps * dt_s * (b - a)`` bytes. Faults come first:
+a muted or blacked-out sender's messages never reach the bucket.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Sequence
 
 import numpy as np
@@ -89,6 +100,9 @@ class Radio:
     n_robots : int
     rng : numpy.random.Generator
         The radio's loss stream.
+    dt_s : float, optional
+        The step [s]; required with a bandwidth cap (``cfg.bandwidth_bps``), which refills
+        ``bandwidth_bps * dt_s`` bytes per step.
 
     Examples
     --------
@@ -100,9 +114,14 @@ class Radio:
     [0, 1, 0]
     """
 
-    def __init__(self, cfg, grid: OccupancyGrid, n_robots: int, rng: np.random.Generator) -> None:
+    def __init__(self, cfg, grid: OccupancyGrid, n_robots: int, rng: np.random.Generator, *,
+                 dt_s: float | None = None) -> None:
         if n_robots < 1:
             raise ValueError(f"n_robots must be >= 1, got {n_robots!r}")
+        cap = getattr(cfg, "bandwidth_bps", None)
+        if cap is not None and not (dt_s is not None and math.isfinite(dt_s) and dt_s > 0.0):
+            raise ValueError(f"dt_s: a radio with bandwidth_bps={cap!r} needs the step, a finite number > 0 [s]; "
+                             f"got {dt_s!r}")
         self.cfg = cfg
         self.n = int(n_robots)
         self.rng = rng
@@ -127,6 +146,16 @@ class Radio:
         #: what faults stopped (None until a fault touches the radio): messages not sent
         #: (their sender muted, or a blackout) and deliveries dropped (receiver muted, blackout)
         self.fault_counts: dict[str, int] | None = None
+        #: the bandwidth cap (None: unlimited): bytes per step, burst, each sender's bucket and
+        #: the step it was last refilled at, and what the cap dropped per sender
+        self._cap = cap
+        if cap is not None:
+            self._refill = float(cap) * float(dt_s)
+            self._burst = float(cap) * float(cfg.bandwidth_burst_s)
+            self._tokens = [self._burst] * self.n
+            self._refilled_at = [0] * self.n
+            self._over_messages = [0] * self.n
+            self._over_bytes = [0] * self.n
 
     @property
     def sent_messages(self) -> np.ndarray:
@@ -204,8 +233,29 @@ class Radio:
             self.fault_counts = {"messages_not_sent": 0, "deliveries_dropped": 0}
         self.fault_counts[key] += int(k)
 
+    def _within_cap(self, outgoing: Sequence[tuple[int, Message]], step: int) -> list[tuple[int, Message]]:
+        """The messages of ``outgoing`` that fit their sender's bucket at ``step`` (in order);
+        the others are counted as over the cap (see the module docstring)."""
+        kept = []
+        tokens, at = self._tokens, self._refilled_at
+        for s, msg in outgoing:
+            if not isinstance(msg, Message):
+                raise ValueError(f"robot {s}'s outbox must hold Message objects, got {type(msg).__name__}")
+            s = int(s)
+            if at[s] != step:
+                tokens[s] = min(self._burst, tokens[s] + self._refill * (step - at[s]))
+                at[s] = step
+            size = msg.size_bytes()
+            if size <= tokens[s]:
+                tokens[s] -= size
+                kept.append((s, msg))
+            else:
+                self._over_messages[s] += 1
+                self._over_bytes[s] += size
+        return kept
+
     def send(self, outgoing: Sequence[tuple[int, Message]], xs: np.ndarray, ys: np.ndarray, *,
-             muted: np.ndarray | None = None, blocked: bool = False) -> None:
+             muted: np.ndarray | None = None, blocked: bool = False, step: int | None = None) -> None:
         """Queue messages sent this step for delivery at the next :meth:`collect`.
 
         Parameters
@@ -219,6 +269,9 @@ class Radio:
             and they hear nobody.
         blocked : bool
             The radio carries nothing now (a blackout): no message is sent.
+        step : int, optional
+            The step index now; required with a bandwidth cap (its buckets refill per step,
+            and steps must not go back).
         """
         if not outgoing:
             return
@@ -230,6 +283,13 @@ class Radio:
             if len(kept) < len(outgoing):
                 self._fault_count("messages_not_sent", len(outgoing) - len(kept))
             outgoing = kept
+            if not outgoing:
+                return
+        if self._cap is not None:
+            if step is None or step < max(self._refilled_at):
+                raise ValueError(f"step: a radio with bandwidth_bps={self._cap!r} needs the step index now, an int "
+                                 f">= the last one sent at ({max(self._refilled_at)}); got {step!r}")
+            outgoing = self._within_cap(outgoing, int(step))
             if not outgoing:
                 return
         senders = sorted({int(s) for s, _ in outgoing})
@@ -308,4 +368,14 @@ class Radio:
                 "bytes_delivered": self.delivered_bytes.tolist(),
             },
             **({"faults": dict(self.fault_counts)} if self.fault_counts is not None else {}),
+            **({"over_cap": self.over_cap()} if self._cap is not None else {}),
         }
+
+    def over_cap(self) -> dict:
+        """What the bandwidth cap dropped: ``messages``, ``bytes`` and ``per_robot`` lists of
+        both, with the cap ``bandwidth_bps`` (zeros without a cap)."""
+        om = self._over_messages if self._cap is not None else [0] * self.n
+        ob = self._over_bytes if self._cap is not None else [0] * self.n
+        return {"bandwidth_bps": self._cap, "burst_bytes": self._burst if self._cap is not None else None,
+                "messages": int(sum(om)), "bytes": int(sum(ob)),
+                "per_robot": {"messages": list(om), "bytes": list(ob)}}

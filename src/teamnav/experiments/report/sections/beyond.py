@@ -34,6 +34,11 @@ mode: the 8 cases x seeds 0-9 x 1 h (about 9 CPU-s per run here), and blazing-tr
 ``beyond-moving-resource-blazing``: 3 motions x crumbs that never expire, the paper, or expire
 after 300 s, ``global_crumb_ttl_s``, beyond it; 60 runs).
 
+The papers' future work, **a restricted radio for every system** (issue 22; the cases and the
+bandwidth cap are ours; sweeps ``beyond-radio-<system>``): each system's headline metric against
+loss, range and one bandwidth cap, with two verdict rules per system (claims ``radio-*``);
+:mod:`~teamnav.experiments.report.sections._radio_beyond` owns the block and documents it.
+
 Left for later (issue 22): localized LOS help, detections for the trail team, trails as LOS memory, and the papers' other
 future work.
 """
@@ -312,8 +317,11 @@ def build(ctx) -> list:
     blocks += _localized_trails(ctx)
     blocks += _moving_resource(ctx)
     blocks += _mail_round(ctx)  # N places, a mail round (Try §2.1, §4): _beyond_mail_round.py
+    from teamnav.experiments.report.sections._radio_beyond import restricted_radio
+
+    blocks += restricted_radio(ctx)
     for what in ("localized LOS help (frames from MCL poses)", "detections help the trail team (eqs. 13-14)",
-                 "trails as LOS memory", "the papers' future work (negative detections, data association, restricted radio, N places)"):
+                 "trails as LOS memory", "the papers' future work (negative detections, data association)"):
         blocks.append(Missing(what=what, why="not built yet (issue 22)"))
     return blocks
 
