@@ -82,6 +82,13 @@ Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report sect
     globally uncertain, or two robots equally plausible) are dropped. With ``anonymous="ignore"``
     the brain does what the paper's method does with anonymous sights: nothing.
 
+``unsure_detections`` (§7.2 "Delayed integration": "it might be more appropriate to delay the update")
+    What an observer whose belief is not concentrated (heaviest cluster below
+    ``send_min_cluster_weight``) does with a detection: send it at once (``"integrate"``, the
+    paper's §3.2 rule and the default), drop it (``"drop"``), or keep it and send it once the
+    belief is concentrated, applied retrospectively by both robots at the detection's time with
+    their own odometry since (``"delay"``; :mod:`teamnav.control.delayed_integration`).
+
 ``paper_rules=True`` is the paper as written (:attr:`MCLWanderParams.PAPER_RULES`,
 :mod:`teamnav.control.paper_rules`; the reports' "paper as written" column): eq. 14 alone on a
 received tree (no sensor resetting), the untempered likelihood (eq. 12), resampling at every
@@ -98,19 +105,23 @@ records (a weighted subsample of the particles every recorded step, see
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from teamnav.control.delayed_integration import (
+    DetectionStore, OdometryHistory, StoredDetection, motion_since, past_frame,
+)
 from teamnav.control.nav.wander import Wander, WanderParams
 from teamnav.control.paper_rules import paper_rules_validator
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.tree_injection import inject_tree
-from teamnav.control.types import Action, Message, Observation
+from teamnav.control.types import Action, Detection, Message, Observation
 from teamnav.localization import (
     BeamModelParams, BeliefSync, DetectionModel, KLDParams, LikelihoodFieldParams, MCL, MCLParams, MotionParams,
     SyncMessage, SyncParams,
@@ -206,9 +217,22 @@ class MCLWanderParams(BaseModel):
     collaborate : bool
         Synchronise beliefs on detections (§3.2); False: single-robot MCL.
     send_min_cluster_weight : float
-        Beyond the paper (§7.2 "Delayed integration" suggests holding back updates when
-        both robots are highly uncertain): a detection is sent only when the observer's
-        heaviest belief cluster holds at least this weight; 0 (default): always, as in §3.2.
+        The observer's belief is *concentrated* when its heaviest cluster holds at least this
+        weight (a declared threshold, not the paper's: §7.2 speaks of robots "highly uncertain"
+        only). 0 (default): every belief counts as concentrated, every detection is sent at once
+        (§3.2). A value > 0 alone means ``unsure_detections="drop"`` (the earlier behaviour).
+    unsure_detections : {"integrate", "drop", "delay"}
+        What the observer does with a detection made while its belief is not concentrated
+        (:mod:`teamnav.control.delayed_integration`): ``"integrate"`` (default, the paper's rule,
+        §3.2): send it at once; ``"drop"``: send nothing; ``"delay"``: §7.2 "Delayed
+        integration", keep it and send it once the belief is concentrated, applied
+        retrospectively at the detection time by both robots. ``"drop"`` and ``"delay"`` need
+        ``send_min_cluster_weight`` > 0; ``"integrate"`` with ``send_min_cluster_weight`` > 0 is
+        an error (the two disagree).
+    delay_max_age_s : float
+        ``"delay"``: a stored detection older than this is dropped [s] (gap-fill: the paper gives
+        no value; odometry drift grows with the time since). Every collaborating robot keeps
+        its odometry (and scans) for this long plus 5 s, to apply delayed trees it receives.
     inject_fraction : float
         Beyond the paper: on a received detection tree, this share of the samples is first
         replaced by draws from the tree (uniform heading) before eq. 14 reweights them all
@@ -333,6 +357,9 @@ class MCLWanderParams(BaseModel):
         "receive_gate": False,
         # §3.2: "When one robot detects another, both sample sets are synchronized" (every detection)
         "send_min_cluster_weight": 0.0,
+        # §3.2 / Table 1: "if the robot is detected by the m-th robot do ... apply the detection model"
+        # at once; §7.2's delayed integration is a suggestion for future work
+        "unsure_detections": "integrate",
         # §7.2: false positives were "not modeled"; "Our sample-based implementation ... is not robust"
         "false_positive_filter": False,
         # §7.2: "The factorial representation, however, cannot deal with measurements such as
@@ -348,6 +375,7 @@ class MCLWanderParams(BaseModel):
         "provenance": "Fox §2.3: the two rules only (rule 2 not transitive)",
         "receive_gate": "Fox §2.3 rule 2: only the detecting robot waits 2.5 m",
         "send_min_cluster_weight": "Fox §3.2: every detection synchronises both beliefs",
+        "unsure_detections": "Fox §3.2, Table 1: a detection is integrated at once (§7.2's delay is future work)",
         "false_positive_filter": "Fox §7.2: false positives not filtered",
         "anonymous": "Fox §7.2: sights without identity are not used",
     }
@@ -364,6 +392,7 @@ class MCLWanderParams(BaseModel):
         "tree_min_samples": "§3.2's stopping rule 'see Thrun et al. (1999b)'; no value",
         "inject_lost_prior": "inert with inject_fraction 0 (the paper's), as are inject_weighting and the "
                              "inject_heading_* settings",
+        "delay_max_age_s": "inert with unsure_detections 'integrate' (the paper's)",
         "wander": "§5: the robots follow an operator or a random walk; our wanderer's settings",
     }
 
@@ -391,6 +420,8 @@ class MCLWanderParams(BaseModel):
     init_std_deg: float = Field(10.0, gt=0.0, le=360.0)
     collaborate: bool = False
     send_min_cluster_weight: float = Field(0.0, ge=0.0, le=1.0)
+    unsure_detections: Literal["integrate", "drop", "delay"] = "integrate"
+    delay_max_age_s: float = Field(60.0, gt=0.0, le=3600.0)
     inject_fraction: float = Field(0.0, ge=0.0, le=0.5)
     inject_weighting: Literal["bayes", "tree"] = "bayes"
     inject_lost_prior: float = Field(0.3, gt=0.0, lt=1.0)
@@ -423,6 +454,23 @@ class MCLWanderParams(BaseModel):
     paper_rules: bool = False
 
     _paper_rules = paper_rules_validator()
+
+    @model_validator(mode="after")
+    def _unsure_detections(self) -> "MCLWanderParams":
+        """``send_min_cluster_weight`` > 0 alone keeps its earlier meaning (``"drop"``); a mode that
+        needs the threshold without it, or ``"integrate"`` with it, is an error."""
+        given = "unsure_detections" in self.model_fields_set
+        w = self.send_min_cluster_weight
+        if not given and w > 0:
+            object.__setattr__(self, "unsure_detections", "drop")
+        elif given and self.unsure_detections == "integrate" and w > 0:
+            raise ValueError(f"unsure_detections 'integrate' sends every detection at once, but "
+                             f"send_min_cluster_weight = {w} > 0 holds back unsure ones: set unsure_detections to "
+                             f"'drop' or 'delay', or send_min_cluster_weight to 0")
+        elif self.unsure_detections in ("drop", "delay") and w <= 0:
+            raise ValueError(f"unsure_detections {self.unsure_detections!r} needs the threshold of a concentrated "
+                             f"belief: send_min_cluster_weight in (0, 1], got {w}")
+        return self
 
     def mcl_params(self) -> MCLParams:
         """The library's filter parameters these stand for."""
@@ -502,6 +550,13 @@ class MCLWander:
         self._det_logged = 0
         #: Counters for logs: detections seen / sent, phantoms filtered, messages dropped, associations.
         self.stats = {"seen": 0, "sent": 0, "filtered": 0, "rejected": 0, "assoc": 0, "assoc_dropped": 0}
+        # §7.2 delayed integration (:mod:`teamnav.control.delayed_integration`): the own odometry pose
+        # (and scan) per step, to move samples back to a detection's time; the detections kept while unsure
+        self._history = OdometryHistory(params.delay_max_age_s + 5.0) if params.collaborate else None
+        self._store = DetectionStore(params.delay_max_age_s)
+        self._filter_odom = np.zeros(3)  # odometry pose the samples stand for (that of the last filter update)
+        if params.unsure_detections == "delay":
+            self.stats.update({"stored": 0, "delayed_sent": 0, "expired": 0, "superseded": 0})
 
     # ------------------------------------------------------------------ step
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
@@ -517,6 +572,9 @@ class MCLWander:
             self._filter_step(acc, scan.ranges_m)
             self._acc = np.zeros(3)
             self._stepped = True
+            self._filter_odom = self._odom
+        if self._history is not None:
+            self._history.record(obs.time_s, self._odom, self._scan)
         out: list[Message] = []
         if self.sync is not None:
             self.sync.travel(obs.odom_delta)
@@ -583,17 +641,64 @@ class MCLWander:
                     self.stats["filtered"] += 1
                     continue
             keep.append(det)
-        if p.send_min_cluster_weight > 0 and self.mcl.estimate().cluster_weight < p.send_min_cluster_weight:
+        if p.unsure_detections != "integrate" and self.mcl.estimate().cluster_weight < p.send_min_cluster_weight:
+            if p.unsure_detections == "delay":  # §7.2: keep the named ones for later (anonymous: dropped)
+                for det in keep:
+                    if det.robot_id is not None:
+                        self._store.put(StoredDetection(int(det.robot_id), float(det.range_m),
+                                                        float(det.bearing_rad), float(obs.time_s)))
+                        self.stats["stored"] += 1
+                self.stats["expired"] += self._store.expire(obs.time_s)
             return out
         named = [d for d in keep if d.robot_id is not None]
         if named:
             msgs = self.sync.on_detections(self.mcl, named, obs.time_s)
             self.stats["sent"] += len(msgs)
             out += msgs
+        if p.unsure_detections == "delay" and len(self._store):
+            out += self._send_stored(obs)
         if p.anonymous == "associate":
             for det in keep:
                 if det.robot_id is None:
                     out += self._query(det, obs)
+        return out
+
+    # ------------------------------------------------------------------ §7.2 delayed integration
+    def _motion_since(self, t_s: float) -> np.ndarray | None:
+        """Own odometry from time ``t_s`` to the pose the samples stand for (None: not in the history)."""
+        then = self._history.pose_at(t_s)
+        return None if then is None else motion_since(then, self._filter_odom)
+
+    @contextmanager
+    def _past(self, t_s: float, motion: np.ndarray):
+        """The samples (and the scan the draws' headings use) as they were at time ``t_s``, and back."""
+        saved = self._scan
+        self._scan = self._history.scan_at(t_s)
+        try:
+            with past_frame(self.mcl, motion):
+                yield
+        finally:
+            self._scan = saved
+
+    def _send_stored(self, obs: Observation) -> list[Message]:
+        """§7.2: the detections kept while unsure, now that the belief is concentrated, each sent once
+        and built from the samples moved back to its time (:mod:`teamnav.control.delayed_integration`)."""
+        out: list[Message] = []
+        self.stats["expired"] += self._store.expire(obs.time_s)
+        for sd in self._store.take():
+            if not self.sync.detect_gate.allowed(sd.target):  # §2.3 rule 2: a fresher sight was used
+                self.stats["superseded"] += 1
+                continue
+            motion = self._motion_since(sd.t_s)
+            if motion is None:
+                self.stats["expired"] += 1
+                continue
+            with self._past(sd.t_s, motion):
+                msgs = self.sync.on_detections(self.mcl, [Detection(sd.range_m, sd.bearing_rad, sd.target)],
+                                               obs.time_s, detected_s=sd.t_s)
+            self.stats["sent"] += len(msgs)
+            self.stats["delayed_sent"] += len(msgs)
+            out += msgs
         return out
 
     def _anon_key(self, det) -> int:
@@ -658,6 +763,21 @@ class MCLWander:
         return float(np.dot(self.mcl.weights, tree(self.mcl.particles[:, :2])))
 
     def _on_message(self, msg: Message, obs: Observation) -> list[Message]:
+        """Handle one message; a tree of a delayed detection (§7.2, ``SyncMessage.detected_s``) is
+        applied to the samples moved back to the detection's time, then moved forward again."""
+        body = msg.body
+        if isinstance(body, SyncMessage) and body.detected_s is not None and (
+                (body.kind == "detection" and body.target == self.robot_id)
+                or (body.kind == "inverse" and body.observer == self.robot_id)):
+            motion = self._motion_since(body.detected_s)
+            if motion is None:  # older than this robot's history: cannot be applied retrospectively
+                self.stats["stale"] = self.stats.get("stale", 0) + 1
+                return []
+            with self._past(body.detected_s, motion):
+                return self._on_message_now(msg, obs)
+        return self._on_message_now(msg, obs)
+
+    def _on_message_now(self, msg: Message, obs: Observation) -> list[Message]:
         """Handle one message; a detection tree addressed to this robot is logged with the belief it
         met (issue 26 §2: the paper's Fig. 10a shows that belief still spread along the corridor)."""
         body = msg.body
