@@ -224,3 +224,47 @@ def test_a_delayed_tree_older_than_the_receivers_history_is_not_applied():
     b = _receiver(delay_max_age_s=1.0)  # history 1 + 5 s: t = 0.5 s is still in it
     b.step(_obs(1, 25, move_m=0.1, inbox=[_delayed_msg((21.5, 9.6), -10.0)]))
     assert b.sync.applied["detection"] == 0 and b.stats["stale"] == 1
+
+
+# ---------------------------------------------------------------------------- the report's numbers
+def test_cotravel_values_pair_by_seed_and_feed_the_claim():
+    from teamnav.experiments.claims import judge, load_claims
+    from teamnav.experiments.report.sections._collab_delayed import cotravel_values
+
+    ttl = {"alone": [300, 200, 250], "integrate": [250, 400, 300], "drop": [260, 380, 290], "delay": [200, 300, 310]}
+    rows = [{"seed": s, "params": {"case": c}, "metrics": {"loc_time_to_localize_s": t[s],
+                                                           "loc_final_localized_fraction": 0.5 + 0.1 * s}}
+            for c, t in ttl.items() for s in range(3)]
+    v = cotravel_values(rows)
+    d = np.array([200 - 250, 300 - 400, 310 - 300])
+    assert v["delay_paired_mean_s"] == pytest.approx(d.mean())
+    assert v["delay_paired_se_s"] == pytest.approx(d.std(ddof=1) / math.sqrt(3))
+    assert v["delay_faster_pairs"] == 2 and v["delay_n_pairs"] == 3
+    assert v["integrate_ttl_mean_s"] == pytest.approx(950 / 3)
+    assert v["delay_vs_drop_paired_mean_s"] == pytest.approx((-60 - 80 + 20) / 3)
+    # the upper bound -20 + 2 * 33 > 0: not clearly faster, so the claim does not hold
+    ok, _ = judge(load_claims("collab-mcl")["delayed-integration"], v)
+    assert ok is False
+
+
+def test_cotravel_sweep_runs_the_claims_seeds_with_valid_params():
+    """The sweep's four cases on the claim's report seeds; every case's params validate (integrate with
+    no threshold, drop and delay with the same one); the robots start together, heading north."""
+    from teamnav.experiments.claims import load_claims
+    from teamnav.experiments.spec import load_scenario
+    from teamnav.experiments.sweep import expand, load_sweep
+
+    trials = expand(load_sweep("collab-mcl-cotravel"))
+    cases = {t.params["case"] for t in trials}
+    assert cases == {"alone", "integrate", "drop", "delay"} and len(trials) == 80
+    assert sorted({t.seed for t in trials}) == load_claims("collab-mcl")["delayed-integration"].seed_list
+    by_case = {t.params["case"]: t.params for t in trials}
+    assert by_case["drop"]["robots.0.params.send_min_cluster_weight"] == \
+        by_case["delay"]["robots.0.params.send_min_cluster_weight"] > 0
+    for case, params in by_case.items():
+        over = {k: v for k, v in params.items() if k not in ("case", "duration_s")}
+        scn = load_scenario("collab-mcl-hallway", overrides=over, duration_s=1.0)
+        p = MCLWanderParams.model_validate(scn.robots[0].params)
+        assert p.unsure_detections == {"alone": "integrate", "integrate": "integrate", "drop": "drop",
+                                       "delay": "delay"}[case]
+        assert scn.robots[0].count == 4 and scn.robots[0].start.theta_deg == 90.0

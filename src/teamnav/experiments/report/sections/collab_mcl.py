@@ -29,6 +29,10 @@ two §7.2 extensions only teamnav has); the seeds are the claim's report seeds (
   (both columns; claim ``fp-breaks``) and with the brain's filter, and detections without
   identity, ignored (the paper's method) or associated by belief (teamnav; claims ``fp-filter``,
   ``anon-assoc``) — on the §5.1 setting, where sights are rare (the case §7.2 warns about).
+- §7.2 "delayed integration" (full mode, teamnav column, :mod:`._collab_delayed`): sweep
+  ``collab-mcl-cotravel``, 4 robots that start together in hallway C, unsure detections sent at
+  once (the paper's rule), dropped or delayed until the observer's belief is concentrated
+  (claims ``delayed-integration``, ``delayed-vs-drop``).
 
 Then three tables measured on tuning seeds (>= 1000) by ``scripts/collab_mcl_collapse.py`` and
 shown as measured (:data:`TUNING_RUNS`, not re-run here): why the paper-rules filter collapses
@@ -63,6 +67,7 @@ from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot,
 
 # the row helpers and the §7.2 part, importable from here as before the split
 from teamnav.experiments.report.sections._collab_beyond import _ANON, _FILTER, _FP, _beyond  # noqa: F401
+from teamnav.experiments.report.sections._collab_delayed import _delayed
 from teamnav.experiments.report.sections._collab_common import (  # noqa: F401
     _band, _metric, _ms, _ok, _param, _series,
 )
@@ -662,7 +667,7 @@ def build(ctx) -> list:
                          "experiments/claims/collab-mcl.yaml, on report seeds (tuning seeds are >= 1000)."
                          + (" Quick mode: few robots and samples, 1-2 seeds, short runs." if ctx.quick else ""))]
     vals: dict = {col: {} for col, _ in COLUMNS}  # {column: {claim id: {metric: value}}}, filled by the parts
-    for part in (_hallway, _hexagon, _detection, _beyond):
+    for part in (_hallway, _hexagon, _detection, _beyond, _delayed):
         blocks += part(ctx, vals)
     return blocks + _tuning_blocks() + _claims_and_gap_fills(ctx, vals)
 
