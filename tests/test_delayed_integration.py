@@ -268,3 +268,25 @@ def test_cotravel_sweep_runs_the_claims_seeds_with_valid_params():
         assert p.unsure_detections == {"alone": "integrate", "integrate": "integrate", "drop": "drop",
                                        "delay": "delay"}[case]
         assert scn.robots[0].count == 4 and scn.robots[0].start.theta_deg == 90.0
+
+
+def test_report_part_is_full_mode_only_and_builds_from_rows():
+    from types import SimpleNamespace
+
+    from teamnav.experiments.report.model import Comparison, Missing, Table
+    from teamnav.experiments.report.sections._collab_delayed import _delayed
+
+    assert isinstance(_delayed(SimpleNamespace(quick=True))[0], Missing)  # CI's quick mode stays short
+    ttl = {"alone": 250.0, "integrate": 300.0, "drop": 260.0, "delay": 200.0}
+    rows = [{"status": "ok", "seed": s, "params": {"case": c},
+             "metrics": {"loc_time_to_localize_s": t + 7.0 * (s % 3), "loc_final_localized_fraction": 0.75,
+                         "loc_censored": 1, "loc_syncs": 50}}
+            for c, t in ttl.items() for s in range(20)]
+    res = SimpleNamespace(rows=lambda: rows, total=len(rows))
+    out = {"paper_rules": {}, "teamnav": {}}
+    blocks = _delayed(SimpleNamespace(quick=False, sweep=lambda *a, **k: res), out)
+    assert isinstance(blocks[0], Table) and len(blocks[0].rows) == 4
+    comps = [b for b in blocks if isinstance(b, Comparison)]
+    assert [c.holds for c in comps] == [True, True]  # 100 s and 60 s faster on every seed
+    assert out["teamnav"]["delayed-integration"]["delay_paired_mean_s"] == pytest.approx(-100.0)
+    assert out["paper_rules"]["delayed-integration"] == {}
