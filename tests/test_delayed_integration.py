@@ -129,7 +129,7 @@ def test_a_stored_detection_is_sent_once_when_the_belief_concentrates_and_not_be
         _, out = a.step(_obs(0, k, move_m=0.1, dets=[Detection(1.5, 0.0, 1)]))
         assert _sync_out(out) == []
     seen_then = se2.transform_points(a.mcl.estimate().cluster_pose, [1.5, 0.0])  # B at t = 0.5 s
-    assert a.stats["stored"] == 5 and len(a._store) == 1
+    assert a._delay.stats["stored"] == 5 and len(a._delay.store) == 1
     for k in range(6, 21):  # A drives on, unsure, B out of sight
         _split(a)
         _, out = a.step(_obs(0, k, move_m=0.1))
@@ -144,7 +144,7 @@ def test_a_stored_detection_is_sent_once_when_the_belief_concentrates_and_not_be
     # the tree is B where it was at t = 0.5 s, not 1.5 m ahead of where A is now (1.5 m further on)
     centre = body.tree.sample(4000, np.random.default_rng(0)).mean(axis=0)
     assert np.hypot(*(centre - seen_then)) < 0.3 and np.hypot(*(centre - seen_now)) > 1.2
-    assert a.stats["delayed_sent"] == 1
+    assert a._delay.stats["delayed_sent"] == 1
     for k in range(22, 30):  # exactly once
         _, out = a.step(_obs(0, k, move_m=0.1))
         assert _sync_out(out) == []
@@ -159,7 +159,7 @@ def test_a_fresher_sight_used_now_supersedes_the_stored_one():
     _, out = a.step(_obs(0, 2, dets=[Detection(1.5, 0.0, 1)]))
     sent = _sync_out(out)
     assert len(sent) == 1 and sent[0].body.detected_s is None  # the live one, §2.3 rule 2 blocks the other
-    assert a.stats["superseded"] == 1 and a.stats["delayed_sent"] == 0
+    assert a._delay.stats["superseded"] == 1 and a._delay.stats["delayed_sent"] == 0
 
 
 def test_a_stored_detection_older_than_the_max_age_is_dropped():
@@ -167,13 +167,13 @@ def test_a_stored_detection_older_than_the_max_age_is_dropped():
     a.step(_obs(0, 0))
     _split(a)
     a.step(_obs(0, 1, dets=[Detection(1.5, 0.0, 1)]))  # t = 0.1 s
-    assert a.stats["stored"] == 1
+    assert a._delay.stats["stored"] == 1
     for k in range(2, 13):
         _split(a)
         a.step(_obs(0, k))
     _join(a)
     _, out = a.step(_obs(0, 13))  # t = 1.3 s: 1.2 s old
-    assert _sync_out(out) == [] and a.stats["expired"] == 1 and a.stats["delayed_sent"] == 0
+    assert _sync_out(out) == [] and a._delay.stats["expired"] == 1 and a._delay.stats["delayed_sent"] == 0
 
 
 def _delayed_msg(center_xy, detected_s: float, seed: int = 9) -> Message:

@@ -64,8 +64,13 @@ from teamnav.geometry import se2
 if TYPE_CHECKING:
     from teamnav.localization import MCL
 
-__all__ = ["DetectionStore", "OdometryHistory", "StoredDetection", "detected_point_now", "motion_since",
+__all__ = ["DelayedIntegration", "resolve_unsure_detections", "DetectionStore", "HISTORY_MARGIN_S", "OdometryHistory", "StoredDetection", "detected_point_now", "motion_since",
            "past_frame", "poses_after", "poses_before"]
+
+
+#: the odometry history covers ``delay_max_age_s`` plus this [s]: a tree sent at the maximum age
+#: reaches its receiver a step later, and the reply comes back a step after that
+HISTORY_MARGIN_S = 5.0
 
 
 def motion_since(odom_then, odom_now) -> np.ndarray:
@@ -185,6 +190,27 @@ class DetectionStore:
         return out
 
 
+def resolve_unsure_detections(params):
+    """The ``unsure_detections`` flag of an ``MCLWanderParams`` checked against its threshold.
+
+    ``send_min_cluster_weight`` > 0 with ``unsure_detections`` not given keeps the earlier meaning
+    of the threshold (``"drop"``); ``"integrate"`` given with a threshold > 0, or ``"drop"`` /
+    ``"delay"`` without one, is an error naming both fields. Returns ``params``.
+    """
+    given = "unsure_detections" in params.model_fields_set
+    w = params.send_min_cluster_weight
+    if not given and w > 0:
+        object.__setattr__(params, "unsure_detections", "drop")
+    elif given and params.unsure_detections == "integrate" and w > 0:
+        raise ValueError(f"unsure_detections 'integrate' sends every detection at once, but "
+                         f"send_min_cluster_weight = {w} > 0 holds back unsure ones: set unsure_detections to "
+                         f"'drop' or 'delay', or send_min_cluster_weight to 0")
+    elif params.unsure_detections in ("drop", "delay") and w <= 0:
+        raise ValueError(f"unsure_detections {params.unsure_detections!r} needs the threshold of a concentrated "
+                         f"belief: send_min_cluster_weight in (0, 1], got {w}")
+    return params
+
+
 @contextmanager
 def past_frame(mcl: MCL, motion) -> Iterator[None]:
     """Inside the block the filter's samples stand where they were before the body moved by
@@ -196,3 +222,72 @@ def past_frame(mcl: MCL, motion) -> Iterator[None]:
         yield
     finally:
         mcl.move_samples(poses_after(mcl.particles, motion))
+
+
+class DelayedIntegration:
+    """One brain's §7.2 state and steps: its odometry history, the detections it keeps, and the
+    pose its samples stand for (the odometry at its last filter update).
+
+    The brain calls :meth:`record` every step, :meth:`keep` with the detections of an unsure frame,
+    :meth:`send_stored` once its belief is concentrated, and :meth:`motion_since` plus its own past
+    frame (:func:`past_frame` and the scan of that time) for a tree that carries a detection time.
+
+    Parameters
+    ----------
+    max_age_s : float
+        ``delay_max_age_s``: stored detections older than this are dropped [s].
+    keep_history : bool
+        Keep the odometry history (every collaborating robot: it may receive delayed trees). It
+        covers ``max_age_s`` plus :data:`HISTORY_MARGIN_S` (the reply's round trip).
+    """
+
+    def __init__(self, max_age_s: float, keep_history: bool) -> None:
+        self.store = DetectionStore(max_age_s)
+        self.history = OdometryHistory(max_age_s + HISTORY_MARGIN_S) if keep_history else None
+        self.filter_odom = np.zeros(3)
+        #: counters for the brain's log (only robots with ``unsure_detections="delay"`` show them)
+        self.stats = {"stored": 0, "delayed_sent": 0, "expired": 0, "superseded": 0}
+
+    def record(self, t_s: float, odom_pose: np.ndarray, scan, filtered: bool) -> None:
+        """This step's odometry pose and scan; ``filtered``: the filter updated its samples to it."""
+        if filtered:
+            self.filter_odom = odom_pose
+        if self.history is not None:
+            self.history.record(t_s, odom_pose, scan)
+
+    def motion_since(self, t_s: float) -> np.ndarray | None:
+        """Own odometry from time ``t_s`` to the pose the samples stand for (None: not in the history)."""
+        then = None if self.history is None else self.history.pose_at(t_s)
+        return None if then is None else motion_since(then, self.filter_odom)
+
+    def keep(self, detections, t_s: float) -> None:
+        """Store the named detections of an unsure frame (anonymous ones are dropped) and forget old ones."""
+        for det in detections:
+            if det.robot_id is not None:
+                self.store.put(StoredDetection(int(det.robot_id), float(det.range_m), float(det.bearing_rad),
+                                               float(t_s)))
+                self.stats["stored"] += 1
+        self.stats["expired"] += self.store.expire(t_s)
+
+    def send_stored(self, sync, mcl: MCL, now_s: float, past) -> list:
+        """The stored detections, each sent once through ``sync`` (:class:`~teamnav.localization.BeliefSync`)
+        with ``mcl``'s samples moved back to its time inside ``past(t_s, motion)`` (a context manager of
+        the brain), unless §2.3's rule 2 blocks the robot (a fresher sight was used) or it is too old."""
+        from teamnav.control.types import Detection
+
+        out: list = []
+        self.stats["expired"] += self.store.expire(now_s)
+        for sd in self.store.take():
+            if not sync.detect_gate.allowed(sd.target):
+                self.stats["superseded"] += 1
+                continue
+            motion = self.motion_since(sd.t_s)
+            if motion is None:
+                self.stats["expired"] += 1
+                continue
+            with past(sd.t_s, motion):
+                msgs = sync.on_detections(mcl, [Detection(sd.range_m, sd.bearing_rad, sd.target)], now_s,
+                                          detected_s=sd.t_s)
+            self.stats["delayed_sent"] += len(msgs)
+            out += msgs
+        return out

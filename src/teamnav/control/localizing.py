@@ -82,12 +82,9 @@ Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report sect
     globally uncertain, or two robots equally plausible) are dropped. With ``anonymous="ignore"``
     the brain does what the paper's method does with anonymous sights: nothing.
 
-``unsure_detections`` (§7.2 "Delayed integration": "it might be more appropriate to delay the update")
-    What an observer whose belief is not concentrated (heaviest cluster below
-    ``send_min_cluster_weight``) does with a detection: send it at once (``"integrate"``, the
-    paper's §3.2 rule and the default), drop it (``"drop"``), or keep it and send it once the
-    belief is concentrated, applied retrospectively by both robots at the detection's time with
-    their own odometry since (``"delay"``; :mod:`teamnav.control.delayed_integration`).
+``unsure_detections`` (§7.2 "Delayed integration"; :mod:`teamnav.control.delayed_integration`)
+    A detection made while unsure: sent at once (the paper's §3.2 rule, default), dropped, or
+    delayed until the belief is concentrated and applied at its time by both robots.
 
 ``paper_rules=True`` is the paper as written (:attr:`MCLWanderParams.PAPER_RULES`,
 :mod:`teamnav.control.paper_rules`; the reports' "paper as written" column): eq. 14 alone on a
@@ -114,14 +111,12 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from teamnav.control.delayed_integration import (
-    DetectionStore, OdometryHistory, StoredDetection, motion_since, past_frame,
-)
+from teamnav.control.delayed_integration import DelayedIntegration, past_frame, resolve_unsure_detections
 from teamnav.control.nav.wander import Wander, WanderParams
 from teamnav.control.paper_rules import paper_rules_validator
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.tree_injection import inject_tree
-from teamnav.control.types import Action, Detection, Message, Observation
+from teamnav.control.types import Action, Message, Observation
 from teamnav.localization import (
     BeamModelParams, BeliefSync, DetectionModel, KLDParams, LikelihoodFieldParams, MCL, MCLParams, MotionParams,
     SyncMessage, SyncParams,
@@ -217,22 +212,16 @@ class MCLWanderParams(BaseModel):
     collaborate : bool
         Synchronise beliefs on detections (§3.2); False: single-robot MCL.
     send_min_cluster_weight : float
-        The observer's belief is *concentrated* when its heaviest cluster holds at least this
-        weight (a declared threshold, not the paper's: §7.2 speaks of robots "highly uncertain"
-        only). 0 (default): every belief counts as concentrated, every detection is sent at once
-        (§3.2). A value > 0 alone means ``unsure_detections="drop"`` (the earlier behaviour).
+        A belief is *concentrated* when its heaviest cluster holds at least this weight (declared
+        threshold; §7.2 says "highly uncertain" only). 0 (default): always (§3.2). > 0 alone means
+        ``unsure_detections="drop"`` (the earlier behaviour).
     unsure_detections : {"integrate", "drop", "delay"}
-        What the observer does with a detection made while its belief is not concentrated
-        (:mod:`teamnav.control.delayed_integration`): ``"integrate"`` (default, the paper's rule,
-        §3.2): send it at once; ``"drop"``: send nothing; ``"delay"``: §7.2 "Delayed
-        integration", keep it and send it once the belief is concentrated, applied
-        retrospectively at the detection time by both robots. ``"drop"`` and ``"delay"`` need
-        ``send_min_cluster_weight`` > 0; ``"integrate"`` with ``send_min_cluster_weight`` > 0 is
-        an error (the two disagree).
+        A detection made while the observer's belief is not concentrated is sent at once
+        (``"integrate"``, default, §3.2), dropped, or kept and sent once it is, applied at the
+        detection's time by both robots (``"delay"``, §7.2; :mod:`teamnav.control.delayed_integration`,
+        which also says which settings conflict).
     delay_max_age_s : float
-        ``"delay"``: a stored detection older than this is dropped [s] (gap-fill: the paper gives
-        no value; odometry drift grows with the time since). Every collaborating robot keeps
-        its odometry (and scans) for this long plus 5 s, to apply delayed trees it receives.
+        ``"delay"``: stored detections older than this are dropped [s] (gap-fill, no value in the paper).
     inject_fraction : float
         Beyond the paper: on a received detection tree, this share of the samples is first
         replaced by draws from the tree (uniform heading) before eq. 14 reweights them all
@@ -457,20 +446,7 @@ class MCLWanderParams(BaseModel):
 
     @model_validator(mode="after")
     def _unsure_detections(self) -> "MCLWanderParams":
-        """``send_min_cluster_weight`` > 0 alone keeps its earlier meaning (``"drop"``); a mode that
-        needs the threshold without it, or ``"integrate"`` with it, is an error."""
-        given = "unsure_detections" in self.model_fields_set
-        w = self.send_min_cluster_weight
-        if not given and w > 0:
-            object.__setattr__(self, "unsure_detections", "drop")
-        elif given and self.unsure_detections == "integrate" and w > 0:
-            raise ValueError(f"unsure_detections 'integrate' sends every detection at once, but "
-                             f"send_min_cluster_weight = {w} > 0 holds back unsure ones: set unsure_detections to "
-                             f"'drop' or 'delay', or send_min_cluster_weight to 0")
-        elif self.unsure_detections in ("drop", "delay") and w <= 0:
-            raise ValueError(f"unsure_detections {self.unsure_detections!r} needs the threshold of a concentrated "
-                             f"belief: send_min_cluster_weight in (0, 1], got {w}")
-        return self
+        return resolve_unsure_detections(self)
 
     def mcl_params(self) -> MCLParams:
         """The library's filter parameters these stand for."""
@@ -550,13 +526,8 @@ class MCLWander:
         self._det_logged = 0
         #: Counters for logs: detections seen / sent, phantoms filtered, messages dropped, associations.
         self.stats = {"seen": 0, "sent": 0, "filtered": 0, "rejected": 0, "assoc": 0, "assoc_dropped": 0}
-        # §7.2 delayed integration (:mod:`teamnav.control.delayed_integration`): the own odometry pose
-        # (and scan) per step, to move samples back to a detection's time; the detections kept while unsure
-        self._history = OdometryHistory(params.delay_max_age_s + 5.0) if params.collaborate else None
-        self._store = DetectionStore(params.delay_max_age_s)
-        self._filter_odom = np.zeros(3)  # odometry pose the samples stand for (that of the last filter update)
-        if params.unsure_detections == "delay":
-            self.stats.update({"stored": 0, "delayed_sent": 0, "expired": 0, "superseded": 0})
+        # §7.2 delayed integration: odometry history, detections kept while unsure
+        self._delay = DelayedIntegration(params.delay_max_age_s, keep_history=params.collaborate)
 
     # ------------------------------------------------------------------ step
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
@@ -568,13 +539,13 @@ class MCLWander:
         self._scan = np.asarray(scan.ranges_m, dtype=float)
         self._accumulate(np.asarray(obs.odom_delta, dtype=float))
         acc = self._acc
+        filtered = False
         if not self._stepped or math.hypot(acc[0], acc[1]) >= p.min_update_m or abs(acc[2]) >= self._min_rot:
             self._filter_step(acc, scan.ranges_m)
             self._acc = np.zeros(3)
             self._stepped = True
-            self._filter_odom = self._odom
-        if self._history is not None:
-            self._history.record(obs.time_s, self._odom, self._scan)
+            filtered = True
+        self._delay.record(obs.time_s, self._odom, self._scan, filtered)
         out: list[Message] = []
         if self.sync is not None:
             self.sync.travel(obs.odom_delta)
@@ -642,21 +613,18 @@ class MCLWander:
                     continue
             keep.append(det)
         if p.unsure_detections != "integrate" and self.mcl.estimate().cluster_weight < p.send_min_cluster_weight:
-            if p.unsure_detections == "delay":  # §7.2: keep the named ones for later (anonymous: dropped)
-                for det in keep:
-                    if det.robot_id is not None:
-                        self._store.put(StoredDetection(int(det.robot_id), float(det.range_m),
-                                                        float(det.bearing_rad), float(obs.time_s)))
-                        self.stats["stored"] += 1
-                self.stats["expired"] += self._store.expire(obs.time_s)
+            if p.unsure_detections == "delay":  # §7.2: keep the named ones for later
+                self._delay.keep(keep, obs.time_s)
             return out
         named = [d for d in keep if d.robot_id is not None]
         if named:
             msgs = self.sync.on_detections(self.mcl, named, obs.time_s)
             self.stats["sent"] += len(msgs)
             out += msgs
-        if p.unsure_detections == "delay" and len(self._store):
-            out += self._send_stored(obs)
+        if p.unsure_detections == "delay" and len(self._delay.store):
+            msgs = self._delay.send_stored(self.sync, self.mcl, obs.time_s, self._past)
+            self.stats["sent"] += len(msgs)
+            out += msgs
         if p.anonymous == "associate":
             for det in keep:
                 if det.robot_id is None:
@@ -664,42 +632,16 @@ class MCLWander:
         return out
 
     # ------------------------------------------------------------------ §7.2 delayed integration
-    def _motion_since(self, t_s: float) -> np.ndarray | None:
-        """Own odometry from time ``t_s`` to the pose the samples stand for (None: not in the history)."""
-        then = self._history.pose_at(t_s)
-        return None if then is None else motion_since(then, self._filter_odom)
-
     @contextmanager
     def _past(self, t_s: float, motion: np.ndarray):
         """The samples (and the scan the draws' headings use) as they were at time ``t_s``, and back."""
         saved = self._scan
-        self._scan = self._history.scan_at(t_s)
+        self._scan = self._delay.history.scan_at(t_s)
         try:
             with past_frame(self.mcl, motion):
                 yield
         finally:
             self._scan = saved
-
-    def _send_stored(self, obs: Observation) -> list[Message]:
-        """§7.2: the detections kept while unsure, now that the belief is concentrated, each sent once
-        and built from the samples moved back to its time (:mod:`teamnav.control.delayed_integration`)."""
-        out: list[Message] = []
-        self.stats["expired"] += self._store.expire(obs.time_s)
-        for sd in self._store.take():
-            if not self.sync.detect_gate.allowed(sd.target):  # §2.3 rule 2: a fresher sight was used
-                self.stats["superseded"] += 1
-                continue
-            motion = self._motion_since(sd.t_s)
-            if motion is None:
-                self.stats["expired"] += 1
-                continue
-            with self._past(sd.t_s, motion):
-                msgs = self.sync.on_detections(self.mcl, [Detection(sd.range_m, sd.bearing_rad, sd.target)],
-                                               obs.time_s, detected_s=sd.t_s)
-            self.stats["sent"] += len(msgs)
-            self.stats["delayed_sent"] += len(msgs)
-            out += msgs
-        return out
 
     def _anon_key(self, det) -> int:
         """Anonymous detections are matched to the previous frame's nearest one (gate 2)."""
@@ -769,7 +711,7 @@ class MCLWander:
         if isinstance(body, SyncMessage) and body.detected_s is not None and (
                 (body.kind == "detection" and body.target == self.robot_id)
                 or (body.kind == "inverse" and body.observer == self.robot_id)):
-            motion = self._motion_since(body.detected_s)
+            motion = self._delay.motion_since(body.detected_s)
             if motion is None:  # older than this robot's history: cannot be applied retrospectively
                 self.stats["stale"] = self.stats.get("stale", 0) + 1
                 return []
@@ -867,6 +809,8 @@ class MCLWander:
             out["group"] = str(self.info.extras.get("group", ""))
         if self.sync is not None and self._n_log % p.layer_every == 0:
             out.update({k: v for k, v in self.stats.items()})
+            if p.unsure_detections == "delay":
+                out.update(self._delay.stats)
         if self._n_log % p.layer_every == 0:
             pts = self._subsample(p.layer_points)[:, :2].astype(np.float32)
             out["layers"] = {"particles": {"data": pts, "kind": "points", "frame": "world", "hold": True,
