@@ -79,6 +79,9 @@ TEAMNAV_CHECKS: dict[str, tuple[str, str, dict[int, dict]]] = {
     "detection": ("collab-mcl-detection", "§5.1 as the scenario is (lost prior 0.3)", {}),
     "detection-prior0.1": ("collab-mcl-detection", "§5.1, inject_lost_prior 0.1", {1: {"inject_lost_prior": 0.1}}),
     "detection-prior0.6": ("collab-mcl-detection", "§5.1, inject_lost_prior 0.6", {1: {"inject_lost_prior": 0.6}}),
+    "detection-scanheading": ("collab-mcl-detection", "§5.1, draws' headings picked by the scan (the hallway's "
+                              "setting) instead of half from the own belief",
+                              {1: {"inject_heading_belief_share": 0.0, "inject_heading_scan_share": 1.0}}),
     "hallway": ("collab-mcl-hallway", "§5.2.1 as the scenario is", {}),
     "hallway-turns": ("collab-mcl-hallway", "§5.2.1, p_turn_at_opening 0.5 (the wanderer's default)",
                       {0: {"wander": {"cruise_speed_mps": 0.3, "turn_rate_radps": 0.8, "p_turn_at_opening": 0.5}}}),

@@ -82,6 +82,10 @@ Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report sect
     globally uncertain, or two robots equally plausible) are dropped. With ``anonymous="ignore"``
     the brain does what the paper's method does with anonymous sights: nothing.
 
+``unsure_detections`` (§7.2 "Delayed integration"; :mod:`teamnav.control.delayed_integration`)
+    A detection made while unsure: sent at once (the paper's §3.2 rule, default), dropped, or
+    delayed until the belief is concentrated and applied at its time by both robots.
+
 ``paper_rules=True`` is the paper as written (:attr:`MCLWanderParams.PAPER_RULES`,
 :mod:`teamnav.control.paper_rules`; the reports' "paper as written" column): eq. 14 alone on a
 received tree (no sensor resetting), the untempered likelihood (eq. 12), resampling at every
@@ -98,14 +102,16 @@ records (a weighted subsample of the particles every recorded step, see
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from teamnav.control.delayed_integration import DelayedIntegration, past_frame, resolve_unsure_detections
 from teamnav.control.nav.wander import Wander, WanderParams
 from teamnav.control.paper_rules import paper_rules_validator
 from teamnav.control.protocol import RobotInfo
@@ -206,9 +212,16 @@ class MCLWanderParams(BaseModel):
     collaborate : bool
         Synchronise beliefs on detections (§3.2); False: single-robot MCL.
     send_min_cluster_weight : float
-        Beyond the paper (§7.2 "Delayed integration" suggests holding back updates when
-        both robots are highly uncertain): a detection is sent only when the observer's
-        heaviest belief cluster holds at least this weight; 0 (default): always, as in §3.2.
+        A belief is *concentrated* when its heaviest cluster holds at least this weight (declared
+        threshold; §7.2 says "highly uncertain" only). 0 (default): always (§3.2). > 0 alone means
+        ``unsure_detections="drop"`` (the earlier behaviour).
+    unsure_detections : {"integrate", "drop", "delay"}
+        A detection made while the observer's belief is not concentrated is sent at once
+        (``"integrate"``, default, §3.2), dropped, or kept and sent once it is, applied at the
+        detection's time by both robots (``"delay"``, §7.2; :mod:`teamnav.control.delayed_integration`,
+        which also says which settings conflict).
+    delay_max_age_s : float
+        ``"delay"``: stored detections older than this are dropped [s] (gap-fill, no value in the paper).
     inject_fraction : float
         Beyond the paper: on a received detection tree, this share of the samples is first
         replaced by draws from the tree (uniform heading) before eq. 14 reweights them all
@@ -333,6 +346,9 @@ class MCLWanderParams(BaseModel):
         "receive_gate": False,
         # §3.2: "When one robot detects another, both sample sets are synchronized" (every detection)
         "send_min_cluster_weight": 0.0,
+        # §3.2 / Table 1: "if the robot is detected by the m-th robot do ... apply the detection model"
+        # at once; §7.2's delayed integration is a suggestion for future work
+        "unsure_detections": "integrate",
         # §7.2: false positives were "not modeled"; "Our sample-based implementation ... is not robust"
         "false_positive_filter": False,
         # §7.2: "The factorial representation, however, cannot deal with measurements such as
@@ -348,6 +364,7 @@ class MCLWanderParams(BaseModel):
         "provenance": "Fox §2.3: the two rules only (rule 2 not transitive)",
         "receive_gate": "Fox §2.3 rule 2: only the detecting robot waits 2.5 m",
         "send_min_cluster_weight": "Fox §3.2: every detection synchronises both beliefs",
+        "unsure_detections": "Fox §3.2, Table 1: a detection is integrated at once (§7.2's delay is future work)",
         "false_positive_filter": "Fox §7.2: false positives not filtered",
         "anonymous": "Fox §7.2: sights without identity are not used",
     }
@@ -364,6 +381,7 @@ class MCLWanderParams(BaseModel):
         "tree_min_samples": "§3.2's stopping rule 'see Thrun et al. (1999b)'; no value",
         "inject_lost_prior": "inert with inject_fraction 0 (the paper's), as are inject_weighting and the "
                              "inject_heading_* settings",
+        "delay_max_age_s": "inert with unsure_detections 'integrate' (the paper's)",
         "wander": "§5: the robots follow an operator or a random walk; our wanderer's settings",
     }
 
@@ -391,6 +409,8 @@ class MCLWanderParams(BaseModel):
     init_std_deg: float = Field(10.0, gt=0.0, le=360.0)
     collaborate: bool = False
     send_min_cluster_weight: float = Field(0.0, ge=0.0, le=1.0)
+    unsure_detections: Literal["integrate", "drop", "delay"] = "integrate"
+    delay_max_age_s: float = Field(60.0, gt=0.0, le=3600.0)
     inject_fraction: float = Field(0.0, ge=0.0, le=0.5)
     inject_weighting: Literal["bayes", "tree"] = "bayes"
     inject_lost_prior: float = Field(0.3, gt=0.0, lt=1.0)
@@ -423,6 +443,10 @@ class MCLWanderParams(BaseModel):
     paper_rules: bool = False
 
     _paper_rules = paper_rules_validator()
+
+    @model_validator(mode="after")
+    def _unsure_detections(self) -> "MCLWanderParams":
+        return resolve_unsure_detections(self)
 
     def mcl_params(self) -> MCLParams:
         """The library's filter parameters these stand for."""
@@ -502,6 +526,8 @@ class MCLWander:
         self._det_logged = 0
         #: Counters for logs: detections seen / sent, phantoms filtered, messages dropped, associations.
         self.stats = {"seen": 0, "sent": 0, "filtered": 0, "rejected": 0, "assoc": 0, "assoc_dropped": 0}
+        # §7.2 delayed integration: odometry history, detections kept while unsure
+        self._delay = DelayedIntegration(params.delay_max_age_s, keep_history=params.collaborate)
 
     # ------------------------------------------------------------------ step
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
@@ -513,10 +539,13 @@ class MCLWander:
         self._scan = np.asarray(scan.ranges_m, dtype=float)
         self._accumulate(np.asarray(obs.odom_delta, dtype=float))
         acc = self._acc
+        filtered = False
         if not self._stepped or math.hypot(acc[0], acc[1]) >= p.min_update_m or abs(acc[2]) >= self._min_rot:
             self._filter_step(acc, scan.ranges_m)
             self._acc = np.zeros(3)
             self._stepped = True
+            filtered = True
+        self._delay.record(obs.time_s, self._odom, self._scan, filtered)
         out: list[Message] = []
         if self.sync is not None:
             self.sync.travel(obs.odom_delta)
@@ -583,11 +612,17 @@ class MCLWander:
                     self.stats["filtered"] += 1
                     continue
             keep.append(det)
-        if p.send_min_cluster_weight > 0 and self.mcl.estimate().cluster_weight < p.send_min_cluster_weight:
+        if p.unsure_detections != "integrate" and self.mcl.estimate().cluster_weight < p.send_min_cluster_weight:
+            if p.unsure_detections == "delay":  # §7.2: keep the named ones for later
+                self._delay.keep(keep, obs.time_s)
             return out
         named = [d for d in keep if d.robot_id is not None]
         if named:
             msgs = self.sync.on_detections(self.mcl, named, obs.time_s)
+            self.stats["sent"] += len(msgs)
+            out += msgs
+        if p.unsure_detections == "delay" and len(self._delay.store):
+            msgs = self._delay.send_stored(self.sync, self.mcl, obs.time_s, self._past)
             self.stats["sent"] += len(msgs)
             out += msgs
         if p.anonymous == "associate":
@@ -595,6 +630,18 @@ class MCLWander:
                 if det.robot_id is None:
                     out += self._query(det, obs)
         return out
+
+    # ------------------------------------------------------------------ §7.2 delayed integration
+    @contextmanager
+    def _past(self, t_s: float, motion: np.ndarray):
+        """The samples (and the scan the draws' headings use) as they were at time ``t_s``, and back."""
+        saved = self._scan
+        self._scan = self._delay.history.scan_at(t_s)
+        try:
+            with past_frame(self.mcl, motion):
+                yield
+        finally:
+            self._scan = saved
 
     def _anon_key(self, det) -> int:
         """Anonymous detections are matched to the previous frame's nearest one (gate 2)."""
@@ -658,6 +705,21 @@ class MCLWander:
         return float(np.dot(self.mcl.weights, tree(self.mcl.particles[:, :2])))
 
     def _on_message(self, msg: Message, obs: Observation) -> list[Message]:
+        """Handle one message; a tree of a delayed detection (§7.2, ``SyncMessage.detected_s``) is
+        applied to the samples moved back to the detection's time, then moved forward again."""
+        body = msg.body
+        if isinstance(body, SyncMessage) and body.detected_s is not None and (
+                (body.kind == "detection" and body.target == self.robot_id)
+                or (body.kind == "inverse" and body.observer == self.robot_id)):
+            motion = self._delay.motion_since(body.detected_s)
+            if motion is None:  # older than this robot's history: cannot be applied retrospectively
+                self.stats["stale"] = self.stats.get("stale", 0) + 1
+                return []
+            with self._past(body.detected_s, motion):
+                return self._on_message_now(msg, obs)
+        return self._on_message_now(msg, obs)
+
+    def _on_message_now(self, msg: Message, obs: Observation) -> list[Message]:
         """Handle one message; a detection tree addressed to this robot is logged with the belief it
         met (issue 26 §2: the paper's Fig. 10a shows that belief still spread along the corridor)."""
         body = msg.body
@@ -747,6 +809,8 @@ class MCLWander:
             out["group"] = str(self.info.extras.get("group", ""))
         if self.sync is not None and self._n_log % p.layer_every == 0:
             out.update({k: v for k, v in self.stats.items()})
+            if p.unsure_detections == "delay":
+                out.update(self._delay.stats)
         if self._n_log % p.layer_every == 0:
             pts = self._subsample(p.layer_points)[:, :2].astype(np.float32)
             out["layers"] = {"particles": {"data": pts, "kind": "points", "frame": "world", "hold": True,

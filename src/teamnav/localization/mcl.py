@@ -712,6 +712,21 @@ class MCL:
         self._weights = w / w.sum()
         self._weighted = True
 
+    def move_samples(self, poses) -> None:
+        """Give every sample a new pose, weights kept (not in Fox et al.: delayed integration,
+        :mod:`teamnav.control.delayed_integration`, moves the set into the frame of a past
+        detection and back).
+
+        Parameters
+        ----------
+        poses : array_like of shape (n, 3)
+            One pose per sample [m, m, rad], in the order of :attr:`particles`.
+        """
+        self._require_particles("move_samples")
+        q = array("poses", poses, (self._particles.shape[0], 3)).copy()
+        q[:, 2] = wrap_angle(q[:, 2])
+        self._particles = np.ascontiguousarray(q, dtype=np.float64)
+
     # ------------------------------------------------------------------ estimates
     def estimate(self) -> Estimate:
         """Weighted mean and covariance, and the heaviest cluster's mean (see :class:`Estimate`)."""

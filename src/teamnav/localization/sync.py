@@ -124,6 +124,12 @@ class SyncMessage:
     sources : tuple of (int, float)
         ``(robot id, that robot's odometer [m])`` for every robot whose information the
         sender's belief holds, the sender included (``SyncParams.provenance``; empty without).
+    detected_s : float or None
+        None: the tree describes the robots at the message's stamp (the detection was just made,
+        §3.2). Else the time the detection was made: a detection integrated later (§7.2 "delayed
+        integration", :mod:`teamnav.control.delayed_integration`); the tree describes the robots
+        at that time and the receiver applies it to its samples moved back to it. A reply
+        (``"inverse"``) carries the time of the detection it answers.
     """
 
     kind: str
@@ -134,6 +140,7 @@ class SyncMessage:
     p_false_positive: float
     tree: DensityTree
     sources: tuple = ()
+    detected_s: float | None = None
 
 
 class SightingGate:
@@ -276,8 +283,11 @@ class BeliefSync:
         self.detect_gate.travel(odom_delta)
         self.receive_gate.travel(odom_delta)
 
-    def on_detections(self, mcl: MCL, detections, stamp_s: float) -> list[Message]:
-        """Messages (one per usable detection) carrying this robot's belief about the robot seen."""
+    def on_detections(self, mcl: MCL, detections, stamp_s: float, detected_s: float | None = None) -> list[Message]:
+        """Messages (one per usable detection) carrying this robot's belief about the robot seen.
+
+        ``detected_s``: the time the detections were made when they are integrated later (§7.2;
+        ``mcl`` then holds the samples moved back to that time); None: now (§3.2)."""
         out = []
         for det in detections:
             if not isinstance(det, Detection):
@@ -288,7 +298,8 @@ class BeliefSync:
             tree = detection_tree(mcl.particles, mcl.weights, det.range_m, det.bearing_rad, self.model, self.rng,
                                   self.params)
             body = SyncMessage("detection", self.robot_id, int(rid), float(det.range_m), float(det.bearing_rad),
-                               float(self.model.p_false_positive), tree, self.outgoing_sources())
+                               float(self.model.p_false_positive), tree, self.outgoing_sources(),
+                               None if detected_s is None else float(detected_s))
             out.append(Message(self.robot_id, float(stamp_s), body, to=int(rid), kind=SYNC_KIND))
             self.detect_gate.use(rid)
         return out
@@ -316,7 +327,7 @@ class BeliefSync:
             if self.params.symmetric:
                 tree = position_tree(mcl.particles, mcl.weights, self.params)
                 reply = SyncMessage("inverse", other, self.robot_id, body.range_m, body.bearing_rad,
-                                    body.p_false_positive, tree, self.outgoing_sources())
+                                    body.p_false_positive, tree, self.outgoing_sources(), body.detected_s)
                 replies.append(Message(self.robot_id, float(stamp_s), reply, to=other, kind=SYNC_KIND))
             if self._looped(body):
                 self.looped += 1
