@@ -139,6 +139,13 @@ def config_key(trial: dict[str, Any]) -> str:
     return f"{trial['sweep']}|{p.get('case', '')}|{tail}"
 
 
+def _plain_key(config: str) -> str:
+    """A configuration key without its case name (the ablation's trials moved from grid points to
+    cases when the section stopped running the tables' setting twice; the params are the same)."""
+    sweep, _case, grid = config.split("|", 2)
+    return f"{sweep}|{grid}"
+
+
 def run_sample(trial: dict[str, Any], k: int) -> dict[str, Any]:
     """The trial with its first ``k`` targets: CPU s, steps, targets reached, gave up, budget."""
     from teamnav.experiments.runner import run
@@ -265,10 +272,36 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", action="append", help="substring filter on the configuration key (repeatable)")
     ap.add_argument("--json", type=Path, default=None, help="write every sample and the summary here")
     ap.add_argument("--from-json", type=Path, default=None, help="print the tables of an earlier --json, run nothing")
+    ap.add_argument("--refine", type=Path, action="append", default=[],
+                    help="with --from-json: another --json (e.g. more targets on some configurations) whose samples "
+                         "replace the first one's for the configurations it holds")
+    ap.add_argument("--relist", action="store_true",
+                    help="with --from-json: count the trials of today's build (configurations it no longer runs drop out)")
     args = ap.parse_args(argv)
     if args.from_json:
         data = json.loads(args.from_json.read_text())
-        report(data["summary"], data["targets"])
+        if not (args.refine or args.relist):
+            report(data["summary"], data["targets"])
+            return 0
+        samples = {}
+        for r in data["samples"]:
+            samples.setdefault(_plain_key(r["config"]), []).append(r)
+        for extra in args.refine:
+            more: dict[str, list] = {}
+            for r in json.loads(extra.read_text())["samples"]:
+                more.setdefault(_plain_key(r["config"]), []).append(r)
+            samples.update(more)
+            print(f"{extra}: {len(more)} configurations replaced", file=sys.stderr)
+        if args.relist:
+            counts: dict[str, int] = defaultdict(int)
+            for t in list_trials():
+                counts[_plain_key(config_key(t))] += 1
+            dropped = [k for k in samples if k not in counts]
+            print(f"{len(dropped)} sampled configurations not in today's build (their trials are read from "
+                  f"another sweep's rows): dropped", file=sys.stderr)
+            samples = {k: [dict(r, trials_full=counts[k]) for r in v] for k, v in samples.items() if k in counts}
+        rows = summarize([r for v in samples.values() for r in v])
+        report(rows, data["targets"])
         return 0
     trials = list_trials()
     per_sweep: dict[str, int] = defaultdict(int)
