@@ -222,9 +222,17 @@ def _group(rows: list[dict[str, Any]], keyf) -> list[tuple[str, dict[str, float]
     return sorted(acc.items(), key=lambda kv: -kv[1]["cpu"])
 
 
+_NAV_CASE = {"potential_field": "pot-field", "avoid_past": "avoid-past", "visbug21": "visbug21"}
+
+
 def _algo(r: dict[str, Any]) -> str:
     c = r["case"] or ""
-    return c.split("/")[0] if c else "?"
+    if c and not r["sweep"].startswith("los-ablation"):
+        return c.split("/")[0]
+    for nav, name in _NAV_CASE.items():  # the ablation's grid points / cases name the navigator
+        if f"navigator={nav}" in r["config"]:
+            return name
+    return "?"
 
 
 def _team(r: dict[str, Any]) -> str:
