@@ -63,9 +63,9 @@ route-plan trials (plans B and C, teams R1,2..R1..R4) and 2 x 60 noise trials (e
 err_max 0 is the tables' R1..R4 run, read from its rows), and 45 ablation trials (teamnav only;
 the column that is the tables' setting of each algorithm is read from Table 1's rows): 705 trials,
 no simulation twice (:mod:`._los_reuse` checks per trial that the reused row is the same resolved
-scenario and seed, and runs the trial when it is not); :data:`FULL_CPU_NOTE` says what one column cost here (the paper-rules
-column and the route plans have not been run in full yet: about 2.2x the note's CPU time in all,
-by trial counts). Set
+scenario and seed, and runs the trial when it is not); :data:`FULL_CPU_NOTE` says what one column cost here and
+what the whole section is estimated to cost (the paper-rules column and the route plans have not been run in
+full yet: about 3.1 CPU-h in all, an upper bound from samples of every trial, ``benchmarks/los_cost_breakdown.py``). Set
 ``NUMBA_NUM_THREADS=1`` for sweeps on a small box: the
 line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread launch
 costs more than the work for four robots.
@@ -117,8 +117,12 @@ FULL_CPU_NOTE = ("Cost of the full reproduction here, measured (2026-11-26, sess
                  "its cores with other work for a while). All five: about 84 min of wall time on 2 cores, about 2.7 "
                  "CPU-hours. A failing trial ends at its first target over budget; wall time is about the CPU time "
                  "over the number of workers (`-j`). That was one column (teamnav) of 330 trials; with the paper-as-written "
-                 "column and Table 2's route plans B and C (issue 21 §3-§4) the section runs 780 trials, about 6 CPU-hours "
-                 "here by trial counts (estimated, not yet measured).")
+                 "column and Table 2's route plans B and C (issue 21 §3-§4) the section runs 705 trials (780 asked before "
+                 "session 15; the noise figures' err_max 0 and three ablation columns are the tables' own runs, read from "
+                 "their rows). Estimated in session 15 (benchmarks/los_cost_breakdown.py: every trial's first 4 targets, 20 "
+                 "for the paper-as-written VisBug-21 on office_simple, scaled to 200 targets with the give-up rate seen): "
+                 "about 47 M simulated steps and 3.1 CPU-hours at load 5-12 on this 2-core machine, an upper bound where "
+                 "a task gives up after the sampled targets; not yet run in full.")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
 GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
