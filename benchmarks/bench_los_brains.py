@@ -19,6 +19,7 @@ Usage::
     python benchmarks/bench_los_brains.py --base-src /path/to/old/src
     python benchmarks/bench_los_brains.py --targets 10 --repeats 1   # CPU of a 10-target task
     python benchmarks/bench_los_brains.py --kernels                  # each fast path vs its numpy version
+    python benchmarks/bench_los_brains.py --paper-rules --only visbug21   # the paper-as-written column
 
 ``--targets N``: instead of a fixed number of steps, each run is the first N targets of task 1
 (the scenario's own step budget per target and ``stop_when_finished``), and the table gives
@@ -53,6 +54,10 @@ BASE_COMMIT = "f9d6cb5"
 
 def _overrides(case: str, team: str, map_key: str = "", targets: int = 0) -> dict:
     ov = dict(CASES[case])
+    if os.environ.get("TEAMNAV_BENCH_PAPER_RULES") == "1":  # --paper-rules: the paper-as-written column
+        from los_fingerprint import _paper_rules_set
+
+        ov = {**_paper_rules_set(map_key), **ov}
     for k in (1, 2, 3):
         ov[f"robots.{k}.count"] = TEAMS[team]
     if targets:
@@ -114,7 +119,11 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--base-src", help=f"the older tree's src folder (default: git archive {BASE_COMMIT})")
     ap.add_argument("--base-commit", default=BASE_COMMIT)
     ap.add_argument("--new-src", help="the newer tree's src folder (default: this checkout's)")
+    ap.add_argument("--paper-rules", action="store_true",
+                    help="both brains at paper_rules: true (the report's paper-as-written column)")
     args = ap.parse_args(argv)
+    if args.paper_rules:
+        os.environ["TEAMNAV_BENCH_PAPER_RULES"] = "1"  # read by the measuring processes
     if args.worker:
         m, c, t, n, k = args.worker
         print(json.dumps(_worker(m, c, t, int(n), int(k))))

@@ -43,6 +43,14 @@ occlusion model returns exact range and bearing there: the 4 potential-field and
 team runs at err_max 0 moved). The other 12 (R1 alone and err_max 0.4 for those two
 algorithms) reproduced their hashes. ``los_fingerprints.json`` still holds the hashes of
 before these changes and needs re-recording on the machine that recorded it (not this one).
+
+``--paper-rules`` (issue 21 §5, session 15): the same 24 runs with both brains at
+``paper_rules: true``, as the report's "paper as written" column runs them (VisBug-21's
+``boundary_shortcut`` and ``turn="left"``, the lifelong Avoid-Past memory, no gap-fills), whose
+code paths the default runs do not reach; ``los_fingerprints_paper_epyc.json`` holds them as
+recorded at 2abec5c on the EPYC machine::
+
+    python benchmarks/los_fingerprint.py --paper-rules --check benchmarks/los_fingerprints_paper_epyc.json
 """
 
 from __future__ import annotations
@@ -79,14 +87,24 @@ def _default(o):
     raise TypeError(type(o).__name__)
 
 
-def run_one(map_key: str, case: str, team: str, err_max: float, steps: int) -> tuple[str, dict]:
-    """(sha256, readable summary) of one run."""
+def _paper_rules_set(map_key: str) -> dict:
+    """Every robot group's params at ``paper_rules: true``, as the report's paper-as-written
+    column sets them (``_trails.paper_rules_spec`` of the map's table sweep)."""
+    from teamnav.experiments.report.sections._trails import paper_rules_spec
+    from teamnav.experiments.sweep import resolve_spec
+
+    return dict(paper_rules_spec(resolve_spec({"simple": "los-table1", "complex": "los-table2"}[map_key])).set)
+
+
+def run_one(map_key: str, case: str, team: str, err_max: float, steps: int, paper_rules: bool = False) -> tuple[str, dict]:
+    """(sha256, readable summary) of one run; ``paper_rules``: both brains as the paper wrote them
+    (the report's "paper as written" column), the case's navigator and sharing flag on top."""
     import numpy as np
 
     from teamnav import load_scenario
     from teamnav.experiments.runner import run
 
-    ov = dict(CASES[case])
+    ov = {**(_paper_rules_set(map_key) if paper_rules else {}), **CASES[case]}
     present = TEAMS[team]
     for k in (1, 2, 3):
         ov[f"robots.{k}.count"] = present
@@ -132,6 +150,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", action="append", help="substring filter on the run key (repeatable: any)")
     ap.add_argument("--save", help="write the fingerprints to this JSON file")
     ap.add_argument("--check", help="compare with the fingerprints in this JSON file")
+    ap.add_argument("--paper-rules", action="store_true",
+                    help="the same 24 runs with both brains at paper_rules: true (the report's paper-as-written "
+                         "column; its own reference file, los_fingerprints_paper_epyc.json)")
     args = ap.parse_args(argv)
     import teamnav
 
@@ -148,7 +169,10 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"reference recorded with {lib} {want or '(not recorded)'}, running {have}: hashes may "
                       "differ without any change of ours (NumPy 2.4's hypot/arctan2 differ from libm's in the "
                       "last bit, and the potential field's and Avoid-Past's numpy lines use them)", file=sys.stderr)
-    out = {"steps": args.steps, "versions": _versions(), "runs": {}}
+    out = {"steps": args.steps, "versions": _versions(), "paper_rules": bool(args.paper_rules), "runs": {}}
+    if ref and bool(ref.get("paper_rules", False)) != bool(args.paper_rules):
+        print(f"reference has paper_rules={ref.get('paper_rules', False)}, running paper_rules={args.paper_rules}",
+              file=sys.stderr)
     bad = 0
     t_all = time.process_time()
     for map_key, case, team, err in itertools.product(MAPS, CASES, TEAMS, ERR_MAX):
@@ -156,7 +180,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.only and not any(s in key for s in args.only):
             continue
         t0 = time.process_time()
-        digest, summary = run_one(map_key, case, team, err, args.steps)
+        digest, summary = run_one(map_key, case, team, err, args.steps, args.paper_rules)
         cpu = time.process_time() - t0
         out["runs"][key] = {"sha256": digest, "summary": summary}
         status = ""

@@ -347,3 +347,37 @@ def test_boundary_heading_equals_numpy(seed, k, side):
     pts = xy + rng.uniform(-2, 2, (k, 2))
     pts[k // 2] = pts[0]  # equal distances: the first one
     assert _bits(boundary_heading(xy, pts, 0.4, side, 1.5)) == _bits(_boundary_heading_numpy(xy, pts, 0.4, side, 1.5))
+
+
+@given(seeds, coord, coord, angle, st.sampled_from([1, -1]), st.sampled_from([0.2, 0.25]),
+       st.sampled_from([0.33, 0.45]), st.sampled_from([2.0, 7.75]), st.sampled_from(["followed", "wall", "ties"]))
+@settings(max_examples=80, deadline=None)
+def test_visbug_boundary_target_equals_numpy(seed, x, y, th, side, r_safe, follow_m, reach_m, kind):
+    """Issue 21 §5: Step 2's boundary target (``boundary_shortcut``, the paper-rules VisBug-21)
+    from ``_boundary_pick`` and from the numpy version it replaced (kept as
+    ``_boundary_target_numpy``), bit for bit: on the followed points of random scans, on a
+    straight wall, and on points with repeated positions and equal bearings (ties in the
+    stable ordering, zero-length chords)."""
+    from teamnav.control.nav.local.visbug21 import VisBug21, VisBugParams
+
+    rng = np.random.default_rng(seed)
+    scan = _scan(rng, n=int(rng.choice([8, 36, 72])))
+    pose = np.array([x, y, th])
+    nav = VisBug21(VisBugParams(turn="left", boundary_shortcut=True), np.random.default_rng(0), 0.2, 0.2)
+    nav.side, nav._slack = side, math.pi / len(scan.ranges_m)
+    points = base.scan_points(pose, scan)
+    if kind == "followed":
+        nav._follow_ref, nav._ends = None, "unset"
+        followed = nav._followed(pose, scan)
+    elif kind == "wall":
+        n = int(rng.integers(3, 60))
+        followed = np.column_stack((np.linspace(-3.0, 3.0, n) + x, np.full(n, y + rng.uniform(-1.0, 1.0))))
+    else:
+        base_pts = pose[:2] + rng.uniform(-3.0, 3.0, (int(rng.integers(2, 6)), 2))
+        followed = base_pts[rng.integers(0, len(base_pts), int(rng.integers(3, 20)))]
+        followed = np.concatenate((followed, pose[:2] + 2.0 * (followed - pose[:2])))  # equal bearings
+    got = nav._boundary_target(pose[:2].copy(), followed, points, r_safe, follow_m, reach_m)
+    want = nav._boundary_target_numpy(pose[:2].copy(), followed, points, r_safe, follow_m, reach_m)
+    assert (got is None) == (want is None)
+    if want is not None:
+        assert np.array_equal(_bits(got), _bits(want))

@@ -125,6 +125,7 @@ from teamnav.control.nav.local.visbug21_geometry import (
     END_TOL_M,
     FOLLOW_GAP_M,
     _follow_kernel,
+    _boundary_pick,
     _last_visible,
     _leave_candidates,
     boundary_heading,
@@ -527,6 +528,26 @@ class VisBug21:
 
     def _boundary_target(self, xy: np.ndarray, followed: np.ndarray, points: np.ndarray, r_safe: float,
                          follow_m: float, reach_m: float) -> np.ndarray | None:
+        """Step 2's boundary target (``boundary_shortcut``): :meth:`_boundary_target_numpy`'s
+        rule and arithmetic, its part after the bearings in one kernel (``_boundary_pick``,
+        issue 21 §5: it stops at the first visible candidate instead of testing all of them);
+        equal bit for bit (``tests/test_los_speed_equivalence.py``)."""
+        if followed.shape[0] < 3:
+            return None
+        rel = followed - xy
+        d = np.hypot(rel[:, 0], rel[:, 1])
+        i = int(np.argmin(d))
+        phi = math.atan2(rel[i, 1], rel[i, 0])
+        delta = self.side * (np.mod(np.arctan2(rel[:, 1], rel[:, 0]) - phi + math.pi, 2.0 * math.pi) - math.pi)
+        k, cx, cy = _boundary_pick(float(xy[0]), float(xy[1]), followed[:, 0], followed[:, 1], delta, float(follow_m),
+                                   float(self.step_length_m), points[:, 0], points[:, 1], float(r_safe), float(reach_m),
+                                   float(self._slack))
+        if k < 0:
+            return None
+        return np.array((cx, cy))
+
+    def _boundary_target_numpy(self, xy: np.ndarray, followed: np.ndarray, points: np.ndarray, r_safe: float,
+                               follow_m: float, reach_m: float) -> np.ndarray | None:
         """Step 2's other intermediate target (``boundary_shortcut``, Lumelsky & Skewis): the
         farthest visible point of the followed obstacle's boundary in the local direction.
 

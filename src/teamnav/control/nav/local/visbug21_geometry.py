@@ -350,3 +350,65 @@ def _leave_candidates(x, y, pts, cand, t, gx, gy, d_max, mgx, mgy, ux, uy, r_vis
             ok[i] = False
             n_ok -= 1
     return sel, ok, tested, run, n_ok
+
+
+@njit(cache=True)
+def _boundary_pick(x, y, fx, fy, delta, follow_m, step_m, px, py, r_safe, reach_m, slack_rad):
+    """Step 2's boundary target (``boundary_shortcut``) after its bearings (numba): issue 21 §5.
+
+    The arithmetic of :meth:`~teamnav.control.nav.local.visbug21.VisBug21._boundary_target_numpy`
+    from its stood-off points on: per followed point ``k`` (``fx``, ``fy``) the chord through its
+    neighbours in beam order (the ends repeat themselves), its unit normal turned towards
+    (``x``, ``y``), the point stood off by ``follow_m`` along it; the candidates are those with
+    ``delta > 0`` and at least ``step_m`` away, in decreasing ``delta`` (ties in beam order, as
+    the stable argsort); the first one that ``_visible`` finds visible is the target. The
+    visibility search is :func:`_last_visible` on the reversed order, which stops at the answer
+    instead of testing every candidate (``math.hypot`` is libm's, as ``np.hypot``). ``delta``
+    (the bearings past the nearest point) stays NumPy's: its ``arctan2`` is not libm's.
+
+    Returns ``(k, cx, cy)``: the followed point's index and the target, or ``(-1, nan, nan)``.
+    """
+    nk = fx.shape[0]
+    cx = np.empty(nk)
+    cy = np.empty(nk)
+    order = np.empty(nk, dtype=np.int64)
+    n = 0
+    for k in range(nk):
+        if k + 1 < nk:
+            ax, ay = fx[k + 1], fy[k + 1]
+        else:
+            ax, ay = fx[nk - 1], fy[nk - 1]
+        if k > 0:
+            bx, by = fx[k - 1], fy[k - 1]
+        else:
+            bx, by = fx[0], fy[0]
+        tx = ax - bx
+        ty = ay - by
+        tn = math.hypot(tx, ty)
+        if tn < 1e-12:
+            tn = 1e-12
+        nx = -ty / tn
+        ny = tx / tn
+        flip = -1.0 if nx * (fx[k] - x) + ny * (fy[k] - y) > 0.0 else 1.0
+        cx[k] = fx[k] + follow_m * (flip * nx)
+        cy[k] = fy[k] + follow_m * (flip * ny)
+        if delta[k] > 0.0 and math.hypot(cx[k] - x, cy[k] - y) >= step_m:
+            # insertion into decreasing delta, after any equal one (a stable sort of -delta)
+            j = n
+            while j > 0 and delta[order[j - 1]] < delta[k]:
+                order[j] = order[j - 1]
+                j -= 1
+            order[j] = k
+            n += 1
+    if n == 0:
+        return -1, np.nan, np.nan
+    rx = np.empty(n)
+    ry = np.empty(n)
+    for j in range(n):
+        rx[n - 1 - j] = cx[order[j]]
+        ry[n - 1 - j] = cy[order[j]]
+    jr = _last_visible(x, y, px, py, rx, ry, r_safe, reach_m, slack_rad)
+    if jr < 0:
+        return -1, np.nan, np.nan
+    k = order[n - 1 - jr]
+    return k, cx[k], cy[k]

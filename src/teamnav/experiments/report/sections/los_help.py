@@ -59,10 +59,13 @@ at its first trap instead of burning a whole task's budget.
 
 Running it: ``teamnav report los-help --out DIR`` (full) runs, per column, 2 x 60 table trials
 (3 algorithms x 4 teams x 5 tasks; ``teamnav sweep los-table1 --out DIR`` runs the same 60), 2 x 45
-route-plan trials (plans B and C, teams R1,2..R1..R4) and 2 x 75 noise trials, and 60 ablation
-trials (teamnav only); :data:`FULL_CPU_NOTE` says what one column cost here (the paper-rules
-column and the route plans have not been run in full yet: about 2.2x the note's CPU time in all,
-by trial counts). Set
+route-plan trials (plans B and C, teams R1,2..R1..R4) and 2 x 60 noise trials (err_max 0.1-0.4:
+err_max 0 is the tables' R1..R4 run, read from its rows), and 45 ablation trials (teamnav only;
+the column that is the tables' setting of each algorithm is read from Table 1's rows): 705 trials,
+no simulation twice (:mod:`._los_reuse` checks per trial that the reused row is the same resolved
+scenario and seed, and runs the trial when it is not); :data:`FULL_CPU_NOTE` says what one column cost here and
+what the whole section is estimated to cost (the paper-rules column and the route plans have not been run in
+full yet: about 3.1 CPU-h in all, an upper bound from samples of every trial, ``benchmarks/los_cost_breakdown.py``). Set
 ``NUMBA_NUM_THREADS=1`` for sweeps on a small box: the
 line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread launch
 costs more than the work for four robots.
@@ -114,8 +117,12 @@ FULL_CPU_NOTE = ("Cost of the full reproduction here, measured (2026-11-26, sess
                  "its cores with other work for a while). All five: about 84 min of wall time on 2 cores, about 2.7 "
                  "CPU-hours. A failing trial ends at its first target over budget; wall time is about the CPU time "
                  "over the number of workers (`-j`). That was one column (teamnav) of 330 trials; with the paper-as-written "
-                 "column and Table 2's route plans B and C (issue 21 §3-§4) the section runs 780 trials, about 6 CPU-hours "
-                 "here by trial counts (estimated, not yet measured).")
+                 "column and Table 2's route plans B and C (issue 21 §3-§4) the section runs 705 trials (780 asked before "
+                 "session 15; the noise figures' err_max 0 and three ablation columns are the tables' own runs, read from "
+                 "their rows). Estimated in session 15 (benchmarks/los_cost_breakdown.py: every trial's first 4 targets, 20 "
+                 "for the paper-as-written VisBug-21 on office_simple, scaled to 200 targets with the give-up rate seen): "
+                 "about 47 M simulated steps and 3.1 CPU-hours at load 5-12 on this 2-core machine, an upper bound where "
+                 "a task gives up after the sampled targets; not yet run in full.")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
 GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
@@ -216,6 +223,17 @@ def _col_rows(ctx, col: str, spec_or_name: Any, name: str, **kw: Any) -> list[di
     return ok_rows(ctx.sweep(spec_or_name, name=name, **kw))
 
 
+def _col_spec(col: str, spec_or_name: Any):
+    """The sweep spec that :func:`_col_rows` runs in column ``col`` (before its call's own grid)."""
+    if col == "paper_rules":
+        from teamnav.experiments.report.sections._trails import paper_rules_spec
+
+        return paper_rules_spec(spec_or_name)
+    from teamnav.experiments.sweep import resolve_spec
+
+    return resolve_spec(spec_or_name)
+
+
 def run_tables(ctx, map_key: str, col: str = "teamnav", plan: str = "A",
                alone: list[dict] | None = None) -> dict[int, list[dict]]:
     """Rows of the table sweep per team size (0..3 helpers, nested) in column ``col``: one sweep
@@ -248,11 +266,57 @@ def run_noise(ctx, map_key: str, all_helpers: list[dict], col: str = "teamnav") 
     """Rows of the noise sweeps in column ``col``; in quick mode only err_max = 0.4 runs, and the
     tables' R1..R4 rows (the same configuration at err_max = 0) stand for err_max = 0."""
     if not ctx.quick:
-        return _col_rows(ctx, col, NOISE_SWEEP[map_key], NOISE_SWEEP[map_key])
+        # err_max = 0 with every helper is the tables' R1..R4 run (same resolved scenario and
+        # seed, checked per trial by _los_reuse): reuse those rows, run only err_max > 0
+        name = NOISE_SWEEP[map_key]
+        spec = _col_spec(col, name)
+        errs = [float(e) for e in spec.grid.get(ERR_KEY, [])]
+        if 0.0 in errs and len(errs) > 1:
+            from teamnav.experiments.report.sections._los_reuse import reused_rows
+            from teamnav.experiments.sweep import resolve_spec
+
+            zero = reused_rows(resolve_spec(spec, grid={ERR_KEY: [0.0]}), all_helpers, {ERR_KEY: 0.0})
+            if zero is not None:
+                return zero + _col_rows(ctx, col, name, name, grid={ERR_KEY: [e for e in errs if e != 0.0]})
+        return _col_rows(ctx, col, name, name)
     kw = {"grid": {TARGETS_KEY: _tasks(map_key, True), ERR_KEY: [0.4]}, "duration_s": _budget_s(map_key, True),
           "set": _quick_set()}
     zero = [{**r, "params": {**r["params"], ERR_KEY: 0.0}} for r in all_helpers]
     return zero + _col_rows(ctx, col, NOISE_SWEEP[map_key], NOISE_SWEEP[map_key] + "-quick", **kw)
+
+
+def run_ablation(ctx, all_helpers: list[dict]) -> list[dict]:
+    """Finished rows of ``los-ablation`` (office_simple, R1..R4, teamnav column). Each of its
+    columns that is Table 1's setting of an algorithm (the same resolved scenario and seed as the
+    tables' R1..R4 run, checked per trial by :func:`._los_reuse.reused_rows`) is read from
+    ``all_helpers``; the others run, as cases of one sweep call."""
+    import itertools
+
+    from teamnav.experiments.report.sections._los_reuse import reused_rows
+    from teamnav.experiments.sweep import resolve_spec
+
+    spec = resolve_spec("los-ablation")
+    keys = (NAV_KEY, DELAYED_KEY, STATE_KEY)
+    if any(k not in spec.grid for k in keys) or spec.cases:
+        return ok_rows(ctx.sweep("los-ablation"))
+    rows: list[dict] = []
+    todo = []
+    combos = list(itertools.product(*(spec.grid[k] for k in keys)))
+    for combo in combos:
+        one = dict(zip(keys, combo))
+        got = reused_rows(resolve_spec(spec, grid={k: [v] for k, v in one.items()}), all_helpers, one)
+        if got is None:
+            todo.append(one)
+        else:
+            rows += got
+    if len(todo) == len(combos):
+        return ok_rows(ctx.sweep("los-ablation"))
+    if todo:
+        cases = [{"case": f"{c[NAV_KEY]}/{'ghosts' if c[DELAYED_KEY] else 'reflected'}/"
+                          f"{'state' if c[STATE_KEY] else 'goal'}", **c} for c in todo]
+        sub = spec.model_copy(update={"cases": cases, "grid": {k: v for k, v in spec.grid.items() if k not in keys}})
+        rows += ok_rows(ctx.sweep(sub))
+    return rows
 
 
 #: Above Table 2 (issue 21 §4): the complex map and the helpers' routes are ours.
@@ -345,7 +409,7 @@ def build(ctx) -> list:
     if quick:
         blocks.append(Missing("the ablation (reflected only / + ghosts / + state sharing)", "full mode only (teamnav report los-help)"))
     else:
-        blocks.append(ablation_block(ok_rows(ctx.sweep("los-ablation"))))
+        blocks.append(ablation_block(run_ablation(ctx, tables["teamnav"].get("simple", {}).get(3, []))))
     blocks.append(where_steps_go_block(tables["teamnav"]))
     blocks.append(legs_block(tables["teamnav"]))
     blocks.append(traffic_block({m: tables["teamnav"][m].get(3, []) for m in maps}))
