@@ -49,9 +49,16 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 
-SCENARIO = "blazing-a-trail"
-#: the scenario's own params (besides the gap-fills): as blazing-paper-rules.yaml
-BASE_PARAMS = {"communicate": True, "layer_every_steps": 6000}
+#: system -> (scenario, params model "module:Class", the scenario's own params besides the gap-fills)
+SYSTEMS: dict[str, tuple[str, str, dict]] = {
+    # blazing-trail-v1 (2000), as blazing-paper-rules.yaml
+    "blazing": ("blazing-a-trail", "teamnav.control.coop.blazing_trail:BlazingTrailParams",
+                {"communicate": True, "layer_every_steps": 6000}),
+    # trail-share-v1 (2002), as the try-to-see-it-my-way scenario
+    "try": ("try-to-see-it-my-way", "teamnav.control.coop.trail_share:TrailShareParams",
+            {"communicate": True, "policy": "optimistic", "layer_every_steps": 6000}),
+}
+SCENARIO, _, BASE_PARAMS = SYSTEMS["blazing"]
 TEAMNAV_CRUISE = 0.4
 #: Try §3.6's per-robot rates [deg/min] in robot order (Bug, Ant, Fly, Tanis), as blazing-drift.yaml
 RATES = (-1.0, 1.0, 2.0, 0.35)
@@ -60,15 +67,17 @@ DRIFT_CASES = ("x0", "x1", "x4", "x1-slip", "x1-scale5")
 DRIFT_CONFIGS = ("paper", "paper+reverse_carried_crumbs", "teamnav@0.25", "teamnav")
 
 
-def gap_fill_table() -> list:
-    """The gap-fills of ``blazing-trail-v1`` (Navigate's included), ours at cruise 0.4 m/s."""
-    from teamnav.control.coop.blazing_trail import BlazingTrailParams
+def gap_fill_table(system: str = "blazing") -> list:
+    """The gap-fills of the system's brain (Navigate's included), ours at cruise 0.4 m/s."""
+    import importlib
+
     from teamnav.control.paper_rules import gap_fills
 
-    return gap_fills(BlazingTrailParams, {"cruise_speed_mps": TEAMNAV_CRUISE})
+    module, _, cls = SYSTEMS[system][1].partition(":")
+    return gap_fills(getattr(importlib.import_module(module), cls), {"cruise_speed_mps": TEAMNAV_CRUISE})
 
 
-def params_for(config: str) -> dict:
+def params_for(config: str, system: str = "blazing") -> dict:
     """The robots' params of a configuration (see the module docstring).
 
     Raises
@@ -76,7 +85,7 @@ def params_for(config: str) -> dict:
     ValueError
         An unknown configuration or gap-fill name (the message lists the known ones).
     """
-    fills = gap_fill_table()
+    fills = gap_fill_table(system)
     names = [g.field for g in fills]
     paper = {g.field: g.paper_value for g in fills}
     ours = {g.field: g.teamnav_value for g in fills}
@@ -93,7 +102,7 @@ def params_for(config: str) -> dict:
     else:
         raise ValueError(f"unknown configuration {config!r}: expected paper, teamnav, teamnav@0.25, "
                          f"paper+G or teamnav-G with G one of {', '.join(names)}")
-    out: dict = dict(BASE_PARAMS)
+    out: dict = dict(SYSTEMS[system][2])
     for key, value in chosen.items():
         head, _, tail = key.partition(".")
         if tail:
@@ -122,19 +131,20 @@ def drift_overrides(case: str) -> dict:
     return out
 
 
-def one_run(job: tuple[str, str, str, int, float]) -> dict:
-    """One run of ``(part, config, case, seed, duration_s)``: units, breakdown, trips, CPU."""
+def one_run(job: tuple) -> dict:
+    """One run of ``(part, config, case, seed, duration_s[, system])``: units, breakdown, CPU."""
     from teamnav.experiments.metric_sets.trails import BREAKDOWN_GAP_S, deliveries
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
 
-    part, config, case, seed, duration = job
-    params = params_for(config)
+    part, config, case, seed, duration = job[:5]
+    system = job[5] if len(job) > 5 else "blazing"
+    params = params_for(config, system)
     ov = {f"robots.{i}.params": params for i in range(4)}
     if case:
         ov.update(drift_overrides(case))
     t0 = time.process_time()
-    res = run(load_scenario(SCENARIO, overrides=ov, seed=seed, duration_s=duration), progress=False)
+    res = run(load_scenario(SYSTEMS[system][0], overrides=ov, seed=seed, duration_s=duration), progress=False)
     times = sorted(t for t, _ in deliveries(res.data.event_log))
     if times and duration - times[-1] >= BREAKDOWN_GAP_S:
         bd, cens = times[-1], False
@@ -143,7 +153,8 @@ def one_run(job: tuple[str, str, str, int, float]) -> dict:
     else:
         bd, cens = duration, True
     half = [t for t in times if t > duration / 2]
-    return {"part": part, "config": config, "case": case, "seed": seed, "duration_s": duration,
+    row = {} if system == "blazing" else {"system": system}  # rows without it are blazing-trail-v1's
+    return {**row, "part": part, "config": config, "case": case, "seed": seed, "duration_s": duration,
             "units": len(times), "units_second_half": len(half), "first_delivery_s": times[0] if times else None,
             "breakdown_s": bd, "breakdown_censored": cens, "cpu_s": round(time.process_time() - t0, 2)}
 
@@ -177,6 +188,8 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("part", choices=["gapfills", "drift", "summary"])
     ap.add_argument("--seeds", default="100-109")
+    ap.add_argument("--system", choices=sorted(SYSTEMS), default="blazing",
+                    help="blazing: blazing-trail-v1 on blazing-a-trail; try: trail-share-v1 on try-to-see-it-my-way")
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--out", required=True, type=Path)
     ap.add_argument("--configs", default=None, help="comma-separated configurations (default: all of the part)")
@@ -188,16 +201,17 @@ def main(argv: list[str] | None = None) -> int:
         print("\n".join(summarize(rows)))
         return 0
     seeds = parse_seeds(a.seeds)
-    names = [g.field for g in gap_fill_table()]
+    names = [g.field for g in gap_fill_table(a.system)]
     if a.part == "gapfills":
         configs = a.configs.split(",") if a.configs else (
             ["paper", "teamnav"] + [f"paper+{n}" for n in names] + [f"teamnav-{n}" for n in names])
-        jobs = [("gapfills", c, "", s, a.duration or 1800.0) for c in configs for s in seeds]
+        jobs = [("gapfills", c, "", s, a.duration or 1800.0, a.system) for c in configs for s in seeds]
     else:
         configs = a.configs.split(",") if a.configs else list(DRIFT_CONFIGS)
-        jobs = [("drift", c, k, s, a.duration or 3600.0) for k in a.cases.split(",") for c in configs for s in seeds]
+        jobs = [("drift", c, k, s, a.duration or 3600.0, a.system)
+                for k in a.cases.split(",") for c in configs for s in seeds]
     for c in configs:
-        params_for(c)  # fail before any run
+        params_for(c, a.system)  # fail before any run
     if a.out.exists():  # resume: a run already in --out is not run again
         done_keys = {(r["part"], r["config"], r["case"], r["seed"])
                      for r in map(json.loads, filter(str.strip, a.out.read_text().splitlines()))}

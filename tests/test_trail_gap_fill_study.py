@@ -108,13 +108,17 @@ def test_study_tables_pair_by_seed():
     assert rows["teamnav-x"][2] == "-5.3 ± 2.9 (0/3)"
 
 
-def test_stored_study_runs_are_the_docs_jsonl():
-    """The section's package data holds exactly the runs recorded in docs/report/ (both parts)."""
-    from teamnav.experiments.report.sections._trails_gap_fills import STUDY_RUNS
+@pytest.mark.parametrize("system, files", [
+    ("blazing", ("blazing-gap-fill-study.jsonl", "blazing-drift-study.jsonl")),
+    ("try", ("try-gap-fill-study.jsonl",)),
+])
+def test_stored_study_runs_are_the_docs_jsonl(system, files):
+    """The sections' package data hold exactly the runs recorded in docs/report/."""
+    from teamnav.experiments.report.sections._trails_gap_fills import study_runs
 
     docs = Path(__file__).resolve().parents[1] / "docs" / "report"
     lines = []
-    for name in ("blazing-gap-fill-study.jsonl", "blazing-drift-study.jsonl"):
+    for name in files:
         path = docs / name
         if path.exists():
             lines += [json.loads(x) for x in path.read_text().splitlines() if x.strip()]
@@ -122,4 +126,15 @@ def test_stored_study_runs_are_the_docs_jsonl():
     def key(r):
         return (r["part"], r["case"], r["config"], r["seed"])
 
-    assert sorted(STUDY_RUNS, key=key) == sorted(lines, key=key)
+    assert sorted(study_runs(system), key=key) == sorted(lines, key=key)
+    assert all(r.get("system", "blazing") == system for r in lines)
+
+
+def test_try_configs_are_trail_share_columns():
+    """``--system try``: the paper configuration is trail-share-v1's paper_rules column."""
+    from teamnav.control.coop.trail_share import TrailShareParams
+
+    p = TrailShareParams(**gs.params_for("paper", "try")).model_dump(exclude={"paper_rules", "navigate"})
+    q = TrailShareParams(**{**gs.SYSTEMS["try"][2], "paper_rules": True}).model_dump(exclude={"paper_rules", "navigate"})
+    assert p == q
+    assert {g.field for g in gs.gap_fill_table("try")} >= {"descend_only", "recover_radius_m"}

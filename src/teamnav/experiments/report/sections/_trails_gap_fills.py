@@ -1,5 +1,6 @@
-"""What each gap-fill of ``blazing-trail-v1`` buys, and what keeps the 2000 team from breaking down
-(issue 25 §4): the runs of ``scripts/trail_gap_fill_study.py``, shown as measured, not re-run by the report.
+"""What each gap-fill of ``blazing-trail-v1`` (and of ``trail-share-v1``) buys, and what keeps the 2000
+team from breaking down (issue 25 §4): the runs of ``scripts/trail_gap_fill_study.py``, shown as
+measured, not re-run by the report.
 
 Vaughan, Støy, Sukhatme & Matarić (2000) §5.1: 28 units in 30 min, then "the unbounded odometry
 error causes the system to break down completely at around 27 minutes". The study pairs seeds
@@ -16,7 +17,10 @@ neither the report's (0-9) nor used to choose any value (nothing is tuned with t
 
 The runs are package data, ``experiments/report/data/blazing-gap-fill-study.json`` (one dict per
 run, as the script writes them; ``docs/report/blazing-gap-fill-study.jsonl`` and
-``blazing-drift-study.jsonl`` hold the same lines; a test checks that they agree).
+``blazing-drift-study.jsonl`` hold the same lines; a test checks that they agree). The same
+``gapfills`` part for the 2002 brain (``--system try``: trail-share-v1 on ``try-to-see-it-my-way``,
+1-h runs) is ``try-gap-fill-study.json`` / ``docs/report/try-gap-fill-study.jsonl``, shown in the
+try-to-see-it-my-way section.
 """
 
 from __future__ import annotations
@@ -29,11 +33,23 @@ import numpy as np
 
 from teamnav.experiments.report.model import Missing, Table, Text
 
-__all__ = ["HEADER", "STUDY_RUNS", "blocks", "cases", "table_rows"]
+__all__ = ["DATA_FILES", "HEADER", "STUDY_RUNS", "blocks", "cases", "study_runs", "table_rows"]
 
-#: the study's runs (see the module docstring); empty until it was run
-STUDY_RUNS: tuple[dict, ...] = tuple(json.loads(
-    (Path(__file__).resolve().parents[1] / "data" / "blazing-gap-fill-study.json").read_text(encoding="utf-8")))
+_DATA = Path(__file__).resolve().parents[1] / "data"
+#: system -> its package-data file of study runs (``--system`` of the script)
+DATA_FILES = {"blazing": "blazing-gap-fill-study.json", "try": "try-gap-fill-study.json"}
+#: system -> (brain, scenario) as the tables name them
+SYSTEM_NAMES = {"blazing": ("blazing-trail-v1", "blazing-a-trail"), "try": ("trail-share-v1", "try-to-see-it-my-way")}
+
+
+def study_runs(system: str = "blazing") -> tuple[dict, ...]:
+    """The stored runs of ``system`` (empty when the file is absent)."""
+    path = _DATA / DATA_FILES[system]
+    return tuple(json.loads(path.read_text(encoding="utf-8"))) if path.is_file() else ()
+
+
+#: the study's runs of blazing-trail-v1 (see the module docstring)
+STUDY_RUNS: tuple[dict, ...] = study_runs("blazing")
 
 #: what the paired column compares with: the first of these that the case ran
 REFERENCES = ("paper", "paper+reverse_carried_crumbs")
@@ -93,20 +109,22 @@ def _seeds(runs) -> str:
     return f"{s[0]}-{s[-1]}" if s else "-"
 
 
-def blocks(runs=None) -> list:
-    """The study's tables for the blazing-a-trail section (both parts), or a Missing block."""
-    runs = list(STUDY_RUNS if runs is None else runs)
+def blocks(runs=None, system: str = "blazing") -> list:
+    """The study's tables of ``system`` for its report section (both parts), or a Missing block."""
+    runs = list(study_runs(system) if runs is None else runs)
+    brain, scenario = SYSTEM_NAMES[system]
     if not runs:
-        return [Missing("gap-fill study (issue 25 §4)", "no runs of scripts/trail_gap_fill_study.py stored")]
+        return [Missing(f"gap-fill study of {brain}", "no runs of scripts/trail_gap_fill_study.py stored")]
     out: list = [Text(
-        "Why the two columns differ, taken apart (issue 25 §4; scripts/trail_gap_fill_study.py, paired seeds "
+        f"Why the two columns of {brain} differ, taken apart (issue 25 §4; scripts/trail_gap_fill_study.py "
+        f"--system {system}, paired seeds "
         f"{_seeds(runs)}, which are neither the report's nor used to choose anything; measured once and shown "
         "as measured, not re-run here). 'paper+G': the paper's rules with gap-fill G alone at teamnav's value "
         "(what G buys on its own); 'teamnav-G': ours with G alone at the paper's value (what G is worth among "
         "the others); 'teamnav@0.25': every gap-fill of ours at the paper's cruise speed.")]
     for case in cases(runs, "gapfills"):
         rs = [r for r in runs if r["part"] == "gapfills" and r["case"] == case]
-        out.append(Table(f"Each gap-fill alone: blazing-a-trail, {rs[0]['duration_s'] / 60:g} min, the scenario's drift",
+        out.append(Table(f"Each gap-fill alone: {scenario}, {rs[0]['duration_s'] / 60:g} min, the scenario's drift",
                          HEADER, table_rows(runs, "gapfills", case)))
     for case in cases(runs, "drift"):
         rs = [r for r in runs if r["part"] == "drift" and r["case"] == case]

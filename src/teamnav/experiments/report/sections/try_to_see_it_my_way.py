@@ -61,6 +61,7 @@ from teamnav.experiments.claims import judge, load_claims, rule_text
 from teamnav.experiments.report.model import Comparison, Missing, SectionSpec, Table, Text
 from teamnav.experiments.metric_sets.trails import ROUTE_LENGTH_M
 from teamnav.experiments.report.sections import _trails as T
+from teamnav.experiments.report.sections import _trails_gap_fills as GF
 
 # the section's parts, importable from here as before the split
 from teamnav.experiments.report.sections._try_blocks import (  # noqa: F401
@@ -253,6 +254,7 @@ def build(ctx) -> list:
                         note="kept in both columns (the paper gives no value): crumb radius 3 m, 'moving' = 5 cm "
                              "since the last temporary trail, the sliding box's 2.0 m reach (lanes), the 180° "
                              "rule's 150° threshold; the map's corridor width, passing places and dead ends are ours"))
+    blocks += GF.blocks(system="try")  # issue 25: each gap-fill alone, paired seeds (stored runs, not re-run)
 
     # 1. hours without breakdown, efficiency
     b_rows, b_dur = (long_blaze, dur) if long_blaze else (T.by_scale(d_blaze).get(1.0, []), drift_dur)
