@@ -416,8 +416,9 @@ def _detection(ctx, out: dict | None = None) -> list:
                    "Marian stands still, so the 2.5 m rule lets it use Robin once per run. The paper-as-written "
                    "column applies eq. 14 alone: it can only reweight the samples Robin has. The teamnav column "
                    "draws part of Robin's samples from the received tree (sensor resetting, weighted by the "
-                   "posterior probability that Robin was lost, lost prior 0.3) with headings from Robin's own "
-                   "belief (half of them; uniform for the rest), and tempers the likelihood (0.03)."
+                   "posterior probability that Robin was lost, lost prior 0.3) with headings picked by its "
+                   "scan (as in the hallway; chosen on tuning seeds 1000-1039 in session 15), and tempers the "
+                   "likelihood (0.03)."
                    + _rule_text(claim, verdicts, n_text)),
         Plot("Fig. 11: the corridor robot's error vs time", "time [s]", "mean distance of samples to the true pose [m]",
              [s for col, head in COLUMNS for s in
