@@ -526,19 +526,27 @@ class VisBug21:
         self._reverse_limit_m = math.inf if f is None else max(2.0, f * math.hypot(*(self.goal_xy - xy)))
         self._reverse_reach_m = self._reverse_limit_m
 
-    def _boundary_target(self, xy: np.ndarray, followed: np.ndarray, points: np.ndarray, r_safe: float,
-                         follow_m: float, reach_m: float) -> np.ndarray | None:
-        """Step 2's boundary target (``boundary_shortcut``): :meth:`_boundary_target_numpy`'s
-        rule and arithmetic, its part after the bearings in one kernel (``_boundary_pick``,
-        issue 21 §5: it stops at the first visible candidate instead of testing all of them);
-        equal bit for bit (``tests/test_los_speed_equivalence.py``)."""
+    def _boundary_bearings(self, xy: np.ndarray, followed: np.ndarray) -> np.ndarray | None:
+        """δ of each followed boundary point: its bearing from the robot less the nearest point's
+        bearing φ, wrapped to (-π, π] and signed by the followed side (see
+        :meth:`_boundary_target_numpy`); None with fewer than 3 points."""
         if followed.shape[0] < 3:
             return None
         rel = followed - xy
         d = np.hypot(rel[:, 0], rel[:, 1])
         i = int(np.argmin(d))
         phi = math.atan2(rel[i, 1], rel[i, 0])
-        delta = self.side * (np.mod(np.arctan2(rel[:, 1], rel[:, 0]) - phi + math.pi, 2.0 * math.pi) - math.pi)
+        return self.side * (np.mod(np.arctan2(rel[:, 1], rel[:, 0]) - phi + math.pi, 2.0 * math.pi) - math.pi)
+
+    def _boundary_target(self, xy: np.ndarray, followed: np.ndarray, points: np.ndarray, r_safe: float,
+                         follow_m: float, reach_m: float) -> np.ndarray | None:
+        """Step 2's boundary target (``boundary_shortcut``): :meth:`_boundary_target_numpy`'s
+        rule and arithmetic, its part after the bearings in one kernel (``_boundary_pick``,
+        issue 21 §5: it stops at the first visible candidate instead of testing all of them);
+        equal bit for bit (``tests/test_los_speed_equivalence.py``)."""
+        delta = self._boundary_bearings(xy, followed)
+        if delta is None:
+            return None
         k, cx, cy = _boundary_pick(float(xy[0]), float(xy[1]), followed[:, 0], followed[:, 1], delta, float(follow_m),
                                    float(self.step_length_m), points[:, 0], points[:, 1], float(r_safe), float(reach_m),
                                    float(self._slack))
@@ -561,13 +569,10 @@ class VisBug21:
         test, which counts a point sensed at range ρ as ``ρ π / n_beams`` nearer, so along a
         straight wall the target lies a metre or two ahead) and that lies at least one step
         away; None when there is none (the reactive follower steers this step)."""
-        if followed.shape[0] < 3:
+        delta = self._boundary_bearings(xy, followed)
+        if delta is None:
             return None
         rel = followed - xy
-        d = np.hypot(rel[:, 0], rel[:, 1])
-        i = int(np.argmin(d))
-        phi = math.atan2(rel[i, 1], rel[i, 0])
-        delta = self.side * (np.mod(np.arctan2(rel[:, 1], rel[:, 0]) - phi + math.pi, 2.0 * math.pi) - math.pi)
         nxt = np.concatenate((followed[1:], followed[-1:]))
         prv = np.concatenate((followed[:1], followed[:-1]))
         tx, ty = nxt[:, 0] - prv[:, 0], nxt[:, 1] - prv[:, 1]
