@@ -125,6 +125,14 @@ def test_parse_seeds_and_set():
     assert parse_seeds(None) is None
     with pytest.raises(SweepError, match=r"--seeds: expected a count N .* received 'many'"):
         parse_seeds("many")
+    # ranges are inclusive; a single number stays a count (1000 seeds), "1000-1000" is seed 1000 alone
+    assert parse_seeds("1000-1002") == [1000, 1001, 1002]
+    assert parse_seeds("1000-1000") == [1000]
+    assert parse_seeds("1, 4,10-12") == [1, 4, 10, 11, 12]
+    assert parse_seeds("1000") == 1000
+    for bad in ("9-3", "1-", "1-2-3", "a-b"):
+        with pytest.raises(SweepError, match="range such as 1000-1009"):
+            parse_seeds(bad)
     assert parse_set(["radio.p_loss=0.1", "robots.0.params.cruise_speed_mps=0.3"]) == {
         "radio.p_loss": 0.1,
         "robots.0.params.cruise_speed_mps": 0.3,

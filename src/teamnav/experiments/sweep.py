@@ -370,17 +370,35 @@ def parse_set(items: Sequence[str] | Mapping[str, Any] | None) -> dict[str, Any]
 
 
 def parse_seeds(value: int | str | Sequence[int] | None) -> int | list[int] | None:
-    """``5`` or ``"5"`` -> 5 (seeds 0..4); ``"1,4,9"`` or ``[1, 4, 9]`` -> that list; None -> None."""
+    """``5`` or ``"5"`` -> 5 (seeds 0..4); ``"1,4,9"`` or ``[1, 4, 9]`` -> that list; ranges
+    ``"1000-1009"`` (inclusive) and mixes ``"1,4,10-12"`` -> the list; None -> None.
+
+    A single number is a *count* (``"1000"`` runs seeds 0..999); one seed alone is ``"1000-1000"``.
+
+    >>> parse_seeds("3"), parse_seeds("1000-1002"), parse_seeds("1,4,10-11")
+    (3, [1000, 1001, 1002], [1, 4, 10, 11])
+    """
     if value is None or isinstance(value, int) and not isinstance(value, bool):
         return value
     if isinstance(value, str):
         text = value.strip()
         try:
-            if "," in text:
-                return [int(t) for t in text.split(",")]
+            if "," in text or "-" in text.lstrip("-"):
+                out: list[int] = []
+                for part in (t.strip() for t in text.split(",")):
+                    a, sep, b = part.partition("-") if not part.startswith("-") else (part, "", "")
+                    if sep:
+                        lo, hi = int(a), int(b)
+                        if hi < lo:
+                            raise ValueError
+                        out.extend(range(lo, hi + 1))
+                    else:
+                        out.append(int(part))
+                return out
             return int(text)
         except ValueError:
-            raise SweepError(f"--seeds: expected a count N (seeds 0..N-1) or a list such as 1,4,9, received {value!r}") from None
+            raise SweepError(f"--seeds: expected a count N (seeds 0..N-1), a list such as 1,4,9 or a range such as "
+                             f"1000-1009, received {value!r}") from None
     if isinstance(value, Iterable):
         out = list(value)
         if all(isinstance(s, int) and not isinstance(s, bool) for s in out):

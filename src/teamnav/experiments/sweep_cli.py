@@ -45,7 +45,8 @@ def sweep_command(
         None, "--grid", metavar="KEY=V1,V2,...", help="Grid axis, with a dotted KEY as in --set (robots.0.count=2,4,8). Repeatable."
     ),
     seeds: Optional[str] = typer.Option(
-        None, "--seeds", metavar="N|S1,S2,...", help="N runs seeds 0..N-1; or a list such as 1,4,9. Default: the sweep's, else 1."
+        None, "--seeds", metavar="N|S1,S2,...|A-B", help="N runs seeds 0..N-1 (a count: 1000 runs 1000 seeds); or a "
+        "list such as 1,4,9, or a range such as 1000-1009 (1000-1000: that seed alone). Default: the sweep's, else 1."
     ),
     set_: Optional[List[str]] = typer.Option(
         None, "--set", metavar="KEY=VALUE", help="Fixed override for every trial, with a dotted KEY. Repeatable."
