@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from _report_fakes import FakeFullContext
 from teamnav.control.beyond.localized import Localized, LocalizedParams, _child_rng
 from teamnav.control.check import check_brain
 from teamnav.experiments import runner
@@ -95,47 +96,31 @@ def test_paired_gain_says_when_there_is_no_difference():
     assert paired_gain_text(ours[:1], same, 3600.0) == "too few paired seeds to compare"
 
 
-class _Rows:
-    def __init__(self, rows):
-        self._rows = rows
-
-    def rows(self):
-        return self._rows
-
-
-class _FakeFull:
+def _fake_full():
     """Full mode without running: each asked sweep gets one row per case and seed; the
     localized team keeps 68 units/h at every k, the odometric ones lose 8 per unit of k."""
 
-    quick = False
-    progress = False
-
-    def __init__(self):
-        self.asked = []
-
-    def sweep(self, name_or_spec, *, seeds, duration_s):
-        from teamnav.experiments.sweep import load_sweep
-
-        spec = load_sweep(name_or_spec) if isinstance(name_or_spec, str) else name_or_spec
-        self.asked.append(spec.sweep_name)
+    def rows_for(spec, seeds):
         local = spec.sweep_name.startswith("beyond-")
 
         def units(case):
             k = float(case[1:]) if case.startswith("x") else 4.0
             return 68 if local else 68 - 8 * k
 
-        return _Rows([{"status": "ok", "seed": s, "params": {"case": c["case"]}, "units_total": units(c["case"]) + s % 2,
-                       "breakdown_censored": 1, "loc_mean_error_m": 0.07 if local else None, "wall_time_s": 20.0}
-                      for c in spec.cases for s in seeds])
+        return [{"status": "ok", "seed": s, "params": {"case": c["case"]}, "units_total": units(c["case"]) + s % 2,
+                 "breakdown_censored": 1, "loc_mean_error_m": 0.07 if local else None, "wall_time_s": 20.0}
+                for c in spec.cases for s in seeds]
+
+    return FakeFullContext(rows_for)
 
 
 def test_full_mode_draws_the_parts_the_particle_counts_and_the_verdict():
     from teamnav.experiments.report.model import Comparison, Table
     from teamnav.experiments.report.sections.beyond import _localized_trails
 
-    ctx = _FakeFull()
+    ctx = _fake_full()
     blocks = _localized_trails(ctx)
-    assert ctx.asked == ["beyond-localized-trails", "blazing-drift", "try-drift", "beyond-localized-particles"]
+    assert [a[0] for a in ctx.asked] == ["beyond-localized-trails", "blazing-drift", "try-drift", "beyond-localized-particles"]
     main, parts = [b for b in blocks if isinstance(b, Table)]
     assert [r[0] for r in main.rows] == ["0", "0", "0", "1", "1", "1", "4", "4", "4"]
     assert [r[0] for r in parts.rows] == ["25", "50", "100", "200", "500"]

@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from _report_fakes import FakeFullContext
 from teamnav.experiments.report.sections import _beyond_mail_round as M
 
 ROUND = ["a", "b", "c", "d"]
@@ -109,40 +110,27 @@ def test_mail_round_block_quick_runs_n2_and_n3(tmp_path):
     assert any(isinstance(b, Plot) for b in blocks)
 
 
-class _Result:
-    def __init__(self, rows):
-        self._rows = rows
-
-    def rows(self):
-        return self._rows
-
-
-class _FakeFull:
+def _fake_full():
     """Full mode without running: each case's robot 0 makes 2 legs per seed, at 600 and 1200 s."""
 
-    quick = False
-    progress = False
-
-    def __init__(self):
-        self.asked = []
-
-    def sweep(self, spec, *, seeds, duration_s):
-        self.asked.append((list(seeds), duration_s))
+    def rows_for(spec, seeds):
         rows = []
         for c in spec.cases:
             first, second = c["robots.0.params.round"][1], c["robots.0.params.round"][2 % len(c["robots.0.params.round"])]
             arr = [[600.0, 0, first], [1200.0, 0, second]]
             rows += [{"status": "ok", "params": {"case": c["case"]}, "seed": s, "arrivals_series": json.dumps(arr),
                       "crumbs_max": 100 + s, "bytes_sent": 1000} for s in seeds]
-        return _Result(rows)
+        return rows
+
+    return FakeFullContext(rows_for)
 
 
 def test_mail_round_block_full_mode_reads_every_case_for_ten_seeds():
     from teamnav.experiments.report.model import Plot, Table
 
-    ctx = _FakeFull()
+    ctx = _fake_full()
     blocks = M.mail_round(ctx)
-    assert ctx.asked == [(list(range(10)), M.FULL_DURATION_S)]
+    assert [(s, d) for _, s, d in ctx.asked] == [(list(range(10)), M.FULL_DURATION_S)]
     (table,) = [b for b in blocks if isinstance(b, Table)]
     assert [r[0] for r in table.rows] == ["2", "3", "4", "5", "3", "4", "5", "2", "3", "4", "5"]
     assert all("(n = 10)" in r[3] for r in table.rows)

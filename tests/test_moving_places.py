@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from pydantic import BaseModel, ConfigDict, ValidationError
 
+from _report_fakes import FakeFullContext
 from teamnav.control import registry
 from teamnav.experiments.errors import ScenarioError
 from teamnav.experiments.spec import load_scenario
@@ -319,39 +320,20 @@ def test_global_crumbs_expire_ttl_after_they_were_added(batches, ttl, cap):
         assert b.global_crumbs.xy_m[:, 0].tolist() == [x for _, x in kept]
 
 
-class _FakeResult:
-    def __init__(self, rows):
-        self._rows = rows
-
-    def rows(self):
-        return self._rows
-
-
-class _FakeFullContext:
+def _fake_full():
     """Full mode without running: every case of the asked sweep gets one row per seed, its units
     falling with the case's position in the sweep (so the table's order and numbers can be read back)."""
-
-    quick = False
-    progress = False
-
-    def __init__(self):
-        self.asked = []
-
-    def sweep(self, name_or_spec, *, seeds, duration_s):
-        from teamnav.experiments.sweep import load_sweep
-
-        spec = load_sweep(name_or_spec) if isinstance(name_or_spec, str) else name_or_spec
-        self.asked.append((spec.sweep_name if hasattr(spec, "sweep_name") else spec.name, list(seeds), duration_s))
-        return _FakeResult([{"status": "ok", "params": {"case": c["case"]}, "units_total": 60 - 5 * i + s,
-                             "breakdown_censored": int(i < 4), "trip_time_s_after_mean": 100.0, "crumbs_max": 500 + i}
-                            for i, c in enumerate(spec.cases) for s in seeds])
+    return FakeFullContext(lambda spec, seeds: [
+        {"status": "ok", "params": {"case": c["case"]}, "units_total": 60 - 5 * i + s,
+         "breakdown_censored": int(i < 4), "trip_time_s_after_mean": 100.0, "crumbs_max": 500 + i}
+        for i, c in enumerate(spec.cases) for s in seeds])
 
 
 def test_moving_resource_block_full_mode_reads_every_case_and_the_blazing_sweep():
     from teamnav.experiments.report.model import Plot, Table
     from teamnav.experiments.report.sections.beyond import _moving_resource
 
-    ctx = _FakeFullContext()
+    ctx = _fake_full()
     blocks = _moving_resource(ctx)
     assert [(seeds, d) for _, seeds, d in ctx.asked] == [(list(range(10)), 3600.0)] * 2
     main, blaze = [b for b in blocks if isinstance(b, Table)]
