@@ -263,11 +263,14 @@ def _exit_status(code: int | None) -> str:
     return f"exit status {code}"
 
 
-def _how_workers_ended(pool: ProcessPoolExecutor) -> str:
+def _how_workers_ended(pool: ProcessPoolExecutor, known: dict | None = None) -> str:
     """``"pid 12: exit status 1; pid 13: killed by SIGTERM"`` for the processes of a broken pool
     (the pool SIGTERMs the survivors after the first death, so the first death is the one not
-    ended by SIGTERM, unless SIGTERM was what killed it)."""
-    procs = getattr(pool, "_processes", None) or {}
+    ended by SIGTERM, unless SIGTERM was what killed it).
+
+    ``known``: the pool's processes as seen while it ran (pid -> process); the pool's own table
+    may already have dropped the dead one by the time its break is noticed."""
+    procs = {**(known or {}), **(getattr(pool, "_processes", None) or {})}
     deadline = time.monotonic() + 2.0  # the pool may not have reaped the dead one yet
     for p in list(procs.values()):
         with contextlib.suppress(Exception):
@@ -315,10 +318,13 @@ class LocalExecutor:
         lost: dict[str, list[str]] = {}  # trial id -> errors of its lost starts
         pool = self._pool(n)
 
+        known: dict = {}  # pid -> process of the current pool, kept while the pool may drop them
+
         def renew() -> None:
             nonlocal pool
             pool.shutdown(wait=True, cancel_futures=True)
             pool = self._pool(n)
+            known.clear()
 
         def lose(task: TrialTask, started: str, how: str) -> None:
             """A start lost with its worker: run it again (up to LOCAL_MAX_RETRIES times), or
@@ -342,6 +348,7 @@ class LocalExecutor:
                     started = _now()
                 try:
                     in_flight[pool.submit(execute, task)] = (task, started)
+                    known.update(getattr(pool, "_processes", None) or {})
                 except BrokenProcessPool:  # the pool broke since the last result: a fresh one
                     again.insert(0, (task, started))
                     renew()
@@ -356,7 +363,7 @@ class LocalExecutor:
                     try:
                         res = fut.result()
                     except BrokenProcessPool:
-                        broken = broken or _how_workers_ended(pool)
+                        broken = broken or _how_workers_ended(pool, known)
                         lose(task, started, broken)
                         continue
                     except Exception as exc:  # noqa: BLE001 - e.g. a trial_fn that cannot be pickled
