@@ -187,3 +187,11 @@ def test_memory_off_runs_exactly_as_los_explorer_v1():
     logs = [[(e.get("robot"), e.get("step"), e.get("values")) for e in res.data.logs] for _, res in out]
     assert repr(logs[0]) == repr(logs[1])
     assert out[0][0]["los_targets_reached"] >= 1
+
+
+@pytest.mark.parametrize("places, want", [("task", 2), ("current", 1)])
+def test_task_places_remember_a_later_target_seen_on_the_way(navs, places, want):
+    r = brain(targets_xy=[(6.0, 0.0), (0.0, 5.0)], goal_memory_places=places)
+    r.step(obs(0))  # both targets in view from the start
+    assert len(r.trail) == want
+    assert sorted(r.trail.crumb_place) == sorted(place_name(t) for t in [(6.0, 0.0), (0.0, 5.0)][:want])

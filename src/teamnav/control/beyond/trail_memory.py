@@ -30,14 +30,26 @@ either:
 Gaps filled (none of the papers has this; each is a parameter, and ``goal_memory: "off"`` is
 the paper's rule):
 
-- ``goal_memory_places``: ``"current"`` lays crumbs only for the current target; ``"task"``
-  for every target Place of the task R1 sees (R1 is given its whole task, §6).
-- ``goal_memory_when``: ``"always"`` uses the memory wherever A would drive; ``"trouble"``
-  only while R1 is in trouble (Tr of §5, whatever ``state_sharing`` says: the bit is R1's own).
-- ``goal_memory_reach``: ``"visible"`` heads only for crumbs in sight (§4.3's "checks if
-  R_i(t1) ∈ V(R_i)"); ``"any"`` also, with none in sight, for the crumb with the shortest
-  straight D anywhere, as a waypoint of A (the Try §2.3 trail-following idea: a remembered
-  point, reached by local navigation).
+- ``goal_memory_places``: ``"task"`` (default) lays crumbs for every target Place of the task
+  R1 sees (R1 is given its whole task, §6, so a room passed on the way is remembered before it
+  is a goal); ``"current"`` for the current target only.
+- ``goal_memory_when``: ``"always"`` (default) uses the memory wherever A would drive;
+  ``"trouble"`` only while R1 is in trouble (Tr of §5, whatever ``state_sharing`` says: the
+  bit is R1's own).
+- ``goal_memory_reach``: ``"visible"`` (default) heads only for crumbs in sight (§4.3's
+  "checks if R_i(t1) ∈ V(R_i)"); ``"any"`` also, with none in sight, for the crumb with the
+  shortest straight D anywhere, as a waypoint of A (the Try §2.3 trail-following idea: a
+  remembered point, reached by local navigation).
+
+  The defaults were chosen on tuning tasks 1001-1004 only (office_complex_closed, R1 alone,
+  first 20 targets, 3000 steps per target at most; docs/report/beyond.md): Avoid-Past, targets
+  reached of 80 (tasks finished of 4), steps per target: off 57 (2) 977; current/always/visible
+  65 (2) 804; task/always/visible 80 (4) 722; current/trouble 56 (1) 845; current/any 69 (3)
+  720; task/any 80 (4) 709 (no gain over visible, so the §4.3 rule stays). The potential field
+  alone is trapped at the first or second target under every setting (3-5 of 80): memory
+  needs a revisit to pay. VisBug-21 alone (tasks 1001-1002): off 40/40 targets, task/always/
+  visible 29/40 (one task lost): the memory *hurts* VisBug alone (it interrupts a boundary
+  walk that would have reached the goal).
 - A crumb reached (within ``ghost_tolerance_m``) without the goal coming into view, or headed
   for ``trouble_cr`` steps without progress, is dropped for the rest of that target (as
   ``drop_stalled_ghost`` drops a ghost), so R1 does not circle a bad crumb.
@@ -100,7 +112,7 @@ class LosTrailExplorerParams(LosExplorerParams):
     """
 
     goal_memory: Literal["off", "trail"] = "off"
-    goal_memory_places: Literal["current", "task"] = "current"
+    goal_memory_places: Literal["current", "task"] = "task"
     goal_memory_when: Literal["always", "trouble"] = "always"
     goal_memory_reach: Literal["visible", "any"] = "visible"
     goal_memory_spacing_m: float = Field(0.4, gt=0.0, le=100.0)
