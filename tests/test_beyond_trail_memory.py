@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -195,3 +196,100 @@ def test_task_places_remember_a_later_target_seen_on_the_way(navs, places, want)
     r.step(obs(0))  # both targets in view from the start
     assert len(r.trail) == want
     assert sorted(r.trail.crumb_place) == sorted(place_name(t) for t in [(6.0, 0.0), (0.0, 5.0)][:want])
+
+
+# ---------------------------------------------------------------------------- the report block
+def test_the_sweep_has_every_case_the_block_reads_and_ten_tasks():
+    from teamnav.experiments import los_tasks as L
+    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+    from teamnav.experiments.sweep import expand, load_sweep
+
+    spec = load_sweep(B.SWEEP)
+    cases = {str(c["case"]) for c in spec.cases}
+    assert cases == {f"{n}/{t}/{m}" for n, _ in B.NAVS for t, _ in B.TEAMS for m in ("off", "trail")}
+    grid = spec.grid[B.TARGETS_KEY]
+    assert [list(map(list, g)) for g in grid] == [
+        [[round(float(x), 3), round(float(y), 3)] for x, y in L.task_targets_xy("complex", k, 30)] for k in range(1, 11)]
+    trials = {(str(t.params["case"]), json.dumps(t.params[B.TARGETS_KEY])): t for t in expand(spec)}
+    assert len(trials) == 120
+    sc = next(t for (c, _), t in trials.items() if c == "avoid-past/R1-4/trail").load()
+    assert sc.robots[0].controller == "los-trail-explorer-v1" and sc.robots[0].params["goal_memory"] == "trail"
+    assert [g.count for g in sc.robots] == [1, 1, 1, 1]
+
+
+def test_each_claim_reads_only_metrics_the_block_computes():
+    from teamnav.experiments.claims import load_claims
+    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+
+    row = {"los_targets_reached": 3.0, "los_steps_per_target": 100.0, "los_finished": 0}
+    vals = B.claim_values({f"{n}/{t}/{m}": {1: row, 2: row} for n, _ in B.NAVS for t, _ in B.TEAMS
+                           for m in ("off", "trail")})
+    for cid in ("trail-memory-r1", "trail-memory-helpers"):
+        claim = load_claims("beyond")[cid]
+        for cond in claim.rule:
+            assert cond.metric in vals and (cond.relative_to is None or cond.relative_to in vals)
+    assert vals["reached_gain_lo_ap_r1"] == 0.0 and vals["spt_r14_ratio_max"] == 1.0
+
+
+def test_claim_values_pair_by_task():
+    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+
+    def r(reached, spt):
+        return {"los_targets_reached": reached, "los_steps_per_target": spt, "los_finished": int(reached == 30)}
+
+    cases = {"avoid-past/R1/off": {1: r(10, 900.0), 2: r(20, 700.0), 3: r(30, 500.0)},
+             "avoid-past/R1/trail": {1: r(14, 800.0), 2: r(22, 600.0), 3: r(30, 400.0)}}
+    for n, _ in B.NAVS:
+        cases[f"{n}/R1-4/off"] = {1: r(30, 400.0)}
+        cases[f"{n}/R1-4/trail"] = {1: r(30, 420.0 if n == "visbug21" else 300.0)}
+    v = B.claim_values(cases)
+    gains = np.array([4.0, 2.0, 0.0])  # paired by task
+    assert v["reached_gain_lo_ap_r1"] == pytest.approx(gains.mean() - 2.0 * gains.std(ddof=1) / math.sqrt(3))
+    assert v["spt_ap_r1_trail_mean"] == pytest.approx(600.0) and v["spt_ap_r1_off_mean"] == pytest.approx(700.0)
+    assert v["spt_r14_ratio_max"] == pytest.approx(1.05)
+
+
+def test_a_row_of_an_unknown_task_is_named():
+    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+
+    with pytest.raises(ValueError, match="robots.0.params.targets_xy: a row's target list is not one of the 1 tasks"):
+        B.per_task([{B.TARGETS_KEY: [[1.0, 2.0]]}], [[[0.0, 0.0]]])
+
+
+def test_full_mode_reads_every_case_and_judges_both_claims():
+    from _report_fakes import FakeFullContext
+
+    from teamnav.experiments.report.model import Comparison, Table
+    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+
+    def rows_for(spec, seeds):
+        out = []
+        for c in spec.cases:
+            for k, targets in enumerate(spec.grid[B.TARGETS_KEY]):
+                mem = c["case"].endswith("/trail")
+                out.append({"status": "ok", "params": {"case": c["case"], B.TARGETS_KEY: targets}, "seed": 0,
+                            B.TARGETS_KEY: json.dumps(targets), "los_targets_reached": 30 if mem else 20 + k % 3,
+                            "los_finished": int(mem), "los_steps_per_target": 500.0 - 10.0 * k - (100.0 if mem else 0.0)})
+        return out
+
+    ctx = FakeFullContext(rows_for)
+    blocks = B.trail_memory(ctx)
+    assert [a[:2] for a in ctx.asked] == [(B.SWEEP, [0])]
+    (table,) = [b for b in blocks if isinstance(b, Table)]
+    assert len(table.rows) == 6
+    assert table.rows[2][2] == "209/300 (0/10)" and table.rows[2][3] == "300/300 (10/10)"
+    assert table.rows[2][7].startswith("-100 ± 0") and "beyond 2 s.e." in table.rows[2][6]
+    verdicts = [b for b in blocks if isinstance(b, Comparison)]
+    assert [v.holds for v in verdicts] == [True, True]
+
+
+def test_quick_mode_runs_avoid_past_alone_with_and_without_memory(tmp_path):
+    from teamnav.experiments.report.context import SweepContext
+    from teamnav.experiments.report.model import Comparison, Table
+    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+
+    blocks = B.trail_memory(SweepContext(tmp_path, quick=True, workers=1, section="beyond"))
+    (table,) = [b for b in blocks if isinstance(b, Table)]
+    assert [r[:2] for r in table.rows] == [["Avoid-Past", "R1 alone"]]
+    assert table.rows[0][2].endswith("/8 (1/1)") or table.rows[0][2].endswith("/8 (0/1)")
+    assert all(v.holds is None for v in blocks if isinstance(v, Comparison))
