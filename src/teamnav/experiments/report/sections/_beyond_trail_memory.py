@@ -174,8 +174,8 @@ def trail_memory(ctx) -> list:
     for tag, nav in NAVS:
         for team, team_text in TEAMS:
             off, on = cases.get(f"{tag}/{team}/off"), cases.get(f"{tag}/{team}/trail")
-            if off is None or on is None:
-                continue
+            if not off or not on:
+                continue  # a case without runs (quick mode, or a sweep cut short)
             cells = []
             for by in (off, on):
                 reached = np.array([_metric(r, "los_targets_reached") for r in by.values()])
