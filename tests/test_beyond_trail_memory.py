@@ -293,3 +293,20 @@ def test_quick_mode_runs_avoid_past_alone_with_and_without_memory(tmp_path):
     assert [r[:2] for r in table.rows] == [["Avoid-Past", "R1 alone"]]
     assert table.rows[0][2].endswith("/8 (1/1)") or table.rows[0][2].endswith("/8 (0/1)")
     assert all(v.holds is None for v in blocks if isinstance(v, Comparison))
+
+
+def test_a_sweep_cut_short_is_shown_but_not_judged():
+    from _report_fakes import FakeFullContext
+
+    from teamnav.experiments.report.model import Comparison
+    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+
+    def rows_for(spec, seeds):
+        targets = spec.grid[B.TARGETS_KEY][0]  # task 1 only
+        return [{"status": "ok", "params": {"case": c["case"]}, B.TARGETS_KEY: json.dumps(targets),
+                 "los_targets_reached": 30, "los_finished": 1, "los_steps_per_target": 400.0} for c in spec.cases]
+
+    blocks = B.trail_memory(FakeFullContext(rows_for))
+    verdicts = [b for b in blocks if isinstance(b, Comparison)]
+    assert [v.holds for v in verdicts] == [None, None]
+    assert all("not judged: only 12 of the 120 runs finished" in v.ours for v in verdicts)

@@ -125,7 +125,9 @@ def claim_values(cases: dict[str, dict[int, dict]]) -> dict[str, float]:
     ratios = []
     for tag, _ in NAVS:
         a, b = cases.get(f"{tag}/R1-4/trail", {}), cases.get(f"{tag}/R1-4/off", {})
-        ratios.append(_mean(a, "los_steps_per_target") / _mean(b, "los_steps_per_target") if a and b else float("nan"))
+        common = sorted(set(a) & set(b))  # the tasks both ran: a ratio of means over the same tasks
+        a, b = {k: a[k] for k in common}, {k: b[k] for k in common}
+        ratios.append(_mean(a, "los_steps_per_target") / _mean(b, "los_steps_per_target") if common else float("nan"))
     vals["spt_r14_ratio_max"] = float(max(ratios)) if all(math.isfinite(x) for x in ratios) else float("nan")
     return vals
 
@@ -210,10 +212,14 @@ def trail_memory(ctx) -> list:
         blocks.append(Text("Where the memory helps, in plain words (a paired mean beyond 2 standard errors counts): "
                            + "; ".join(plain) + "."))
     vals = claim_values(cases)
+    done = sum(len(v) for v in cases.values())
+    short = "" if done == len(labels) * len(grid) else f"only {done} of the {len(labels) * len(grid)} runs finished"
     for cid in ("trail-memory-r1", "trail-memory-helpers"):
         claim = load_claims("beyond")[cid]
         if quick:
             holds, how = None, "not judged in quick mode (one short task, Avoid-Past alone)"
+        elif short:
+            holds, how = None, f"not judged: {short}"
         else:
             holds, how = judge(claim, vals)
         blocks.append(Comparison(f"{claim.title} ({rule_text(claim)})",
