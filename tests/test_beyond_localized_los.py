@@ -254,3 +254,58 @@ def test_a_short_localized_run_with_mcl_frames_finishes_and_shares_poses(tmp_pat
     m = res.metrics
     assert m["los_finished"] == 1 and m["los_targets_reached"] == 2
     assert m["loc_mean_error_m"] < 0.3  # the filters track (the frames' source)
+
+
+# ---------------------------------------------------------------------------- the report block
+def _fake_full(mcl_gain: float, fused_gain: float):
+    """Full mode without running: bearings 150 (+1 per seed, +20 at err_max 0.4); mcl and fused
+    ``gain`` steps per target faster at err_max 0.4 (with a seed-dependent wobble), equal at 0."""
+    from _report_fakes import FakeFullContext
+
+    def rows_for(spec, seeds):
+        rows = []
+        for c in spec.cases:
+            source, e = c["case"].split("-e")
+            e = float(e)
+            for s in seeds:
+                v = 150.0 + s + (20.0 if e else 0.0)
+                if e and source != "bearings":
+                    v -= (mcl_gain if source == "mcl" else fused_gain) + (s % 3 - 1)
+                rows.append({"status": "ok", "seed": s, "params": {"case": c["case"]}, "los_steps_per_target": v,
+                             "los_finished": 1, "loc_mean_error_m": 0.05})
+        return rows
+
+    return FakeFullContext(rows_for)
+
+
+def test_full_mode_reads_both_maps_and_judges_with_the_paired_rule():
+    from teamnav.experiments.report.model import Comparison, Table
+    from teamnav.experiments.report.sections._beyond_localized_los import localized_los
+
+    ctx = _fake_full(mcl_gain=10.0, fused_gain=0.0)
+    blocks = localized_los(ctx)
+    assert [a[0] for a in ctx.asked] == ["beyond-localized-los-simple", "beyond-localized-los-complex"]
+    assert all(a[1] == list(range(10)) for a in ctx.asked)
+    tables = [b for b in blocks if isinstance(b, Table)]
+    assert len(tables) == 2 and [r[0] for r in tables[0].rows] == [
+        "bearings-e0", "mcl-e0", "fused-e0", "bearings-e0.4", "mcl-e0.4", "fused-e0.4"]
+    mcl04 = tables[0].rows[4]
+    assert mcl04[3].startswith("165 ± 3") and mcl04[4] == "10/10" and mcl04[5].startswith("-9.9 ± 0.9")
+    assert "faster on 10/10 seeds" in mcl04[5]
+    text = " ".join(b.text for b in blocks if hasattr(b, "text"))
+    assert "err_max 0.4: MCL poses helps" in text and "err_max 0.4: both, fused no measurable difference" in text
+    verdicts = [(b.claim, b.holds) for b in blocks if isinstance(b, Comparison)]
+    assert [h for _, h in verdicts] == [True, False]  # mcl helps on both maps; fused equal to bearings
+    assert "frames from MCL poses" in verdicts[0][0] and "fusing" in verdicts[1][0]
+
+
+def test_quick_mode_runs_two_short_runs_and_judges_nothing(tmp_path):
+    from teamnav.experiments.report.context import SweepContext
+    from teamnav.experiments.report.model import Comparison, Table
+    from teamnav.experiments.report.sections._beyond_localized_los import localized_los
+
+    blocks = localized_los(SweepContext(tmp_path, quick=True, workers=1, section="beyond"))
+    (table,) = [b for b in blocks if isinstance(b, Table)]
+    assert [r[0] for r in table.rows] == ["bearings-e0.4", "mcl-e0.4"]
+    assert all(r[4] == "1/1" for r in table.rows), table.rows  # 3 targets, both finished
+    assert all(b.holds is None for b in blocks if isinstance(b, Comparison))
