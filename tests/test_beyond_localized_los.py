@@ -309,3 +309,23 @@ def test_quick_mode_runs_two_short_runs_and_judges_nothing(tmp_path):
     assert [r[0] for r in table.rows] == ["bearings-e0.4", "mcl-e0.4"]
     assert all(r[4] == "1/1" for r in table.rows), table.rows  # 3 targets, both finished
     assert all(b.holds is None for b in blocks if isinstance(b, Comparison))
+
+
+def test_each_sweep_case_sets_every_robots_source_noise_and_noise_model():
+    from teamnav.experiments import beyond_localized_los as B
+    from teamnav.experiments import runner
+    from teamnav.experiments.sweep import expand, load_sweep
+
+    for m in B.MAPS:
+        spec = load_sweep(B.sweep_name(m))
+        assert spec.seeds == 10 and [c["case"] for c in spec.cases] == [B.case_label(s, e) for s, e in B.CASES]
+        trials = expand(spec)
+        assert len(trials) == 60
+        t = next(t for t in trials if t.params["case"] == "fused-e0.4")
+        overrides = {k: v for k, v in t.params.items() if k != "case"}
+        scn = runner.load_scenario(spec.scenario, overrides=overrides)
+        assert len(scn.robots) == 4
+        for g in scn.robots:
+            assert g.detector.err_max == 0.4
+            assert g.params["brain_params"]["frame_source"] == "fused"
+            assert g.params["brain_params"]["frame_err_max"] == 0.4
