@@ -16,7 +16,7 @@ filters' mean error (``loc_mean_error_m``). Verdicts: claims ``localized-los-mcl
 
 Quick mode (CI): ``bearings-e0.4`` and ``mcl-e0.4`` on office_simple, seed 0, R1's first 3
 targets (two runs of a few seconds): the pipeline works; no verdict. Full mode: 2 maps x 6 cases
-x seeds 0-9, 20 targets each (120 runs; the cost is in docs/report/beyond.md).
+x seeds 0-9, 10 targets each (120 runs; the cost is in docs/report/beyond.md).
 """
 
 from __future__ import annotations
@@ -98,6 +98,7 @@ def verdict_text(d: np.ndarray, t: float) -> str:
 
 
 def _map_block(m: str, rows_by_case: dict[str, list[dict]], labels: list[str], quick: bool) -> tuple[list, list[str]]:
+    from teamnav.experiments import beyond_localized_los as B
     from teamnav.experiments.beyond_localized_los import CASES, case_label
 
     table, notes = [], []
@@ -132,7 +133,7 @@ def _map_block(m: str, rows_by_case: dict[str, list[dict]], labels: list[str], q
         ["case", "frame from", "err_max (eqs. 1-2)", "steps per target: mean ± sd (n)", "tasks finished",
          "paired vs bearings, same err_max: mean ± sd", "MCL mean error [m]"], table,
         note=f"sweep beyond-localized-los-{m}" + (" (quick: two cases, one seed, 3 targets; not the result)"
-                                                  if quick else f", 20 targets of task 1") + f", seeds {seed_text}; "
+                                                  if quick else f", {B.N_TARGETS} targets of task 1") + f", seeds {seed_text}; "
              "every brain on localized-v1's MCL pose; lower is better.")
     return [block], notes
 
