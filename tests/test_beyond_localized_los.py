@@ -293,7 +293,8 @@ def test_full_mode_reads_both_maps_and_judges_with_the_paired_rule():
     assert mcl04[3].startswith("165 ± 3") and mcl04[4] == "10/10" and mcl04[5].startswith("-9.9 ± 0.9")
     assert "faster on 10/10 seeds" in mcl04[5]
     text = " ".join(b.text for b in blocks if hasattr(b, "text"))
-    assert "err_max 0.4: MCL poses helps" in text and "err_max 0.4: both, fused no measurable difference" in text
+    assert "err_max 0.4, frames from MCL poses: helps" in text
+    assert "err_max 0.4, frames from both, fused: no measurable difference" in text
     verdicts = [(b.claim, b.holds) for b in blocks if isinstance(b, Comparison)]
     assert [h for _, h in verdicts] == [True, False]  # mcl helps on both maps; fused equal to bearings
     assert "frames from MCL poses" in verdicts[0][0] and "fusing" in verdicts[1][0]

@@ -119,8 +119,8 @@ def _map_block(m: str, rows_by_case: dict[str, list[dict]], labels: list[str], q
                 diff = (f"{d.mean():+.1f} ± {d.std(ddof=1) if d.size > 1 else 0.0:.1f} (t = {t:.1f}; faster on "
                         f"{wins}/{d.size} seeds)")
                 word = verdict_text(d, t)
-                notes.append(f"{MAP_TEXT[m].split(' ')[0]}, err_max {e:g}: {SOURCE_TEXT[source]} {word} "
-                             f"({d.mean():+.1f} steps per target against bearings)")
+                notes.append(f"{MAP_TEXT[m].split(' ')[0]}, err_max {e:g}, frames from {SOURCE_TEXT[source]}: {word} "
+                             f"({d.mean():+.1f} steps per target against bearings, n = {d.size})")
             else:
                 diff = "n/a"
         table.append([lab, SOURCE_TEXT[source], f"{e:g}", T.msd(np.array(list(v.values())), "{:.0f}"),
