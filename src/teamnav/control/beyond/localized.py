@@ -17,6 +17,12 @@ the two without copying either:
   between filter updates. For the trail brains that is where crumbs are dropped and looked up
   (Blazing §4.1, Try §3.2), so trails are laid in the map frame.
 
+Two hooks for inner brains that want them (duck-typed; brains without them see nothing new):
+``set_pose_cov(cov)``, when the inner brain has it, is called before each step with the filter's
+sample covariance (3 x 3, map frame) at its last update (the LOS brains' ``frame_source:
+fused``, :mod:`teamnav.control.beyond.localized_los`); and ``finished`` is the inner brain's own
+(None when it has none), so ``stop_when_finished`` sees a wrapped LOS explorer's task end.
+
 What the inner brain still sees unchanged: ``odom_delta`` (the odometry's own motion since the
 last step: a relative measurement, true to what the wheels report), the scans, detections,
 inbox and events. The filter sees only the observation and the map the scenario gives
@@ -173,6 +179,13 @@ class Localized:
         self._min_rot = math.radians(params.min_update_deg)
         self._spread = float("nan")
         self._updates = 0
+        self._cov: np.ndarray | None = None
+        self._cov_hook = getattr(self.inner, "set_pose_cov", None)
+
+    @property
+    def finished(self) -> bool | None:
+        """The inner brain's ``finished`` (None when it has none: a brain without a task)."""
+        return getattr(self.inner, "finished", None)
 
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
         """Filter (when odometry moved enough), then the inner brain on the filter's pose."""
@@ -190,10 +203,14 @@ class Localized:
             est = self.mcl.estimate()
             self._base = np.array(est.cluster_pose if p.pose == "cluster" else est.pose, dtype=float)
             self._spread = float(math.sqrt(max(0.0, est.cov[0, 0] + est.cov[1, 1])))
+            if self._cov_hook is not None:
+                self._cov = np.array(est.cov, dtype=float)
             self._acc = np.zeros(3)
             self._updates += 1
             self._started = True
         pose = se2.compose(self._base, self._acc)
+        if self._cov_hook is not None:
+            self._cov_hook(self._cov)
         return self.inner.step(dataclasses.replace(obs, odom_pose=pose))
 
     def log(self) -> dict[str, Any]:

@@ -230,6 +230,19 @@ class _CommonParams(BaseModel):
         (an Id of 0 names no goal and is not sent). In a team of M robots that accept a report only
         with an Id at least the stored one, a goal relayed at ``Nr = 1`` reaches only robots that
         already hold it first- or second-hand, so both values give the same runs there.
+    frame_source : {"bearings", "mcl", "fused"}
+        Where the frame between sender and receiver comes from (issue 22, combination 2;
+        :mod:`teamnav.control.beyond.localized_los` documents the rules and the frames they need).
+        ``"bearings"``: §3.1's mutual bearings, θ21 = 180° + α21 − α12 (the paper's rule; messages
+        and behaviour exactly as without this parameter). ``"mcl"``: from the sender's pose, sent in
+        each message, and the receiver's, both in one common frame (the map, under ``localized-v1``);
+        no sighting needed. ``"fused"``: both, inverse-covariance weighted, when both robots saw
+        each other; the poses alone otherwise. Beyond the paper, so not a gap-fill of
+        :attr:`PAPER_RULES` (its default is the paper's rule).
+    frame_err_max : float
+        ``"fused"`` only: the err_max of eqs. 1-2 the robots assume for their detector (§6.1).
+    frame_robot_size_m : float or None
+        ``"fused"`` only: eq. 2's robot size [m]; None: twice the robot's own radius.
     paper_rules : bool
         Every gap-fill of :attr:`PAPER_RULES` at the paper's value, and ``navigator_params``
         with ``paper_rules: true`` (the navigator's own, e.g. VisBug-21's ``turn="left"``);
@@ -330,6 +343,9 @@ class _CommonParams(BaseModel):
     see_past_teammates: bool = True
     navigate_past_teammates_beyond_m: float | None = Field(None, gt=0.0, le=100.0)
     relay_hop_limit: bool = True
+    frame_source: Literal["bearings", "mcl", "fused"] = "bearings"
+    frame_err_max: float = Field(0.0, ge=0.0, le=1.0)
+    frame_robot_size_m: float | None = Field(None, gt=0.0, le=100.0)
     paper_rules: bool = False
 
 
@@ -398,6 +414,13 @@ class _LosBrain(abc.ABC):
         self._max_range = 0.0
         self._set_pose(np.zeros(3))
         self._step = 0
+        #: frame_source "fused": this robot's pose covariance (set by ``localized-v1`` through
+        #: :meth:`set_pose_cov`; None: unknown, the floor) and its value per recent step
+        self._pose_cov: np.ndarray | None = None
+        self._cov_history: dict[int, np.ndarray | None] = {}
+        #: frames taken from poses, and of those fused with a bearing frame (frame_source != "bearings")
+        self.frames_from_poses = 0
+        self.frames_fused = 0
         #: steps spent per mode, cumulative (where the steps go: own goal seen, navigator,
         #: teammate, ghost, trouble helper)
         self.mode_steps: dict[str, int] = {}
@@ -471,6 +494,11 @@ class _LosBrain(abc.ABC):
     def _me_xy(self) -> XY:
         return self._px, self._py
 
+    def set_pose_cov(self, cov) -> None:
+        """This step's covariance (3 x 3) of the pose ``odom_pose`` carries: ``localized-v1`` calls it
+        with its filter's sample covariance before each step (frame_source "fused" reads it)."""
+        self._pose_cov = None if cov is None else np.array(cov, dtype=np.float64).reshape(3, 3)
+
     # ------------------------------------------------------------------ the step
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
         """One step (see the module docstring)."""
@@ -491,6 +519,10 @@ class _LosBrain(abc.ABC):
         self._history[int(obs.step)] = ((self._px, self._py, self._th), sightings)
         for old in [k for k in self._history if k <= obs.step - _HISTORY_STEPS]:
             del self._history[old]
+        if self.params.frame_source == "fused":
+            self._cov_history[int(obs.step)] = self._pose_cov
+            for old in [k for k in self._cov_history if k <= obs.step - _HISTORY_STEPS]:
+                del self._cov_history[old]
         px, py, c, sn = self._px, self._py, self._c, self._s
         seen_now = {}
         for rid, (r, b) in sightings.items():
@@ -544,6 +576,7 @@ class _LosBrain(abc.ABC):
         me = self.me
         history = self._history
         goal_sharing = self.params.goal_sharing
+        by_bearings = self.params.frame_source == "bearings"
         receive_goal, receive_report = self.sharing.receive_goal, self.sharing.receive_report
         for msg in obs.inbox:
             body = msg.body
@@ -560,20 +593,25 @@ class _LosBrain(abc.ABC):
             if not goal_sharing:
                 continue
             hist = history.get(int(body.step))
-            if hist is None or s not in hist[1]:
-                continue  # I did not see the sender when it sent: no frame
-            back = None
-            for sg in body.sightings:
-                if sg.robot_id == me:
-                    back = sg
-                    break
-            if back is None:
-                continue  # the sender did not see me: no mutual bearing
+            if by_bearings:
+                if hist is None or s not in hist[1]:
+                    continue  # I did not see the sender when it sent: no frame
+                back = None
+                for sg in body.sightings:
+                    if sg.robot_id == me:
+                        back = sg
+                        break
+                if back is None:
+                    continue  # the sender did not see me: no mutual bearing
+                rng_m, bearing = hist[1][s]
+                # §3.1: the sender's body frame in mine (at the sending step), θ21 = 180° + α21 − α12
+                rel = sender_frame(bearing, back.bearing_rad, rng_m)
+            else:
+                if hist is None or body.pose is None:
+                    continue  # no pose of mine at the sending step, or none sent: no frame
+                rel = self._frame_from_poses(body, hist, s)
             (kx, ky, kth), seen_k = hist
             ck, sk = math.cos(kth), math.sin(kth)
-            rng_m, bearing = seen_k[s]
-            # §3.1: the sender's body frame in mine (at the sending step), θ21 = 180° + α21 − α12
-            rel = sender_frame(bearing, back.bearing_rad, rng_m)
             r0, r1 = rel[0], rel[1]
             sender_xy = (kx + ck * r0 - sk * r1, ky + sk * r0 + ck * r1)
             c, sn = math.cos(rel[2]), math.sin(rel[2])
@@ -591,6 +629,31 @@ class _LosBrain(abc.ABC):
                     via = (kx + ck * bx - sk * by, ky + sk * bx + ck * by)
                 receive_report(r.owner, r.goal_id, s, sender_xy, r.d_m, me_xy=me_k, step=step_k, via_xy=via,
                                via_d_m=r.via_d_m)
+
+    def _frame_from_poses(self, body: LosHelpMsg, hist, sender: int) -> tuple[float, float, float]:
+        """frame_source "mcl" / "fused": the sender's body frame in mine at the sending step from
+        the two poses; "fused" combines it with §3.1's bearing frame when both robots saw each
+        other then (:mod:`teamnav.control.beyond.localized_los`)."""
+        from teamnav.control.beyond import localized_los as LL
+
+        own = hist[0]
+        rel = LL.frame_from_poses(own, body.pose)
+        self.frames_from_poses += 1
+        if self.params.frame_source != "fused" or sender not in hist[1]:
+            return rel
+        back = next((sg for sg in body.sightings if sg.robot_id == self.me), None)
+        if back is None:
+            return rel
+        rng_m, bearing = hist[1][sender]
+        by_b = sender_frame(bearing, back.bearing_rad, rng_m)
+        size = self.params.frame_robot_size_m or 2.0 * self.radius_m
+        cov_b = LL.bearing_frame_cov(rng_m, bearing, self.params.frame_err_max, size)
+        zero = np.zeros((3, 3))
+        own_cov = self._cov_history.get(int(body.step))
+        snd_cov = LL.cov_from_upper(body.pose_cov) if body.pose_cov is not None else zero
+        cov_m = LL.pose_frame_cov(own, zero if own_cov is None else own_cov, body.pose, snd_cov)
+        self.frames_fused += 1
+        return LL.fuse_frames(rel, cov_m, by_b, cov_b)[0]
 
     # ------------------------------------------------------------------ broadcast (§4.4)
     def _broadcast(self, obs: Observation, sightings: dict[int, tuple[float, float]]) -> list[Message]:
@@ -611,7 +674,16 @@ class _LosBrain(abc.ABC):
                                  for owner, gid, d, vx, vy, vd in self.sharing.reports_via((px, py))])
             else:
                 reports = tuple(VisReport(owner, gid, d) for owner, gid, d in self.sharing.reports(self._me_xy()))
-        body = LosHelpMsg(int(obs.step), sights, goals, reports, bool(self.trouble.tr) if p.state_sharing else None)
+        tr = bool(self.trouble.tr) if p.state_sharing else None
+        if p.frame_source == "bearings":
+            body = LosHelpMsg(int(obs.step), sights, goals, reports, tr)
+        else:  # beyond the paper: the sender's pose (and its covariance) for the receiver's frame
+            cov = None
+            if p.frame_source == "fused" and self._pose_cov is not None:
+                from teamnav.control.beyond.localized_los import cov_upper
+
+                cov = cov_upper(self._pose_cov)
+            body = LosHelpMsg(int(obs.step), sights, goals, reports, tr, (self._px, self._py, self._th), cov)
         msg = Message(self.me, float(obs.time_s), body, kind=MESSAGE_KIND)
         self.msgs_sent += 1
         self.bytes_sent += message_size_bytes(body)

@@ -18,6 +18,10 @@ Its parts are exactly the terms §4.4 counts, so a message is O(M) for a team of
   sender's D leads through and that point's own distance to the goal: 24 bytes more, still
   O(M).
 - ``trouble``: the one-bit internal state Tr of §5 (None when state sharing is off).
+- ``pose``, ``pose_cov``: beyond the paper (issue 22, combination 2, the brains' ``frame_source``
+  other than ``"bearings"``): the sender's pose in its own (common, map) frame and its six
+  covariance numbers (:mod:`teamnav.control.beyond.localized_los`); None (0 bytes) under the
+  paper's §3.1 rule.
 
 All fields are plain numbers so :meth:`teamnav.control.types.Message.size_bytes` counts them
 (8 bytes per number, 1 per bool).
@@ -94,6 +98,10 @@ class LosHelpMsg:
     reports : tuple of VisReport
     trouble : bool or None
         Tr of §5, None when the sender does not share its state.
+    pose : (x, y, θ) or None
+        The sender's pose at the sending step (``frame_source`` "mcl" / "fused"; beyond the paper).
+    pose_cov : six floats or None
+        Its covariance, xx, xy, xθ, yy, yθ, θθ (``frame_source`` "fused").
     """
 
     step: int
@@ -101,14 +109,17 @@ class LosHelpMsg:
     goals: tuple[GoalShare, ...] = ()
     reports: tuple[VisReport, ...] = ()
     trouble: bool | None = None
+    pose: tuple[float, float, float] | None = None
+    pose_cov: tuple[float, ...] | None = None
 
 
 def message_size_bytes(body: LosHelpMsg) -> int:
     """``Message.size_bytes()`` of a message carrying ``body``, by formula (no recursive walk).
 
     Header 24 + step 8 + 24 per sighting + 32 per goal + 24 per report (48 with its via point)
-    + 1 for a Tr bit; equal to :meth:`teamnav.control.types.Message.size_bytes` (the tests check it).
+    + 1 for a Tr bit (+ 24 for a pose, + 48 for its covariance); equal to :meth:`teamnav.control.types.Message.size_bytes` (the tests check it).
     """
     return (32 + 24 * len(body.sightings) + 32 * len(body.goals) + 24 * len(body.reports)
             + 24 * sum(1 for r in body.reports if r.via_d_m is not None)
-            + (0 if body.trouble is None else 1))
+            + (0 if body.trouble is None else 1)
+            + (0 if body.pose is None else 24) + (0 if body.pose_cov is None else 48))

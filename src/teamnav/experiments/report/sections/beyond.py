@@ -39,7 +39,7 @@ bandwidth cap are ours; sweeps ``beyond-radio-<system>``): each system's headlin
 loss, range and one bandwidth cap, with two verdict rules per system (claims ``radio-*``);
 :mod:`~teamnav.experiments.report.sections._radio_beyond` owns the block and documents it.
 
-Left for later (issue 22): localized LOS help, detections for the trail team, and the papers' other
+Left for later (issue 22): detections for the trail team, and the papers' other
 future work.
 """
 
@@ -321,8 +321,11 @@ def build(ctx) -> list:
     from teamnav.experiments.report.sections._radio_beyond import restricted_radio
 
     blocks += restricted_radio(ctx)
+    from teamnav.experiments.report.sections._beyond_localized_los import localized_los
+
+    blocks += localized_los(ctx)  # combination 2: _beyond_localized_los.py
     blocks += _trail_memory(ctx)  # combination 4, trails as LOS memory: _beyond_trail_memory.py
-    for what in ("localized LOS help (frames from MCL poses)", "detections help the trail team (eqs. 13-14)",
+    for what in ("detections help the trail team (eqs. 13-14)",
                  "the papers' future work (negative detections, data association)"):
         blocks.append(Missing(what=what, why="not built yet (issue 22)"))
     return blocks
