@@ -194,3 +194,12 @@ def test_paper_rules_refuse_negative_sights():
     with pytest.raises(ValueError, match="negative_detections"):
         MCLWanderParams(paper_rules=True, collaborate=True, negative_detections=True)
     assert MCLWanderParams(paper_rules=True).negative_detections is False
+
+
+def test_a_concentrated_observer_uses_no_negative_sight_unless_asked():
+    there = [[2.0, 5.0]] * 24
+    for always, used in ((False, 0), (True, 1)):
+        a = _brain(0, init_pose=(1.0, 5.0, 0.0), max_particles=500, min_particles=500, neg_when_concentrated=always)
+        _frame(a, 0)
+        _frame(a, 10, inbox=[_points_msg(there)])  # 1 m ahead of its belief, not detected
+        assert a._neg.stats["neg_used"] == used

@@ -18,7 +18,12 @@ future work); ``negative_detections: false`` is that rule and the brain's defaul
    samples x teammate points, the detector's range, field of view and line of sight on the
    known map). A frame with a detection without identity uses no negative sight (the unnamed
    robot may be n). A frame from which no own sample could see any of n's points changes nothing.
-3. *Rate*: §2.3 rule 2 applied to negative sights: after one use of n, the next waits until the
+3. *Only while unsure* (``neg_when_concentrated`` false, the default): an observer whose own belief
+   is concentrated (the same spread test) uses none. Its samples then all see a teammate's claimed
+   place alike, so a miss reweights only its few uniform recovery samples (up by ``1 / (1 - (1 -
+   p_fn)(1 - eps))`` each time); a confidently *wrong* teammate, which the factorial representation
+   cannot tell from a right one, then pulls a right robot off its place within a few misses.
+4. *Rate*: §2.3 rule 2 applied to negative sights: after one use of n, the next waits until the
    observer has travelled ``neg_min_travel_m`` (its own :class:`~teamnav.localization.sync.SightingGate`).
    Consecutive frames that miss the same teammate are the same evidence (the factorial
    representation cannot tell), as consecutive sights are for the paper's 2.5 m rule.
@@ -100,8 +105,7 @@ class NegativeSights:
         """This robot's points, on the step before a camera frame, when its belief is concentrated."""
         if t_s + self.dt_s + 1e-9 < next_frame_s:
             return []
-        cov = mcl.estimate().cov
-        if not cov[0, 0] + cov[1, 1] <= self.p.neg_max_spread_m ** 2:
+        if not self.concentrated(mcl):
             return []
         w = mcl.weights
         k = int(self.p.neg_points)
@@ -110,8 +114,15 @@ class NegativeSights:
         self.stats["neg_sent"] += 1
         return [Message(self.robot_id, float(t_s), BeliefPoints(xy), to=None, kind=BELIEF_KIND)]
 
+    def concentrated(self, mcl: "MCL") -> bool:
+        """The belief's position spread ``sqrt(var x + var y)`` is at most ``neg_max_spread_m``."""
+        cov = mcl.estimate().cov
+        return bool(cov[0, 0] + cov[1, 1] <= self.p.neg_max_spread_m ** 2)
+
     def on_frame(self, mcl: "MCL", detections, t_s: float) -> int:
         """Apply the negative sights of one camera frame; returns how many were applied."""
+        if not self.p.neg_when_concentrated and self.concentrated(mcl):
+            return 0
         if any(d.robot_id is None for d in detections):
             self.stats["neg_skipped_anon"] += 1
             return 0
