@@ -39,8 +39,7 @@ bandwidth cap are ours; sweeps ``beyond-radio-<system>``): each system's headlin
 loss, range and one bandwidth cap, with two verdict rules per system (claims ``radio-*``);
 :mod:`~teamnav.experiments.report.sections._radio_beyond` owns the block and documents it.
 
-Left for later (issue 22): localized LOS help, detections for the trail team, trails as LOS memory, and the papers' other
-future work.
+Left for later (issue 22): localized LOS help, detections for the trail team, trails as LOS memory.
 """
 
 from __future__ import annotations
@@ -320,8 +319,11 @@ def build(ctx) -> list:
     from teamnav.experiments.report.sections._radio_beyond import restricted_radio
 
     blocks += restricted_radio(ctx)
+    from teamnav.experiments.report.sections._beyond_negative_detections import negative_detections
+
+    blocks += negative_detections(ctx)  # Fox §7.2: negative sights, anonymous robots
     for what in ("localized LOS help (frames from MCL poses)", "detections help the trail team (eqs. 13-14)",
-                 "trails as LOS memory", "the papers' future work (negative detections, data association)"):
+                 "trails as LOS memory"):
         blocks.append(Missing(what=what, why="not built yet (issue 22)"))
     return blocks
 
