@@ -203,3 +203,16 @@ def test_a_concentrated_observer_uses_no_negative_sight_unless_asked():
         _frame(a, 0)
         _frame(a, 10, inbox=[_points_msg(there)])  # 1 m ahead of its belief, not detected
         assert a._neg.stats["neg_used"] == used
+
+
+@pytest.mark.parametrize("name", ["collab-mcl-hallway", "collab-mcl-hexagon"])
+def test_the_brains_detector_datasheet_is_the_scenarios_detector(name):
+    """The sweeps turn negative sights on with the brain's defaults: they must describe the detector
+    the simulator runs in those scenarios (range, field of view, what hides a robot)."""
+    from teamnav.experiments.spec import load_scenario
+
+    p = MCLWanderParams()
+    for g in load_scenario(name).robots:
+        d = g.detector
+        assert (d.max_range_m, d.fov_deg, tuple(d.sees), d.line_of_sight) == (p.neg_max_range_m, p.neg_fov_deg,
+                                                                              tuple(p.neg_sees), True)
