@@ -30,7 +30,7 @@ def _rows(spec, seeds, ttl):
 def test_full_mode_reads_the_three_sweeps_and_judges_the_claims():
     # negative sights 20 s faster on every seed but the hexagon (no change); association 50 % faster
     def ttl(case, s):
-        return {"on": 80.0 + s, "off": 100.0 + s + (s % 2), "identity": 40.0, "anon-ignore": 200.0 + s,
+        return {"on": 80.0 + s, "off": 100.0 + s + (s % 2), "anon-ignore": 200.0 + s,
                 "anon-associate": 100.0 + s}[case]
 
     def rows_for(spec, seeds):
@@ -48,6 +48,7 @@ def test_full_mode_reads_the_three_sweeps_and_judges_the_claims():
     neg, anon = [b for b in blocks if isinstance(b, Table)]
     assert neg.rows[2][3].startswith("-20 ± 0 s (s.e., 10 paired seeds, 10 lower)")
     assert "(n = 10)" in anon.rows[1][3] and anon.rows[3][3].startswith("-100 ± 0 s")
+    assert anon.rows[0][3].startswith("105 ± 3") and anon.rows[4][3].startswith("-0 ± 0 s (s.e., 10 paired seeds, 5 lower)")  # the hallway's off case
     assert not any(isinstance(b, Missing) for b in blocks)
 
 
