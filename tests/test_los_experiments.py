@@ -746,3 +746,22 @@ def test_a_route_plan_without_a_paired_mean_at_a_team_fails_the_table2_trend():
     assert ap.holds is False and "route plan has no paired mean" in ap.differs and "plan C: n/a → n/a → n/a → n/a, 0 of 2 tasks" in ap.ours
     assert next(x for x in S.table_comparisons("complex", S.table_block("complex", a)[1], a, plans=[a, b])
                 if "Av. Past" in x.claim).holds is True
+
+
+def test_table1_trend_fails_when_no_task_is_finished_by_every_team_that_finished_one():
+    # claims/los-help.yaml (rule change of 2026-11-27): R1 alone finished task 0 only, R1..4 task 1
+    # only; the helpers lost a task that R1 finished, so the trend does not hold (it was "not judged")
+    a = _plan({0: [500, 500], 1: [400, 400], 2: [300, 300], 3: [200, 200]})
+    a[0][1]["metrics"]["los_finished"] = 0
+    for h in (1, 2, 3):
+        a[h][0]["metrics"]["los_finished"] = 0
+    a[3][1]["metrics"]["los_finished"] = 1
+    record: dict = {}
+    ap = next(x for x in S.table_comparisons("simple", S.table_block("simple", a)[1], a, record=record)
+              if "Av. Past" in x.claim)
+    assert ap.holds is False and record["table1-avoid-past-falls"][1][0] is False
+    assert "no task was finished by every team that finished one" in ap.differs
+    # with a common task the same rows are judged on the paired means again (and fall)
+    a[0][1]["metrics"]["los_finished"] = 1
+    assert next(x for x in S.table_comparisons("simple", S.table_block("simple", a)[1], a)
+                if "Av. Past" in x.claim).holds is True

@@ -541,11 +541,17 @@ class LosExplorer(_LosBrain):
             action, progressing = self._head_to(goal, ("promised", self.target_index),
                                                 end_margin_m=0.5 * p.goal_tolerance_m, trust=True)
         if action is None:
-            self.mode = "own_goal"
-            action, progressing = self._drive(goal)
+            action, progressing = self._unseen_goal(goal)
         self.trouble.update(progressing)
         self._prev_goal_d = goal_d
         return action
+
+    def _unseen_goal(self, goal: XY) -> tuple[Action, bool]:
+        """The goal is out of sight and nothing else leads R1 (no teammate, ghost or trouble
+        helper): the navigator A drives towards it (§2). A hook: ``los-trail-explorer-v1``
+        (:mod:`teamnav.control.beyond.trail_memory`) heads for a remembered viewpoint first."""
+        self.mode = "own_goal"
+        return self._drive(goal)
 
     def _remember_helper(self) -> None:
         """Keep where a teammate not in trouble was last seen (own frame; ``trouble_return``):

@@ -175,6 +175,7 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         fails_first = not failing or not ok_hs or max(failing) < min(ok_hs)
         cid = f"table{tab}-{nav.replace('_', '-')}-falls"
         plan_gap = multi and bool(ok_hs) and not all(np.isfinite(ms))
+        no_common = False
         if plan_gap:
             # claims/los-help.yaml's plan rule: a plan without a paired mean at a team (it finished no
             # task common to the teams that finished one) makes the trend fail
@@ -188,9 +189,14 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         elif all(np.isfinite(ms)):
             holds = _judged(cid, {"max_rise": float(np.diff(np.asarray(ms, dtype=float)).max()),
                                   "fails_first": float(fails_first)}, record)
+        elif any(np.isfinite(ms)):
+            # some team between others has no paired mean: the trend cannot hold
+            holds = _failed(cid, "a team between others has no paired mean", record)
         else:
-            # some team between others has no paired mean: the trend cannot hold (None if none has one)
-            holds = _failed(cid, "a team between others has no paired mean", record) if any(np.isfinite(ms)) else None
+            # no task finished by every team that finished one: helpers lost tasks that fewer helpers
+            # finished, so the trend fails (claims/los-help.yaml, rule change of 2026-11-27; was "not judged")
+            no_common = True
+            holds = _failed(cid, "no task finished by every team that finished one", record)
         ours = " → ".join([f"fails ({int(fin[h].sum())}/{fin[h].size})" for h in failing if h < min(ok_hs, default=9)]
                           + ["n/a" if not np.isfinite(m) else f"{m:.0f}" for m in ms]
                           + [f"fails ({int(fin[h].sum())}/{fin[h].size})" for h in failing if h > min(ok_hs, default=9)])
@@ -202,6 +208,8 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
             "" if holds or holds is None else
             "a route plan has no paired mean at some team (no task finished by every team that finished one in "
             "that plan), which fails the trend (claims/los-help.yaml)" if plan_gap else
+            "no task was finished by every team that finished one: added helpers lost tasks that fewer helpers "
+            "finished, which fails the trend (claims/los-help.yaml)" if no_common else
             "not strictly falling at every added helper in our runs"
             + (f" (each rise paired by task, {'; '.join(rises)})" if not multi and (rises := paired_rises(by_team, nav, ok_hs))
                else " (see the table)")))

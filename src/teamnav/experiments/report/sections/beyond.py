@@ -39,7 +39,7 @@ bandwidth cap are ours; sweeps ``beyond-radio-<system>``): each system's headlin
 loss, range and one bandwidth cap, with two verdict rules per system (claims ``radio-*``);
 :mod:`~teamnav.experiments.report.sections._radio_beyond` owns the block and documents it.
 
-Left for later (issue 22): localized LOS help, detections for the trail team, trails as LOS memory.
+Left for later (issue 22): localized LOS help, detections for the trail team.
 """
 
 from __future__ import annotations
@@ -49,6 +49,7 @@ import numpy as np
 from teamnav.experiments.report.model import Comparison, Missing, Plot, SectionSpec, Series, Table, Text
 from teamnav.experiments.report.sections import _trails as T
 from teamnav.experiments.report.sections._beyond_mail_round import mail_round as _mail_round
+from teamnav.experiments.report.sections._beyond_trail_memory import trail_memory as _trail_memory
 
 PAPER = "vaughan-stoy-sukhatme-mataric-blazing-a-trail.txt"
 LOCALIZED_SWEEP = "beyond-localized-trails"
@@ -319,11 +320,11 @@ def build(ctx) -> list:
     from teamnav.experiments.report.sections._radio_beyond import restricted_radio
 
     blocks += restricted_radio(ctx)
+    blocks += _trail_memory(ctx)  # combination 4, trails as LOS memory: _beyond_trail_memory.py
     from teamnav.experiments.report.sections._beyond_negative_detections import negative_detections
 
     blocks += negative_detections(ctx)  # Fox §7.2: negative sights, anonymous robots
-    for what in ("localized LOS help (frames from MCL poses)", "detections help the trail team (eqs. 13-14)",
-                 "trails as LOS memory"):
+    for what in ("localized LOS help (frames from MCL poses)", "detections help the trail team (eqs. 13-14)"):
         blocks.append(Missing(what=what, why="not built yet (issue 22)"))
     return blocks
 
