@@ -330,7 +330,7 @@ from teamnav.control.paper_rules import gap_fills  # noqa: E402
 _NOT_PAPER = {"inject_fraction": 0.1, "inject_min_draws": 500, "inject_sender_lost_prior": 0.3,
               "likelihood_exponent": 0.1, "resample_ess_fraction": 0.5, "provenance": True, "receive_gate": True,
               "send_min_cluster_weight": 0.5, "false_positive_filter": True, "anonymous": "associate",
-              "unsure_detections": "delay"}
+              "unsure_detections": "delay", "negative_detections": True}
 
 
 def test_paper_rules_sets_every_listed_field():

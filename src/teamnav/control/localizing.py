@@ -82,6 +82,11 @@ Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report sect
     globally uncertain, or two robots equally plausible) are dropped. With ``anonymous="ignore"``
     the brain does what the paper's method does with anonymous sights: nothing.
 
+``negative_detections`` (§7.2 "Not seeing each other"; :mod:`teamnav.control.negative_sights`)
+    Not seeing a teammate where its broadcast belief says it should be visible weighs the own
+    samples down, by a likelihood over the detector's range and field of view with line of sight
+    on the known map (:mod:`teamnav.localization.negative_detection`). Off by default (§2.3 rule 1).
+
 ``unsure_detections`` (§7.2 "Delayed integration"; :mod:`teamnav.control.delayed_integration`)
     A detection made while unsure: sent at once (the paper's §3.2 rule, default), dropped, or
     delayed until the belief is concentrated and applied at its time by both robots.
@@ -90,7 +95,7 @@ Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report sect
 :mod:`teamnav.control.paper_rules`; the reports' "paper as written" column): eq. 14 alone on a
 received tree (no sensor resetting), the untempered likelihood (eq. 12), resampling at every
 update (§3.1), §2.3's two rules only (no provenance, no gate on the receiving side), every
-detection sent (§3.2), no false-positive filter and anonymous sights ignored (§7.2). Setting one
+detection sent (§3.2), no false-positive filter, anonymous and negative sights ignored (§7.2, §2.3). Setting one
 of those fields as well is an error. What the paper gives no value for is kept in both columns
 and listed in :attr:`MCLWanderParams.GAP_FILLS_KEPT` (the KLD floor among them).
 
@@ -113,6 +118,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from teamnav.control.delayed_integration import DelayedIntegration, past_frame, resolve_unsure_detections
 from teamnav.control.nav.wander import Wander, WanderParams
+from teamnav.control.negative_sights import NegativeSights
 from teamnav.control.paper_rules import paper_rules_validator
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.tree_injection import inject_tree
@@ -124,7 +130,7 @@ from teamnav.localization import (
 from teamnav.localization.density_tree import DensityTree
 from teamnav.localization.resample import low_variance_kernel
 from teamnav.localization.sync import SYNC_KIND, detection_tree
-from teamnav.world.grid import FREE
+from teamnav.world.grid import DEFAULT_SEES, FREE
 
 __all__ = ["MCLWander", "MCLWanderParams", "load_detection_model", "MODEL_DIR"]
 
@@ -287,6 +293,34 @@ class MCLWanderParams(BaseModel):
         multiplied its own belief in again (double counting: a confidently wrong sender was
         confirmed by the teammate it had just dragged along). False (default): the reply is
         built from the belief as it was before the message.
+    negative_detections : bool
+        Beyond the paper (§7.2 future work; issue 22): on a camera frame that does not see teammate n,
+        weigh each own sample by the probability of not seeing n from it, given the points of n's
+        belief that n broadcast (:mod:`teamnav.control.negative_sights`, the likelihood
+        :mod:`teamnav.localization.negative_detection`). False (default): §2.3 rule 1, negative
+        sights ignored. Needs ``collaborate``.
+    neg_points : int
+        Points of its belief a concentrated robot broadcasts before each camera frame.
+    neg_max_spread_m : float
+        A robot broadcasts only while its belief's position spread ``sqrt(var x + var y)`` is at most
+        this [m] (gap-fill; the heaviest cluster's weight is no test here: a uniform belief over a
+        connected free space is one cluster of 0.5 m cells, weight 1).
+    neg_when_concentrated : bool
+        False (default, gap-fill): the observer uses negative sights only while its own belief is *not*
+        concentrated (spread above ``neg_max_spread_m``); True: always. Measured on tuning seed 1000 in
+        the hallway: a localized robot's samples all see a confidently wrong teammate's claimed place
+        alike, so each miss multiplies only its few uniform recovery samples up (x 6 per miss), and a
+        few misses in a row moved a right robot off (final error 18 m; 0.2 m without negative sights).
+    neg_teammate_lost_prior : float
+        Probability that the teammate's belief is wrong (the factor becomes ``1 - (1 - p_fn)(1 -
+        eps) P_vis``; 0: the plain marginal).
+    neg_min_travel_m : float
+        §2.3 rule 2 for negative sights: one use of a teammate per this much own travel [m].
+    neg_max_age_s : float
+        Teammate points older than this are not used [s].
+    neg_max_range_m, neg_fov_deg, neg_sees
+        The detector's datasheet as the brain knows it: range centre to centre [m], field of view
+        [deg] and the materials that hide a robot (defaults: the collaborative scenarios' detector).
     receive_gate : bool
         Rule 2 of §2.3 applied on the receiving side too (:class:`~teamnav.localization.SyncParams`):
         a tree from a given teammate is applied at most once per ``min_travel_m`` of own travel
@@ -354,6 +388,8 @@ class MCLWanderParams(BaseModel):
         # §7.2: "The factorial representation, however, cannot deal with measurements such as
         # 'either robot A or robot B'": sights without identity are not used
         "anonymous": "ignore",
+        # §2.3 rule 1: "Our approach ignores *negative* sights"; §7.2 lists them as future work
+        "negative_detections": False,
     }
     PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
         "inject_fraction": "Fox §3.2 eq. 14: the tree only reweights the existing samples (no sensor resetting)",
@@ -367,6 +403,7 @@ class MCLWanderParams(BaseModel):
         "unsure_detections": "Fox §3.2, Table 1: a detection is integrated at once (§7.2's delay is future work)",
         "false_positive_filter": "Fox §7.2: false positives not filtered",
         "anonymous": "Fox §7.2: sights without identity are not used",
+        "negative_detections": "Fox §2.3 rule 1: negative sights are ignored (§7.2: future work)",
     }
     #: gap-fills the paper gives no value for: the same value in both columns (field: why)
     GAP_FILLS_KEPT: ClassVar[dict[str, str]] = {
@@ -383,6 +420,7 @@ class MCLWanderParams(BaseModel):
                              "inject_heading_* settings",
         "delay_max_age_s": "inert with unsure_detections 'integrate' (the paper's)",
         "wander": "§5: the robots follow an operator or a random walk; our wanderer's settings",
+        "neg_points": "inert with negative_detections false (the paper's), as are the other neg_* settings",
     }
 
     sensor: str | None = Field(None, min_length=1)
@@ -440,6 +478,16 @@ class MCLWanderParams(BaseModel):
     layer_every: int = Field(20, ge=1, le=100_000)
     layer_points: int = Field(200, ge=1, le=1000)
     receive_gate: bool = True
+    negative_detections: bool = False
+    neg_points: int = Field(24, ge=1, le=1000)
+    neg_max_spread_m: float = Field(1.0, gt=0.0, le=1000.0)
+    neg_when_concentrated: bool = False
+    neg_teammate_lost_prior: float = Field(0.1, ge=0.0, lt=1.0)
+    neg_min_travel_m: float = Field(2.5, ge=0.0, le=1000.0)
+    neg_max_age_s: float = Field(1.5, gt=0.0, le=60.0)
+    neg_max_range_m: float = Field(5.0, gt=0.0, le=1000.0)
+    neg_fov_deg: float = Field(180.0, gt=0.0, le=360.0)
+    neg_sees: tuple[str, ...] = Field(DEFAULT_SEES["vision"], min_length=1)
     paper_rules: bool = False
 
     _paper_rules = paper_rules_validator()
@@ -447,6 +495,13 @@ class MCLWanderParams(BaseModel):
     @model_validator(mode="after")
     def _unsure_detections(self) -> "MCLWanderParams":
         return resolve_unsure_detections(self)
+
+    @model_validator(mode="after")
+    def _negative_needs_team(self) -> "MCLWanderParams":
+        if self.negative_detections and not self.collaborate:
+            raise ValueError("negative_detections: true needs collaborate: true (teammates' beliefs come "
+                             "over the radio of the collaborative brain)")
+        return self
 
     def mcl_params(self) -> MCLParams:
         """The library's filter parameters these stand for."""
@@ -528,6 +583,9 @@ class MCLWander:
         self.stats = {"seen": 0, "sent": 0, "filtered": 0, "rejected": 0, "assoc": 0, "assoc_dropped": 0}
         # §7.2 delayed integration: odometry history, detections kept while unsure
         self._delay = DelayedIntegration(params.delay_max_age_s, keep_history=params.collaborate)
+        # §7.2 negative sights (issue 22): teammates' broadcast points and the rate rule
+        self._neg = (NegativeSights(params, self.robot_id, info.known_map, self.model.p_false_negative, info.dt_s)
+                     if params.negative_detections else None)
 
     # ------------------------------------------------------------------ step
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
@@ -549,12 +607,20 @@ class MCLWander:
         out: list[Message] = []
         if self.sync is not None:
             self.sync.travel(obs.odom_delta)
+            neg = self._neg
+            if neg is not None:
+                neg.travel(obs.odom_delta)
             for msg in obs.inbox:
-                out += self._on_message(msg, obs)
+                if neg is None or not neg.on_message(msg, obs.time_s):
+                    out += self._on_message(msg, obs)
             if obs.time_s + 1e-9 >= self._next_frame_s:
                 self._next_frame_s = obs.time_s + p.detection_period_s
                 out += self._on_detections(obs)
+                if neg is not None:
+                    neg.on_frame(self.mcl, obs.detections, obs.time_s)
             out += self._close_queries(obs)
+            if neg is not None:
+                out += neg.broadcast(self.mcl, self.rng, obs.time_s, self._next_frame_s)
         action, _ = self.wander.step(obs)
         if p.motion_mode == "stay":
             action = Action.stop()
@@ -811,6 +877,8 @@ class MCLWander:
             out.update({k: v for k, v in self.stats.items()})
             if p.unsure_detections == "delay":
                 out.update(self._delay.stats)
+            if self._neg is not None:
+                out.update(self._neg.stats)
         if self._n_log % p.layer_every == 0:
             pts = self._subsample(p.layer_points)[:, :2].astype(np.float32)
             out["layers"] = {"particles": {"data": pts, "kind": "points", "frame": "world", "hold": True,

@@ -39,8 +39,7 @@ bandwidth cap are ours; sweeps ``beyond-radio-<system>``): each system's headlin
 loss, range and one bandwidth cap, with two verdict rules per system (claims ``radio-*``);
 :mod:`~teamnav.experiments.report.sections._radio_beyond` owns the block and documents it.
 
-Left for later (issue 22): detections for the trail team, and the papers' other
-future work.
+Left for later (issue 22): detections for the trail team.
 """
 
 from __future__ import annotations
@@ -325,8 +324,10 @@ def build(ctx) -> list:
 
     blocks += localized_los(ctx)  # combination 2: _beyond_localized_los.py
     blocks += _trail_memory(ctx)  # combination 4, trails as LOS memory: _beyond_trail_memory.py
-    for what in ("detections help the trail team (eqs. 13-14)",
-                 "the papers' future work (negative detections, data association)"):
+    from teamnav.experiments.report.sections._beyond_negative_detections import negative_detections
+
+    blocks += negative_detections(ctx)  # Fox §7.2: negative sights, anonymous robots
+    for what in ("detections help the trail team (eqs. 13-14)",):
         blocks.append(Missing(what=what, why="not built yet (issue 22)"))
     return blocks
 
