@@ -109,3 +109,42 @@ def test_trip_memory_reaches_a_sequence_the_robot_memory_does_not():
     assert reached({"memory_scope": "goal"}) == (12, True)
     n, finished = reached({"memory_scope": "robot", "memory_radius_m": 2.0})
     assert n < 12 and not finished
+
+
+def test_memory_half_life_weighs_each_visit_by_its_age():
+    """The decay gap-fill (issue 21 §1): after the same walk, the push equals the one of an
+    undecayed memory whose visits were each scaled by 2^(-age / h), and it is smaller."""
+    from teamnav.control.nav.local.avoid_past import avoid_past_vector
+
+    h = 40.0
+    nav = nav_of("avoid_past", {"memory_half_life_steps": h, "avoid_max": 1000.0})
+    ref = nav_of("avoid_past", {"avoid_max": 1000.0})
+    poses = [np.array([0.1 * k, 0.0, 0.0]) for k in range(60)] + [np.array([6.0, 0.0, 0.0])]
+    pts = np.array([[5.0, 5.0]])
+    for n in (nav, ref):
+        n.set_goal(np.array([30.0, 0.0]))
+        for pose in poses[:-1]:
+            n._vector(pose, pts, 72)
+    got = nav._vector(poses[-1], pts, 72) - ref._vector(poses[-1], pts, 72)  # the same field part
+    expected: dict = {}
+    for k, pose in enumerate(poses):  # the k-th deposit is (60 - k) steps old at the last call
+        key = (int(np.floor(pose[0] / 0.3)), int(np.floor(pose[1] / 0.3)))
+        expected[key] = expected.get(key, 0.0) + STEP_M * 2.0 ** (-(len(poses) - 1 - k) / h)
+    p = nav.params
+    here = poses[-1][:2]
+    decayed = p.avoid_gain_per_m * avoid_past_vector(here, expected, p.cell_m, p.memory_radius_m, 1.0)
+    undecayed = p.avoid_gain_per_m * avoid_past_vector(here, ref.visits, p.cell_m, p.memory_radius_m, 1.0)
+    assert np.linalg.norm(decayed) < 0.9 * np.linalg.norm(undecayed)
+    np.testing.assert_allclose(got, decayed - undecayed, rtol=1e-9, atol=1e-12)
+
+
+def test_memory_half_life_survives_the_rescale_and_is_not_a_paper_rule():
+    nav = nav_of("avoid_past", {"memory_half_life_steps": 0.01})  # rescales every few steps
+    nav.set_goal(np.array([30.0, 0.0]))
+    pts = np.array([[5.0, 5.0]])
+    for k in range(200):
+        v = nav._vector(np.array([0.01 * k, 0.0, 0.0]), pts, 72)
+        assert np.isfinite(v).all() and all(np.isfinite(n) for n in nav.visits.values())
+    assert AvoidPastParams.PAPER_RULES["memory_half_life_steps"] is None
+    with pytest.raises(ValueError, match="memory_half_life_steps"):
+        AvoidPastParams(memory_half_life_steps=0.0)

@@ -115,15 +115,22 @@ class AvoidPastParams(PotentialFieldParams):
         spatial memory at a new goal, nor decay it), or forgotten at each new goal of the
         robot's own, temporary goals keeping it (a gap-fill, the default of sessions 6-13; see
         the module docstring).
+    memory_half_life_steps : float or None, default None
+        Decay of the memory (a gap-fill, issue 21 §1; None, the paper's rule: no decay): a
+        visit's weight halves every ``memory_half_life_steps`` navigator steps (calls of
+        :meth:`direction`). Stored as visits inflated by ``2^(t / h)`` and a push deflated by
+        the same factor, so a step stays O(cells near the robot); see the module docstring.
     """
 
     #: Avoid-Past as Sgorbissa & Arkin §6 and its source [17] (Balch & Arkin 1993) describe it.
     PAPER_RULES: ClassVar[dict[str, Any]] = {
         # §6 / Balch & Arkin 1993: a spatial memory of visited places, never reset at a new goal nor decayed
         "memory_scope": "robot",
+        "memory_half_life_steps": None,
     }
     PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
         "memory_scope": "Sgorbissa §6, Balch & Arkin 1993: one lifelong memory of visited places, no reset, no decay",
+        "memory_half_life_steps": "Sgorbissa §6, Balch & Arkin 1993: the visits never decay",
     }
 
     cell_m: float = Field(0.3, gt=0.0, le=10.0)
@@ -131,6 +138,7 @@ class AvoidPastParams(PotentialFieldParams):
     avoid_gain_per_m: float = Field(1.0, ge=0.0, le=1000.0)
     avoid_max: float = Field(2.0, ge=0.0, le=1000.0)
     memory_scope: Literal["goal", "robot"] = "robot"
+    memory_half_life_steps: float | None = Field(None, gt=0.0)
 
 
 def avoid_past_vector(xy: np.ndarray, visits: dict[tuple[int, int], float], cell_m: float,
@@ -227,6 +235,8 @@ class AvoidPast(PotentialField):
         self._grid_of: dict | None = None
         self._grid_len = 0
         self._own_goal: np.ndarray | None = None
+        #: decay (``memory_half_life_steps``): steps since ``visits`` were last rescaled
+        self._decay_t = 0
 
     def _new_goal(self) -> None:
         """Restart the progress estimate; with ``memory_scope="goal"`` forget the visits when the
@@ -247,8 +257,19 @@ class AvoidPast(PotentialField):
         # speed (H7a): the cells near the robot come from a dense mirror of ``visits`` (rebuilt
         # when ``visits`` was replaced or changed size behind its back): the same rows as
         # avoid_past_vector's dictionary walk, so the same vector to the bit
+        h = p.memory_half_life_steps
+        inflate = 1.0
+        if h is not None:
+            # decay as inflation: a visit deposited at step t weighs 2^(t/h); the push below is
+            # deflated by 2^(-t/h), so every visit weighs 2^(-(now - then)/h) (rescaled before overflow)
+            self._decay_t += 1
+            if self._decay_t > 500.0 * h:
+                f = 2.0 ** (-self._decay_t / h)
+                self.visits = {c: n * f for c, n in self.visits.items()}
+                self._decay_t = 0
+            inflate = 2.0 ** (self._decay_t / h)
         stale = self._grid_of is not self.visits or self._grid_len != len(self.visits)
-        self.visits[key] = self.visits.get(key, 0.0) + self.step_length_m
+        self.visits[key] = self.visits.get(key, 0.0) + (self.step_length_m if h is None else self.step_length_m * inflate)
         v = super()._vector(pose, points, n_beams)
         if stale:
             self._grid, self._grid_of = _VisitGrid(), self.visits
@@ -270,6 +291,8 @@ class AvoidPast(PotentialField):
         # the rest on floats, the same operations per component as the array expressions
         # ``va = gain * rep``, ``v + (va * (max / norm) if norm > max else va)``
         va0, va1 = p.avoid_gain_per_m * float(rep[0]), p.avoid_gain_per_m * float(rep[1])
+        if h is not None:
+            va0, va1 = va0 / inflate, va1 / inflate
         norm = math.hypot(va0, va1)
         if norm > p.avoid_max:
             f = p.avoid_max / norm
