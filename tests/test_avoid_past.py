@@ -23,14 +23,17 @@ def _visited(nav: AvoidPast, steps: int) -> Loop:
 
 
 def test_default_memory_is_the_robots_lifelong_one():
-    """Issue 21 §1: the paper's rule (one memory, never reset, no decay) is the default."""
+    """Issue 21 §1: the paper's lifelong memory, never reset, is the default; its decay is the
+    declared gap-fill (125 steps, chosen on tuning tasks), None under paper_rules."""
     assert AvoidPastParams().memory_scope == "robot" and AvoidPastParams().memory_radius_m == 3.0
+    assert AvoidPastParams().memory_half_life_steps == 125.0
+    assert AvoidPastParams(paper_rules=True).memory_half_life_steps is None
     with pytest.raises(ValueError):
         AvoidPastParams(memory_scope="task")
 
 
 def test_a_new_own_goal_forgets_the_visits_a_temporary_one_does_not():
-    nav = nav_of("avoid_past", {"memory_scope": "goal"})
+    nav = nav_of("avoid_past", {"memory_scope": "goal", "memory_half_life_steps": None})
     loop = _visited(nav, 100)
     visits = dict(nav.visits)
     assert sum(visits.values()) == pytest.approx(100 * STEP_M)
@@ -49,7 +52,7 @@ def test_a_new_own_goal_forgets_the_visits_a_temporary_one_does_not():
 
 
 def test_robot_scope_keeps_one_memory():
-    nav = nav_of("avoid_past")
+    nav = nav_of("avoid_past", {"memory_half_life_steps": None})
     loop = _visited(nav, 50)
     nav.set_goal(loop.to_own(np.array([1.0, 1.0])))
     assert sum(nav.visits.values()) == pytest.approx(50 * STEP_M)
@@ -118,7 +121,7 @@ def test_memory_half_life_weighs_each_visit_by_its_age():
 
     h = 40.0
     nav = nav_of("avoid_past", {"memory_half_life_steps": h, "avoid_max": 1000.0})
-    ref = nav_of("avoid_past", {"avoid_max": 1000.0})
+    ref = nav_of("avoid_past", {"avoid_max": 1000.0, "memory_half_life_steps": None})
     poses = [np.array([0.1 * k, 0.0, 0.0]) for k in range(60)] + [np.array([6.0, 0.0, 0.0])]
     pts = np.array([[5.0, 5.0]])
     for n in (nav, ref):

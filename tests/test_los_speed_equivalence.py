@@ -197,7 +197,7 @@ def test_avoid_past_visit_grid_gives_the_dictionary_walks_vector(seed, step):
     reset the memory): each step's vector equals the potential field's plus avoid_past_vector
     over the visits dictionary."""
     rng = np.random.default_rng(seed)
-    p = AvoidPastParams(memory_scope="goal")  # the resets exercise the mirror's rebuild
+    p = AvoidPastParams(memory_scope="goal", memory_half_life_steps=None)  # the resets exercise the mirror's rebuild
     nav = AvoidPast(p, np.random.default_rng(0), step, 0.2)
     nav.set_goal(np.array([5.0, 5.0]))
     pose = np.array([0.0, 0.0, 0.0])

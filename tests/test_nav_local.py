@@ -256,7 +256,7 @@ def test_avoid_past_escapes_the_u(seed, x0):
 
 
 def test_avoid_past_robot_memory_survives_a_new_goal():
-    nav = nav_of("avoid_past", {"memory_scope": "robot"})
+    nav = nav_of("avoid_past", {"memory_scope": "robot", "memory_half_life_steps": None})
     assert isinstance(nav, AvoidPast)
     loop = Loop(u_trap(), nav, U_START, U_GOAL)
     for _ in range(200):

@@ -32,6 +32,18 @@ Here:
   into rooms N4/N5/S5 for 1500 steps without entering S4's door 1.5 m from where it stood.
   With ``"goal"``: 28 % saturated, 12 m of path in memory over the same task's last 1500
   steps;
+- decay (``memory_half_life_steps``, issue 21 §1; a gap-fill, None under ``paper_rules``): the
+  full section of session 16 (docs/report/los-help.md) ran the paper's lifelong memory at
+  today's budgets (6000 / 12000 steps per target): R1 alone finished 0 of 5 200-target tasks on
+  either map (19 and 34 targets reached on average), so the issue's fallback applies. The
+  half-life was chosen by a rule fixed before its runs (sweep ``los-avoid-past-half-life``,
+  commit of the sweep file): *the shortest of 125, 250, 500, 1000, 2000, 4000 navigator steps
+  with which R1 alone finishes every one of tuning tasks 1001-1005 on office_simple*, no task
+  of the tables. Measured (steps per target, tasks finished of 5): no decay 0/5 (12-42
+  targets reached); 125: 284 5/5; 250: 330 5/5; 500: 409 4/5; 1000: 515 4/5; 2000: 672 3/5;
+  4000: 725 1/5. So 125 (the grid's shortest: shorter ones were not tried; the trend says a
+  longer memory only costs steps on these tasks). It is a short memory (12.5 m of path at
+  half weight), closer to the old per-goal reset than to the paper's;
 - avoid-past vector: ``avoid_gain_per_m · Σ_c n_c · (1 − d_c / memory_radius_m) · (x − c) / d_c``
   over the cells ``c`` whose centre is within ``memory_radius_m`` of the robot (``n_c`` metres
   of path in the cell, ``d_c`` distance from the cell centre to the robot ``x``): a discrete,
@@ -115,11 +127,12 @@ class AvoidPastParams(PotentialFieldParams):
         spatial memory at a new goal, nor decay it), or forgotten at each new goal of the
         robot's own, temporary goals keeping it (a gap-fill, the default of sessions 6-13; see
         the module docstring).
-    memory_half_life_steps : float or None, default None
-        Decay of the memory (a gap-fill, issue 21 §1; None, the paper's rule: no decay): a
-        visit's weight halves every ``memory_half_life_steps`` navigator steps (calls of
-        :meth:`direction`). Stored as visits inflated by ``2^(t / h)`` and a push deflated by
-        the same factor, so a step stays O(cells near the robot); see the module docstring.
+    memory_half_life_steps : float or None, default 125.0
+        Decay of the memory (a gap-fill, issue 21 §1; None, the paper's rule and
+        ``paper_rules``' value: no decay): a visit's weight halves every
+        ``memory_half_life_steps`` navigator steps (calls of :meth:`direction`). Stored as
+        visits inflated by ``2^(t / h)`` and a push deflated by the same factor, so a step stays
+        O(cells near the robot). How 125 was chosen: see the module docstring.
     """
 
     #: Avoid-Past as Sgorbissa & Arkin §6 and its source [17] (Balch & Arkin 1993) describe it.
@@ -138,7 +151,7 @@ class AvoidPastParams(PotentialFieldParams):
     avoid_gain_per_m: float = Field(1.0, ge=0.0, le=1000.0)
     avoid_max: float = Field(2.0, ge=0.0, le=1000.0)
     memory_scope: Literal["goal", "robot"] = "robot"
-    memory_half_life_steps: float | None = Field(None, gt=0.0)
+    memory_half_life_steps: float | None = Field(125.0, gt=0.0)
 
 
 def avoid_past_vector(xy: np.ndarray, visits: dict[tuple[int, int], float], cell_m: float,
@@ -249,6 +262,7 @@ class AvoidPast(PotentialField):
         if (p.memory_scope == "goal" and self._own_goal is not None
                 and math.hypot(g[0] - self._own_goal[0], g[1] - self._own_goal[1]) > GOAL_SAME_TOL_M):
             self.visits = {}
+            self._decay_t = 0
         self._own_goal = g.copy()
 
     def _vector(self, pose: np.ndarray, points: np.ndarray, n_beams: int) -> np.ndarray:
