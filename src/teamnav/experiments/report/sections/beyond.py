@@ -39,7 +39,7 @@ bandwidth cap are ours; sweeps ``beyond-radio-<system>``): each system's headlin
 loss, range and one bandwidth cap, with two verdict rules per system (claims ``radio-*``);
 :mod:`~teamnav.experiments.report.sections._radio_beyond` owns the block and documents it.
 
-Left for later (issue 22): localized LOS help, detections for the trail team, trails as LOS memory, and the papers' other
+Left for later (issue 22): localized LOS help, trails as LOS memory, and the papers' other
 future work.
 """
 
@@ -320,7 +320,10 @@ def build(ctx) -> list:
     from teamnav.experiments.report.sections._radio_beyond import restricted_radio
 
     blocks += restricted_radio(ctx)
-    for what in ("localized LOS help (frames from MCL poses)", "detections help the trail team (eqs. 13-14)",
+    from teamnav.experiments.report.sections._beyond_detecting_trails import detecting_trails
+
+    blocks += detecting_trails(ctx)  # combination 3, detections help the trail team: _beyond_detecting_trails.py
+    for what in ("localized LOS help (frames from MCL poses)",
                  "trails as LOS memory", "the papers' future work (negative detections, data association)"):
         blocks.append(Missing(what=what, why="not built yet (issue 22)"))
     return blocks
