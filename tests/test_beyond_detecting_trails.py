@@ -225,3 +225,20 @@ def test_quick_mode_asks_one_short_run_each_and_gives_no_verdict():
     assert ctx.asked == [("beyond-detecting-trails", [0], 300.0), ("blazing-drift", [0], 300.0)]
     (cmp,) = [b for b in blocks if isinstance(b, Comparison)]
     assert cmp.holds is None and "quick mode" in cmp.ours
+
+
+def test_the_sweep_pairs_with_blazing_drift_case_by_case():
+    """x<k> of beyond-detecting-trails has blazing-drift x<k>'s drift on every robot; x<k>-nosync the
+    same with the sync off on every robot (the block pairs them by case label and seed)."""
+    from teamnav.experiments.sweep import load_sweep
+
+    ours = {c["case"]: c for c in load_sweep("beyond-detecting-trails").cases}
+    odo = {c["case"]: c for c in load_sweep("blazing-drift").cases}
+    assert sorted(ours) == ["x0", "x0-nosync", "x1", "x1-nosync", "x4", "x4-nosync"]
+    for lab, case in ours.items():
+        k = lab.removesuffix("-nosync")
+        drift = {key: v for key, v in case.items() if key.endswith("heading_drift_deg_per_min")}
+        assert drift == {key: v for key, v in odo[k].items() if key.endswith("heading_drift_deg_per_min")}
+        assert len(drift) == 4
+        off = [case.get(f"robots.{i}.params.collaborate") for i in range(4)]
+        assert off == ([False] * 4 if lab.endswith("-nosync") else [None] * 4)
