@@ -190,3 +190,4 @@ register("trail-share-v1", "teamnav.control.coop.trail_share:TrailShare")
 # Beyond the papers (issue 22): the systems combined
 register("localized-v1", "teamnav.control.beyond.localized:Localized")
 register("los-trail-explorer-v1", "teamnav.control.beyond.trail_memory:LosTrailExplorer")
+register("detecting-trails-v1", "teamnav.control.beyond.detecting:DetectingTrails")

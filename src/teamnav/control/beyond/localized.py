@@ -62,7 +62,7 @@ from teamnav.localization.likelihood_field import LikelihoodFieldParams
 from teamnav.localization.motion import MotionParams
 from teamnav.localization.resample import low_variance_indices
 
-__all__ = ["LOG_SAMPLES", "Localized", "LocalizedParams"]
+__all__ = ["LOG_SAMPLES", "Localized", "LocalizedParams", "belief_log"]
 
 #: samples logged per record step (``pts``), read by :mod:`teamnav.experiments.metric_sets.localization`
 LOG_SAMPLES = 32
@@ -216,15 +216,23 @@ class Localized:
     def log(self) -> dict[str, Any]:
         """The inner brain's log, plus ``mcl_spread_m`` and ``mcl_updates``; the inner brain's
         ``odom``-frame layers are relabelled ``world`` (its "odometry" pose is the map's here)."""
-        inner = getattr(self.inner, "log", None)
-        out = dict(inner() or {}) if callable(inner) else {}
-        out["mcl_spread_m"] = self._spread
-        out["mcl_updates"] = self._updates
-        if self._started:  # K samples by weight: the localization metric's error estimate (Fox et al. §5.1)
-            idx = low_variance_indices(self.mcl.weights, min(LOG_SAMPLES, self.mcl.n_particles), self._log_rng)
-            out["pts"] = [round(float(v), 2) for v in self.mcl.particles[idx, :2].ravel()]
-        layers = out.get("layers")
-        if isinstance(layers, dict):
-            out["layers"] = {k: ({**v, "frame": "world"} if isinstance(v, dict) and v.get("frame") == "odom" else v)
-                             for k, v in layers.items()}
-        return out
+        return belief_log(self.inner, self.mcl if self._started else None, self._log_rng, self._spread, self._updates)
+
+
+def belief_log(inner: Any, belief: Any, log_rng: np.random.Generator, spread_m: float, updates: int) -> dict[str, Any]:
+    """The log of a brain that drives ``inner`` with a sample belief's pose (``localized-v1`` and
+    ``detecting-trails-v1``): ``inner``'s log, ``mcl_spread_m``, ``mcl_updates`` and ``pts``
+    (``LOG_SAMPLES`` samples of ``belief`` drawn by weight with ``log_rng``; none while ``belief``
+    is None), the inner brain's ``odom``-frame layers relabelled ``world``."""
+    log = getattr(inner, "log", None)
+    out = dict(log() or {}) if callable(log) else {}
+    out["mcl_spread_m"] = spread_m
+    out["mcl_updates"] = updates
+    if belief is not None:  # K samples by weight: the localization metric's error estimate (Fox et al. §5.1)
+        idx = low_variance_indices(belief.weights, min(LOG_SAMPLES, belief.n_particles), log_rng)
+        out["pts"] = [round(float(v), 2) for v in belief.particles[idx, :2].ravel()]
+    layers = out.get("layers")
+    if isinstance(layers, dict):
+        out["layers"] = {k: ({**v, "frame": "world"} if isinstance(v, dict) and v.get("frame") == "odom" else v)
+                         for k, v in layers.items()}
+    return out

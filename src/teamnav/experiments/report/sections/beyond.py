@@ -39,14 +39,17 @@ bandwidth cap are ours; sweeps ``beyond-radio-<system>``): each system's headlin
 loss, range and one bandwidth cap, with two verdict rules per system (claims ``radio-*``);
 :mod:`~teamnav.experiments.report.sections._radio_beyond` owns the block and documents it.
 
-Left for later (issue 22): detections for the trail team.
+Also built (issue 22), each in its own module: combination 2, localized LOS help
+(:mod:`._beyond_localized_los`); combination 3, detections help the trail team
+(:mod:`._beyond_detecting_trails`); combination 4, trails as LOS memory (:mod:`._beyond_trail_memory`);
+Fox et al. §7's negative detections and anonymous robots (:mod:`._beyond_negative_detections`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from teamnav.experiments.report.model import Comparison, Missing, Plot, SectionSpec, Series, Table, Text
+from teamnav.experiments.report.model import Comparison, Plot, SectionSpec, Series, Table, Text
 from teamnav.experiments.report.sections import _trails as T
 from teamnav.experiments.report.sections._beyond_mail_round import mail_round as _mail_round
 from teamnav.experiments.report.sections._beyond_trail_memory import trail_memory as _trail_memory
@@ -309,26 +312,25 @@ def _moving_blazing(ctx, seeds: list[int], dur: float, speed: dict[str, float]) 
 
 
 def build(ctx) -> list:
-    """The section's blocks (one combination so far)."""
+    """The section's blocks: the four combinations and the papers' future work (issue 22)."""
     blocks: list = [Text(
         "Each paper gives its robots one kind of help; here a team gets two, measured against the systems it is "
         "built from. Every combination is a registered brain composing the papers' rules (no copies); its module "
-        "docstring says which. Only combination 1 is built so far; the others of issue 22 are listed as missing.")]
+        "docstring says which. Where a combination does not help, its block says so.")]
     blocks += _localized_trails(ctx)
     blocks += _moving_resource(ctx)
     blocks += _mail_round(ctx)  # N places, a mail round (Try §2.1, §4): _beyond_mail_round.py
     from teamnav.experiments.report.sections._radio_beyond import restricted_radio
 
     blocks += restricted_radio(ctx)
+    from teamnav.experiments.report.sections._beyond_detecting_trails import detecting_trails
     from teamnav.experiments.report.sections._beyond_localized_los import localized_los
-
-    blocks += localized_los(ctx)  # combination 2: _beyond_localized_los.py
-    blocks += _trail_memory(ctx)  # combination 4, trails as LOS memory: _beyond_trail_memory.py
     from teamnav.experiments.report.sections._beyond_negative_detections import negative_detections
 
+    blocks += localized_los(ctx)  # combination 2: _beyond_localized_los.py
+    blocks += detecting_trails(ctx)  # combination 3, detections help the trail team: _beyond_detecting_trails.py
+    blocks += _trail_memory(ctx)  # combination 4, trails as LOS memory: _beyond_trail_memory.py
     blocks += negative_detections(ctx)  # Fox §7.2: negative sights, anonymous robots
-    for what in ("detections help the trail team (eqs. 13-14)",):
-        blocks.append(Missing(what=what, why="not built yet (issue 22)"))
     return blocks
 
 
@@ -337,7 +339,7 @@ SECTION = SectionSpec(
     title="Beyond the papers: the systems combined",
     paper=PAPER,
     build=build,
-    summary="Trail robots on MCL poses against the odometric trail teams under drift (issue 22).",
+    summary="The four systems combined, each beside its parts, and the papers' future work (issue 22).",
     order=95,
     tags=("trails", "localization", "beyond"),
 )
