@@ -63,9 +63,8 @@ route-plan trials (plans B and C, teams R1,2..R1..R4) and 2 x 60 noise trials (e
 err_max 0 is the tables' R1..R4 run, read from its rows), and 45 ablation trials (teamnav only;
 the column that is the tables' setting of each algorithm is read from Table 1's rows): 705 trials,
 no simulation twice (:mod:`._los_reuse` checks per trial that the reused row is the same resolved
-scenario and seed, and runs the trial when it is not); :data:`FULL_CPU_NOTE` says what one column cost here and
-what the whole section is estimated to cost (the paper-rules column and the route plans have not been run in
-full yet: about 3.1 CPU-h in all, an upper bound from samples of every trial, ``benchmarks/los_cost_breakdown.py``). Set
+scenario and seed, and runs the trial when it is not); :data:`FULL_CPU_NOTE` says
+what the whole section cost in its first full run (session 16: 705 trials, 3.33 CPU-h, 101 min on 2 workers). Set
 ``NUMBA_NUM_THREADS=1`` for sweeps on a small box: the
 line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread launch
 costs more than the work for four robots.
@@ -109,20 +108,13 @@ NOISE_SWEEP = {"simple": "los-noise-simple", "complex": "los-noise-complex"}
 
 # ---------------------------------------------------------------------------- sweeps
 #: What the full reproduction costs on this machine (measured, see the note's numbers).
-FULL_CPU_NOTE = ("Cost of the full reproduction here, measured (2026-11-26, session 12, this 2-core machine): "
-                 "`teamnav sweep los-table1` (3 algorithms x 4 nested teams x 5 tasks of 200 targets = 60 trials) "
-                 "took 996 s and `los-table2` 1245 s of wall time, one worker each, the two side by side (session 10: "
-                 "21 and 27 min); then `teamnav report los-help -j 2` ran `los-noise-simple` (75 trials) in 1788 s, "
-                 "`los-noise-complex` (75) in 1305 s and `los-ablation` (60) in 686 s on 2 workers (the first shared "
-                 "its cores with other work for a while). All five: about 84 min of wall time on 2 cores, about 2.7 "
-                 "CPU-hours. A failing trial ends at its first target over budget; wall time is about the CPU time "
-                 "over the number of workers (`-j`). That was one column (teamnav) of 330 trials; with the paper-as-written "
-                 "column and Table 2's route plans B and C (issue 21 §3-§4) the section runs 705 trials (780 asked before "
-                 "session 15; the noise figures' err_max 0 and three ablation columns are the tables' own runs, read from "
-                 "their rows). Estimated in session 15 (benchmarks/los_cost_breakdown.py: every trial's first 4 targets, 20 "
-                 "for the paper-as-written VisBug-21 on office_simple, scaled to 200 targets with the give-up rate seen): "
-                 "about 47 M simulated steps and 3.1 CPU-hours at load 5-12 on this 2-core machine, an upper bound where "
-                 "a task gives up after the sampled targets; not yet run in full.")
+FULL_CPU_NOTE = ("Cost of the full reproduction here, measured (2026-11-27, session 16, this 2-core machine): "
+                 "`teamnav report los-help -j 2` ran the section's 705 trials (two columns, Table 2 over three route "
+                 "plans; the noise figures' err_max 0 and three ablation columns are the tables' own runs, read from "
+                 "their rows) in 6084 s of wall time, 45.7 M simulated steps and 3.33 CPU-hours summed over the trials, "
+                 "beside other work at load 8-19 (session 15's estimate from sampled targets, "
+                 "benchmarks/los_cost_breakdown.py: 3.1 CPU-h, 47 M steps). A failing trial ends at its first target "
+                 "over budget; wall time is about the CPU time over the number of workers (`-j`).")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
 #: ``los-explorer-v1`` / ``los-helper-v1``; False gives the paper's rule back).
 GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on the brains' Params): a report must "
