@@ -51,6 +51,26 @@ from teamnav.world.raycast import RayCaster
 __all__ = ["Estimate", "MCL", "MCLParams", "pose_error", "sample_error_m"]
 
 
+
+def gaussian_poses(rng: np.random.Generator, pose, cov, n: int) -> np.ndarray:
+    """``n`` poses drawn from ``N(pose, cov)`` (headings wrapped), shape (n, 3): the tracking
+    prior of :meth:`MCL.init_pose` and of :class:`~teamnav.localization.odometry_belief.OdometryBelief`.
+
+    Raises
+    ------
+    ValueError
+        ``pose`` not of shape (3,), or ``cov`` not a symmetric positive semi-definite (3, 3) matrix.
+    """
+    mu = array("pose", pose, (3,))
+    c = array("cov", cov, (3, 3))
+    if not np.allclose(c, c.T, atol=1e-12) or np.linalg.eigvalsh(c).min() < -1e-12:
+        raise ValueError(f"cov must be a symmetric positive semi-definite (3, 3) matrix, got {c.tolist()}")
+    z = rng.standard_normal((n, 3))
+    vals, vecs = np.linalg.eigh(c)
+    p = mu + (z * np.sqrt(np.clip(vals, 0.0, None))) @ vecs.T
+    p[:, 2] = wrap_angle(p[:, 2])
+    return p
+
 class MCLParams(BaseModel):
     """Parameters of one robot's MCL filter.
 
@@ -444,16 +464,7 @@ class MCL:
         cov : array_like of shape (3, 3)
             Symmetric positive semi-definite covariance [m², m², rad²].
         """
-        mu = array("pose", pose, (3,))
-        c = array("cov", cov, (3, 3))
-        if not np.allclose(c, c.T, atol=1e-12) or np.linalg.eigvalsh(c).min() < -1e-12:
-            raise ValueError(f"cov must be a symmetric positive semi-definite (3, 3) matrix, got {c.tolist()}")
-        n = self.params.n_particles
-        z = self.rng.standard_normal((n, 3))
-        vals, vecs = np.linalg.eigh(c)
-        p = mu + (z * np.sqrt(np.clip(vals, 0.0, None))) @ vecs.T
-        p[:, 2] = wrap_angle(p[:, 2])
-        self._set(p)
+        self._set(gaussian_poses(self.rng, pose, cov, self.params.n_particles))
         self._reset_recovery()
 
     def _reset_recovery(self) -> None:

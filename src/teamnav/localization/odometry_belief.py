@@ -40,7 +40,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from teamnav.geometry.angles import wrap_angle
 from teamnav.localization._checks import array, generator
-from teamnav.localization.mcl import MCL
+from teamnav.localization.mcl import MCL, gaussian_poses
 from teamnav.localization.motion import MotionParams, motion_kernel_serial
 from teamnav.localization.resample import low_variance_kernel
 
@@ -146,15 +146,8 @@ class OdometryBelief:
         cov : array_like of shape (3, 3)
             Symmetric positive semi-definite covariance [m², m², rad²].
         """
-        mu = array("pose", pose, (3,))
-        c = array("cov", cov, (3, 3))
-        if not np.allclose(c, c.T, atol=1e-12) or np.linalg.eigvalsh(c).min() < -1e-12:
-            raise ValueError(f"cov must be a symmetric positive semi-definite (3, 3) matrix, got {c.tolist()}")
         n = self.params.n_particles
-        vals, vecs = np.linalg.eigh(c)
-        p = mu + (self.rng.standard_normal((n, 3)) * np.sqrt(np.clip(vals, 0.0, None))) @ vecs.T
-        p[:, 2] = wrap_angle(p[:, 2])
-        self._particles = np.ascontiguousarray(p)
+        self._particles = np.ascontiguousarray(gaussian_poses(self.rng, pose, cov, n))
         self._weights = np.full(n, 1.0 / n)
         self._rates = self.rng.standard_normal(n) * math.radians(self.params.heading_rate_std_deg_per_min) / 60.0
         self._weighted = False
