@@ -153,7 +153,7 @@ def negative_detections(ctx) -> list:
                                 f"time to localize {T.msd(vn, '{:.0f}')} s with, {T.msd(vo, '{:.0f}')} s without; "
                                 f"paired {_diff_text(a, b)}", h,
                                 "Negative sights only reweight samples that could have seen a teammate; a teammate's "
-                                "confidently wrong belief (the hallway's rotated places) makes them evidence against "
+                                "confidently wrong belief (on a rotated copy of its place, as in the hexagon's seed 8) makes them evidence against "
                                 "the right place." + why))
     blocks.append(Table("Negative sights (Fox et al. §7.2): time to localize with and without",
                         ["setting", "negative sights", "runs", "time to localize [s]", "robots never localized",
