@@ -225,12 +225,14 @@ class AvoidPast(PotentialField):
     ``visits`` is the robot's memory (cell index in the own frame -> metres of path in the cell);
     with ``memory_scope="robot"`` (the default) it is kept for the robot's life; with
     ``memory_scope="goal"`` a new goal of the robot's own (``temporary=False``, farther than
-    ``GOAL_SAME_TOL_M`` from the last one) starts an empty memory.
+    ``GOAL_SAME_TOL_M`` from the last one) starts an empty memory. With a half-life
+    (``memory_half_life_steps``, the default 125) the stored metres are inflated by
+    ``2^(t / h)`` (see the Params); without one (None, the paper) they are the metres walked:
 
     Examples
     --------
     >>> from teamnav.control.types import RangeScan
-    >>> nav = AvoidPast(AvoidPastParams(), np.random.default_rng(0), 0.1, 0.25)
+    >>> nav = AvoidPast(AvoidPastParams(memory_half_life_steps=None), np.random.default_rng(0), 0.1, 0.25)
     >>> nav.set_goal(np.array([2.15, 0.15]))
     >>> scan = RangeScan(np.full(72, 4.0), np.linspace(-np.pi, np.pi, 72, endpoint=False), 4.0)
     >>> abs(round(nav.direction(np.array([0.15, 0.15, 0.0]), scan), 3)), nav.visits   # at a cell centre
