@@ -53,5 +53,12 @@ def generator(name: str, value) -> np.random.Generator:
     return value
 
 
+def read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a`` (the filters' ``particles`` / ``weights`` properties)."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
 def _fmt(shape: tuple) -> str:
     return "(" + ", ".join("n" if s == -1 else str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"

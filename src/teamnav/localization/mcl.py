@@ -36,7 +36,7 @@ from numba import njit
 
 from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
-from teamnav.localization._checks import array, generator
+from teamnav.localization._checks import array, generator, read_only
 from teamnav.localization.beam_model import BeamModelParams, BeamTable, beam_loglik_kernel, beam_loglik_kernel_serial
 from teamnav.localization.kld import KLDParams, kld_count_kernel
 from teamnav.localization.likelihood_field import (
@@ -409,15 +409,11 @@ class MCL:
     # ------------------------------------------------------------------ state
     @property
     def particles(self) -> np.ndarray:
-        v = self._particles.view()
-        v.flags.writeable = False
-        return v
+        return read_only(self._particles)
 
     @property
     def weights(self) -> np.ndarray:
-        v = self._weights.view()
-        v.flags.writeable = False
-        return v
+        return read_only(self._weights)
 
     @property
     def n_particles(self) -> int:

@@ -39,7 +39,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from teamnav.geometry.angles import wrap_angle
-from teamnav.localization._checks import array, generator
+from teamnav.localization._checks import array, generator, read_only
 from teamnav.localization.mcl import MCL, gaussian_poses
 from teamnav.localization.motion import MotionParams, motion_kernel_serial
 from teamnav.localization.resample import low_variance_kernel
@@ -110,22 +110,16 @@ class OdometryBelief:
     # ------------------------------------------------------------------ state
     @property
     def particles(self) -> np.ndarray:
-        v = self._particles.view()
-        v.flags.writeable = False
-        return v
+        return read_only(self._particles)
 
     @property
     def weights(self) -> np.ndarray:
-        v = self._weights.view()
-        v.flags.writeable = False
-        return v
+        return read_only(self._weights)
 
     @property
     def rates_radps(self) -> np.ndarray:
         """Each sample's drift rate of the odometry's heading [rad/s] (read-only view)."""
-        v = self._rates.view()
-        v.flags.writeable = False
-        return v
+        return read_only(self._rates)
 
     @property
     def n_particles(self) -> int:
