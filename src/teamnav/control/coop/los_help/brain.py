@@ -594,18 +594,9 @@ class _LosBrain(abc.ABC):
                 continue
             hist = history.get(int(body.step))
             if by_bearings:
-                if hist is None or s not in hist[1]:
-                    continue  # I did not see the sender when it sent: no frame
-                back = None
-                for sg in body.sightings:
-                    if sg.robot_id == me:
-                        back = sg
-                        break
-                if back is None:
-                    continue  # the sender did not see me: no mutual bearing
-                rng_m, bearing = hist[1][s]
-                # §3.1: the sender's body frame in mine (at the sending step), θ21 = 180° + α21 − α12
-                rel = sender_frame(bearing, back.bearing_rad, rng_m)
+                rel = self._bearing_frame(body, hist, s)
+                if rel is None:
+                    continue  # no mutual sighting at the sending step: no frame
             else:
                 if hist is None or body.pose is None:
                     continue  # no pose of mine at the sending step, or none sent: no frame
@@ -630,6 +621,22 @@ class _LosBrain(abc.ABC):
                 receive_report(r.owner, r.goal_id, s, sender_xy, r.d_m, me_xy=me_k, step=step_k, via_xy=via,
                                via_d_m=r.via_d_m)
 
+    def _bearing_frame(self, body: LosHelpMsg, hist, sender: int) -> tuple[float, float, float] | None:
+        """§3.1: the sender's body frame in mine at the sending step from the mutual bearings,
+        θ21 = 180° + α21 − α12; None when I did not see the sender then (``hist``: my pose and
+        sightings of that step) or it did not see me."""
+        if hist is None or sender not in hist[1]:
+            return None
+        back = None
+        for sg in body.sightings:
+            if sg.robot_id == self.me:
+                back = sg
+                break
+        if back is None:
+            return None
+        rng_m, bearing = hist[1][sender]
+        return sender_frame(bearing, back.bearing_rad, rng_m)
+
     def _frame_from_poses(self, body: LosHelpMsg, hist, sender: int) -> tuple[float, float, float]:
         """frame_source "mcl" / "fused": the sender's body frame in mine at the sending step from
         the two poses; "fused" combines it with §3.1's bearing frame when both robots saw each
@@ -639,13 +646,10 @@ class _LosBrain(abc.ABC):
         own = hist[0]
         rel = LL.frame_from_poses(own, body.pose)
         self.frames_from_poses += 1
-        if self.params.frame_source != "fused" or sender not in hist[1]:
-            return rel
-        back = next((sg for sg in body.sightings if sg.robot_id == self.me), None)
-        if back is None:
+        by_b = self._bearing_frame(body, hist, sender) if self.params.frame_source == "fused" else None
+        if by_b is None:
             return rel
         rng_m, bearing = hist[1][sender]
-        by_b = sender_frame(bearing, back.bearing_rad, rng_m)
         size = self.params.frame_robot_size_m or 2.0 * self.radius_m
         cov_b = LL.bearing_frame_cov(rng_m, bearing, self.params.frame_err_max, size)
         zero = np.zeros((3, 3))
