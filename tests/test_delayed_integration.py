@@ -290,3 +290,49 @@ def test_report_part_is_full_mode_only_and_builds_from_rows():
     assert [c.holds for c in comps] == [True, True]  # 100 s and 60 s faster on every seed
     assert out["teamnav"]["delayed-integration"]["delay_paired_mean_s"] == pytest.approx(-100.0)
     assert out["paper_rules"]["delayed-integration"] == {}
+
+
+# ---------------------------------------------------------------------------- what "concentrated" means
+def _hallway_brain(**over) -> MCLWander:
+    """A lost robot in the real symmetric hallway: global initialisation with 4000 samples."""
+    from teamnav.control.protocol import RobotInfo
+    from teamnav.world.generators import symmetric_hallway
+
+    from tests.test_localizing_brain import LASER
+
+    info = RobotInfo(0, 2, 0.25, "unicycle", 0.5, 1.5, 0.1, 0.1, sensors={"laser": LASER},
+                     known_map=symmetric_hallway().grid, extras={"group": "g"})
+    p = MCLWanderParams(collaborate=True, max_particles=4000, min_particles=100, send_min_cluster_weight=0.6,
+                        unsure_detections="drop", detection_period_s=0.0, **over)
+    b = MCLWander(p, np.random.default_rng(3), info)
+    b.mcl.init_global()
+    return b
+
+
+def test_a_lost_robots_uniform_belief_is_not_concentrated():
+    """Issue found in session 17: a uniform belief over the connected hallway is one 0.5-m-cell cluster
+    of weight 1, so the weight alone (None, the session 15-16 rule) calls a lost robot sure."""
+    b = _hallway_brain()
+    est = b.mcl.estimate()
+    assert est.n_clusters == 1 and est.cluster_weight > 0.99 and est.cluster_spread_m > 5.0
+    assert not b._concentrated()
+    assert _hallway_brain(send_max_cluster_spread_m=None)._concentrated()  # the earlier definition
+    # a tight belief at a known pose is concentrated under both
+    b.mcl.init_pose([20.0, 9.6, 0.0], np.diag([0.04, 0.04, 0.01]))
+    assert b.mcl.estimate().cluster_spread_m < 0.5 and b._concentrated()
+
+
+def test_drop_holds_back_a_lost_robots_detection_that_the_weight_alone_sent():
+    sent = {}
+    for spread in (2.0, None):
+        b = _hallway_brain(send_max_cluster_spread_m=spread)
+        _, out = b.step(_obs(0, 0, dets=[Detection(1.5, 0.0, 1)]))
+        sent[spread] = len(_sync_out(out))
+    assert sent == {2.0: 0, None: 1}
+
+
+def test_the_spread_threshold_is_validated_with_field_and_range():
+    with pytest.raises(ValueError, match="send_max_cluster_spread_m"):
+        MCLWanderParams(send_max_cluster_spread_m=0.0)
+    with pytest.raises(ValueError, match="send_max_cluster_spread_m"):
+        MCLWanderParams(send_max_cluster_spread_m=-1.0)

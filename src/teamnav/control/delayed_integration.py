@@ -24,7 +24,10 @@ detecting robot does with a detection made while its own belief is *not concentr
 Gaps filled here (the paper states the idea only; each is a declared choice, not the paper's):
 
 1. *Concentrated* means the heaviest cluster of the belief holds at least
-   ``send_min_cluster_weight`` of the weight (:meth:`MCL.estimate`, cells of 0.5 m).
+   ``send_min_cluster_weight`` of the weight (:meth:`MCL.estimate`, cells of 0.5 m) and its
+   position spread is at most ``send_max_cluster_spread_m``. The weight alone (sessions 15-16)
+   called a lost robot's uniform belief concentrated: once the samples fill the free space it is
+   one connected cluster of weight 1.
 2. One stored detection per detected robot, the latest: a newer sight of the same robot carries
    the same constraint with less odometry in between. When the belief becomes concentrated the
    stored detections are sent, each exactly once, unless §2.3's rule 2 blocks the robot (a

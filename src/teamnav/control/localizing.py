@@ -218,9 +218,17 @@ class MCLWanderParams(BaseModel):
     collaborate : bool
         Synchronise beliefs on detections (§3.2); False: single-robot MCL.
     send_min_cluster_weight : float
-        A belief is *concentrated* when its heaviest cluster holds at least this weight (declared
-        threshold; §7.2 says "highly uncertain" only). 0 (default): always (§3.2). > 0 alone means
-        ``unsure_detections="drop"`` (the earlier behaviour).
+        A belief is *concentrated* when its heaviest cluster holds at least this weight and is no
+        wider than ``send_max_cluster_spread_m`` (declared thresholds; §7.2 says "highly uncertain"
+        only). 0 (default): always (§3.2). > 0 alone means ``unsure_detections="drop"`` (the earlier
+        behaviour).
+    send_max_cluster_spread_m : float or None
+        The heaviest cluster's position spread ``sqrt(var x + var y)`` must be at most this [m] for a
+        concentrated belief (gap-fill, session 17). None: the weight alone, the definition of
+        sessions 15-16, which called a lost robot's uniform belief concentrated (one connected
+        cluster of weight 1 once the samples fill the free space: 2000 or more in the hallway), so
+        "drop" and "delay" sent a lost robot's detections at once. Inert with
+        ``send_min_cluster_weight`` 0.
     unsure_detections : {"integrate", "drop", "delay"}
         A detection made while the observer's belief is not concentrated is sent at once
         (``"integrate"``, default, §3.2), dropped, or kept and sent once it is, applied at the
@@ -419,6 +427,7 @@ class MCLWanderParams(BaseModel):
         "inject_lost_prior": "inert with inject_fraction 0 (the paper's), as are inject_weighting and the "
                              "inject_heading_* settings",
         "delay_max_age_s": "inert with unsure_detections 'integrate' (the paper's)",
+        "send_max_cluster_spread_m": "inert with send_min_cluster_weight 0 (the paper's)",
         "wander": "§5: the robots follow an operator or a random walk; our wanderer's settings",
         "neg_points": "inert with negative_detections false (the paper's), as are the other neg_* settings",
     }
@@ -447,6 +456,7 @@ class MCLWanderParams(BaseModel):
     init_std_deg: float = Field(10.0, gt=0.0, le=360.0)
     collaborate: bool = False
     send_min_cluster_weight: float = Field(0.0, ge=0.0, le=1.0)
+    send_max_cluster_spread_m: float | None = Field(2.0, gt=0.0, le=1000.0)
     unsure_detections: Literal["integrate", "drop", "delay"] = "integrate"
     delay_max_age_s: float = Field(60.0, gt=0.0, le=3600.0)
     inject_fraction: float = Field(0.0, ge=0.0, le=0.5)
@@ -678,7 +688,7 @@ class MCLWander:
                     self.stats["filtered"] += 1
                     continue
             keep.append(det)
-        if p.unsure_detections != "integrate" and self.mcl.estimate().cluster_weight < p.send_min_cluster_weight:
+        if p.unsure_detections != "integrate" and not self._concentrated():
             if p.unsure_detections == "delay":  # §7.2: keep the named ones for later
                 self._delay.keep(keep, obs.time_s)
             return out
@@ -696,6 +706,14 @@ class MCLWander:
                 if det.robot_id is None:
                     out += self._query(det, obs)
         return out
+
+    def _concentrated(self) -> bool:
+        """§7.2's "more certain", as declared by ``send_min_cluster_weight`` and
+        ``send_max_cluster_spread_m`` (gap-fills: the heaviest cluster is heavy *and* narrow)."""
+        p, est = self.params, self.mcl.estimate()
+        if est.cluster_weight < p.send_min_cluster_weight:
+            return False
+        return p.send_max_cluster_spread_m is None or est.cluster_spread_m <= p.send_max_cluster_spread_m
 
     # ------------------------------------------------------------------ §7.2 delayed integration
     @contextmanager

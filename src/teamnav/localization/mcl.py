@@ -161,12 +161,17 @@ class Estimate:
         Weighted mean of the heaviest cluster (connected cells of ``cluster_cell_m`` holding
         samples): the estimate to act on when the belief is multi-modal.
     cluster_weight : float
-        Total weight of that cluster, in (0, 1].
+        Total weight of that cluster, in (0, 1]. Not a concentration measure on its own: a
+        uniform belief over a connected free space fills every cell and is one cluster of
+        weight 1 (2000 samples in the symmetric hallway); read it with ``cluster_spread_m``.
     n_clusters : int
         Number of clusters.
     ess : float
         Effective sample size of the weights.
     n_particles : int
+    cluster_spread_m : float
+        Position spread of the heaviest cluster, ``sqrt(var x + var y)`` of its samples under
+        their weights [m].
     """
 
     pose: np.ndarray
@@ -176,6 +181,7 @@ class Estimate:
     n_clusters: int
     ess: float
     n_particles: int
+    cluster_spread_m: float
 
 
 @njit(cache=True)
@@ -746,7 +752,9 @@ class MCL:
         n_clusters, cluster_weight = _clusters_kernel(p, w, float(self.params.cluster_cell_m), sel)
         cmean, ccov = np.empty(3), np.empty((3, 3))
         _weighted_pose_kernel(p, w, sel, cmean, ccov)
-        return Estimate(mean, cov, cmean, float(cluster_weight), int(n_clusters), effective_sample_size(w), int(n))
+        spread = math.sqrt(max(0.0, float(ccov[0, 0] + ccov[1, 1])))
+        return Estimate(mean, cov, cmean, float(cluster_weight), int(n_clusters), effective_sample_size(w), int(n),
+                        spread)
 
 
 # ---------------------------------------------------------------------------- scoring helpers
