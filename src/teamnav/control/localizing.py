@@ -71,16 +71,11 @@ Beyond the paper (each behind a flag, measured in the ``collab-mcl`` report sect
        it also drops the *true* detections that matter most: those that reach a robot whose
        belief has collapsed onto a wrong place, which cannot tell them from phantoms.
 
-``identity`` = ``"withheld"`` handling (§7.2 "Identification of robots": the factorial
-    representation "cannot deal with measurements such as 'either robot A or robot B'"): a
-    detection with ``robot_id`` None is *associated by belief*. The observer broadcasts its tree
-    as a query (``kind="assoc_query"``); every robot that hears it answers with the tree's
-    density under its own belief, ``E_n = sum_i w_i tree(x_i)`` (one float). Two steps later
-    (query out, answers back) the observer picks the robot with the largest ``E_n``, provided it beats the uniform
-    density ``1 / A`` by ``assoc_min_ratio`` and the runner-up by ``assoc_margin``, and sends it
-    the ordinary detection message (the tree it kept). Ambiguous detections (every robot still
-    globally uncertain, or two robots equally plausible) are dropped. With ``anonymous="ignore"``
-    the brain does what the paper's method does with anonymous sights: nothing.
+``anonymous`` (§7.2 "Identification of robots"; :mod:`teamnav.control.anonymous_association`)
+    A detection without identity (``robot_id`` None) is *associated by belief*: the observer
+    broadcasts its tree, every teammate answers with the tree's density under its own belief, and
+    the detection goes to the one that clearly fits best, or is dropped when none does. With
+    ``anonymous="ignore"`` the brain does what the paper's method does with anonymous sights: nothing.
 
 ``negative_detections`` (§7.2 "Not seeing each other"; :mod:`teamnav.control.negative_sights`)
     Not seeing a teammate where its broadcast belief says it should be visible weighs the own
@@ -113,13 +108,13 @@ from __future__ import annotations
 
 import math
 from contextlib import contextmanager
-from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from teamnav.control.anonymous_association import ASSOC_KIND, AnonymousAssociation, to_odom
 from teamnav.control.delayed_integration import DelayedIntegration, past_frame
 from teamnav.control.mcl_wander_params import MCLWanderParams
 from teamnav.control.nav.wander import Wander
@@ -128,9 +123,8 @@ from teamnav.control.protocol import RobotInfo
 from teamnav.control.tree_injection import inject_tree
 from teamnav.control.types import Action, Message, Observation
 from teamnav.localization import BeliefSync, DetectionModel, MCL, SyncMessage, SyncParams
-from teamnav.localization.density_tree import DensityTree
 from teamnav.localization.resample import low_variance_kernel
-from teamnav.localization.sync import SYNC_KIND, detection_tree
+from teamnav.localization.sync import SYNC_KIND
 from teamnav.world.grid import FREE
 
 # MCLWanderParams lives in teamnav.control.mcl_wander_params; it stays importable from here
@@ -139,9 +133,6 @@ __all__ = ["MCLWander", "MCLWanderParams", "load_detection_model", "MODEL_DIR"]
 #: Folder of the detection models shipped with teamnav (``detection_model: default`` is
 #: ``MODEL_DIR / "detection-default.json"``).
 MODEL_DIR: Path = Path(str(resources.files("teamnav.localization"))) / "models"
-
-#: ``Message.kind`` of identity-association traffic.
-ASSOC_KIND = "mcl_assoc"
 
 
 def load_detection_model(name: str) -> DetectionModel:
@@ -156,31 +147,7 @@ def load_detection_model(name: str) -> DetectionModel:
     return DetectionModel.load(p)
 
 
-@dataclass(frozen=True)
-class _AssocQuery:
-    """Broadcast: "whose belief fits this tree of the robot I saw?" (identity withheld)."""
-
-    qid: int
-    observer: int
-    tree: DensityTree
-
-
-@dataclass(frozen=True)
-class _AssocAnswer:
-    """Answer to :class:`_AssocQuery`: the tree's density under the answering robot's belief."""
-
-    qid: int
-    observer: int
-    evidence: float
-
-
-def _to_odom(odom_pose: np.ndarray, range_m: float, bearing_rad: float) -> np.ndarray:
-    """A detection's point in the observer's odometry frame."""
-    a = float(odom_pose[2]) + bearing_rad
-    return np.array([odom_pose[0] + range_m * math.cos(a), odom_pose[1] + range_m * math.sin(a)])
-
-
-class MCLWander:
+class MCLWander(AnonymousAssociation):
     """``mcl-wander-v1``: wander and localize, optionally with the team (see the module docstring).
 
     Parameters
@@ -223,8 +190,7 @@ class MCLWander:
         self._free = (info.known_map.cells == FREE)
         self._next_frame_s = 0.0
         self._last_seen: dict[Any, tuple[float, np.ndarray]] = {}  # id -> (time, point in odom frame)
-        self._pending: dict[int, dict] = {}  # association queries: query id -> {"tree", "det", "scores", "t"}
-        self._query_seq = 0
+        self._init_association()  # §7.2 anonymous detections: queries waiting for answers
         self._odom = np.zeros(3)
         self._scan: np.ndarray | None = None  # this step's ranges (scan-picked headings of draws)
         self._acc = np.zeros(3)  # odometry composed since the last filter update
@@ -314,7 +280,7 @@ class MCLWander:
 
     def _confirmed(self, key, det, t_s: float) -> bool:
         """Gate 2: the same robot seen on a recent frame at a consistent place (odometry frame)."""
-        pt = _to_odom(self._odom, det.range_m, det.bearing_rad)
+        pt = to_odom(self._odom, det.range_m, det.bearing_rad)
         prev = self._last_seen.get(key)
         self._last_seen[key] = (t_s, pt)
         if prev is None or t_s - prev[0] > self.params.fp_confirm_window_s:
@@ -374,67 +340,7 @@ class MCLWander:
         finally:
             self._scan = saved
 
-    def _anon_key(self, det) -> int:
-        """Anonymous detections are matched to the previous frame's nearest one (gate 2)."""
-        pt = _to_odom(self._odom, det.range_m, det.bearing_rad)
-        best, best_d = None, math.inf
-        for key, (_, q) in self._last_seen.items():
-            if isinstance(key, tuple) and key[0] == "anon":
-                d = float(np.hypot(*(pt - q)))
-                if d < best_d:
-                    best, best_d = key[1], d
-        if best is not None and best_d <= self.params.fp_confirm_gate_m:
-            return best
-        self._query_seq += 1
-        return -self._query_seq
-
-    # ------------------------------------------------------------------ identity by belief
-    def _query(self, det, obs: Observation) -> list[Message]:
-        """Broadcast the detection tree; teammates answer with its density under their beliefs."""
-        if not self.sync.detect_gate.allowed(-1):  # one anonymous use per min_travel_m
-            return []
-        tree = detection_tree(self.mcl.particles, self.mcl.weights, det.range_m, det.bearing_rad, self.model,
-                              self.rng, self.sync.params)
-        self._query_seq += 1
-        qid = self._query_seq
-        self._pending[qid] = {"tree": tree, "det": det, "scores": {}, "step": obs.step}
-        return [Message(self.robot_id, float(obs.time_s), _AssocQuery(qid, self.robot_id, tree), to=None,
-                        kind=ASSOC_KIND)]
-
-    def _close_queries(self, obs: Observation) -> list[Message]:
-        """Pick the robot an anonymous detection was of, once the answers are in.
-
-        The query reaches the others one step after it is sent and their answers come back one
-        step later still, so a query is closed two steps after it was sent.
-        """
-        out: list[Message] = []
-        p = self.params
-        for qid in [q for q, v in self._pending.items() if obs.step >= v["step"] + 2]:
-            pend = self._pending.pop(qid)
-            scores = sorted(pend["scores"].items(), key=lambda kv: -kv[1])
-            uniform = 1.0 / self.mcl.free_area_m2
-            if not scores or scores[0][1] < p.assoc_min_ratio * uniform or (
-                    len(scores) > 1 and not scores[0][1] > p.assoc_margin * scores[1][1]):
-                self.stats["assoc_dropped"] += 1
-                continue
-            rid = int(scores[0][0])
-            if not self.sync.detect_gate.allowed(rid):
-                continue
-            det = pend["det"]
-            body = SyncMessage("detection", self.robot_id, rid, float(det.range_m), float(det.bearing_rad),
-                               float(self.model.p_false_positive), pend["tree"], self.sync.outgoing_sources())
-            out.append(Message(self.robot_id, float(obs.time_s), body, to=rid, kind=SYNC_KIND))
-            self.sync.detect_gate.use(rid)
-            self.sync.detect_gate.use(-1)
-            self.stats["assoc"] += 1
-            self.stats["sent"] += 1
-        return out
-
     # ------------------------------------------------------------------ messages
-    def _evidence(self, tree) -> float:
-        """``E = sum_i w_i tree(x_i)``: the tree's density under this robot's belief [1/m²]."""
-        return float(np.dot(self.mcl.weights, tree(self.mcl.particles[:, :2])))
-
     def _on_message(self, msg: Message, obs: Observation) -> list[Message]:
         """Handle one message; a tree of a delayed detection (§7.2, ``SyncMessage.detected_s``) is
         applied to the samples moved back to the detection's time, then moved forward again."""
@@ -471,13 +377,7 @@ class MCLWander:
         p = self.params
         body = msg.body
         if msg.kind == ASSOC_KIND:
-            if isinstance(body, _AssocQuery) and body.observer != self.robot_id:
-                return [Message(self.robot_id, float(obs.time_s), _AssocAnswer(body.qid, body.observer,
-                                                                                self._evidence(body.tree)),
-                                to=body.observer, kind=ASSOC_KIND)]
-            if isinstance(body, _AssocAnswer) and body.observer == self.robot_id and body.qid in self._pending:
-                self._pending[body.qid]["scores"][msg.sender] = body.evidence
-            return []
+            return self._on_assoc_message(msg, obs)
         if msg.kind != SYNC_KIND or not isinstance(body, SyncMessage):
             return []
         if p.false_positive_filter and body.kind == "detection" and body.target == self.robot_id:
