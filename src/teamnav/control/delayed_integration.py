@@ -11,7 +11,7 @@ Fox, Burgard, Kruppa & Thrun (2000), §7.2 (Limitations and Discussion):
 
 The paper's rule (§3.2, Table 1) is to integrate every detection at once; this is the default
 of ``mcl-wander-v1`` and what ``paper_rules: true`` keeps. The brain's flag
-``unsure_detections`` (:class:`~teamnav.control.localizing.MCLWanderParams`) chooses what the
+``unsure_detections`` (:class:`~teamnav.control.mcl_wander_params.MCLWanderParams`) chooses what the
 detecting robot does with a detection made while its own belief is *not concentrated*:
 
 ``"integrate"``
@@ -34,7 +34,7 @@ Gaps filled here (the paper states the idea only; each is a declared choice, not
    fresher detection of it was used within the last 2.5 m): then the stored one is dropped.
 3. A stored detection older than ``delay_max_age_s`` is dropped (odometry drift grows with time).
 4. Detections without identity made while unsure are dropped (association needs the beliefs of
-   now; :mod:`teamnav.control.localizing`).
+   now; :mod:`teamnav.control.anonymous_association`).
 5. *Retrospective* update. Robots know their own odometry: each keeps a short history
    (:class:`OdometryHistory`: odometry pose and scan per step). The observer moves its samples
    back to the detection time by its odometry since then (:func:`poses_before`), builds the

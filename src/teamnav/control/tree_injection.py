@@ -6,7 +6,7 @@ replaces (or adds) ``inject_*`` draws from the tree, because its sample sets los
 of a symmetric belief long before a detection arrives and eq. 14 alone cannot move weight onto
 samples that do not exist. This module holds that step and the weighting that keeps the
 detection from being counted twice; the parameters (``inject_*``) live on
-:class:`~teamnav.control.localizing.MCLWanderParams`, where each deviation is documented.
+:class:`~teamnav.control.mcl_wander_params.MCLWanderParams`, where each deviation is documented.
 Belief only: the tree, the own particles and the own scan; no true pose.
 """
 

@@ -5,7 +5,7 @@ scenario (brain ``mcl-wander-v1``, metrics :mod:`teamnav.experiments.metric_sets
 every one in two columns beside the paper's number:
 
 - "paper as written": every mcl-wander-v1 group at ``paper_rules: true``
-  (:attr:`~teamnav.control.localizing.MCLWanderParams.PAPER_RULES`: eq. 14 alone, no sensor
+  (:attr:`~teamnav.control.mcl_wander_params.MCLWanderParams.PAPER_RULES`: eq. 14 alone, no sensor
   resetting, untempered likelihood, resampling at every update, §2.3's two rules only, every
   detection sent, no false-positive filter, anonymous sights ignored), the params those rules set
   dropped from the scenario (:func:`._trails.paper_rules_spec`);
