@@ -2,7 +2,8 @@
 
 Modules: :mod:`.messages` (message bodies), :mod:`.goal_sharing` (§3–§4 rules: Id, frames
 from mutual bearings, reflected/delayed visibility, §4.3 bookkeeping), :mod:`.state_sharing`
-(§5 Tr/Pr/Cr/Nt), :mod:`.brain` (the step both brains share), :mod:`.explorer` (``los-explorer-v1``, R1) and
+(§5 Tr/Pr/Cr/Nt), :mod:`.params` (the parameters both brains share, the paper's rules among
+them), :mod:`.brain` (the step both brains share), :mod:`.explorer` (``los-explorer-v1``, R1) and
 :mod:`.helper` (``los-helper-v1``, R2..R4).
 """
 
