@@ -70,7 +70,7 @@ class _CommonParams(BaseModel):
         door). Should be at least half a step length.
     slide_when_blocked : bool
         Heading for a point it sees whose straight corridor is too narrow for its body, step
-        along the nearest free direction (see ``_LosBrain._slide_heading``) instead of asking
+        along the nearest free direction (see ``driving._Driving._slide_heading``) instead of asking
         A (gap filled; False: ask A, the earlier behaviour).
     slide_lookahead_m : float
         Length of the corridor that must be clear for a sliding direction [m].
