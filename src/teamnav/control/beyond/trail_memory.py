@@ -24,7 +24,7 @@ either:
   i.e. exactly where ``los-explorer-v1`` hands over to A), R1 heads for the crumb of its goal's
   Place with the shortest ``D = dist(R1, crumb) + s`` among those it sees (§4.3's estimate
   through a "ghost robot" R_i(t1), applied to its own viewpoints of all earlier visits), straight
-  when the corridor is clear (as to any point in sight, :meth:`~.brain._LosBrain._head_to`).
+  when the corridor is clear (as to any point in sight, :meth:`~.driving._Driving._head_to`).
   There it sees its goal and heads straight in (§2 point 4).
 
 Gaps filled (none of the papers has this; each is a parameter, and ``goal_memory: "off"`` is

@@ -13,7 +13,8 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
-from teamnav.control.coop.los_help.brain import XY, _CommonParams, _LosBrain
+from teamnav.control.coop.los_help.brain import XY, _LosBrain
+from teamnav.control.coop.los_help.params import _CommonParams
 from teamnav.control.coop.los_help.state_sharing import choose_helper
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, Observation

@@ -12,7 +12,8 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
-from teamnav.control.coop.los_help.brain import _CommonParams, _LosBrain
+from teamnav.control.coop.los_help.brain import _LosBrain
+from teamnav.control.coop.los_help.params import _CommonParams
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, Observation
 

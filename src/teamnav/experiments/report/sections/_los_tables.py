@@ -326,7 +326,7 @@ def gap_fill_blocks() -> list[Table]:
     sets the paper's), and the rules the paper leaves unspecified with how each is filled (kept in
     both columns)."""
     from teamnav.control import registry
-    from teamnav.control.coop.los_help.brain import los_gap_fills
+    from teamnav.control.coop.los_help.params import los_gap_fills
     from teamnav.experiments.spec import load_scenario
 
     scn = load_scenario("los-help-simple")
