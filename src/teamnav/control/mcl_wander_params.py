@@ -90,7 +90,10 @@ class MCLWanderParams(BaseModel):
         sessions 15-16, which called a lost robot's uniform belief concentrated (one connected
         cluster of weight 1 once the samples fill the free space: 2000 or more in the hallway), so
         "drop" and "delay" sent a lost robot's detections at once. Inert with
-        ``send_min_cluster_weight`` 0.
+        ``send_min_cluster_weight`` 0. 1 m chosen on tuning seeds 1000-1009 of the co-travel hallway
+        (sweep ``collab-mcl-cotravel-spread``, rule fixed before the runs: the lowest paired
+        delay - integrate of 1, 2, 4 m): -63 ± 46 s (s.e.) at 1 m, -50 ± 47 s at 2 and 4 m, -49 ± 24 s
+        with the weight alone.
     unsure_detections : {"integrate", "drop", "delay"}
         A detection made while the observer's belief is not concentrated is sent at once
         (``"integrate"``, default, §3.2), dropped, or kept and sent once it is, applied at the
@@ -318,7 +321,7 @@ class MCLWanderParams(BaseModel):
     init_std_deg: float = Field(10.0, gt=0.0, le=360.0)
     collaborate: bool = False
     send_min_cluster_weight: float = Field(0.0, ge=0.0, le=1.0)
-    send_max_cluster_spread_m: float | None = Field(2.0, gt=0.0, le=1000.0)
+    send_max_cluster_spread_m: float | None = Field(1.0, gt=0.0, le=1000.0)
     unsure_detections: Literal["integrate", "drop", "delay"] = "integrate"
     delay_max_age_s: float = Field(60.0, gt=0.0, le=3600.0)
     inject_fraction: float = Field(0.0, ge=0.0, le=0.5)

@@ -21,8 +21,8 @@ from teamnav.experiments.report.sections._collab_common import _metric, _ms
 #: the sweep's cases, in table order: (case label, what the observer does with an unsure detection)
 CASES = (("alone", "no detections used (collaborate off)"),
          ("integrate", "sent at once (§3.2, the paper's rule)"),
-         ("drop", "dropped (heaviest cluster below 0.6)"),
-         ("delay", "kept, sent once concentrated (>= 0.6), applied at its time (§7.2)"))
+         ("drop", "dropped (heaviest cluster below 0.6 or wider than 1 m)"),
+         ("delay", "kept, sent once concentrated (>= 0.6, <= 1 m), applied at its time (§7.2)"))
 
 SWEEP = "collab-mcl-cotravel"
 
