@@ -807,6 +807,14 @@ class VisBug21:
         keep = np.flatnonzero(ok & tested)
         if keep.size:
             ok[keep] = self._run_seen(pose, scan, cand[keep], run[keep], u, r_safe - self.params.leave_hysteresis_m)
+        return self._nearest_leave_point(xy, cand, t, ok)
+
+    def _nearest_leave_point(self, xy: np.ndarray, cand: np.ndarray, t: np.ndarray,
+                             ok: np.ndarray) -> np.ndarray | None:
+        """The leave test's last part, shared with :meth:`_leave_point_numpy`: of the M-line
+        samples ``cand`` (parameters ``t``) that passed (``ok``), the one nearest the goal, kept
+        as the new anchor of Step 1's search; None when none passed or it is less than a step
+        away and short of the goal."""
         if not ok.any():
             return None
         j = int(np.flatnonzero(ok)[-1])
@@ -838,13 +846,7 @@ class VisBug21:
             if keep.any():
                 ok[idx[keep]] = self._run_seen(pose, scan, cand[idx[keep]], run[keep], u,
                                                r_safe - self.params.leave_hysteresis_m)
-        if not ok.any():
-            return None
-        j = int(np.flatnonzero(ok)[-1])
-        if t[j] < 1.0 - 1e-12 and math.hypot(*(cand[j] - xy)) < self.step_length_m:
-            return None
-        self._t_anchor = float(t[j])
-        return cand[j]
+        return self._nearest_leave_point(xy, cand, t, ok)
 
     def _run_seen(self, pose, scan, starts: np.ndarray, runs_m: np.ndarray, u: np.ndarray,
                   half_width_m: float) -> np.ndarray:
