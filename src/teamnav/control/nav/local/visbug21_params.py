@@ -76,7 +76,8 @@ class VisBugParams(BaseModel):
         Lumelsky & Skewis' second kind of Step 2 intermediate target, which our follower omits
         (:mod:`~teamnav.control.nav.local.visbug21`, "Where we deviate"): while walking the boundary with no leave point
         in sight, head straight for the *farthest visible point of the followed obstacle's
-        boundary in the local direction* (:meth:`~teamnav.control.nav.local.visbug21.VisBug21._boundary_target`), so that concave
+        boundary in the local direction*
+        (:meth:`~teamnav.control.nav.local.visbug21.VisBug21._boundary_target`), so that concave
         stretches are cut across; the constant-offset follower takes over when no such point is
         at least a step away. True: VisBug-21 as its authors wrote it (``paper_rules``); False:
         the reactive follower alone (our default, unchanged behaviour).
