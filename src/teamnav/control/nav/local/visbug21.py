@@ -99,15 +99,19 @@ within ``progress_window_steps`` steps (as for the potential field); in Step 2, 
 along the boundary since H is shorter than ``follow_patience_m`` (Lumelsky's progress is
 made at leave points, each closer to T than its hit point; a boundary walk much longer
 than expected is "trouble"); False once T is found unreachable.
+
+Where the rest lives: the parameters, with the paper's values of our gap-fills
+(``PAPER_RULES``), in :mod:`~teamnav.control.nav.local.visbug21_params`; the boundary-following
+heading and the numba kernels of the scan geometry in
+:mod:`~teamnav.control.nav.local.visbug21_geometry`; the numpy reference versions those kernels
+replaced (for the equivalence tests) in :mod:`~teamnav.control.nav.local.visbug21_reference`.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from teamnav.control.nav.local.base import (
     GOAL_SAME_TOL_M,
@@ -118,11 +122,8 @@ from teamnav.control.nav.local.base import (
     safe_heading,
     scan_points,
     seen_free,
-    segment_clear,
 )
 from teamnav.control.nav.local.visbug21_geometry import (
-    END_TOL_FRACTION,
-    END_TOL_M,
     FOLLOW_GAP_M,
     _follow_kernel,
     _boundary_pick,
@@ -130,7 +131,8 @@ from teamnav.control.nav.local.visbug21_geometry import (
     _leave_candidates,
     boundary_heading,
 )
-from teamnav.control.paper_rules import paper_rules_validator
+from teamnav.control.nav.local.visbug21_params import VisBugParams
+from teamnav.control.nav.local.visbug21_reference import VisBugReference
 from teamnav.control.types import RangeScan
 
 __all__ = ["MODE_FOLLOW", "MODE_TO_GOAL", "MODE_UNREACHABLE", "VisBug21", "VisBugParams", "boundary_heading"]
@@ -147,111 +149,7 @@ NEARER_END_TIE_M: float = 0.05
 RUN_SEEN_FRACTION: float = 0.8
 
 
-class VisBugParams(BaseModel):
-    """Parameters of VisBug-21 (units in the names; the module docstring gives the rules).
-
-    Attributes
-    ----------
-    turn : {"nearer_end", "left", "right", "random"}, default "nearer_end"
-        Local direction at a hit point ("left": the obstacle stays on the robot's right).
-        "random": drawn (fair coin from the robot's ``rng``) at every new goal and kept for
-        that goal, so a map whose doors all sit on one side of the rooms does not favour
-        or punish the algorithm systematically. "nearer_end" (our default; a deviation, see
-        the module docstring): chosen at every hit point, towards the sensed end of the hit
-        obstacle that promises the shorter way to T; "left" until the first choice.
-    safety_margin_m : float, default 0.05
-        Free corridors keep ``R = radius + this`` from sensed points [m].
-    follow_margin_m : float, default 0.08
-        The boundary is followed at ``R + this`` [m]. It must leave room to pass a door:
-        ``2 (R + follow_margin_m)`` below the narrowest door (0.9 m in ``office_complex``;
-        0.76 m with a 0.25 m robot and the defaults).
-    leave_hysteresis_m : float, default 0.03
-        The leave test's free corridor is this much wider than Step 1's [m]; it must be
-        smaller than ``follow_margin_m`` (a robot following at ``R + follow_margin_m`` must
-        be able to see a leave point from where it is).
-    follow_gain : float, default 1.5
-        Heading correction per relative distance error while following (rad per unit).
-    leave_margin_m : float, default 0.1
-        A leave point must be this much closer to the goal than the hit point [m].
-    leave_run_m : float, default 0.5
-        From a leave point the M-line must run on free this far (or up to the goal) [m].
-    mline_sample_m : float, default 0.1
-        Spacing of the M-line points tested as intermediate targets [m].
-    return_tol_m : float, default 0.3
-        Back within this of the hit point (after leaving it) = goal unreachable [m].
-    guard_margin_m : float, default 0.03
-        Collision guard: each step keeps radius + this from sensed points [m].
-    follow_patience_m : float, default 20.0
-        Boundary walk after which the robot no longer counts as progressing [m].
-    progress_window_steps : int, default 30
-    progress_fraction : float, default 0.5
-        As for the potential field (Step 1's progress estimate).
-    reverse_walk_factor : float or None, default None
-        Alternating boundary walk (our deviation; None: Lumelsky & Skewis' walk in one local
-        direction until a leave point or back at H). A walk longer than this many times the
-        hit point's distance to T, ``d_H`` (at least ``2 m``), turns back in the other local
-        direction, passes H and goes on twice as far beyond H; each reversal doubles the reach
-        (the doubling of the "reverse" Bug variants: the walk stays within a constant factor
-        of the shorter side's), and the lap count at H starts over, so T is still declared unreachable
-        only after a full lap in one direction. Meant for the trap that ``turn="nearer_end"``
-        falls into in an office: T straight behind the side wall of a room whose door is the
-        nearer sensed end (office_simple, S1 -> N5: a lap of every north room, ~1300 steps).
-    boundary_shortcut : bool, default False
-        Lumelsky & Skewis' second kind of Step 2 intermediate target, which our follower omits
-        (module docstring, "Where we deviate"): while walking the boundary with no leave point
-        in sight, head straight for the *farthest visible point of the followed obstacle's
-        boundary in the local direction* (:meth:`VisBug21._boundary_target`), so that concave
-        stretches are cut across; the constant-offset follower takes over when no such point is
-        at least a step away. True: VisBug-21 as its authors wrote it (``paper_rules``); False:
-        the reactive follower alone (our default, unchanged behaviour).
-    paper_rules : bool, default False
-        Every gap-fill of :attr:`PAPER_RULES` at its paper value (:mod:`teamnav.control.paper_rules`).
-    """
-
-    #: VisBug-21 as Lumelsky & Skewis wrote it (Sgorbissa & Arkin §6 run "the VisBug21 algorithm
-    #: [7]"): {field: the paper's value}; ``paper_rules: true`` sets them.
-    PAPER_RULES: ClassVar[dict[str, Any]] = {
-        # Lumelsky & Skewis fix the local direction a priori ("left"); nearer_end is TangentBug's heuristic
-        "turn": "left",
-        # Lumelsky & Skewis: Ti is also the farthest visible boundary point in the local direction
-        "boundary_shortcut": True,
-    }
-    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
-        "turn": "VisBug-21 (Lumelsky & Skewis): one local direction fixed a priori, left",
-        "boundary_shortcut": "VisBug-21 (Lumelsky & Skewis): Step 2's Ti may be the farthest visible boundary point",
-    }
-
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-    turn: Literal["left", "right", "random", "nearer_end"] = "nearer_end"
-    safety_margin_m: float = Field(0.05, ge=0.0, le=2.0)
-    follow_margin_m: float = Field(0.08, ge=0.0, le=2.0)
-    leave_hysteresis_m: float = Field(0.03, ge=0.0, le=2.0)
-    follow_gain: float = Field(1.5, ge=0.0, le=20.0)
-    leave_margin_m: float = Field(0.1, ge=0.0, le=10.0)
-    leave_run_m: float = Field(0.5, ge=0.0, le=10.0)
-    mline_sample_m: float = Field(0.1, gt=0.0, le=5.0)
-    return_tol_m: float = Field(0.3, gt=0.0, le=10.0)
-    guard_margin_m: float = Field(0.03, ge=0.0, le=1.0)
-    follow_patience_m: float = Field(20.0, gt=0.0, le=10_000.0)
-    progress_window_steps: int = Field(30, ge=1, le=100_000)
-    progress_fraction: float = Field(0.5, gt=0.0, le=10.0)
-    reverse_walk_factor: float | None = Field(None, gt=0.0, le=1000.0)
-    boundary_shortcut: bool = False
-    paper_rules: bool = False
-
-    _paper_rules = paper_rules_validator()
-
-    @model_validator(mode="after")
-    def _hysteresis_below_follow(self) -> "VisBugParams":
-        if not self.leave_hysteresis_m < self.follow_margin_m:
-            raise ValueError(
-                f"leave_hysteresis_m must be < follow_margin_m ({self.follow_margin_m}), got {self.leave_hysteresis_m}"
-            )
-        return self
-
-
-class VisBug21:
+class VisBug21(VisBugReference):
     """VisBug-21 local navigator (Sgorbissa & Arkin §6, algorithm 3; Lumelsky & Skewis 1990).
 
     Parameters
@@ -274,6 +172,9 @@ class VisBug21:
         The current goal was set with ``temporary=True`` (a task goal is suspended).
     hit_xy : ndarray or None
         The current hit point H.
+
+    The numpy reference versions of its fast paths (``_*_numpy``, ``_visible``, ``_sensed_ends``)
+    come from :class:`~teamnav.control.nav.local.visbug21_reference.VisBugReference`.
 
     Examples
     --------
@@ -529,7 +430,7 @@ class VisBug21:
     def _boundary_bearings(self, xy: np.ndarray, followed: np.ndarray) -> np.ndarray | None:
         """δ of each followed boundary point: its bearing from the robot less the nearest point's
         bearing φ, wrapped to (-π, π] and signed by the followed side (see
-        :meth:`_boundary_target_numpy`); None with fewer than 3 points."""
+        :meth:`_boundary_target`); None with fewer than 3 points."""
         if followed.shape[0] < 3:
             return None
         rel = followed - xy
@@ -540,22 +441,6 @@ class VisBug21:
 
     def _boundary_target(self, xy: np.ndarray, followed: np.ndarray, points: np.ndarray, r_safe: float,
                          follow_m: float, reach_m: float) -> np.ndarray | None:
-        """Step 2's boundary target (``boundary_shortcut``): :meth:`_boundary_target_numpy`'s
-        rule and arithmetic, its part after the bearings in one kernel (``_boundary_pick``,
-        issue 21 §5: it stops at the first visible candidate instead of testing all of them);
-        equal bit for bit (``tests/test_los_speed_equivalence.py``)."""
-        delta = self._boundary_bearings(xy, followed)
-        if delta is None:
-            return None
-        k, cx, cy = _boundary_pick(float(xy[0]), float(xy[1]), followed[:, 0], followed[:, 1], delta, float(follow_m),
-                                   float(self.step_length_m), points[:, 0], points[:, 1], float(r_safe), float(reach_m),
-                                   float(self._slack))
-        if k < 0:
-            return None
-        return np.array((cx, cy))
-
-    def _boundary_target_numpy(self, xy: np.ndarray, followed: np.ndarray, points: np.ndarray, r_safe: float,
-                               follow_m: float, reach_m: float) -> np.ndarray | None:
         """Step 2's other intermediate target (``boundary_shortcut``, Lumelsky & Skewis): the
         farthest visible point of the followed obstacle's boundary in the local direction.
 
@@ -568,28 +453,21 @@ class VisBug21:
         that the robot reaches through a free corridor of half-width ``r_safe`` (Step 1's
         test, which counts a point sensed at range ρ as ``ρ π / n_beams`` nearer, so along a
         straight wall the target lies a metre or two ahead) and that lies at least one step
-        away; None when there is none (the reactive follower steers this step)."""
+        away; None when there is none (the reactive follower steers this step).
+
+        Speed (issue 21 §5): the part after the bearings in one kernel (``_boundary_pick``: it
+        stops at the first visible candidate instead of testing all of them), with the arithmetic
+        of :meth:`VisBugReference._boundary_target_numpy`; equal bit for bit
+        (``tests/test_los_speed_equivalence.py``)."""
         delta = self._boundary_bearings(xy, followed)
         if delta is None:
             return None
-        rel = followed - xy
-        nxt = np.concatenate((followed[1:], followed[-1:]))
-        prv = np.concatenate((followed[:1], followed[:-1]))
-        tx, ty = nxt[:, 0] - prv[:, 0], nxt[:, 1] - prv[:, 1]
-        tn = np.maximum(np.hypot(tx, ty), 1e-12)
-        nx, ny = -ty / tn, tx / tn
-        flip = np.where(nx * rel[:, 0] + ny * rel[:, 1] > 0.0, -1.0, 1.0)  # the normal towards the robot
-        cand = followed + follow_m * np.column_stack((flip * nx, flip * ny))
-        far = np.hypot(cand[:, 0] - xy[0], cand[:, 1] - xy[1])
-        ok = (delta > 0.0) & (far >= self.step_length_m)
-        if not ok.any():
+        k, cx, cy = _boundary_pick(float(xy[0]), float(xy[1]), followed[:, 0], followed[:, 1], delta, float(follow_m),
+                                   float(self.step_length_m), points[:, 0], points[:, 1], float(r_safe), float(reach_m),
+                                   float(self._slack))
+        if k < 0:
             return None
-        idx = np.flatnonzero(ok)
-        idx = idx[np.argsort(-delta[idx], kind="stable")]
-        vis = self._visible(xy, points, cand[idx], r_safe, reach_m)
-        if not vis.any():
-            return None
-        return cand[idx[int(np.argmax(vis))]]
+        return np.array((cx, cy))
 
     def _followed(self, pose: np.ndarray, scan: RangeScan) -> np.ndarray:
         """Sensed points of the obstacle being followed (own frame), shape (K, 2).
@@ -601,8 +479,11 @@ class VisBug21:
         passing between two obstacles (a U in a room, a pillar near a wall) would switch to
         following the other one, which is not Bug2.
 
+        With ``turn="nearer_end"`` it also keeps the followed obstacle's two sensed ends for
+        :meth:`_choose_side` (TangentBug's endpoints; the rule: :meth:`VisBugReference._sensed_ends`).
+
         Speed (H7a): one numba kernel (:func:`_follow_kernel`) with the arithmetic of
-        :meth:`_followed_numpy`, the beams' angular order kept per beam layout.
+        :meth:`VisBugReference._followed_numpy`, the beams' angular order kept per beam layout.
         """
         angles = scan.angles_rad
         if self._order_for is not angles:
@@ -625,97 +506,6 @@ class VisBug21:
         if ends:
             self._ends = (e[0].copy(), e[1].copy()) if found else None
         return pts[members[:n_members]]
-
-    def _followed_numpy(self, pose: np.ndarray, scan: RangeScan) -> np.ndarray:
-        """The numpy :meth:`_followed` (kept for the equivalence tests and the benchmark).
-
-        Sensed points of the obstacle being followed (own frame), shape (K, 2).
-
-        The scan is cut into obstacles: beams adjacent in angle whose points are closer than
-        ``FOLLOW_GAP_M`` (or 2.5 beam gaps at that range) belong to one. The followed one is
-        the obstacle holding the point nearest to last step's followed point; at the hit point
-        (or when that point is lost) the obstacle nearest the robot. Without this, a robot
-        passing between two obstacles (a U in a room, a pillar near a wall) would switch to
-        following the other one, which is not Bug2.
-        """
-        r = np.asarray(scan.ranges_m, dtype=np.float64)
-        a = np.asarray(scan.angles_rad, dtype=np.float64)
-        order = np.argsort(np.mod(a, 2.0 * math.pi), kind="stable")
-        r, a = r[order], a[order]
-        hit = r < float(scan.max_range_m) * (1.0 - 1e-9)
-        if not hit.any():
-            self._follow_ref = None
-            return np.zeros((0, 2))
-        ang = pose[2] + a
-        pts = np.column_stack((pose[0] + r * np.cos(ang), pose[1] + r * np.sin(ang)))
-        nxt = np.roll(np.arange(r.size), -1)
-        gap = np.hypot(*(pts[nxt] - pts).T)
-        allowed = np.maximum(FOLLOW_GAP_M, 2.5 * (2.0 * math.pi / r.size) * np.maximum(r, r[nxt]))
-        joined = hit & hit[nxt] & (gap <= allowed)  # beam i joined to beam i+1
-        # labels: a new obstacle starts after every break; the wrap-around joins last and first
-        labels = np.concatenate(([0], np.cumsum(~joined[:-1])))
-        if joined[-1]:
-            labels[labels == labels[-1]] = labels[0]
-        idx = np.flatnonzero(hit)
-        d_robot = np.hypot(pts[idx, 0] - pose[0], pts[idx, 1] - pose[1])
-        choice = idx[int(np.argmin(d_robot))]
-        if self._follow_ref is not None:
-            d_ref = np.hypot(pts[idx, 0] - self._follow_ref[0], pts[idx, 1] - self._follow_ref[1])
-            k = int(np.argmin(d_ref))
-            if d_ref[k] <= self.step_length_m + FOLLOW_GAP_M:
-                choice = idx[k]
-        members = idx[labels[idx] == labels[choice]]
-        near = members[int(np.argmin(np.hypot(pts[members, 0] - pose[0], pts[members, 1] - pose[1])))]
-        self._follow_ref = pts[near].copy()
-        if self.params.turn == "nearer_end":
-            self._ends = self._sensed_ends(pose[:2], r, ang, hit, joined, near)
-        return pts[members]
-
-    @staticmethod
-    def _sensed_ends(xy: np.ndarray, r: np.ndarray, ang: np.ndarray, hit: np.ndarray, joined: np.ndarray,
-                     start: int):
-        """The two sensed ends (counter-clockwise first: the one side +1 walks to) of the
-        surface holding beam ``start`` (beams sorted by angle), or None when it is seen all round.
-
-        TangentBug's endpoints (Kamon, Rimon & Rivlin 1998): the surface ends where the range
-        jumps *beyond* it. Walking from beam to beam, the surface is the line through the last
-        two points; the next beam continues it when it meets that line ahead and reads no
-        farther than the line (plus ``END_TOL_M + END_TOL_FRACTION × range``): a wall seen at a
-        grazing angle (on the line) and a concave corner (nearer than the line) continue it; a
-        door, a jamb's edge (the line turns away from the beam) or a beam without return end
-        it. Neighbouring points closer than the following's joining gap always continue it.
-        """
-        n = r.size
-        pts = np.column_stack((xy[0] + r * np.cos(ang), xy[1] + r * np.sin(ang)))
-        d = np.column_stack((np.cos(ang), np.sin(ang)))
-
-        def continues(i: int, j: int, k: int) -> bool:
-            """Does beam k continue the surface through points j (older) and i (newest)?"""
-            if not hit[k]:
-                return False
-            v = pts[i] - pts[j]
-            den = d[k, 0] * v[1] - d[k, 1] * v[0]
-            w = pts[i] - xy
-            if abs(den) <= 1e-12:
-                return False
-            r_line = (w[0] * v[1] - w[1] * v[0]) / den
-            if not r_line > 0.0:
-                return False  # the surface turns away from the beam: a convex edge (a jamb)
-            return bool(r[k] <= r_line + END_TOL_M + END_TOL_FRACTION * min(r[k], r_line))
-
-        ends = []
-        for step in (1, -1):  # counter-clockwise, then clockwise
-            i, j, walked = start, start, 0
-            while walked < n:
-                k = (i + step) % n
-                close = joined[i] if step == 1 else joined[k]
-                if not (close and hit[k]) and not (j != i and continues(i, j, k)):
-                    break
-                j, i, walked = i, k, walked + 1
-            if walked >= n:
-                return None
-            ends.append(pts[i].copy())
-        return ends[0], ends[1]
 
     def _choose_side(self, xy: np.ndarray) -> None:
         """``turn="nearer_end"``: at a hit, the side whose sensed end O of the hit obstacle
@@ -755,22 +545,11 @@ class VisBug21:
         self._dir_key = (self.mline, g, u)
         return g, u
 
-    def _visible(self, xy: np.ndarray, pts: np.ndarray, cand: np.ndarray, r_safe: float, reach_m: float) -> np.ndarray:
-        """Which candidate points the robot reaches through a free corridor of half-width ``r_safe``."""
-        dist = np.hypot(cand[:, 0] - xy[0], cand[:, 1] - xy[1])
-        ok = dist <= reach_m
-        if ok.any() and pts.shape[0]:
-            rng_p = np.hypot(pts[:, 0] - xy[0], pts[:, 1] - xy[1])
-            keep = rng_p <= reach_m + 2.0 * r_safe
-            idx = np.flatnonzero(ok)
-            ok[idx] = segment_clear(pts[keep], xy, cand[idx], r_safe, self._slack * rng_p[keep])
-        return ok
-
     def _intermediate_target(self, xy, points, r_safe, reach_m) -> np.ndarray | None:
         """Step 1's Ti: the visible M-line point nearest the goal, at least one step away (else None)."""
         cand, t = self._mline_samples(self._t_anchor)
         # speed: the last visible candidate, searched from the goal end (``_last_visible``: the
-        # arithmetic of ``_visible``, which tested every candidate; kept for the tests)
+        # arithmetic of ``_visible``, which tests every candidate; kept in visbug21_reference for the tests)
         j = int(_last_visible(float(xy[0]), float(xy[1]), points[:, 0], points[:, 1], cand[:, 0], cand[:, 1],
                               float(r_safe), float(reach_m), float(self._slack)))
         self._blocked_xy = None
@@ -807,40 +586,19 @@ class VisBug21:
         keep = np.flatnonzero(ok & tested)
         if keep.size:
             ok[keep] = self._run_seen(pose, scan, cand[keep], run[keep], u, r_safe - self.params.leave_hysteresis_m)
+        return self._nearest_leave_point(xy, cand, t, ok)
+
+    def _nearest_leave_point(self, xy: np.ndarray, cand: np.ndarray, t: np.ndarray,
+                             ok: np.ndarray) -> np.ndarray | None:
+        """The leave test's last part, shared with
+        :meth:`VisBugReference._leave_point_numpy`: of the M-line
+        samples ``cand`` (parameters ``t``) that passed (``ok``), the one nearest the goal, kept
+        as the new anchor of Step 1's search; None when none passed or it is less than a step
+        away and short of the goal."""
         if not ok.any():
             return None
         j = int(np.flatnonzero(ok)[-1])
         # moving to it must be possible: it is at least a step away, or it is the goal
-        if t[j] < 1.0 - 1e-12 and math.hypot(*(cand[j] - xy)) < self.step_length_m:
-            return None
-        self._t_anchor = float(t[j])
-        return cand[j]
-
-    def _leave_point_numpy(self, pose, scan, points, r_safe, reach_m) -> np.ndarray | None:
-        """The numpy :meth:`_leave_point` (kept for the equivalence tests and the benchmark)."""
-        xy = pose[:2]
-        cand, t = self._mline_samples(0.0)
-        closer = np.hypot(cand[:, 0] - self.goal_xy[0], cand[:, 1] - self.goal_xy[1]) < self.hit_dist_m - self.params.leave_margin_m
-        if not closer.any():
-            return None
-        cand, t = cand[closer], t[closer]
-        ok = self._visible(xy, points, cand, r_safe, reach_m)
-        idx = np.flatnonzero(ok & (t < 1.0 - 1e-12))
-        if idx.size:
-            s, g = self.mline
-            u = (g - s) / max(math.hypot(*(g - s)), 1e-12)
-            run = np.minimum(self.params.leave_run_m, np.hypot(g[0] - cand[idx, 0], g[1] - cand[idx, 1]))
-            ahead = cand[idx] + run[:, None] * u
-            if points.shape[0]:
-                slack = self._slack * np.hypot(points[:, 0] - xy[0], points[:, 1] - xy[1])
-                ok[idx] = segment_clear(points, cand[idx], ahead, r_safe - self.params.leave_hysteresis_m, slack)
-            keep = ok[idx]
-            if keep.any():
-                ok[idx[keep]] = self._run_seen(pose, scan, cand[idx[keep]], run[keep], u,
-                                               r_safe - self.params.leave_hysteresis_m)
-        if not ok.any():
-            return None
-        j = int(np.flatnonzero(ok)[-1])
         if t[j] < 1.0 - 1e-12 and math.hypot(*(cand[j] - xy)) < self.step_length_m:
             return None
         self._t_anchor = float(t[j])

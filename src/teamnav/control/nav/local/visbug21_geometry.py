@@ -3,7 +3,8 @@ numba kernels behind :class:`~teamnav.control.nav.local.visbug21.VisBug21`'s obs
 sensed ends (Lumelsky & Skewis 1990, as used by Sgorbissa & Arkin §6; the rules are documented in
 :mod:`teamnav.control.nav.local.visbug21`). Split from that module to keep the algorithm's state
 machine and these per-beam loops apart; each kernel is pinned bit for bit against the numpy code
-it replaced by ``tests/test_los_speed_equivalence.py``.
+it replaced (kept in :mod:`teamnav.control.nav.local.visbug21_reference`) by
+``tests/test_los_speed_equivalence.py`` and ``tests/test_los_speed_kernels.py``.
 """
 
 from __future__ import annotations
@@ -86,7 +87,8 @@ def _nearest_hit(pts, hit, x, y):
 
 @njit(cache=True)
 def _follow_kernel(px, py, th, r, a, thr, has_ref, refx, refy, ref_lim, gap_per_m, want_ends):
-    """:meth:`VisBug21._followed_numpy` and :meth:`VisBug21._sensed_ends` in one pass (numba),
+    """:meth:`VisBugReference._followed_numpy` and :meth:`VisBugReference._sensed_ends`
+    (:mod:`~teamnav.control.nav.local.visbug21_reference`) in one pass (numba),
     on beams sorted by angle. Returns (number of members, member indices, nearest member,
     points (n, 2), ends found, ends (2, 2)); -1 members when no beam returned."""
     n = r.shape[0]
@@ -167,7 +169,7 @@ def _follow_kernel(px, py, th, r, a, thr, has_ref, refx, refy, ref_lim, gap_per_
 @njit(cache=True)
 def _continues(pts, dirs, r, hit, px, py, i, j, k):
     """Does beam k continue the surface through points j (older) and i (newest)?
-    (:meth:`VisBug21._sensed_ends`'s ``continues``, numba)."""
+    (:meth:`VisBugReference._sensed_ends`'s ``continues``, numba)."""
     if not hit[k]:
         return False
     v0 = pts[i, 0] - pts[j, 0]
@@ -186,7 +188,7 @@ def _continues(pts, dirs, r, hit, px, py, i, j, k):
 @njit(cache=True)
 def _last_visible(x, y, px, py, cx, cy, r_safe, reach_m, slack_rad):
     """Step 1's Ti search (numba): the index of the *last* candidate point (``cx``, ``cy``)
-    that :meth:`~teamnav.control.nav.local.visbug21.VisBug21._visible` finds visible from
+    that :meth:`~teamnav.control.nav.local.visbug21_reference.VisBugReference._visible` finds visible from
     (``x``, ``y``), or -1; the candidates after it are tested, the ones before it are not.
 
     The same arithmetic per candidate as ``_visible`` and ``segment_clear``: a candidate is
@@ -356,7 +358,7 @@ def _leave_candidates(x, y, pts, cand, t, gx, gy, d_max, mgx, mgy, ux, uy, r_vis
 def _boundary_pick(x, y, fx, fy, delta, follow_m, step_m, px, py, r_safe, reach_m, slack_rad):
     """Step 2's boundary target (``boundary_shortcut``) after its bearings (numba): issue 21 §5.
 
-    The arithmetic of :meth:`~teamnav.control.nav.local.visbug21.VisBug21._boundary_target_numpy`
+    The arithmetic of :meth:`~teamnav.control.nav.local.visbug21_reference.VisBugReference._boundary_target_numpy`
     from its stood-off points on: per followed point ``k`` (``fx``, ``fy``) the chord through its
     neighbours in beam order (the ends repeat themselves), its unit normal turned towards
     (``x``, ``y``), the point stood off by ``follow_m`` along it; the candidates are those with
