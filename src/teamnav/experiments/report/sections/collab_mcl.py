@@ -69,7 +69,7 @@ from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot,
 from teamnav.experiments.report.sections._collab_beyond import _ANON, _FILTER, _FP, _beyond  # noqa: F401
 from teamnav.experiments.report.sections._collab_delayed import _delayed
 from teamnav.experiments.report.sections._collab_common import (  # noqa: F401
-    _band, _metric, _ms, _ok, _param, _series,
+    COLUMNS, HEAD, _band, _col_sweep, _metric, _ms, _ok, _param, _rule_text, _seeds, _series, _verdicts,
 )
 
 PAPER = "fox-burgard-kruppa-thrun-collaborative-multi-robot-localization.txt"
@@ -81,47 +81,6 @@ QUICK_HEXAGON = {"robots.0.count": 2, "robots.1.count": 2, "robots.0.params.max_
                  "robots.1.params.min_particles": 200}
 QUICK_DETECTION = {"robots.1.params.max_particles": 3000}
 
-
-# ---------------------------------------------------------------------------- columns and claims
-def _seeds(ctx, claim) -> list[int]:
-    """The claim's report seeds (its quick seeds in quick mode)."""
-    from teamnav.experiments.claims import _parse_seeds
-
-    return _parse_seeds(claim.quick_seeds) if ctx.quick and claim.quick_seeds else claim.seed_list
-
-
-def _col_sweep(ctx, col: str, sweep_name: str, **kw) -> list[dict]:
-    """Finished rows of sweep ``sweep_name`` in column ``col``: ``"teamnav"`` as the scenario is,
-    ``"paper_rules"`` with every mcl-wander-v1 group at ``paper_rules: true`` (the params those
-    rules set dropped from the scenario; :func:`._trails.paper_rules_spec`), in its own folder."""
-    if col == "paper_rules":
-        from teamnav.experiments.report.sections._trails import paper_rules_spec
-
-        if kw.get("name"):
-            kw["name"] = f"{kw['name']}-paper-rules"
-        return _ok(ctx.sweep(paper_rules_spec(sweep_name), **kw))
-    return _ok(ctx.sweep(sweep_name, **kw))
-
-
-def _verdicts(claim, vals: dict[str, dict]) -> dict[str, tuple]:
-    """``{column: judge(claim, that column's values)}``."""
-    from teamnav.experiments.claims import judge
-
-    return {col: judge(claim, vals[col]) for col, _ in COLUMNS}
-
-
-def _rule_text(claim, verdicts: dict[str, tuple], n_text: str) -> str:
-    """The rule, its reading on the judged column and on the other one, and the runs judged."""
-    from teamnav.experiments.claims import rule_text
-
-    other = "teamnav" if claim.judged == "paper_rules" else "paper_rules"
-    return (f" Rule (claims/collab-mcl.yaml, {claim.id}, judged on {HEAD[claim.judged]}): {rule_text(claim)}; "
-            f"{verdicts[claim.judged][1]}. {HEAD[other]}: {verdicts[other][1]}. {n_text}")
-
-
-#: the two columns: (key, heading)
-COLUMNS = (("paper_rules", "paper as written"), ("teamnav", "teamnav"))
-HEAD = dict(COLUMNS)
 
 
 # ---------------------------------------------------------------------------- §5.2.1
