@@ -97,11 +97,15 @@ def _col_sweep(ctx, col: str, sweep_name: str, **kw) -> list[dict]:
     return _ok(ctx.sweep(sweep_name, **kw))
 
 
-def _verdicts(claim, vals: dict[str, dict]) -> dict[str, tuple]:
-    """``{column: judge(claim, that column's values)}``."""
+def _verdicts(claim, vals: dict[str, dict], out: dict | None = None) -> dict[str, tuple]:
+    """``{column: judge(claim, that column's values)}``; each column of ``out`` (the section's
+    ``{column: {claim id: metrics}}``) also gets its values as ``out[column][claim.id]``."""
     from teamnav.experiments.claims import judge
 
-    return {col: judge(claim, vals[col]) for col, _ in COLUMNS}
+    verdicts = {col: judge(claim, vals[col]) for col, _ in COLUMNS}
+    for col in (out or {}):
+        out[col][claim.id] = vals[col]
+    return verdicts
 
 
 def _rule_text(claim, verdicts: dict[str, tuple], n_text: str) -> str:

@@ -116,9 +116,7 @@ def _detection(ctx, out: dict | None = None) -> list:
     if not all(a and t for a, t in split.values()):
         return [Missing("collab-mcl-detection results", "no finished trials in a column")]
     vals = {col: detection_values(*split[col]) for col, _ in COLUMNS}
-    verdicts = _verdicts(claim, vals)
-    for col in (out or {}):
-        out[col]["single-detection"] = vals[col]
+    verdicts = _verdicts(claim, vals, out)
 
     def ours(col: str) -> str:
         alone, team = split[col]

@@ -134,9 +134,7 @@ def _hallway(ctx, out: dict | None = None) -> list:
         return [Missing("collab-mcl-hallway results",
                         "; ".join(f"{HEAD[c]}: {len(rs)} trials finished" for c, rs in cols.items()))]
     vals = {col: hallway_values(rs) for col, rs in cols.items()}
-    verdicts = _verdicts(claim, vals)
-    for col in (out or {}):
-        out[col]["hallway-faster"] = vals[col]
+    verdicts = _verdicts(claim, vals, out)
 
     def ours(col: str) -> str:
         alone, team = split[col]
@@ -216,9 +214,7 @@ def _hexagon(ctx, out: dict | None = None) -> list:
     if not all(a and t for a, t in runs.values()):
         return [Missing("collab-mcl-hexagon results", "no finished trials in a column")]
     vals = {col: hexagon_values(*runs[col]) for col, _ in COLUMNS}
-    verdicts = _verdicts(claim, vals)
-    for col in (out or {}):
-        out[col]["hexagon-together"] = vals[col]
+    verdicts = _verdicts(claim, vals, out)
     series, rows = [], []
     for col, head in COLUMNS:
         alone, team = runs[col]
