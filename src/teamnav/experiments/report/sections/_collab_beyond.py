@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from teamnav.experiments.report.model import Comparison, Missing, Table
-from teamnav.experiments.report.sections._collab_common import _metric, _ms, _ok
+from teamnav.experiments.report.sections._collab_common import COLUMNS, HEAD, _col_sweep, _metric, _ms, _ok
 
 
 _FP = {"robots.0.detector.p_false_positive": 0.035}
@@ -25,7 +25,6 @@ def _beyond(ctx, out: dict | None = None) -> list:
     ``fp-breaks`` (paper as written), ``fp-filter`` and ``anon-assoc`` (teamnav); their metrics per
     column go into ``out[column][claim id]``."""
     from teamnav.experiments.claims import judge, load_claims, rule_text
-    from teamnav.experiments.report.sections.collab_mcl import COLUMNS, HEAD, _col_sweep
 
     if ctx.quick:
         return [Missing("false positives and withheld identities (§7.2)", "measured in the full report only "

@@ -1,5 +1,6 @@
 """Row helpers of the ``collab-mcl`` section: rows that ran, mean ± std, and error curves with a
-95 % band over runs (Fox, Burgard, Kruppa & Thrun 2000).
+95 % band over runs (Fox, Burgard, Kruppa & Thrun 2000); and its two columns ("paper as written",
+"teamnav"): a sweep's rows per column, a claim's seeds, verdicts and rule text.
 
 Split from :mod:`.collab_mcl` (no behaviour change).
 """
@@ -68,3 +69,49 @@ def _series(label: str, rows: list[dict], pick) -> list[Series]:
 
 def _metric(rows: list[dict], key: str) -> list[float]:
     return [r["metrics"][key] for r in rows if isinstance(r["metrics"].get(key), (int, float))]
+
+
+# ---------------------------------------------------------------------------- columns and claims
+#: the two columns: (key, heading)
+COLUMNS = (("paper_rules", "paper as written"), ("teamnav", "teamnav"))
+HEAD = dict(COLUMNS)
+
+
+def _seeds(ctx, claim) -> list[int]:
+    """The claim's report seeds (its quick seeds in quick mode)."""
+    from teamnav.experiments.claims import _parse_seeds
+
+    return _parse_seeds(claim.quick_seeds) if ctx.quick and claim.quick_seeds else claim.seed_list
+
+
+def _col_sweep(ctx, col: str, sweep_name: str, **kw) -> list[dict]:
+    """Finished rows of sweep ``sweep_name`` in column ``col``: ``"teamnav"`` as the scenario is,
+    ``"paper_rules"`` with every mcl-wander-v1 group at ``paper_rules: true`` (the params those
+    rules set dropped from the scenario; :func:`._trails.paper_rules_spec`), in its own folder."""
+    if col == "paper_rules":
+        from teamnav.experiments.report.sections._trails import paper_rules_spec
+
+        if kw.get("name"):
+            kw["name"] = f"{kw['name']}-paper-rules"
+        return _ok(ctx.sweep(paper_rules_spec(sweep_name), **kw))
+    return _ok(ctx.sweep(sweep_name, **kw))
+
+
+def _verdicts(claim, vals: dict[str, dict], out: dict | None = None) -> dict[str, tuple]:
+    """``{column: judge(claim, that column's values)}``; each column of ``out`` (the section's
+    ``{column: {claim id: metrics}}``) also gets its values as ``out[column][claim.id]``."""
+    from teamnav.experiments.claims import judge
+
+    verdicts = {col: judge(claim, vals[col]) for col, _ in COLUMNS}
+    for col in (out or {}):
+        out[col][claim.id] = vals[col]
+    return verdicts
+
+
+def _rule_text(claim, verdicts: dict[str, tuple], n_text: str) -> str:
+    """The rule, its reading on the judged column and on the other one, and the runs judged."""
+    from teamnav.experiments.claims import rule_text
+
+    other = "teamnav" if claim.judged == "paper_rules" else "paper_rules"
+    return (f" Rule (claims/collab-mcl.yaml, {claim.id}, judged on {HEAD[claim.judged]}): {rule_text(claim)}; "
+            f"{verdicts[claim.judged][1]}. {HEAD[other]}: {verdicts[other][1]}. {n_text}")

@@ -51,25 +51,33 @@ The full report runs 20 seeds of the hallway (600 s, 8 robots) and of the hexago
 condition and column, 30 seeds of the §5.1 setting (150 s) and 20 of each §7.2 variant.
 What was measured, with seeds and CPU cost: ``docs/report/collab-mcl.md``.
 
-Files: the row helpers (error curves with 95 % bands) in :mod:`._collab_common`, the §7.2 variants
-in :mod:`._collab_beyond`; the paper's experiments here.
+Files: the row helpers (error curves with 95 % bands) and the two columns in :mod:`._collab_common`;
+§5.2.1 (hallway), §5.2.2 (hexagon), the claim and gap-fill tables and :func:`build` here; §5.1
+(detection, with the Fig. 10 belief views) in :mod:`._collab_detection`; the §7.2 variants in
+:mod:`._collab_beyond`; §7.2 delayed integration in :mod:`._collab_delayed`; the tuning-seed tables
+(issue 26 §2-§3, :data:`TUNING_RUNS`) in :mod:`._collab_tuning`.
 """
 
 from __future__ import annotations
 
-import json
 import math
-from pathlib import Path
 
 import numpy as np
 
-from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, SectionSpec, Table, Text
+from teamnav.experiments.report.model import Comparison, Missing, Plot, SectionSpec, Table, Text
 
-# the row helpers and the §7.2 part, importable from here as before the split
+# the parts split off, importable from here as before the splits
 from teamnav.experiments.report.sections._collab_beyond import _ANON, _FILTER, _FP, _beyond  # noqa: F401
-from teamnav.experiments.report.sections._collab_delayed import _delayed
 from teamnav.experiments.report.sections._collab_common import (  # noqa: F401
-    _band, _metric, _ms, _ok, _param, _series,
+    COLUMNS, HEAD, _band, _col_sweep, _metric, _ms, _ok, _param, _rule_text, _seeds, _series, _verdicts,
+)
+from teamnav.experiments.report.sections._collab_delayed import _delayed
+from teamnav.experiments.report.sections._collab_detection import (  # noqa: F401
+    PICTURED_SEED, QUICK_DETECTION, _detection, detection_belief_rows, detection_values,
+)
+from teamnav.experiments.report.sections._collab_tuning import (  # noqa: F401
+    COLLAPSE_FACTORS, TUNING_RUNS, _tuning_blocks, collapse_rows, hallway_factor_rows, out_of_sample_rows,
+    tuning_claim_values,
 )
 
 PAPER = "fox-burgard-kruppa-thrun-collaborative-multi-robot-localization.txt"
@@ -79,49 +87,6 @@ QUICK_HALLWAY = {"robots.0.count": 4, "robots.0.params.max_particles": 1000, "ro
 QUICK_HEXAGON = {"robots.0.count": 2, "robots.1.count": 2, "robots.0.params.max_particles": 1000,
                  "robots.1.params.max_particles": 1000, "robots.0.params.min_particles": 200,
                  "robots.1.params.min_particles": 200}
-QUICK_DETECTION = {"robots.1.params.max_particles": 3000}
-
-
-# ---------------------------------------------------------------------------- columns and claims
-def _seeds(ctx, claim) -> list[int]:
-    """The claim's report seeds (its quick seeds in quick mode)."""
-    from teamnav.experiments.claims import _parse_seeds
-
-    return _parse_seeds(claim.quick_seeds) if ctx.quick and claim.quick_seeds else claim.seed_list
-
-
-def _col_sweep(ctx, col: str, sweep_name: str, **kw) -> list[dict]:
-    """Finished rows of sweep ``sweep_name`` in column ``col``: ``"teamnav"`` as the scenario is,
-    ``"paper_rules"`` with every mcl-wander-v1 group at ``paper_rules: true`` (the params those
-    rules set dropped from the scenario; :func:`._trails.paper_rules_spec`), in its own folder."""
-    if col == "paper_rules":
-        from teamnav.experiments.report.sections._trails import paper_rules_spec
-
-        if kw.get("name"):
-            kw["name"] = f"{kw['name']}-paper-rules"
-        return _ok(ctx.sweep(paper_rules_spec(sweep_name), **kw))
-    return _ok(ctx.sweep(sweep_name, **kw))
-
-
-def _verdicts(claim, vals: dict[str, dict]) -> dict[str, tuple]:
-    """``{column: judge(claim, that column's values)}``."""
-    from teamnav.experiments.claims import judge
-
-    return {col: judge(claim, vals[col]) for col, _ in COLUMNS}
-
-
-def _rule_text(claim, verdicts: dict[str, tuple], n_text: str) -> str:
-    """The rule, its reading on the judged column and on the other one, and the runs judged."""
-    from teamnav.experiments.claims import rule_text
-
-    other = "teamnav" if claim.judged == "paper_rules" else "paper_rules"
-    return (f" Rule (claims/collab-mcl.yaml, {claim.id}, judged on {HEAD[claim.judged]}): {rule_text(claim)}; "
-            f"{verdicts[claim.judged][1]}. {HEAD[other]}: {verdicts[other][1]}. {n_text}")
-
-
-#: the two columns: (key, heading)
-COLUMNS = (("paper_rules", "paper as written"), ("teamnav", "teamnav"))
-HEAD = dict(COLUMNS)
 
 
 # ---------------------------------------------------------------------------- §5.2.1
@@ -169,9 +134,7 @@ def _hallway(ctx, out: dict | None = None) -> list:
         return [Missing("collab-mcl-hallway results",
                         "; ".join(f"{HEAD[c]}: {len(rs)} trials finished" for c, rs in cols.items()))]
     vals = {col: hallway_values(rs) for col, rs in cols.items()}
-    verdicts = _verdicts(claim, vals)
-    for col in (out or {}):
-        out[col]["hallway-faster"] = vals[col]
+    verdicts = _verdicts(claim, vals, out)
 
     def ours(col: str) -> str:
         alone, team = split[col]
@@ -251,9 +214,7 @@ def _hexagon(ctx, out: dict | None = None) -> list:
     if not all(a and t for a, t in runs.values()):
         return [Missing("collab-mcl-hexagon results", "no finished trials in a column")]
     vals = {col: hexagon_values(*runs[col]) for col, _ in COLUMNS}
-    verdicts = _verdicts(claim, vals)
-    for col in (out or {}):
-        out[col]["hexagon-together"] = vals[col]
+    verdicts = _verdicts(claim, vals, out)
     series, rows = [], []
     for col, head in COLUMNS:
         alone, team = runs[col]
@@ -292,339 +253,6 @@ def _hexagon(ctx, out: dict | None = None) -> list:
               ["column", "setting", "sensor", "runs", "final error [m]", "localized at the end",
                "time to localize [s]"], rows),
     ]
-
-
-# ---------------------------------------------------------------------------- §5.1
-#: the run pictured in Fig. 10 (a report seed; both columns)
-PICTURED_SEED = 1
-
-
-def _pictured_run(col: str, seed: int = PICTURED_SEED, duration_s: float = 150.0):
-    """One collab-mcl-detection run of column ``col`` with 300 logged samples per record."""
-    from teamnav.experiments.report.sections._trails import paper_rules_spec
-    from teamnav.experiments.runner import run
-    from teamnav.experiments.spec import load_scenario
-
-    over: dict = {"robots.1.params.log_points": 300}
-    if col == "paper_rules":
-        over = dict(paper_rules_spec("collab-mcl-detection").set)  # both robots' params, paper_rules: true
-        over["robots.1.params"] = {**over["robots.1.params"], "log_points": 300}
-    return run(load_scenario("collab-mcl-detection", overrides=over, seed=seed, duration_s=duration_s), progress=False)
-
-
-def detection_belief_rows(logs: list[dict], robot: int = 1) -> list[dict]:
-    """Every ``det_belief`` record (a detection tree that reached ``robot``, with the belief it met)
-    in a run's logs, in time order."""
-    out = []
-    for r in sorted((r for r in logs if r["robot"] == robot), key=lambda r: r["step"]):
-        out += list(r["values"].get("det_belief", []))
-    return out
-
-
-def _belief_views(ctx) -> list:
-    """Robin's samples just before and after the first detection of one run per column (Fig. 10),
-    and Robin's sample count and spread at every detection tree it received (issue 26 §2)."""
-    from teamnav.world import builtin_map
-
-    grid = builtin_map("lab_and_corridor").grid
-    out, table = [], []
-    for col, head in COLUMNS:
-        res = _pictured_run(col)
-        for rec in detection_belief_rows(res.data.logs):
-            table.append([head, PICTURED_SEED, f"{rec['t_s']:.1f}", rec["n_particles"], f"{rec['spread_m']:.2f}",
-                          f"{rec['cluster_weight']:.2f}", "yes" if rec["applied"] else "no (gated)"])
-        logs = sorted((r for r in res.data.logs if r["robot"] == 1 and "pts" in r["values"]), key=lambda r: r["step"])
-        k = next((i for i, r in enumerate(logs) if r["values"].get("syncs", 0) > 0), None)
-        if k is None:
-            out.append(Missing(f"belief before/after the detection, {head}", "no detection was applied in the "
-                               "pictured run"))
-            continue
-        t_s = np.asarray(res.data.t_s)
-        for title, rec in ((f"Fig. 10(a): Robin's belief as it passes Marian (before the detection), {head}",
-                            logs[max(0, k - 1)]),
-                           (f"Fig. 10(b): Robin's belief after integrating Marian's detection, {head}",
-                            logs[min(len(logs) - 1, k + 2)])):
-            j = int(np.argmin(np.abs(t_s - rec["t_s"])))
-            truth = res.data.true_pose[j]
-            out.append(MapView(title, grid,
-                               points=[("Robin's samples", np.asarray(rec["values"]["pts"]).reshape(-1, 2))],
-                               markers=[("Robin (true)", float(truth[1, 0]), float(truth[1, 1])),
-                                        ("Marian (true)", float(truth[0, 0]), float(truth[0, 1]))],
-                               caption=f"t = {rec['t_s']:.0f} s; 300 samples drawn by weight from the belief; "
-                                       f"{rec['values'].get('n_particles', '?')} samples, spread "
-                                       f"{rec['values'].get('spread_m', float('nan')):.2f} m."))
-    out.insert(0, Table("Fig. 10(a)'s precondition: Robin's belief when Marian's tree arrives",
-                        ["column", "seed", "t [s]", "samples", "spread [m]", "heaviest cluster's weight", "applied"],
-                        table or [["(no tree reached Robin)", PICTURED_SEED, "", "", "", "", ""]],
-                        note="spread = sqrt(var x + var y) of Robin's weighted samples just before the tree; the "
-                             "paper's Fig. 10a shows a belief still spread along the corridor (metres), where eq. 14 "
-                             "can pick the right samples. A spread of a few decimetres with one heavy cluster is a "
-                             "belief that already collapsed, right or wrong."))
-    return out
-
-
-def detection_values(alone: list[dict], team: list[dict]) -> dict[str, float]:
-    """Claim ``single-detection``'s metrics from one column's §5.1 runs."""
-    nan = float("nan")
-    ea = _metric(alone, "loc_final_error_m_g_robin")
-    et = _metric(team, "loc_final_error_m_g_robin")
-    return {"alone_final_error_mean_m": float(np.mean(ea)) if ea else nan,
-            "team_final_error_mean_m": float(np.mean(et)) if et else nan,
-            "alone_localized_frac": float(np.mean(np.asarray(ea) < 1.5)) if ea else nan,
-            "team_localized_frac": float(np.mean(np.asarray(et) < 1.5)) if et else nan}
-
-
-def _detection(ctx, out: dict | None = None) -> list:
-    """Blocks of claim ``single-detection``; its metrics per column go into ``out[column]["single-detection"]``."""
-    from teamnav.experiments.claims import load_claims
-
-    claim = load_claims("collab-mcl")["single-detection"]
-    seeds = _seeds(ctx, claim)
-    kw = {"seeds": seeds, "duration_s": 90, "set": QUICK_DETECTION} if ctx.quick else {"seeds": seeds}
-    split = {}
-    for col, _ in COLUMNS:
-        rows = _col_sweep(ctx, col, "collab-mcl-detection", **kw)
-        split[col] = ([r for r in rows if not _param(r, "robots.1.params.collaborate", True)],
-                      [r for r in rows if _param(r, "robots.1.params.collaborate", False)])
-    if not all(a and t for a, t in split.values()):
-        return [Missing("collab-mcl-detection results", "no finished trials in a column")]
-    vals = {col: detection_values(*split[col]) for col, _ in COLUMNS}
-    verdicts = _verdicts(claim, vals)
-    for col in (out or {}):
-        out[col]["single-detection"] = vals[col]
-
-    def ours(col: str) -> str:
-        alone, team = split[col]
-        v = vals[col]
-        return (f"{HEAD[col]}: Robin's final error {_ms(_metric(alone, 'loc_final_error_m_g_robin'))} m ignoring "
-                f"detections vs {_ms(_metric(team, 'loc_final_error_m_g_robin'))} m using them; localized at the "
-                f"end in {v['alone_localized_frac']:.0%} vs {v['team_localized_frac']:.0%} of runs; time to < 1.5 m "
-                f"{_ms(_metric(alone, 'loc_time_to_localize_s_g_robin'))} s vs "
-                f"{_ms(_metric(team, 'loc_time_to_localize_s_g_robin'))} s (n = {len(alone)} / {len(team)} runs)")
-
-    n_text = f"Seeds {seeds[0]}-{seeds[-1]}."
-    if ctx.quick:
-        n_text += (" Quick mode: one seed of 90 s per condition, so the verdict rests on Robin's final error alone "
-                   "(one run's time to < 1.5 m says nothing about a spread, and is often the same in both "
-                   "conditions).")
-    blocks = [
-        Comparison("§5.1 / Fig. 11: a single detection collapses the corridor robot's belief",
-                   "error falls much faster with detections (10 runs, detection after 60-100 s)",
-                   "; ".join(ours(col) for col, _ in COLUMNS),
-                   verdicts[claim.judged][0],
-                   "Our corridor robot starts 15-19 m west of the lab opening and passes it after about 60 s; "
-                   "Marian stands still, so the 2.5 m rule lets it use Robin once per run. The paper-as-written "
-                   "column applies eq. 14 alone: it can only reweight the samples Robin has. The teamnav column "
-                   "draws part of Robin's samples from the received tree (sensor resetting, weighted by the "
-                   "posterior probability that Robin was lost, lost prior 0.3) with headings picked by its "
-                   "scan (as in the hallway; chosen on tuning seeds 1000-1039 in session 15), and tempers the "
-                   "likelihood (0.03)."
-                   + _rule_text(claim, verdicts, n_text)),
-        Plot("Fig. 11: the corridor robot's error vs time", "time [s]", "mean distance of samples to the true pose [m]",
-             [s for col, head in COLUMNS for s in
-              _series(f"single-robot MCL (ignores detections), {head}", split[col][0],
-                      lambda d: d["by_group"].get("robin"))
-              + _series(f"using Marian's detection, {head}", split[col][1], lambda d: d["by_group"].get("robin"))],
-             hlines=[(1.5, "localized (1.5 m)")], caption="Bands: 95 % confidence interval over runs."),
-    ]
-    return blocks + _belief_views(ctx)
-
-
-# ---------------------------------------------------------------------------- issue 26 §2-§3, tuning seeds
-#: What ``scripts/collab_mcl_collapse.py`` measured on tuning seeds (>= 1000; the report never runs
-#: them), as its ``table_rows`` of ``docs/report/collab-mcl-collapse.jsonl`` (the runs; tests check
-#: that the two agree), kept as package data in ``experiments/report/data/collab-mcl-tuning-runs.json``. Shown as measured, not re-run by the report (about 20 CPU min).
-#: ``column`` "paper_rules": one filter setting (``factor``) on top of ``paper_rules: true``;
-#: "teamnav": the scenario as the report runs it, or one of its tuned values changed.
-TUNING_RUNS: tuple[dict, ...] = tuple(json.loads(
-    (Path(__file__).resolve().parents[1] / "data" / "collab-mcl-tuning-runs.json").read_text(encoding="utf-8")))
-
-#: factor -> (what it changes, the paper's status): scripts/collab_mcl_collapse.py's FACTORS, copied
-#: so that the report does not import a script (tests check that they agree)
-COLLAPSE_FACTORS: dict[str, tuple[str, str]] = {
-    "paper": ("paper_rules: true as the report runs it (KLD floor 500; Robin: 90 laser beams, sigma_hit "
-         "0.2 m; hallway: 16 sonar cones, 0.3 m; motion alpha (0.1, 0.05, 0.05, 0.05); exponent 1; "
-         "resampling every update)",
-        "baseline"),
-    "floor": ("KLD floor 500 -> 5000 samples",
-        "unspecified (gap-fill)"),
-    "fixed": ("fixed 10000 samples (no KLD adaptation)",
-        "unspecified (gap-fill)"),
-    "motion": ("motion noise x3: alpha (0.3, 0.15, 0.15, 0.15)",
-        "unspecified (gap-fill)"),
-    "sigma": ("beam model sigma_hit 0.2 m (laser) or 0.3 m (sonar) -> 1.0 m",
-        "unspecified (gap-fill)"),
-    "beams": ("every 10th beam (9 of 90 laser beams; 2 of 16 sonar cones)",
-        "unspecified (gap-fill)"),
-    "sigma+beams": ("sigma_hit 1.0 m and every 10th beam (both unspecified values at once)",
-        "unspecified (gap-fill)"),
-    "sigma+beams+floor": ("sigma_hit 1.0 m, every 10th beam and a KLD floor of 5000",
-        "unspecified (gap-fill)"),
-    "sigma+floor": ("sigma_hit 1.0 m and a KLD floor of 5000 (every beam; for the 16-cone sonar)",
-        "unspecified (gap-fill)"),
-    "update": ("filter update every 1.0 m / 45 deg instead of 0.2 m / 15 deg",
-        "unspecified (gap-fill)"),
-    "temper": ("likelihood exponent 1 -> 0.03 (teamnav's)",
-        "not the paper (eq. 12)"),
-    "ess": ("resample only when ESS < 50 % (teamnav's)",
-        "not the paper (\u00a73.1)"),
-}
-
-
-def tuning_claim_values(row: dict) -> dict[str, float]:
-    """The claim metrics (claims/collab-mcl.yaml) of one :data:`TUNING_RUNS` row, as the section's
-    ``hallway_values`` / ``hexagon_values`` / ``detection_values`` define them."""
-    nan = float("nan")
-
-    def num(x):
-        return nan if x is None else float(x)
-
-    if row["part"] == "detection":
-        return {"alone_final_error_mean_m": num(row["alone_final_m"]),
-                "team_final_error_mean_m": num(row["team_final_m"]),
-                "alone_localized_frac": row["alone_localized"] / row["alone_runs"] if row["alone_runs"] else nan,
-                "team_localized_frac": row["team_localized"] / row["team_runs"] if row["team_runs"] else nan}
-    out = {"alone_ttl_mean_s": num(row["alone_ttl_s"]), "together_ttl_mean_s": num(row["team_ttl_s"]),
-           "alone_final_localized": num(row["alone_final_localized"]),
-           "together_final_localized": num(row["team_final_localized"]),
-           "paired_change_upper_s": num(row["paired_s"]) + 2.0 * num(row["paired_se_s"])}
-    if row["part"] == "hexagon":
-        out.update({"together_min_localized": min(num(row["team_localized_sonar"]), num(row["team_localized_laser"])),
-                    "alone_best_localized": max(num(row["alone_localized_sonar"]), num(row["alone_localized_laser"])),
-                    "together_all_runs_frac": row["team_all_localized"] / row["team_runs"]})
-    return out
-
-
-def _seed_text(seeds: list[int]) -> str:
-    return f"{seeds[0]}-{seeds[-1]}" if seeds == list(range(seeds[0], seeds[-1] + 1)) else ", ".join(map(str, seeds))
-
-
-def _f(x, fmt: str = ".2f") -> str:
-    return "n/a" if x is None else format(x, fmt)
-
-
-def _in_factor_order(part: str) -> list[dict]:
-    order = list(COLLAPSE_FACTORS)
-    return sorted((r for r in TUNING_RUNS if r["part"] == part and r["column"] == "paper_rules"),
-                  key=lambda r: order.index(r["factor"]))
-
-
-def collapse_rows() -> list[list]:
-    """Issue 26 §2's table: Robin's paper-rules belief per factor (one setting changed at a time)."""
-    rows = []
-    for r in _in_factor_order("detection"):
-        what, status = COLLAPSE_FACTORS[r["factor"]]
-        rows.append([r["factor"], what, status, _seed_text(r["seeds"]),
-                     f"{_f(r['spread_5s_m'])} / {_f(r['spread_5s_median_m'])}", _f(r["spread_30s_m"]),
-                     f"{_f(r['det_n'], '.0f')}, {_f(r['det_spread_m'])} m, {_f(r['det_error_m'], '.1f')} m "
-                     f"({r['det_right']} / {r['team_runs']})",
-                     f"{_f(r['alone_final_m'], '.1f')} m ({r['alone_localized']} / {r['alone_runs']})",
-                     f"{_f(r['team_final_m'], '.1f')} m ({r['team_localized']} / {r['team_runs']})"])
-    return rows
-
-
-def hallway_factor_rows() -> list[list]:
-    """Issue 26 §2's hallway check: the report's time to localize per factor (paper rules)."""
-    rows = []
-    for r in _in_factor_order("hallway"):
-        rows.append([r["factor"], COLLAPSE_FACTORS[r["factor"]][0], _seed_text(r["seeds"]),
-                     f"{_f(r['alone_ttl_s'], '.0f')} → {_f(r['team_ttl_s'], '.0f')}",
-                     f"{_f(r['paired_s'], '+.0f')} ± {_f(r['paired_se_s'], '.0f')} ({r['faster']} / {r['pairs']})",
-                     f"{_f(r['alone_final_localized'])} / {_f(r['team_final_localized'])}"])
-    return rows
-
-
-#: claim -> the TUNING_RUNS factor of the teamnav column that re-checks it on tuning seeds
-_RECHECK = {"hallway-faster": "hallway", "hexagon-together": "hexagon", "single-detection": "detection"}
-
-
-def out_of_sample_rows() -> list[list]:
-    """Issue 26 §3: each teamnav-judged reading of a paper claim on tuning seeds, by the claim file's rule."""
-    from teamnav.experiments.claims import judge, load_claims
-
-    claims = load_claims("collab-mcl")
-    rows = []
-    for cid, factor in _RECHECK.items():
-        r = next((r for r in TUNING_RUNS if r["column"] == "teamnav" and r["factor"] == factor), None)
-        if r is None:
-            continue
-        ok, how = judge(claims[cid], tuning_claim_values(r))
-        rows.append([cid, _seed_text(r["seeds"]), {True: "holds", False: "does not hold", None: "not judged"}[ok], how])
-    return rows
-
-
-def _tuning_blocks() -> list:
-    """Issue 26 §2 (why the paper-rules filter collapses) and §3 (the teamnav values out of sample),
-    as measured on tuning seeds by scripts/collab_mcl_collapse.py (:data:`TUNING_RUNS`)."""
-    if not TUNING_RUNS:
-        return [Missing("tuning-seed diagnostics", "TUNING_RUNS is empty")]
-    prior = {r["factor"]: r for r in TUNING_RUNS if r["factor"].startswith("detection-prior")}
-    base = next(r for r in TUNING_RUNS if r["column"] == "teamnav" and r["factor"] == "detection")
-    prior_text = "; ".join(f"{f.removeprefix('detection-prior')}: {r['team_final_m']:.2f} m, {r['team_localized']} / "
-                           f"{r['team_runs']} localized" for f, r in sorted(prior.items()))
-    return [
-        Table("Issue 26 §2: why the paper-rules filter collapses (Robin, §5.1 setting, one setting changed at a "
-              "time; tuning seeds, measured by scripts/collab_mcl_collapse.py, not re-run here)",
-              ["factor", "what changes", "the paper", "seeds", "spread at 5 s, mean / median [m]",
-               "spread at 30 s [m]", "when Marian's tree arrives: samples, spread, error (runs within 1.5 m)",
-               "final error ignoring detections (runs localized)", "final error using them (runs localized)"],
-              collapse_rows(), note=COLLAPSE_READING),
-        Table("Issue 26 §2: the hallway per factor (paper rules, 8 sonar robots, 600 s; tuning seeds)",
-              ["factor", "what changes", "seeds", "time to localize alone → together [s]",
-               "paired change together - alone [s] (± s.e.; seeds faster)", "localized at the end alone / together"],
-              hallway_factor_rows(), note=HALLWAY_FACTOR_READING),
-        Table("Issue 26 §3: the teamnav column out of sample (its values were chosen on report seeds; here on tuning "
-              "seeds, by the claim file's rules)", ["claim", "tuning seeds", "teamnav column", "reading"],
-              out_of_sample_rows(),
-              note=f"§5.1's lost prior (inject_lost_prior, chosen on report seed 7), Robin's final error and runs "
-                   f"localized with the detection on seeds {_seed_text(base['seeds'])}: 0.3 (the scenario's): "
-                   f"{base['team_final_m']:.2f} m, {base['team_localized']} / {base['team_runs']}; {prior_text}. "
-                   + OUT_OF_SAMPLE_READING),
-    ]
-
-
-#: issue 26 §2's answer, from the table above it (tuning seeds 1000-1009; docs/report/collab-mcl.md)
-COLLAPSE_READING = (
-    "spread = sqrt(var x + var y) of Robin's weighted samples; error = mean distance of 64 logged samples to "
-    "the truth; 'localized' = final error < 1.5 m. Reading: the collapse is the likelihood's sharpness against "
-    "the sample set, not the sample count, the motion noise or the resampling rule. At exponent 1 (eq. 12), "
-    "90 laser beams with sigma_hit 0.2 m give one sample nearly all the weight within the first scans: 5 s in, "
-    "10 000 uniform samples have become 500 within 0.08 m (median), on a wrong place in most runs (1 of 10 "
-    "within 1.5 m of the truth when Marian's tree arrives). A KLD floor of 5000 or a fixed 10 000 samples, "
-    "motion noise x3, an update every 1 m, or ESS-gated resampling (at exponent 1 the ESS is below half at "
-    "every update, so it resamples every time anyway: the same beliefs) leave it collapsed by 30 s. A flatter "
-    "likelihood keeps it spread longer: sigma_hit 1.0 m or every 10th beam, 7.5 m at 5 s; both at once, 7.5 m "
-    "at 30 s; teamnav's tempering (0.03, not eq. 12), 6.4 m at 30 s. No setting keeps Fig. 10(a)'s spread "
-    "belief until the tree arrives (54-65 s). With a flat enough likelihood and enough samples (sigma_hit "
-    "1.0 m, 9 beams, a floor of 5000: three values the paper does not give) the belief collapses onto the "
-    "right place instead: Robin localizes by itself in 10 of 10 runs, about when it passes Marian, so the "
-    "detection has nothing left to do. The paper's precondition (Robin still uncertain as it passes the lab) "
-    "belongs to its corridor and sensors; our corridor with an 8 m, 90-beam laser does not give it to a "
-    "filter that works. Neither column was changed: these values are gap-fills kept in both columns "
-    "(GAP_FILLS_KEPT); adopting them needs the full report re-run and the hallway check below.")
-HALLWAY_FACTOR_READING = (
-    "Time to localize as in the hallway claim (mean over robots, censored at 600 s), mean over 4 tuning seeds "
-    "1000-1003 per condition. A wider beam model (the sonar's sigma_hit 0.3 -> 1.0 m, with or without a floor "
-    "of 5000 samples) makes the single robots faster (223 -> 148-157 s) and takes the collaborative gain away "
-    "(paired +4 to +5 s, 2 of 4 seeds faster): nothing here makes the paper-rules hallway claim hold. Four "
-    "seeds are a check, not a verdict; the 5000-sample floor costs 5.5x the CPU (57 against 10.6 s a run).")
-OUT_OF_SAMPLE_READING = (
-    "The hallway settings (chosen on report seeds 0-23) hold out of sample with a smaller gain: 185 -> 120 s "
-    "(-35 %, report seeds 0-19: -49 %), paired -66 ± 23 s (s.e.), 10 of 12 seeds faster. The hexagon's "
-    "(chosen on 0-7) hold: every robot localized together in 6 of 6 runs, none alone. §5.1's do not: Robin's "
-    "mean final error with the detection is 2.49 m (report seeds 0-29: 1.2 m) because 2 of 20 runs end on a "
-    "wrong place 21-25 m off (seeds 1001, 1016), so the rule's mean < 1.5 m fails while 18 of 20 (90 %) "
-    "localize. Teamnav's Robin has also collapsed when the tree arrives (500 samples, 0.33 m, within 1.5 m of "
-    "the truth in 8 of 20 runs): the sensor resetting, not eq. 14, moves it. The lost prior 0.3 is not beaten "
-    "by 0.1 (worse) or 0.6 (one run's difference), so it stays. The other chosen values against their "
-    "alternatives, together only, tuning seeds 1000-1005 (paired against the chosen values on the same seeds): "
-    "hallway p_turn_at_opening 0.5 instead of 0: 266 against 153 s (+114 ± 20 s), the choice holds; the "
-    "brain's defaults inject_min_draws 0 and inject_sender_lost_prior 0 instead of 500 and 0.3: 110 against "
-    "153 s (-43 ± 27 s), the choice does NOT hold out of sample (the defaults are no worse, perhaps better; "
-    "re-checked in session 15 on tuning seeds 1000-1014: -22 ± 12 s, lower on 11 of 15 seeds, so the "
-    "scenario went back to the defaults; the hallway's teamnav column needs the full re-run); "
-    "hexagon laser exponent 0.03 instead of 0.01, or heading share 0.5 instead of 0: every robot localized in "
-    "5 of 6 runs against 6 of 6 (both lose seed 1002 entirely), the choices hold, by one run.")
 
 
 def _claims_and_gap_fills(ctx, vals: dict) -> list:
