@@ -34,9 +34,11 @@ One step of either brain (belief only: its odometry pose, its omnidirectional ra
 6. update Pr/Tr/Nt from this step's progress (§5);
 7. broadcast its sightings, goals, reports and Tr if it sees a teammate (§4.4: O(M) terms).
 
-Heading to a visible point (goal, teammate, ghost) goes straight unless the next step would
-touch something the laser sees; then the navigator is asked for a heading towards that point
-(gap filled: the paper's robots are points, ours have a radius). Progress (§5) is the
+Heading to a visible point (goal, teammate, ghost) goes straight while the laser shows a
+corridor as wide as the body all the way to it; else, if the point is in sight, the robot slides
+along the blocked side (``slide_when_blocked``), and otherwise the navigator is asked for a
+heading towards it (gap filled: the paper's robots are points, ours have a radius;
+:meth:`.driving._Driving._head_to`). Progress (§5) is the
 navigator's own estimate while it drives, and "the distance to the point being headed for fell
 by at least ``progress_min_fraction`` of a step below its best so far" otherwise (:mod:`.driving`).
 

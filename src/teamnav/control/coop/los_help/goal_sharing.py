@@ -57,7 +57,7 @@ from typing import Callable, Iterable
 import numpy as np
 from numba import njit
 
-from teamnav.control.nav.local.base import mod_two_pi, pymod
+from teamnav.control.nav.local.base import mod_two_pi
 from teamnav.control.types import _fast_frozen_init
 from teamnav.geometry.bearings import relative_frame_from_bearings, transform_goal
 from teamnav.geometry.se2 import compose, transform_points

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from teamnav.experiments.report.model import Comparison, Missing, Table
-from teamnav.experiments.report.sections._collab_common import COLUMNS, HEAD, _col_sweep, _metric, _ms, _ok
+from teamnav.experiments.report.sections._collab_common import COLUMNS, HEAD, _col_sweep, _metric, _ms
 
 
 _FP = {"robots.0.detector.p_false_positive": 0.035}
