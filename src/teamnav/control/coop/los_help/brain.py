@@ -52,7 +52,7 @@ the default; detections without an id are ignored) and ``radio: {mode: line_of_s
 world point ``w`` is ``R(-θ0)(w - p0)`` for a robot starting at ``(p0, θ0)``. With
 ``stop_when_finished`` a run ends once R1 is ``finished`` (helpers have no such attribute).
 
-Parameters, log keys and layers are documented on :class:`~.explorer.LosExplorerParams`,
+Parameters, log keys and layers are documented on :class:`~.explorer_params.LosExplorerParams`,
 :meth:`~.explorer.LosExplorer.log` and :class:`~.helper.LosHelperParams`; keep them stable (experiments and
 the report read them).
 """

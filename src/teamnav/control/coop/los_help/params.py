@@ -9,7 +9,7 @@ arbitration, §4.4's message) and state sharing (§5's Cr, Pr, Tr, Nt), each gap
 away. Its ``paper_rules`` validator sets every gap-fill of :attr:`_CommonParams.PAPER_RULES` to
 the paper's value (:mod:`teamnav.control.paper_rules`); :func:`los_gap_fills` lists a brain's
 gap-fills with our value and the paper's (the report's two columns). The brains' own
-parameters extend it: :class:`~.explorer.LosExplorerParams` and :class:`~.helper.LosHelperParams`.
+parameters extend it: :class:`~.explorer_params.LosExplorerParams` and :class:`~.helper.LosHelperParams`.
 """
 
 from __future__ import annotations
