@@ -9,7 +9,7 @@ and routes, deterministically, and writes the scenario and sweep files that run 
 What is ours (the paper leaves it open)
 ---------------------------------------
 - Targets are the room centres of the built-in maps (places ``room_*`` of
-  :func:`teamnav.world.generators.office_simple` / ``office_complex``), drawn with a
+  :func:`teamnav.world.maps_los_help.office_simple` / ``office_complex``), drawn with a
   SHA-256 counter stream so that the lists never change with a NumPy version; consecutive
   targets are different rooms.
 - R1 starts at the map's ``base`` place with a heading of 90° (so R1's start frame is
