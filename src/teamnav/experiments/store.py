@@ -8,7 +8,7 @@ it while the sweep runs.
 
 Table ``trials`` (a tidy table: one row per trial, one column per variable)::
 
-    trial_id         TEXT PRIMARY KEY   stable id (teamnav.experiments.sweep)
+    trial_id         TEXT PRIMARY KEY   stable id (teamnav.experiments.sweep_trials)
     sweep            TEXT               sweep name
     scenario         TEXT               scenario name
     params           TEXT               JSON: every override of the trial ({key: value})

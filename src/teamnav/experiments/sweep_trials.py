@@ -1,0 +1,197 @@
+"""A sweep's trials: :func:`expand` turns a :class:`~teamnav.experiments.sweep_spec.SweepSpec`
+into :class:`Trial` objects, each with its stable ``trial_id`` and its ``config_hash``.
+
+Trials are cases (slowest) x grid combinations x seeds (fastest); each combination is
+validated before any trial runs (:mod:`teamnav.experiments.sweep` runs them).
+
+Trial identity
+--------------
+``trial_id`` is the first 16 hex digits of the SHA-256 of the canonical JSON (sorted keys,
+no spaces) of ``{"scenario": <scenario name>, "params": <every override of the trial, fixed
+ones and grid values, plus duration_s when given>, "seed": <seed>}``. It depends only on what
+the user asked for, so it is the same in every process and on every machine, and a rerun
+recognises the trials it already has. Values count as written: ``2`` and ``2.0`` are different
+trials. ``config_hash`` is the hash of the fully resolved scenario without its seed, name and
+description: trials that simulate the same configuration share it, whatever the seed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+from dataclasses import dataclass
+from typing import Any, Mapping, Sequence
+
+from teamnav.experiments.sweep_spec import SweepError, SweepSpec, _canonical
+
+__all__ = ["Trial", "config_hash", "expand", "trial_id"]
+
+
+# ---------------------------------------------------------------------------- trials
+def _hash(value: Any) -> str:
+    return hashlib.sha256(_canonical(value).encode("utf-8")).hexdigest()[:16]
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One run of a sweep.
+
+    Attributes
+    ----------
+    trial_id : str
+        16 hex digits, stable (see the module docstring).
+    sweep : str
+        The sweep's name.
+    scenario : str
+        The scenario as the sweep names it (built-in name or absolute file path).
+    scenario_name : str
+        The resolved scenario's ``name``.
+    params : dict of str to value
+        Every override of this trial: the fixed ``set``, this combination of grid values,
+        and ``duration_s`` when the sweep sets it.
+    seed : int
+    config_hash : str
+        16 hex digits: hash of the resolved scenario without seed, name and description.
+    grid_keys : tuple of str
+        Which keys of ``params`` vary across the sweep.
+    """
+
+    trial_id: str
+    sweep: str
+    scenario: str
+    scenario_name: str
+    params: dict[str, Any]
+    seed: int
+    config_hash: str
+    grid_keys: tuple[str, ...] = ()
+    #: robot-steps of the resolved scenario (robots x steps): the schedule's size estimate
+    work: float = 0.0
+
+    @property
+    def overrides(self) -> dict[str, Any]:
+        """``params`` without ``duration_s`` and the ``case`` label (what ``load_scenario(overrides=...)`` gets)."""
+        return {k: v for k, v in self.params.items() if k not in ("duration_s", "case")}
+
+    @property
+    def duration_s(self) -> float | None:
+        return self.params.get("duration_s")
+
+    def load(self):
+        """The trial's validated :class:`~teamnav.experiments.spec.Scenario`."""
+        from teamnav.experiments.spec import load_scenario
+
+        return load_scenario(self.scenario, overrides=self.overrides or None, seed=self.seed, duration_s=self.duration_s)
+
+    def label(self) -> str:
+        """``robots.0.count=4 seed=2`` (grid values and seed)."""
+        shown = " ".join(f"{k}={self.params[k]!r}" for k in self.grid_keys)
+        if "case" in self.params:
+            shown = f"case={self.params['case']} {shown}"
+        return f"{shown} seed={self.seed}".strip()
+
+
+def trial_id(scenario_name: str, params: Mapping[str, Any], seed: int) -> str:
+    """The stable id of a trial (see the module docstring)."""
+    return _hash({"scenario": scenario_name, "params": dict(params), "seed": int(seed)})
+
+
+def config_hash(scenario) -> str:
+    """Hash of a resolved scenario without its seed, name and description."""
+    data = scenario.model_dump(mode="json")
+    for key in ("seed", "name", "description"):
+        data.pop(key, None)
+    return _hash(data)
+
+
+def _blame(exc, grid_keys: Sequence[str]) -> str | None:
+    """Which grid key a ScenarioError is about (from its field path or its --set note)."""
+    from teamnav.experiments.spec import _pretty
+
+    for problem in getattr(exc, "problems", ()):
+        for key in grid_keys:
+            pretty = _pretty(key.split("."))
+            if problem.field in (f"--set {key}", pretty) or problem.field.startswith((pretty + ".", pretty + "[")):
+                return key
+            if problem.note and problem.note.startswith(f"from --set {key}="):
+                return key
+    return None
+
+
+def _problem_text(exc) -> str:
+    problems = getattr(exc, "problems", None)
+    if not problems:
+        return str(exc)
+    return "; ".join(f"{p.field}: {p.message}" + (f" (received {p.received})" if p.received is not None else "") for p in problems)
+
+
+def expand(spec: SweepSpec) -> list[Trial]:
+    """Every trial of ``spec``: cases (slowest) x grid combinations (first key slowest) x seeds (fastest).
+
+    Each combination is loaded and validated with :func:`~teamnav.experiments.spec.load_scenario`
+    first, so a bad value fails here, before any trial runs.
+
+    Returns
+    -------
+    list of Trial
+        ``spec.n_trials`` trials with distinct ``trial_id``.
+
+    Raises
+    ------
+    SweepError
+        One message listing every grid value that makes the scenario invalid (key, what was
+        expected, value), or the scenario's own error when it is invalid whatever the grid.
+    """
+    from teamnav.experiments.errors import ScenarioError
+    from teamnav.experiments.spec import load_scenario
+
+    keys = list(spec.grid)
+    seeds = spec.seed_list
+    fixed = dict(spec.set)
+    trials: list[Trial] = []
+    bad: dict[tuple[str, str], str] = {}
+    cases = spec.cases or [{}]
+    for case, combo in itertools.product(cases, itertools.product(*(spec.grid[k] for k in keys))):
+        values = dict(zip(keys, combo))
+        bundle = {k: v for k, v in case.items() if k != "case"}
+        params = {**fixed, **bundle, **values}
+        duration = spec.duration_s
+        if "duration_s" in params:
+            duration = params.pop("duration_s")
+        try:
+            scn = load_scenario(spec.scenario, overrides=params or None, seed=seeds[0], duration_s=duration)
+        except ScenarioError as exc:
+            culprit = _blame(exc, keys) if keys else None
+            if culprit is None:
+                where = f" with set {fixed}" if fixed else ""
+                where += f" in case {case['case']!r}" if case else ""
+                raise SweepError(f"sweep {spec.sweep_name!r}: the scenario is invalid{where}: {exc}") from None
+            bad.setdefault((culprit, _canonical(values[culprit])), f"grid {culprit}={values[culprit]!r}: {_problem_text(exc)}")
+            continue
+        if duration is not None:
+            params["duration_s"] = float(duration)
+        if case:
+            params["case"] = case["case"]
+        chash = config_hash(scn)
+        for seed in seeds:
+            trials.append(
+                Trial(
+                    trial_id=trial_id(scn.name, params, seed),
+                    sweep=spec.sweep_name,
+                    scenario=spec.scenario,
+                    scenario_name=scn.name,
+                    params=dict(params),
+                    seed=seed,
+                    config_hash=chash,
+                    grid_keys=tuple(keys),
+                    work=float(scn.n_robots * scn.n_steps),
+                )
+            )
+    if bad:
+        lines = list(bad.values())
+        if len(lines) == 1:
+            raise SweepError(f"sweep {spec.sweep_name!r}: {lines[0]}")
+        raise SweepError(f"sweep {spec.sweep_name!r} has {len(lines)} invalid grid values:\n" + "\n".join(f"  {x}" for x in lines))
+    ids = [t.trial_id for t in trials]
+    if len(set(ids)) != len(ids):  # pragma: no cover - distinct values make distinct ids
+        raise SweepError(f"sweep {spec.sweep_name!r}: two trials share an id; expected distinct grid values")
+    return trials
