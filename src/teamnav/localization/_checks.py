@@ -60,5 +60,31 @@ def read_only(a: np.ndarray) -> np.ndarray:
     return v
 
 
+class SampleSetState:
+    """The sample set's read-only state, shared by :class:`~teamnav.localization.mcl.MCL` and
+    :class:`~teamnav.localization.odometry_belief.OdometryBelief` (both keep ``_particles`` of
+    shape (n, 3) and normalised ``_weights``). ``_EMPTY_HINT`` says how to fill an empty set."""
+
+    _particles: np.ndarray
+    _weights: np.ndarray
+    _EMPTY_HINT = "has no samples yet"
+
+    @property
+    def particles(self) -> np.ndarray:
+        return read_only(self._particles)
+
+    @property
+    def weights(self) -> np.ndarray:
+        return read_only(self._weights)
+
+    @property
+    def n_particles(self) -> int:
+        return int(self._particles.shape[0])
+
+    def _require_particles(self, what: str) -> None:
+        if self._particles.shape[0] == 0:
+            raise ValueError(f"{what}: {self._EMPTY_HINT}")
+
+
 def _fmt(shape: tuple) -> str:
     return "(" + ", ".join("n" if s == -1 else str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"

@@ -36,7 +36,7 @@ from numba import njit
 
 from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
-from teamnav.localization._checks import array, generator, read_only
+from teamnav.localization._checks import SampleSetState, array, generator
 from teamnav.localization.beam_model import BeamModelParams, BeamTable, beam_loglik_kernel, beam_loglik_kernel_serial
 from teamnav.localization.kld import KLDParams, kld_count_kernel
 from teamnav.localization.likelihood_field import (
@@ -306,7 +306,7 @@ def _clusters_kernel(p, w, cell, sel):
     return n_clusters, cw[best]
 
 
-class MCL:
+class MCL(SampleSetState):
     """One robot's Monte Carlo localization filter (Fox et al. §3.1).
 
     Parameters
@@ -338,6 +338,8 @@ class MCL:
     >>> bool(abs(est.pose[0] - 1.1) < 0.1), f.particles.shape
     (True, (200, 3))
     """
+
+    _EMPTY_HINT = "the filter has no samples yet; call init_global() or init_pose() first"
 
     def __init__(self, params: MCLParams, known_map: OccupancyGrid, sensor: SensorInfo, rng: np.random.Generator):
         if not isinstance(params, MCLParams):
@@ -413,18 +415,6 @@ class MCL:
         self.last_log_mean_likelihood = float("nan")
 
     # ------------------------------------------------------------------ state
-    @property
-    def particles(self) -> np.ndarray:
-        return read_only(self._particles)
-
-    @property
-    def weights(self) -> np.ndarray:
-        return read_only(self._weights)
-
-    @property
-    def n_particles(self) -> int:
-        return int(self._particles.shape[0])
-
     def _set(self, particles: np.ndarray) -> None:
         self._particles = np.ascontiguousarray(particles, dtype=np.float64)
         n = self._particles.shape[0]
@@ -474,10 +464,6 @@ class MCL:
         self._log_w_fast = None
         self._since_update[:] = 0.0
         self._updated_once = False
-
-    def _require_particles(self, what: str) -> None:
-        if self._particles.shape[0] == 0:
-            raise ValueError(f"{what}: the filter has no samples yet; call init_global() or init_pose() first")
 
     # ------------------------------------------------------------------ the three phases
     def predict(self, odom_delta) -> None:

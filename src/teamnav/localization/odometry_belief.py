@@ -39,7 +39,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from teamnav.geometry.angles import wrap_angle
-from teamnav.localization._checks import array, generator, read_only
+from teamnav.localization._checks import SampleSetState, array, generator, read_only
 from teamnav.localization.mcl import MCL, gaussian_poses
 from teamnav.localization.motion import MotionParams, motion_kernel_serial
 from teamnav.localization.resample import low_variance_kernel
@@ -76,7 +76,7 @@ class OdometryBeliefParams(BaseModel):
     cluster_cell_m: float = Field(0.5, gt=0.0, le=100.0)
 
 
-class OdometryBelief:
+class OdometryBelief(SampleSetState):
     """A map-less sample belief: motion model plus eq. 14, nothing else (module docstring).
 
     Parameters
@@ -94,6 +94,8 @@ class OdometryBelief:
     (True, (200, 3))
     """
 
+    _EMPTY_HINT = "the belief has no samples yet; call init_pose() first"
+
     def __init__(self, params: OdometryBeliefParams, rng: np.random.Generator) -> None:
         if not isinstance(params, OdometryBeliefParams):
             raise ValueError(f"params must be an OdometryBeliefParams, got {type(params).__name__}")
@@ -109,25 +111,9 @@ class OdometryBelief:
 
     # ------------------------------------------------------------------ state
     @property
-    def particles(self) -> np.ndarray:
-        return read_only(self._particles)
-
-    @property
-    def weights(self) -> np.ndarray:
-        return read_only(self._weights)
-
-    @property
     def rates_radps(self) -> np.ndarray:
         """Each sample's drift rate of the odometry's heading [rad/s] (read-only view)."""
         return read_only(self._rates)
-
-    @property
-    def n_particles(self) -> int:
-        return int(self._particles.shape[0])
-
-    def _require_particles(self, what: str) -> None:
-        if self._particles.shape[0] == 0:
-            raise ValueError(f"{what}: the belief has no samples yet; call init_pose() first")
 
     # ------------------------------------------------------------------ the phases
     def init_pose(self, pose, cov) -> None:
