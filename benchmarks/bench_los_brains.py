@@ -24,7 +24,7 @@ Usage::
 ``--targets N``: instead of a fixed number of steps, each run is the first N targets of task 1
 (the scenario's own step budget per target and ``stop_when_finished``), and the table gives
 the CPU seconds of the whole task (the run, not the process start) and its steps: the unit of
-FULL_CPU_NOTE in ``teamnav/experiments/report/sections/los_help.py``.
+FULL_CPU_NOTE in ``teamnav/papers/los_help/report/section.py``.
 
 Otherwise the runs are those of the Tables (``record_every`` 10, no step budget reached: the targets'
 step budget is lifted so a potential field trapped alone keeps running for the whole time).
@@ -174,7 +174,7 @@ def _kernels() -> None:
     sys.path.insert(0, str(REPO / "tests"))
     import test_los_speed_equivalence as eq
 
-    from teamnav.control.coop.los_help.goal_sharing import beam_near_reaches, point_visible
+    from teamnav.papers.los_help.brains.goal_sharing import beam_near_reaches, point_visible
     from teamnav.control.nav.local import base
     from teamnav.control.nav.local.potential_field import PotentialFieldParams, _field_vector_numpy, field_vector
     from teamnav.control.nav.local.visbug21 import VisBug21, VisBugParams, boundary_heading
@@ -254,7 +254,7 @@ def _radio_pairs() -> dict:
 
     import test_radio_speed as rs
 
-    from teamnav.control.coop.los_help.messages import GoalShare, LosHelpMsg, Sighting, VisReport
+    from teamnav.papers.los_help.brains.messages import GoalShare, LosHelpMsg, Sighting, VisReport
     from teamnav.control.types import Message, _payload_size_bytes_generic, payload_size_bytes
     from teamnav.sim.config import RadioConfig
     from teamnav.sim.radio import Radio

@@ -118,7 +118,7 @@ def list_trials() -> list[dict[str, Any]]:
 
 def _task_of(trial: dict[str, Any]) -> int:
     """Which of the map's tasks a trial's targets are (1-based; 0 when none matches)."""
-    from teamnav.experiments import los_tasks as L
+    from teamnav.papers.los_help import tasks as L
 
     xy = trial["params"].get(TARGETS_KEY)
     if xy is None:

@@ -90,7 +90,7 @@ def _default(o):
 def _paper_rules_set(map_key: str) -> dict:
     """Every robot group's params at ``paper_rules: true``, as the report's paper-as-written
     column sets them (``_trails.paper_rules_spec`` of the map's table sweep)."""
-    from teamnav.experiments.report.sections._trails import paper_rules_spec
+    from teamnav.papers.trails.report._trails import paper_rules_spec
     from teamnav.experiments.sweep import resolve_spec
 
     return dict(paper_rules_spec(resolve_spec({"simple": "los-table1", "complex": "los-table2"}[map_key])).set)

@@ -122,7 +122,7 @@ def overrides(part: str, factor: str, collaborate: bool, column: str = "paper_ru
     the factor on Robin only in ``detection``, on every group otherwise), or the scenario plus a
     :data:`TEAMNAV_CHECKS` variant (``column="teamnav"``); ``collaborate`` set on every group that
     localizes (in ``detection``, on Robin: Marian keeps sending)."""
-    from teamnav.experiments.report.sections._trails import paper_rules_spec
+    from teamnav.papers.trails.report._trails import paper_rules_spec
     from teamnav.experiments.spec import load_scenario
 
     scen = PART_SCENARIO[part]
@@ -148,7 +148,7 @@ def overrides(part: str, factor: str, collaborate: bool, column: str = "paper_ru
 
 
 def _paper_rules() -> dict:
-    from teamnav.control.localizing import MCLWanderParams
+    from teamnav.papers.collab_mcl.brains.localizing import MCLWanderParams
 
     return dict(MCLWanderParams.PAPER_RULES)
 
@@ -174,7 +174,7 @@ def _belief_at(data, robot: int, t_s: float) -> tuple[int, float]:
 
 def one_run(job: tuple[str, str, str, int, bool, float | None]) -> dict:
     """One run of ``(part, column, factor, seed, collaborate, duration_s)``; the measures of the module docstring."""
-    from teamnav.experiments.metric_sets.localization import localization
+    from teamnav.papers.collab_mcl.metrics import localization
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
 
@@ -210,7 +210,7 @@ def one_run(job: tuple[str, str, str, int, bool, float | None]) -> dict:
             if f"loc_final_localized_fraction_{k}" in m:
                 out[f"final_localized_{k}"] = m[f"loc_final_localized_fraction_{k}"]
         if part == "hexagon":
-            from teamnav.experiments.metric_sets.localization import error_matrix
+            from teamnav.papers.collab_mcl.metrics import error_matrix
 
             err = error_matrix(res.data)[1]
             out["all_localized"] = bool(all(e[~np.isnan(e)][-1] < 1.5 for e in err.T))

@@ -52,10 +52,10 @@ from pathlib import Path
 #: system -> (scenario, params model "module:Class", the scenario's own params besides the gap-fills)
 SYSTEMS: dict[str, tuple[str, str, dict]] = {
     # blazing-trail-v1 (2000), as blazing-paper-rules.yaml
-    "blazing": ("blazing-a-trail", "teamnav.control.coop.blazing_trail:BlazingTrailParams",
+    "blazing": ("blazing-a-trail", "teamnav.papers.trails.brains.blazing_trail:BlazingTrailParams",
                 {"communicate": True, "layer_every_steps": 6000}),
     # trail-share-v1 (2002), as the try-to-see-it-my-way scenario
-    "try": ("try-to-see-it-my-way", "teamnav.control.coop.trail_share:TrailShareParams",
+    "try": ("try-to-see-it-my-way", "teamnav.papers.trails.brains.trail_share:TrailShareParams",
             {"communicate": True, "policy": "optimistic", "layer_every_steps": 6000}),
 }
 SCENARIO, _, BASE_PARAMS = SYSTEMS["blazing"]
@@ -133,7 +133,7 @@ def drift_overrides(case: str) -> dict:
 
 def one_run(job: tuple) -> dict:
     """One run of ``(part, config, case, seed, duration_s[, system])``: units, breakdown, CPU."""
-    from teamnav.experiments.metric_sets.trails import BREAKDOWN_GAP_S, deliveries
+    from teamnav.papers.trails.metrics import BREAKDOWN_GAP_S, deliveries
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
 
@@ -172,8 +172,8 @@ def parse_seeds(text: str) -> list[int]:
 
 def summarize(rows: list[dict]) -> list[str]:
     """Markdown tables of the runs, as the report section shows them
-    (:mod:`teamnav.experiments.report.sections._trails_gap_fills`)."""
-    from teamnav.experiments.report.sections._trails_gap_fills import HEADER, cases, table_rows
+    (:mod:`teamnav.papers.trails.report._trails_gap_fills`)."""
+    from teamnav.papers.trails.report._trails_gap_fills import HEADER, cases, table_rows
 
     out: list[str] = []
     for part in ("gapfills", "drift"):

@@ -98,7 +98,7 @@ def test_trip_memory_reaches_a_sequence_the_robot_memory_does_not():
     radius of 2 m and budget; with the trip's memory (``memory_scope="goal"``, the default of
     sessions 6-13) it reaches all 12."""
     from teamnav import load_scenario, run
-    from teamnav.experiments.los_tasks import task_targets_xy
+    from teamnav.papers.los_help.tasks import task_targets_xy
 
     def reached(navigator_params) -> tuple[int, bool]:
         ov = {"robots.0.params.navigator": "avoid_past", "robots.0.params.state_sharing": False,

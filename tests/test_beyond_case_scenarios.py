@@ -9,16 +9,16 @@ from __future__ import annotations
 
 import pytest
 
-from teamnav.experiments import beyond_case_scenarios as B
+from teamnav.papers.beyond import case_scenarios as B
 
 
 def test_shipped_files_are_what_the_generator_writes(tmp_path):
-    from teamnav.experiments.registry import SCENARIO_DIR
+    from teamnav.experiments import registry
 
     for p in B.write_files(tmp_path):
-        shipped = SCENARIO_DIR / p.name
+        shipped = registry.path(p.stem)
         assert shipped.read_text(encoding="utf-8") == p.read_text(encoding="utf-8"), (
-            f"{shipped.name} is stale: run python -m teamnav.experiments.beyond_case_scenarios")
+            f"{shipped.name} is stale: run python -m teamnav.papers.beyond.case_scenarios")
 
 
 @pytest.mark.parametrize("item", B.CASE_SCENARIOS, ids=lambda i: i.name)

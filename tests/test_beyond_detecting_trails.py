@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from teamnav.control.beyond.detecting import DetectingTrails, DetectingTrailsParams
+from teamnav.papers.beyond.brains.detecting import DetectingTrails, DetectingTrailsParams
 from teamnav.control.check import check_brain
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Detection, Observation
@@ -187,7 +187,7 @@ def _fake_full(gain: float):
 @pytest.mark.parametrize("gain, holds", [(3, True), (0, False)])
 def test_full_mode_pairs_by_seed_and_judges_the_claim(gain, holds):
     from teamnav.experiments.report.model import Comparison, Table
-    from teamnav.experiments.report.sections._beyond_detecting_trails import detecting_trails
+    from teamnav.papers.beyond.report._beyond_detecting_trails import detecting_trails
 
     ctx = _fake_full(gain)
     blocks = detecting_trails(ctx)
@@ -205,7 +205,7 @@ def test_full_mode_pairs_by_seed_and_judges_the_claim(gain, holds):
 
 
 def test_claim_values_pair_only_common_seeds():
-    from teamnav.experiments.report.sections._beyond_detecting_trails import claim_values
+    from teamnav.papers.beyond.report._beyond_detecting_trails import claim_values
 
     sync = {4.0: [{"seed": s, "units_total": 10 + s} for s in range(5)]}
     odo = {4.0: [{"seed": s, "units_total": 8} for s in (0, 1, 2)]}
@@ -217,7 +217,7 @@ def test_claim_values_pair_only_common_seeds():
 
 def test_quick_mode_asks_one_short_run_each_and_gives_no_verdict():
     from teamnav.experiments.report.model import Comparison
-    from teamnav.experiments.report.sections._beyond_detecting_trails import detecting_trails
+    from teamnav.papers.beyond.report._beyond_detecting_trails import detecting_trails
 
     ctx = _fake_full(3)
     ctx.quick = True

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from _report_fakes import FakeFullContext
-from teamnav.control.beyond.localized import Localized, LocalizedParams, _child_rng
+from teamnav.papers.beyond.brains.localized import Localized, LocalizedParams, _child_rng
 from teamnav.control.check import check_brain
 from teamnav.experiments import runner
 
@@ -58,7 +58,7 @@ def test_localized_pose_stays_on_the_truth_while_odometry_drifts(tmp_path):
 
 def test_beyond_claim_values_and_verdict():
     from teamnav.experiments.claims import judge, load_claims
-    from teamnav.experiments.report.sections.beyond import localized_values
+    from teamnav.papers.beyond.report.section import localized_values
 
     def rows(*units):
         return [{"units_total": u} for u in units]
@@ -73,7 +73,7 @@ def test_beyond_claim_values_and_verdict():
 
 
 def test_cheapest_particle_count_without_breakdown():
-    from teamnav.experiments.report.sections.beyond import cheapest_without_breakdown, particle_count
+    from teamnav.papers.beyond.report.section import cheapest_without_breakdown, particle_count
 
     def row(n, censored):
         return {"params": {"case": f"p{n}"}, "breakdown_censored": censored}
@@ -85,7 +85,7 @@ def test_cheapest_particle_count_without_breakdown():
 
 
 def test_paired_gain_says_when_there_is_no_difference():
-    from teamnav.experiments.report.sections.beyond import paired_gain_text
+    from teamnav.papers.beyond.report.section import paired_gain_text
 
     ours = [{"seed": s, "units_total": u} for s, u in enumerate([10, 12, 11, 13])]
     same = [{"seed": s, "units_total": u} for s, u in enumerate([11, 11, 12, 12])]
@@ -116,7 +116,7 @@ def _fake_full():
 
 def test_full_mode_draws_the_parts_the_particle_counts_and_the_verdict():
     from teamnav.experiments.report.model import Comparison, Table
-    from teamnav.experiments.report.sections.beyond import _localized_trails
+    from teamnav.papers.beyond.report.section import _localized_trails
 
     ctx = _fake_full()
     blocks = _localized_trails(ctx)

@@ -1,5 +1,5 @@
 """Issue 22, combination 2 (localized LOS help): frames from MCL poses, fused frames, and the
-paper's bearing rule left as it was (teamnav.control.beyond.localized_los)."""
+paper's bearing rule left as it was (teamnav.papers.beyond.brains.localized_los)."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ from hypothesis import strategies as st
 from pydantic import ValidationError
 
 from teamnav.control import Detection, Message, Observation, RangeScan, RobotInfo, SensorInfo
-from teamnav.control.beyond import localized_los as LL
-from teamnav.control.coop.los_help import LosExplorer, LosHelper
-from teamnav.control.coop.los_help.goal_sharing import goal_id, sender_frame
-from teamnav.control.coop.los_help.messages import MESSAGE_KIND, GoalShare, LosHelpMsg, Sighting, message_size_bytes
+from teamnav.papers.beyond.brains import localized_los as LL
+from teamnav.papers.los_help.brains import LosExplorer, LosHelper
+from teamnav.papers.los_help.brains.goal_sharing import goal_id, sender_frame
+from teamnav.papers.los_help.brains.messages import MESSAGE_KIND, GoalShare, LosHelpMsg, Sighting, message_size_bytes
 from teamnav.geometry import wrap_angle
 from teamnav.geometry.bearings import relative_frame_from_bearings
 from teamnav.geometry.se2 import relative, transform_points
@@ -215,21 +215,21 @@ def test_bad_frame_parameters_are_named(kwargs, field):
 
 # ---------------------------------------------------------------------------- files and a run
 def test_shipped_files_are_what_the_generator_writes(tmp_path):
-    from teamnav.experiments import beyond_localized_los as B
-    from teamnav.experiments.registry import SCENARIO_DIR
-    from teamnav.experiments.sweep import SWEEP_DIR
+    from teamnav.papers.beyond import localized_los_scenarios as B
+    from teamnav.experiments import registry
+    from teamnav.experiments.sweep import sweep_files
 
     (tmp_path / "sc").mkdir()
     (tmp_path / "sw").mkdir()
     for p in B.write_files(tmp_path / "sc", tmp_path / "sw"):
-        shipped = (SCENARIO_DIR if p.parent.name == "sc" else SWEEP_DIR) / p.name
+        shipped = registry.path(p.stem) if p.parent.name == "sc" else sweep_files()[p.stem]
         assert shipped.read_text(encoding="utf-8") == p.read_text(encoding="utf-8"), (
-            f"{shipped.name} is stale: run python -m teamnav.experiments.beyond_localized_los")
+            f"{shipped.name} is stale: run python -m teamnav.papers.beyond.localized_los_scenarios")
 
 
 def test_world_frame_targets_are_the_papers_targets():
-    from teamnav.experiments import beyond_localized_los as B
-    from teamnav.experiments import los_tasks as L
+    from teamnav.papers.beyond import localized_los_scenarios as B
+    from teamnav.papers.los_help import tasks as L
 
     for m in B.MAPS:
         data = B.scenario_data(m)
@@ -242,7 +242,7 @@ def test_world_frame_targets_are_the_papers_targets():
 
 
 def test_a_short_localized_run_with_mcl_frames_finishes_and_shares_poses(tmp_path):
-    from teamnav.experiments import beyond_localized_los as B
+    from teamnav.papers.beyond import localized_los_scenarios as B
     from teamnav.experiments import runner
 
     targets = B.scenario_data("simple")["robots"][0]["params"]["brain_params"]["targets_xy"][:2]
@@ -280,7 +280,7 @@ def _fake_full(mcl_gain: float, fused_gain: float):
 
 def test_full_mode_reads_both_maps_and_judges_with_the_paired_rule():
     from teamnav.experiments.report.model import Comparison, Table
-    from teamnav.experiments.report.sections._beyond_localized_los import localized_los
+    from teamnav.papers.beyond.report._beyond_localized_los import localized_los
 
     ctx = _fake_full(mcl_gain=10.0, fused_gain=0.0)
     blocks = localized_los(ctx)
@@ -303,7 +303,7 @@ def test_full_mode_reads_both_maps_and_judges_with_the_paired_rule():
 def test_quick_mode_runs_two_short_runs_and_judges_nothing(tmp_path):
     from teamnav.experiments.report.context import SweepContext
     from teamnav.experiments.report.model import Comparison, Table
-    from teamnav.experiments.report.sections._beyond_localized_los import localized_los
+    from teamnav.papers.beyond.report._beyond_localized_los import localized_los
 
     blocks = localized_los(SweepContext(tmp_path, quick=True, workers=1, section="beyond"))
     (table,) = [b for b in blocks if isinstance(b, Table)]
@@ -313,7 +313,7 @@ def test_quick_mode_runs_two_short_runs_and_judges_nothing(tmp_path):
 
 
 def test_each_sweep_case_sets_every_robots_source_noise_and_noise_model():
-    from teamnav.experiments import beyond_localized_los as B
+    from teamnav.papers.beyond import localized_los_scenarios as B
     from teamnav.experiments import runner
     from teamnav.experiments.sweep import expand, load_sweep
 

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from _report_fakes import FakeFullContext
-from teamnav.experiments.report.sections import _beyond_mail_round as M
+from teamnav.papers.beyond.report import _beyond_mail_round as M
 
 ROUND = ["a", "b", "c", "d"]
 EVENT_OF = {p: p for p in ROUND}

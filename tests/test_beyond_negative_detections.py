@@ -9,7 +9,7 @@ import math
 import pytest
 
 from teamnav.experiments.report.model import Comparison, Missing, Table
-from teamnav.experiments.report.sections import _beyond_negative_detections as N
+from teamnav.papers.beyond.report import _beyond_negative_detections as N
 from _report_fakes import FakeFullContext
 
 

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from teamnav.experiments.claims import load_claims
-from teamnav.experiments.report.sections import _radio_beyond as R
+from teamnav.papers.beyond.report import _radio_beyond as R
 from teamnav.experiments.sweep import expand, load_sweep
 
 

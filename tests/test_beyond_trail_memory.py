@@ -1,5 +1,5 @@
 """Issue 22, combination 4: ``los-trail-explorer-v1``, R1 with a Trail of its goals' viewpoints
-(teamnav.control.beyond.trail_memory): where crumbs are laid, which one R1 heads for, that
+(teamnav.papers.beyond.brains.trail_memory): where crumbs are laid, which one R1 heads for, that
 ``goal_memory: "off"`` is ``los-explorer-v1`` exactly, and that bad values are refused."""
 
 from __future__ import annotations
@@ -14,9 +14,9 @@ from hypothesis import strategies as st
 from pydantic import ValidationError
 
 from teamnav.control import Observation, RangeScan, RobotInfo, SensorInfo
-from teamnav.control.beyond.trail_memory import LosTrailExplorer, place_name
-from teamnav.control.coop.los_help import LosExplorer
-from teamnav.control.coop.los_help import brain as brain_mod
+from teamnav.papers.beyond.brains.trail_memory import LosTrailExplorer, place_name
+from teamnav.papers.los_help.brains import LosExplorer
+from teamnav.papers.los_help.brains import brain as brain_mod
 from teamnav.geometry import wrap_angle
 
 N_BEAMS = 360
@@ -173,7 +173,7 @@ def test_bad_values_are_refused_naming_the_field():
 
 def test_memory_off_runs_exactly_as_los_explorer_v1():
     """The same scenario with either brain (goal_memory off): identical metrics and logs."""
-    from teamnav.experiments import los_tasks as L
+    from teamnav.papers.los_help import tasks as L
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
 
@@ -200,8 +200,8 @@ def test_task_places_remember_a_later_target_seen_on_the_way(navs, places, want)
 
 # ---------------------------------------------------------------------------- the report block
 def test_the_sweep_has_every_case_the_block_reads_and_ten_tasks():
-    from teamnav.experiments import los_tasks as L
-    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+    from teamnav.papers.los_help import tasks as L
+    from teamnav.papers.beyond.report import _beyond_trail_memory as B
     from teamnav.experiments.sweep import expand, load_sweep
 
     spec = load_sweep(B.SWEEP)
@@ -219,7 +219,7 @@ def test_the_sweep_has_every_case_the_block_reads_and_ten_tasks():
 
 def test_each_claim_reads_only_metrics_the_block_computes():
     from teamnav.experiments.claims import load_claims
-    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+    from teamnav.papers.beyond.report import _beyond_trail_memory as B
 
     row = {"los_targets_reached": 3.0, "los_steps_per_target": 100.0, "los_finished": 0}
     vals = B.claim_values({f"{n}/{t}/{m}": {1: row, 2: row} for n, _ in B.NAVS for t, _ in B.TEAMS
@@ -232,7 +232,7 @@ def test_each_claim_reads_only_metrics_the_block_computes():
 
 
 def test_claim_values_pair_by_task():
-    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+    from teamnav.papers.beyond.report import _beyond_trail_memory as B
 
     def r(reached, spt):
         return {"los_targets_reached": reached, "los_steps_per_target": spt, "los_finished": int(reached == 30)}
@@ -250,7 +250,7 @@ def test_claim_values_pair_by_task():
 
 
 def test_a_row_of_an_unknown_task_is_named():
-    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+    from teamnav.papers.beyond.report import _beyond_trail_memory as B
 
     with pytest.raises(ValueError, match="robots.0.params.targets_xy: a row's target list is not one of the 1 tasks"):
         B.per_task([{B.TARGETS_KEY: [[1.0, 2.0]]}], [[[0.0, 0.0]]])
@@ -260,7 +260,7 @@ def test_full_mode_reads_every_case_and_judges_both_claims():
     from _report_fakes import FakeFullContext
 
     from teamnav.experiments.report.model import Comparison, Table
-    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+    from teamnav.papers.beyond.report import _beyond_trail_memory as B
 
     def rows_for(spec, seeds):
         out = []
@@ -286,7 +286,7 @@ def test_full_mode_reads_every_case_and_judges_both_claims():
 def test_quick_mode_runs_avoid_past_alone_with_and_without_memory(tmp_path):
     from teamnav.experiments.report.context import SweepContext
     from teamnav.experiments.report.model import Comparison, Table
-    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+    from teamnav.papers.beyond.report import _beyond_trail_memory as B
 
     blocks = B.trail_memory(SweepContext(tmp_path, quick=True, workers=1, section="beyond"))
     (table,) = [b for b in blocks if isinstance(b, Table)]
@@ -299,7 +299,7 @@ def test_a_sweep_cut_short_is_shown_but_not_judged():
     from _report_fakes import FakeFullContext
 
     from teamnav.experiments.report.model import Comparison
-    from teamnav.experiments.report.sections import _beyond_trail_memory as B
+    from teamnav.papers.beyond.report import _beyond_trail_memory as B
 
     def rows_for(spec, seeds):
         targets = spec.grid[B.TARGETS_KEY][0]  # task 1 only

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from teamnav.control.localizing import MCLWanderParams
+from teamnav.papers.collab_mcl.brains.localizing import MCLWanderParams
 from teamnav.experiments.spec import load_scenario
 
 _PATH = Path(__file__).resolve().parents[1] / "scripts" / "collab_mcl_collapse.py"
@@ -88,7 +88,7 @@ def test_section_numbers_are_the_committed_runs():
     """The report section quotes TUNING_RUNS; they must be the script's summary of the committed runs."""
     import json
 
-    from teamnav.experiments.report.sections import collab_mcl as sec
+    from teamnav.papers.collab_mcl.report import section as sec
 
     rows = [json.loads(x) for x in _DATA.read_text().splitlines() if x.strip()]
     assert all(r["seed"] >= cc.TUNING_SEED_MIN for r in rows)
@@ -106,14 +106,14 @@ def _det_row(team_final_m, team_localized, alone_final_m=6.9):
                                         (_det_row(1.2, 17), False), (_det_row(1.2, 19, alone_final_m=0.2), False)])
 def test_tuning_rows_are_judged_by_the_claim_files_rule(row, holds):
     from teamnav.experiments.claims import judge, load_claims
-    from teamnav.experiments.report.sections.collab_mcl import tuning_claim_values
+    from teamnav.papers.collab_mcl.report.section import tuning_claim_values
 
     assert judge(load_claims("collab-mcl")["single-detection"], tuning_claim_values(row))[0] is holds
 
 
 def test_hallway_tuning_row_needs_the_paired_reduction():
     from teamnav.experiments.claims import judge, load_claims
-    from teamnav.experiments.report.sections.collab_mcl import tuning_claim_values
+    from teamnav.papers.collab_mcl.report.section import tuning_claim_values
 
     row = {"part": "hallway", "alone_ttl_s": 150.0, "team_ttl_s": 139.0, "alone_final_localized": 0.78,
            "team_final_localized": 0.91, "paired_s": -11.0, "paired_se_s": 33.0}
@@ -124,7 +124,7 @@ def test_hallway_tuning_row_needs_the_paired_reduction():
 
 def test_the_tuning_blocks_have_rows():
     from teamnav.experiments.report.model import Table
-    from teamnav.experiments.report.sections.collab_mcl import _tuning_blocks
+    from teamnav.papers.collab_mcl.report.section import _tuning_blocks
 
     blocks = _tuning_blocks()
     assert [type(b) for b in blocks] == [Table, Table, Table]

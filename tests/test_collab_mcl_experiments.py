@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from teamnav.experiments.detection_training import DEFAULT_DETECTOR, generate_training_data
-from teamnav.experiments.metric_sets.localization import LOCALIZED_M, localization
+from teamnav.papers.collab_mcl.detection_training import DEFAULT_DETECTOR, generate_training_data
+from teamnav.papers.collab_mcl.metrics import LOCALIZED_M, localization
 from teamnav.experiments.metrics import RunData
 from teamnav.experiments.runner import run
 from teamnav.experiments.spec import load_scenario
@@ -161,7 +161,7 @@ def test_report_section_quick_build(tmp_path):
     import time
 
     from teamnav.experiments.report.model import Comparison, Plot
-    from teamnav.experiments.report.sections.collab_mcl import SECTION
+    from teamnav.papers.collab_mcl.report.section import SECTION
     from teamnav.experiments.sweep import sweep
 
     class Ctx:
@@ -192,7 +192,7 @@ def _hallway_rows(alone_s, team_s):
 def test_hallway_verdict_needs_a_paired_reduction_beyond_two_standard_errors(team_shift_s, holds):
     from types import SimpleNamespace
 
-    from teamnav.experiments.report.sections.collab_mcl import _hallway
+    from teamnav.papers.collab_mcl.report.section import _hallway
 
     alone = [100.0, 300.0, 200.0, 400.0, 150.0, 250.0, 350.0, 180.0]       # a large run-to-run spread
     jitter = [10.0, -10.0, 5.0, -5.0, 8.0, -8.0, 3.0, -3.0]

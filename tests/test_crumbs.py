@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from teamnav.control.coop.crumbs import CrumbBatch, CrumbList, average_heading, preferred_heading
+from teamnav.papers.trails.brains.crumbs import CrumbBatch, CrumbList, average_heading, preferred_heading
 from teamnav.geometry.angles import angle_diff
 
 from _trail_brain_fakes import make_brains, make_obs
@@ -124,7 +124,7 @@ _obs = make_obs
 
 
 def _brains(monkeypatch, n=2, **params):
-    from teamnav.control.coop import blazing_trail as B
+    from teamnav.papers.trails.brains import blazing_trail as B
 
     return make_brains(monkeypatch, B, B.BlazingTrail, n, **params)
 

@@ -1,5 +1,5 @@
 """§7.2 delayed integration (Fox, Burgard, Kruppa & Thrun 2000): the SE(2) moves, the store, and the
-brain's use of them (:mod:`teamnav.control.delayed_integration`)."""
+brain's use of them (:mod:`teamnav.papers.collab_mcl.brains.delayed_integration`)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from teamnav.control.delayed_integration import (
+from teamnav.papers.collab_mcl.brains.delayed_integration import (
     DetectionStore, OdometryHistory, StoredDetection, detected_point_now, motion_since, poses_after, poses_before,
 )
-from teamnav.control.localizing import MCLWander, MCLWanderParams
+from teamnav.papers.collab_mcl.brains.localizing import MCLWander, MCLWanderParams
 from teamnav.control.types import Detection, Message
 from teamnav.geometry import se2
 from teamnav.localization.sync import SYNC_KIND, SyncMessage
@@ -229,7 +229,7 @@ def test_a_delayed_tree_older_than_the_receivers_history_is_not_applied():
 # ---------------------------------------------------------------------------- the report's numbers
 def test_cotravel_values_pair_by_seed_and_feed_the_claim():
     from teamnav.experiments.claims import judge, load_claims
-    from teamnav.experiments.report.sections._collab_delayed import cotravel_values
+    from teamnav.papers.collab_mcl.report._collab_delayed import cotravel_values
 
     ttl = {"alone": [300, 200, 250], "integrate": [250, 400, 300], "drop": [260, 380, 290], "delay": [200, 300, 310]}
     rows = [{"seed": s, "params": {"case": c}, "metrics": {"loc_time_to_localize_s": t[s],
@@ -274,7 +274,7 @@ def test_report_part_is_full_mode_only_and_builds_from_rows():
     from types import SimpleNamespace
 
     from teamnav.experiments.report.model import Comparison, Missing, Table
-    from teamnav.experiments.report.sections._collab_delayed import _delayed
+    from teamnav.papers.collab_mcl.report._collab_delayed import _delayed
 
     assert isinstance(_delayed(SimpleNamespace(quick=True))[0], Missing)  # CI's quick mode stays short
     ttl = {"alone": 250.0, "integrate": 300.0, "drop": 260.0, "delay": 200.0}
@@ -296,7 +296,7 @@ def test_report_part_is_full_mode_only_and_builds_from_rows():
 def _hallway_brain(**over) -> MCLWander:
     """A lost robot in the real symmetric hallway: global initialisation with 4000 samples."""
     from teamnav.control.protocol import RobotInfo
-    from teamnav.world.generators import symmetric_hallway
+    from teamnav.papers.collab_mcl.maps import symmetric_hallway
 
     from tests.test_localizing_brain import LASER
 

@@ -29,6 +29,6 @@ def test_module_examples(name):
 def test_examples_exist():
     """Guard against the walk finding nothing (the check above would pass vacuously)."""
     attempted = 0
-    for name in ("teamnav.geometry.angles", "teamnav.world.los", "teamnav.control.coop.los_help.goal_sharing"):
+    for name in ("teamnav.geometry.angles", "teamnav.world.los", "teamnav.papers.los_help.brains.goal_sharing"):
         attempted += doctest.testmod(importlib.import_module(name), verbose=False).attempted
     assert attempted >= 5

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from teamnav.experiments.report.model import Comparison, Missing, Text
-from teamnav.experiments.report.sections import _trails as T
-from teamnav.experiments.report.sections import try_to_see_it_my_way as S
+from teamnav.papers.trails.report import _trails as T
+from teamnav.papers.trails.report import try_to_see_it_my_way as S
 from teamnav.experiments.spec import load_scenario
 
 #: 4 robots, one 1-crumb trail every 2 s each, crumbs destroyed after 240 s: at most 4 x 121 held

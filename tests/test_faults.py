@@ -419,7 +419,7 @@ def test_a_run_without_faults_has_no_fault_metrics_and_the_same_config_hash():
 
 
 def test_relocalization_metrics_from_a_kidnapping_and_the_belief_logs():
-    from teamnav.experiments.metric_sets.faults import fault_metrics
+    from teamnav.papers.robustness.metrics import fault_metrics
     from teamnav.experiments.metrics import RunData
 
     t = np.arange(0.0, 10.0)

@@ -1,9 +1,13 @@
-"""The one rule, by construction: brains never import the simulator nor read a true pose.
+"""Two rules, by construction.
 
-DESIGN.md "truth and belief never mix": code under ``teamnav/control`` and
-``teamnav/localization`` imports neither ``teamnav.sim``, ``teamnav.experiments``,
-``teamnav.viz`` nor ``teamnav.cli``, and names nothing that smells of ground truth. Each
-checker is also run on a synthetic offending source, so a checker that stopped flagging
+1. Brains never import the simulator nor read a true pose. DESIGN.md "truth and belief never
+   mix": code under ``teamnav/control``, ``teamnav/localization`` and every paper's
+   ``teamnav/papers/<paper>/brains`` imports neither ``teamnav.sim``, ``teamnav.experiments``,
+   ``teamnav.viz`` nor ``teamnav.cli``, and names nothing that smells of ground truth.
+2. The core names no paper: nothing outside ``teamnav/papers`` imports ``teamnav.papers``
+   (papers plug in through the ``teamnav.papers`` entry-point group, :mod:`teamnav.plugins`).
+
+Each checker is also run on a synthetic offending source, so a checker that stopped flagging
 would fail here too.
 """
 
@@ -21,8 +25,12 @@ import pytest
 import teamnav
 
 PKG = Path(teamnav.__file__).resolve().parent
-BRAIN_DIRS = ("control", "localization")
+BRAIN_DIRS = ("control", "localization", *sorted(str(p.relative_to(PKG)) for p in PKG.glob("papers/*/brains")))
 FORBIDDEN = ("teamnav.sim", "teamnav.experiments", "teamnav.viz", "teamnav.cli")
+#: What the core may never import: any paper.
+PAPERS = ("teamnav.papers",)
+#: The one core module allowed to name papers' modules: the one-release table of moved import paths.
+CORE_EXEMPT = ("_moved_paths.py",)
 #: Names of truth: the simulator's state fields and anything called "true_…" / "ground_truth".
 TRUTH_NAMES = ("x_m", "y_m", "theta_rad")
 _TRUTHY = re.compile(r"(?:^|_)true_|ground_?truth")
@@ -51,8 +59,9 @@ def _resolve(node: ast.ImportFrom, module: str, is_package: bool) -> str:
     return ".".join(base + ([node.module] if node.module else []))
 
 
-def forbidden_imports(source: str, module: str, is_package: bool = False) -> list[str]:
-    """Imported modules of ``source`` (as module ``module``) that are under a forbidden package."""
+def forbidden_imports(source: str, module: str, is_package: bool = False,
+                      forbidden: tuple[str, ...] = FORBIDDEN) -> list[str]:
+    """Imported modules of ``source`` (as module ``module``) that are under a ``forbidden`` package."""
     hits = []
     for node in ast.walk(ast.parse(source)):
         targets: list[str] = []
@@ -66,7 +75,7 @@ def forbidden_imports(source: str, module: str, is_package: bool = False) -> lis
         ):
             targets = [a.value for a in node.args[:1] if isinstance(a, ast.Constant) and isinstance(a.value, str)]
         for t in targets:
-            if any(t == f or t.startswith(f + ".") for f in FORBIDDEN):
+            if any(t == f or t.startswith(f + ".") for f in forbidden):
                 hits.append(f"line {node.lineno}: {t}")
     return hits
 
@@ -98,6 +107,38 @@ def _brain_files() -> list[Path]:
     files = sorted(p for d in BRAIN_DIRS for p in (PKG / d).rglob("*.py"))
     assert files, f"no sources found under {PKG}/{{{','.join(BRAIN_DIRS)}}}"
     return files
+
+
+def _core_files() -> list[Path]:
+    files = sorted(p for p in PKG.rglob("*.py") if "papers" not in p.relative_to(PKG).parts[:1]
+                   and p.name not in CORE_EXEMPT)
+    assert len(files) > 50, f"too few core sources found under {PKG}"
+    return files
+
+
+def test_every_paper_has_brains_under_the_boundary():
+    papers = sorted(p.name for p in PKG.glob("papers/*/") if (p / "__init__.py").is_file())
+    assert papers == ["beyond", "collab_mcl", "los_help", "robustness", "trails"]
+    assert {f"papers/{p}/brains" for p in papers if p != "robustness"} <= set(BRAIN_DIRS)
+
+
+@pytest.mark.parametrize("path", _core_files(), ids=lambda p: str(p.relative_to(PKG)))
+def test_core_imports_no_paper(path):
+    hits = forbidden_imports(path.read_text(), _module_name(path), _is_package(path), PAPERS)
+    assert not hits, (f"{path.relative_to(PKG)} imports a paper: {hits}; the core finds papers only through "
+                      "the teamnav.papers entry-point group (teamnav.plugins)")
+
+
+@pytest.mark.parametrize(
+    ("source", "module"),
+    [("from teamnav.papers.los_help.brains import LosExplorer", "teamnav.experiments.runner"),
+     ("import teamnav.papers.trails.metrics", "teamnav.cli"),
+     ("from teamnav import papers", "teamnav.world.generators"),
+     ("from ..papers.beyond import brains", "teamnav.control.registry"),
+     ("import importlib\nimportlib.import_module('teamnav.papers.collab_mcl.maps')", "teamnav.world.x")],
+)
+def test_paper_checker_flags_core_offenders(source, module):
+    assert forbidden_imports(source, module, False, PAPERS)
 
 
 @pytest.mark.parametrize("path", _brain_files(), ids=lambda p: str(p.relative_to(PKG)))
@@ -154,7 +195,10 @@ def test_truth_checker_passes_belief():
 _PROBE = """
 import importlib, json, pkgutil, sys
 import teamnav.control, teamnav.localization
-for pkg in (teamnav.control, teamnav.localization):
+pkgs = [teamnav.control, teamnav.localization]
+for name in ("los_help", "collab_mcl", "trails", "beyond"):
+    pkgs.append(importlib.import_module(f"teamnav.papers.{name}.brains"))
+for pkg in pkgs:
     for info in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + "."):
         importlib.import_module(info.name)
 print(json.dumps(sorted(m for m in sys.modules if m.startswith("teamnav."))))
@@ -166,5 +210,24 @@ def test_importing_every_brain_module_loads_no_simulator():
     assert out.returncode == 0, out.stderr
     loaded = json.loads(out.stdout.strip().splitlines()[-1])
     assert "teamnav.control.nav.wander" in loaded  # the walk really imported the modules
+    assert "teamnav.papers.los_help.brains.explorer" in loaded
     bad = [m for m in loaded if any(m == f or m.startswith(f + ".") for f in FORBIDDEN)]
     assert not bad, f"importing the brain packages loaded the truth side: {bad}"
+
+
+_SWEEP_PARTS = ("teamnav.experiments.sweep", "teamnav.experiments.executors", "teamnav.experiments.store")
+
+
+@pytest.mark.parametrize(("module", "may_import"), [
+    ("teamnav.experiments.trial", ()),
+    ("teamnav.experiments.store", ()),
+    ("teamnav.experiments.executors", ()),
+    ("teamnav.experiments.sweep", ("teamnav.experiments.executors", "teamnav.experiments.store")),
+])
+def test_sweep_executors_and_store_form_no_circle(module, may_import):
+    """Trial, TrialTask and TrialResult live in experiments/trial.py, which all three import:
+    the store and the executors need neither the sweep nor each other (not even for types)."""
+    path = PKG.parent / (module.replace(".", "/") + ".py")
+    banned = tuple(m for m in _SWEEP_PARTS if m != module and m not in may_import)
+    hits = forbidden_imports(path.read_text(), module, False, banned)
+    assert not hits, f"{module} imports {hits}"

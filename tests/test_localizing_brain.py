@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from teamnav.control import registry
-from teamnav.control.localizing import ASSOC_KIND, MCLWander, MCLWanderParams, load_detection_model
+from teamnav.papers.collab_mcl.brains.localizing import ASSOC_KIND, MCLWander, MCLWanderParams, load_detection_model
 from teamnav.control.protocol import RobotInfo, SensorInfo
 from teamnav.control.types import Detection, Message, Observation, RangeScan
 from teamnav.experiments.runner import run

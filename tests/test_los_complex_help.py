@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from teamnav.experiments import los_tasks as L
+from teamnav.papers.los_help import tasks as L
 from teamnav.experiments.runner import run
 from teamnav.experiments.spec import load_scenario
 from teamnav.world import builtin_map

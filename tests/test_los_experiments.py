@@ -12,11 +12,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from teamnav.control import registry as controllers
-from teamnav.experiments import los_tasks as L
-from teamnav.experiments.metric_sets.los_help import los_help, los_legs
+from teamnav.papers.los_help import tasks as L
+from teamnav.papers.los_help.metrics import los_help, los_legs
 from teamnav.experiments.metrics import RunData
 from teamnav.experiments.report.model import Comparison, Missing, Plot, Table
-from teamnav.experiments.report.sections import los_help as S
+from teamnav.papers.los_help.report import section as S
 from teamnav.world import builtin_map
 from teamnav.world.distance import distance_field
 
@@ -200,15 +200,15 @@ def test_targets_xy_are_the_world_targets_in_r1s_start_frame():
 
 # ---------------------------------------------------------------------------- files
 def test_shipped_scenario_and_sweep_files_are_what_the_generator_writes(tmp_path):
-    from teamnav.experiments.registry import SCENARIO_DIR
-    from teamnav.experiments.sweep import SWEEP_DIR
+    from teamnav.experiments import registry
+    from teamnav.experiments.sweep import sweep_files
 
     (tmp_path / "sc").mkdir()
     (tmp_path / "sw").mkdir()
     for p in L.write_files(tmp_path / "sc", tmp_path / "sw"):
-        shipped = (SCENARIO_DIR if p.parent.name == "sc" else SWEEP_DIR) / p.name
+        shipped = registry.path(p.stem) if p.parent.name == "sc" else sweep_files()[p.stem]
         assert shipped.read_text(encoding="utf-8") == p.read_text(encoding="utf-8"), (
-            f"{shipped.name} is stale: run python -m teamnav.experiments.los_tasks")
+            f"{shipped.name} is stale: run python -m teamnav.papers.los_help.tasks")
 
 
 @needs_brains
@@ -536,7 +536,7 @@ def test_steps_fall_verdict_pairs_tasks_so_a_failed_hard_task_cannot_fake_a_fall
 
 
 def test_a_failed_falling_verdict_says_how_large_each_rise_is_against_the_task_noise():
-    from teamnav.experiments.report.sections._los_verdicts import paired_rises
+    from teamnav.papers.los_help.report._los_verdicts import paired_rises
 
     steps = {0: [100.0, 110.0, 120.0], 1: [110.0, 115.0, 118.0], 2: [90.0, 95.0, 99.0]}
     by_team = {h: [_row("avoid_past", s, **{S.TARGETS_KEY: [[float(task), 0.0]] * 20})
@@ -550,7 +550,7 @@ def test_a_failed_falling_verdict_says_how_large_each_rise_is_against_the_task_n
 
 
 def test_legs_table_sets_the_finished_tasks_against_their_shortest_path():
-    from teamnav.experiments.report.sections._los_tables import legs_block
+    from teamnav.papers.los_help.report._los_tables import legs_block
 
     t = L.task_targets_xy("simple", 1, 3)
     legs = {"los_leg_leave": 100.0, "los_leg_corridor": 60.0, "los_leg_other_rooms": 10.0, "los_leg_enter": 20.0}
@@ -574,7 +574,7 @@ def test_verdict_rules_are_read_from_the_claim_file(monkeypatch):
     """Issue 21 §3: the section's rules live in claims/los-help.yaml (judged on the paper-rules
     column, report seeds < 1000); a stricter threshold there changes the verdict here."""
     from teamnav.experiments.claims import load_claims
-    from teamnav.experiments.report.sections import _los_verdicts as V
+    from teamnav.papers.los_help.report import _los_verdicts as V
 
     cf = load_claims("los-help")
     assert all(c.judged == "paper_rules" and max(c.seed_list) < 1000 for c in cf.claims)
@@ -608,7 +608,7 @@ def test_verdicts_are_the_paper_as_written_columns_and_the_teamnav_column_says_w
 @needs_brains
 def test_the_paper_rules_column_runs_every_robot_at_paper_rules_with_the_cases_plan_and_quick_budget():
     from teamnav.control import registry
-    from teamnav.experiments.report.sections._trails import paper_rules_spec
+    from teamnav.papers.trails.report._trails import paper_rules_spec
     from teamnav.experiments.spec import load_scenario
     from teamnav.experiments.sweep import expand, resolve_spec
 
@@ -666,12 +666,12 @@ def test_table2_verdicts_read_the_mean_over_route_plans():
 
 
 def test_route_plan_files_are_what_the_generator_writes_and_differ_only_in_the_helpers_routes(tmp_path):
-    from teamnav.experiments.registry import SCENARIO_DIR
-    from teamnav.experiments.report.sections import _los_common as C
+    from teamnav.experiments import registry
+    from teamnav.papers.los_help.report import _los_common as C
 
     for p in C.write_route_plan_files(tmp_path):
-        assert (SCENARIO_DIR / p.name).read_text(encoding="utf-8") == p.read_text(encoding="utf-8"), (
-            f"{p.name} is stale: run python -m teamnav.experiments.report.sections._los_common")
+        assert registry.path(p.stem).read_text(encoding="utf-8") == p.read_text(encoding="utf-8"), (
+            f"{p.name} is stale: run python -m teamnav.papers.los_help.report._los_common")
     a = L.scenario_data("complex")
     routes = {}
     for plan in ("B", "C"):
@@ -688,7 +688,7 @@ def test_route_plan_files_are_what_the_generator_writes_and_differ_only_in_the_h
 
 
 def test_route_plans_lie_in_the_corridors_with_clearance_and_see_every_room_together():
-    from teamnav.experiments.report.sections._los_common import ROUTE_PLANS
+    from teamnav.papers.los_help.report._los_common import ROUTE_PLANS
 
     env = builtin_map(L.MAPS["complex"])
     clear = distance_field(env.grid)
@@ -723,7 +723,7 @@ def test_table2_claims_are_judged_on_the_mean_over_route_plans_fixed_before_the_
 
 
 def test_noise_table_pairs_each_algorithms_rows_across_columns_when_one_column_lacks_an_algorithm():
-    from teamnav.experiments.report.sections._los_tables import noise_table_cols
+    from teamnav.papers.los_help.report._los_tables import noise_table_cols
 
     rows = [_row(nav, s, **{S.ERR_KEY: e}) for nav, s in (("avoid_past", 200), ("visbug21", 300)) for e in (0.0, 0.4)]
     tab = noise_table_cols("simple", {"paper_rules": rows[2:], "teamnav": rows}, {"paper_rules": [], "teamnav": []})

@@ -12,9 +12,9 @@ from hypothesis import strategies as st
 from pydantic import ValidationError
 
 from teamnav.control import Detection, Message, Observation, RangeScan, RobotInfo, SensorInfo
-from teamnav.control.coop.los_help import brain as brain_mod
-from teamnav.control.coop.los_help import LosExplorer, LosHelper
-from teamnav.control.coop.los_help.goal_sharing import (
+from teamnav.papers.los_help.brains import brain as brain_mod
+from teamnav.papers.los_help.brains import LosExplorer, LosHelper
+from teamnav.papers.los_help.brains.goal_sharing import (
     GoalSharing,
     accept_goal_id,
     can_relay,
@@ -26,7 +26,7 @@ from teamnav.control.coop.los_help.goal_sharing import (
     see_past_teammates,
     sender_frame,
 )
-from teamnav.control.coop.los_help.messages import (
+from teamnav.papers.los_help.brains.messages import (
     MESSAGE_KIND,
     GoalShare,
     LosHelpMsg,
@@ -34,7 +34,7 @@ from teamnav.control.coop.los_help.messages import (
     VisReport,
     message_size_bytes,
 )
-from teamnav.control.coop.los_help.state_sharing import TroubleState, choose_helper
+from teamnav.papers.los_help.brains.state_sharing import TroubleState, choose_helper
 from teamnav.geometry import wrap_angle
 from teamnav.geometry.bearings import relative_frame_from_bearings
 from teamnav.geometry.se2 import relative, transform_points

@@ -6,10 +6,10 @@ from __future__ import annotations
 import pytest
 from pydantic import ValidationError
 
-from teamnav.control.coop.los_help.brain import los_gap_fills
-from teamnav.control.coop.los_help.explorer import LosExplorerParams
-from teamnav.control.coop.los_help.goal_sharing import GoalSharing, goal_id
-from teamnav.control.coop.los_help.helper import LosHelperParams
+from teamnav.papers.los_help.brains.brain import los_gap_fills
+from teamnav.papers.los_help.brains.explorer import LosExplorerParams
+from teamnav.papers.los_help.brains.goal_sharing import GoalSharing, goal_id
+from teamnav.papers.los_help.brains.helper import LosHelperParams
 from teamnav.control.nav.local import NAVIGATORS, AvoidPastParams, PotentialFieldParams, VisBugParams
 from teamnav.control.paper_rules import gap_fills
 

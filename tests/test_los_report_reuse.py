@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from teamnav.experiments.report.sections import _los_reuse as RU
-from teamnav.experiments.report.sections._los_common import ERR_KEY, TARGETS_KEY
+from teamnav.papers.los_help.report import _los_reuse as RU
+from teamnav.papers.los_help.report._los_common import ERR_KEY, TARGETS_KEY
 from teamnav.experiments.sweep import expand, resolve_spec
 
 TASK = [[[4.1, -7.9], [4.1, -2.0]], [[-4.1, -19.9], [4.1, -13.9]]]
@@ -77,7 +77,7 @@ def test_full_build_asks_for_no_simulation_twice_and_reads_the_duplicates_from_t
     task and column."""
     from teamnav.experiments.report import available_sections
     from teamnav.experiments.report.context import SweepContext
-    from teamnav.experiments.report.sections import los_help as S
+    from teamnav.papers.los_help.report import section as S
 
     asked: dict[tuple[str, int], str] = {}
     twice: list[tuple[str, str]] = []

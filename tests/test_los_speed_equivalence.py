@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from teamnav.control.coop.los_help.goal_sharing import beam_near_reaches, max_beam_gap, point_visible
+from teamnav.papers.los_help.brains.goal_sharing import beam_near_reaches, max_beam_gap, point_visible
 from teamnav.control.nav.local import base
 from teamnav.control.nav.local.avoid_past import AvoidPast, AvoidPastParams, avoid_past_vector
 from teamnav.control.nav.local.potential_field import (

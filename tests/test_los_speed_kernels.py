@@ -99,8 +99,8 @@ def test_last_visible_is_the_last_of_visible(seed, k, j, r_safe, reach):
 def test_sharing_records_keep_dataclass_behaviour():
     """The goal-sharing records and message parts built by the slot-descriptor ``__init__``
     (``_fast_frozen_init``) keep their fields, defaults, equality, ``replace`` and frozenness."""
-    from teamnav.control.coop.los_help.goal_sharing import GoalPath, KnownGoal
-    from teamnav.control.coop.los_help.messages import GoalShare, LosHelpMsg, Sighting, VisReport
+    from teamnav.papers.los_help.brains.goal_sharing import GoalPath, KnownGoal
+    from teamnav.papers.los_help.brains.messages import GoalShare, LosHelpMsg, Sighting, VisReport
 
     p = GoalPath(4, 1.0, 2.0, 0.5, "ghost", 1, 7)
     assert (p.reached, p.d_promised_m, p.via_x_m, p.via_y_m, p.via_d_m) == (False, math.inf, None, None, None)

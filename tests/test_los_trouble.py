@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from teamnav.control.coop.los_help import LosExplorer
-from teamnav.control.coop.los_help import brain as brain_mod
+from teamnav.papers.los_help.brains import LosExplorer
+from teamnav.papers.los_help.brains import brain as brain_mod
 
 from test_los_help import StraightNav, info, msg, obs
 

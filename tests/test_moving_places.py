@@ -255,7 +255,7 @@ def test_robot_driving_through_gets_the_event_at_the_moved_place_not_the_old_spo
 
 # ------------------------------------------------------------------------ the report block (section beyond)
 def test_motion_speed_counts_the_cycle_distance_over_its_duration():
-    from teamnav.experiments.report.sections.beyond import motion_speed_mps
+    from teamnav.papers.beyond.report.section import motion_speed_mps
 
     far = {"t_s": 600.0, "x_m": 24.4, "y_m": 15.9}
     assert motion_speed_mps((5.4, 15.9), None) == 0.0
@@ -268,7 +268,7 @@ def test_motion_speed_counts_the_cycle_distance_over_its_duration():
 def test_moving_resource_block_quick_runs_its_two_cases(tmp_path):
     from teamnav.experiments.report.context import SweepContext
     from teamnav.experiments.report.model import Plot, Table
-    from teamnav.experiments.report.sections.beyond import MOVING_QUICK_CASES, _moving_resource
+    from teamnav.papers.beyond.report.section import MOVING_QUICK_CASES, _moving_resource
 
     ctx = SweepContext(tmp_path, quick=True, workers=1, section="beyond")
     blocks = _moving_resource(ctx)
@@ -284,13 +284,13 @@ def test_moving_resource_block_quick_runs_its_two_cases(tmp_path):
 # ------------------------------------------------------------------------ blazing-trail-v1's optional crumb expiry
 def _blaze(**params):
     from teamnav.control.check import synthetic_infos
-    from teamnav.control.coop.blazing_trail import BlazingTrail
+    from teamnav.papers.trails.brains.blazing_trail import BlazingTrail
 
     return BlazingTrail(BlazingTrail.Params(**params), np.random.default_rng(0), synthetic_infos(1)[0])
 
 
 def _batch(n, x0):
-    from teamnav.control.coop.crumbs import CrumbBatch
+    from teamnav.papers.trails.brains.crumbs import CrumbBatch
 
     return CrumbBatch(np.column_stack([x0 + np.arange(n, dtype=float), np.zeros(n)]), np.zeros(n))
 
@@ -331,7 +331,7 @@ def _fake_full():
 
 def test_moving_resource_block_full_mode_reads_every_case_and_the_blazing_sweep():
     from teamnav.experiments.report.model import Plot, Table
-    from teamnav.experiments.report.sections.beyond import _moving_resource
+    from teamnav.papers.beyond.report.section import _moving_resource
 
     ctx = _fake_full()
     blocks = _moving_resource(ctx)

@@ -172,7 +172,7 @@ def test_trail_brains_cross_back_to_their_lane_from_the_oncoming_one():
     ``try-to-see-it-my-way``). With Navigate's default reach (1.2 m) the first box is free and
     the robot drives straight on in that lane ("big open space", Blazing §4.2); the trail
     brains' ``box_reach_m = 2.0`` spans the corridor, so it crosses to its own (left) lane."""
-    from teamnav.control.coop.blazing_trail import NAVIGATE_DEFAULTS, navigate_params
+    from teamnav.papers.trails.brains.blazing_trail import NAVIGATE_DEFAULTS, navigate_params
 
     assert NAVIGATE_DEFAULTS["box_reach_m"] >= 1.8  # the trail office's corridor width
     wide = [(-5, 0.9, 60, 0.9), (-5, -0.9, 60, -0.9)]

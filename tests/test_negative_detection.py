@@ -11,8 +11,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from teamnav.control.localizing import MCLWander, MCLWanderParams
-from teamnav.control.negative_sights import BELIEF_KIND, BeliefPoints
+from teamnav.papers.collab_mcl.brains.localizing import MCLWander, MCLWanderParams
+from teamnav.papers.collab_mcl.brains.negative_sights import BELIEF_KIND, BeliefPoints
 from teamnav.control.protocol import RobotInfo, SensorInfo
 from teamnav.control.types import Detection, Message, Observation, RangeScan
 from teamnav.localization.negative_detection import negative_factors, visible_mass

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from pydantic import ValidationError
 
-from teamnav.control.coop.blazing_trail import BlazingTrail, BlazingTrailParams, navigate_params
-from teamnav.control.coop.trail_share import TrailShareParams
+from teamnav.papers.trails.brains.blazing_trail import BlazingTrail, BlazingTrailParams, navigate_params
+from teamnav.papers.trails.brains.trail_share import TrailShareParams
 from teamnav.control.nav.navigate import NavigateParams
 from teamnav.control.nav.wall_follow import SlidingBox
 from teamnav.control.paper_rules import gap_fills

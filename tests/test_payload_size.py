@@ -18,9 +18,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from teamnav.control.coop.crumbs import CrumbBatch
-from teamnav.control.coop.los_help.messages import GoalShare, LosHelpMsg, Sighting, VisReport, message_size_bytes
-from teamnav.control.coop.trails import TrailMessage
+from teamnav.papers.trails.brains.crumbs import CrumbBatch
+from teamnav.papers.los_help.brains.messages import GoalShare, LosHelpMsg, Sighting, VisReport, message_size_bytes
+from teamnav.papers.trails.brains.trails import TrailMessage
 from teamnav.control.types import Message, _payload_size_bytes_generic, payload_size_bytes
 from teamnav.localization.density_tree import DensityTree
 from teamnav.localization.sync import SyncMessage

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from teamnav.experiments import los_tasks as L
+from teamnav.papers.los_help import tasks as L
 from teamnav.world import OccupancyGrid
 from teamnav.world.shortest_path import MOVE_ERROR_BOUND, GridPaths
 
@@ -107,7 +107,7 @@ def test_no_navigator_beats_the_floor_on_a_short_task():
     """R1 alone with VisBug-21 on the first 4 targets of task 1: its steps per target can only be
     above the shortest path (a floor computed too long would fail here)."""
     from teamnav import load_scenario, run
-    from teamnav.experiments.metric_sets.los_help import los_help
+    from teamnav.papers.los_help.metrics import los_help
 
     n = 4
     over = {"robots.0.params.targets_xy": L.task_targets_xy("simple", 1, n), **L.team_overrides("simple", 0)}

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from teamnav.control import registry as controllers
 from teamnav.control.nav.route_follow import pursuit_point
-from teamnav.experiments.metric_sets import trails as M
+from teamnav.papers.trails import metrics as M
 from teamnav.experiments.metrics import RunData
 from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, Table, Text
 from teamnav.experiments.runner import run
@@ -235,7 +235,7 @@ def test_trail_scenario_validates_and_runs_5_s(name):
 
 # ---------------------------------------------------------------------------- drift sweeps
 def test_drift_sweeps_give_each_robot_its_own_drift_the_same_for_both_algorithms():
-    from teamnav.experiments.report.sections import _trails as T
+    from teamnav.papers.trails.report import _trails as T
     from teamnav.experiments.sweep import expand, load_sweep
 
     scenes = {}
@@ -328,7 +328,7 @@ class _FakeCtx:
 
 @pytest.mark.skipif("blazing-trail-v1" not in controllers.names(), reason="blazing-trail-v1 not registered yet")
 def test_blazing_section_verdicts_follow_the_data():
-    from teamnav.experiments.report.sections.blazing_a_trail import SECTION
+    from teamnav.papers.trails.report.blazing_a_trail import SECTION
 
     def table(key, kw):
         if key == "trail-solo-optimal":
@@ -370,7 +370,7 @@ def test_blazing_section_verdicts_follow_the_data():
 def test_blazing_three_times_is_judged_against_the_route_follow_robot(solo_trip_s, route_follow_units, holds):
     """§5.1: team units >= 2.5x one route-follow-v1 robot's (claims/blazing-a-trail.yaml, restored by
     issue 25 §3); the paper's method (one robot at its optimal round-trip rate) is shown, not judged."""
-    from teamnav.experiments.report.sections.blazing_a_trail import SECTION
+    from teamnav.papers.trails.report.blazing_a_trail import SECTION
 
     def table(key, kw):
         if key == "trail-solo-optimal":
@@ -414,7 +414,7 @@ def _drift_runs(k, last, broke_min):
     (_drift_runs(0, [10, 11], [None, None]) + _drift_runs(4, [1, 0], [4, 3]), 300.0, None),
 ])
 def test_blazing_drift_verdict_reads_the_trend_over_all_runs(runs, dur_s, holds):
-    from teamnav.experiments.report.sections.blazing_a_trail import drift_verdict
+    from teamnav.papers.trails.report.blazing_a_trail import drift_verdict
 
     verdict, text = drift_verdict(runs, dur_s)
     assert verdict is holds
@@ -422,7 +422,7 @@ def test_blazing_drift_verdict_reads_the_trend_over_all_runs(runs, dur_s, holds)
 
 
 def test_paper_method_ratio_on_the_papers_numbers_and_without_trips():
-    from teamnav.experiments.report.sections.blazing_a_trail import paper_method_ratio
+    from teamnav.papers.trails.report.blazing_a_trail import paper_method_ratio
 
     assert paper_method_ratio(28.0, [90.0, 85.0, 95.0], 1800.0) == pytest.approx((2.8, 10.0))
     r, u = paper_method_ratio(28.0, [float("nan")], 1800.0)
@@ -431,7 +431,7 @@ def test_paper_method_ratio_on_the_papers_numbers_and_without_trips():
 
 @pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
 def test_try_section_says_it_does_not_hold_when_the_2002_team_breaks_down():
-    from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
+    from teamnav.papers.trails.report.try_to_see_it_my_way import SECTION
 
     broke = {"breakdown_censored": 0, "breakdown_s": 200.0, "units_per_10min_last": 0}
 
@@ -452,7 +452,7 @@ def test_try_section_says_it_does_not_hold_when_the_2002_team_breaks_down():
 def test_try_efficiency_is_split_into_detours_and_time_moving():
     # efficiency = route / (lifetime / trips) / cruise = (route / m per trip) x (m / lifetime / cruise):
     # 40 trips of 45 m in 100 min at 0.4 m/s cruise -> 45.0 m per trip, 75 % of cruise moving
-    from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
+    from teamnav.papers.trails.report.try_to_see_it_my_way import SECTION
 
     def table(key, kw):
         extra = {"trips_total": 40, "distance_m_lifetime_total": 1800.0, "lifetime_min_total": 100.0,
@@ -466,7 +466,7 @@ def test_try_efficiency_is_split_into_detours_and_time_moving():
 
 @pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
 def test_try_section_draws_fig2_trips_and_the_crumb_figures():
-    from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
+    from teamnav.papers.trails.report.try_to_see_it_my_way import SECTION
 
     # robot 0: home -> source -> home -> home again (not a trip); robot 2: source, source (one trip)
     arrivals = [[60.0, 0, "source"], [120.0, 0, "home"], [130.0, 0, "home"], [200.0, 2, "source"], [260.0, 2, "source"]]
@@ -506,7 +506,7 @@ def _hours_row(seed, per_hour, broke_at_s=None):
     ([30, 28, 31], None, 6.0, False),    # the 2000 team did not collapse (6 of 9, and none broke down)
 ])
 def test_hours_claim_reads_units_per_hour_and_breakdowns_from_the_runs(hourly, broke_at_s, blaze_last, holds):
-    from teamnav.experiments.report.sections import try_to_see_it_my_way as S
+    from teamnav.papers.trails.report import try_to_see_it_my_way as S
 
     hours = [_hours_row(s, [30, 28, 31]) for s in range(7)] + [_hours_row(7, hourly, broke_at_s=broke_at_s)]
     collapsed = blaze_last < 1.0
@@ -526,7 +526,7 @@ def test_hours_claim_reads_units_per_hour_and_breakdowns_from_the_runs(hourly, b
 
 
 def test_first_part_of_a_long_run_is_a_run_that_long():
-    from teamnav.experiments.report.sections import _trails as T
+    from teamnav.papers.trails.report import _trails as T
 
     row = _hours_row(0, [30, 0, 0])  # worked for an hour, then nothing
     one = T.first_part(row, 3600.0, "x4")
@@ -541,7 +541,7 @@ def test_first_part_of_a_long_run_is_a_run_that_long():
 
 
 def test_survival_and_trend_on_hand_made_runs():
-    from teamnav.experiments.report.sections import _trails as T
+    from teamnav.papers.trails.report import _trails as T
 
     def runs(k, broke_min):  # None: no breakdown in the hour
         return [_row(5, 90.0, k, {"breakdown_s": 60.0 * (b if b is not None else 60),
@@ -563,7 +563,7 @@ def test_survival_and_trend_on_hand_made_runs():
 @pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
 def test_a_run_does_not_depend_on_its_length():
     """first_part's premise: the first minute of a 2-minute run is a 1-minute run of the same seed."""
-    from teamnav.experiments.metric_sets import trails as M
+    from teamnav.papers.trails import metrics as M
 
     logs = []
     for dur in (60.0, 120.0):
@@ -619,7 +619,7 @@ def test_trail_share_memory_flat_over_ten_hours():
 @pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
 @pytest.mark.parametrize("blazing_last_at_k4, holds", [(5.0, False), (3.0, True)])
 def test_try_section_needs_the_2000_team_to_collapse_not_just_slow_down(blazing_last_at_k4, holds):
-    from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
+    from teamnav.papers.trails.report.try_to_see_it_my_way import SECTION
 
     def table(key, kw):
         if key == "try-drift" and kw.get("duration_s") == 10800.0:  # the hours runs at k = 4: 7 per 10 min
@@ -642,7 +642,7 @@ def test_try_section_judges_the_drift_claim_at_the_highest_k_both_ran():
     k = 6 the 2000 team keeps a trickle (4 of 9) and the 2002 team degrades (4 of 9): does not
     hold, although at k = 4 the 2000 team collapses (1 of 9) while the 2002 team keeps 6 of 9
     (the rule ece0e2d had chosen after seeing such data)."""
-    from teamnav.experiments.report.sections.try_to_see_it_my_way import SECTION
+    from teamnav.papers.trails.report.try_to_see_it_my_way import SECTION
 
     def table(key, kw):
         if key == "try-drift" and kw.get("duration_s") == 10800.0:

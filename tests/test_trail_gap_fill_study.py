@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from teamnav.control.coop.blazing_trail import BlazingTrailParams, navigate_params
+from teamnav.papers.trails.brains.blazing_trail import BlazingTrailParams, navigate_params
 from teamnav.experiments.spec import load_scenario
 from teamnav.experiments.sweep import load_sweep
 
@@ -86,7 +86,7 @@ def test_report_seeds_are_refused():
 def test_study_tables_pair_by_seed():
     """The paired column is the mean over seeds of (config - paper) on the same seed, with its
     standard error and the count of seeds where the config delivered more."""
-    from teamnav.experiments.report.sections._trails_gap_fills import table_rows
+    from teamnav.papers.trails.report._trails_gap_fills import table_rows
 
     def run(config, seed, units, bd=None):
         return {"part": "gapfills", "case": "", "config": config, "seed": seed, "duration_s": 1800.0,
@@ -114,7 +114,7 @@ def test_study_tables_pair_by_seed():
 ])
 def test_stored_study_runs_are_the_docs_jsonl(system, files):
     """The sections' package data hold exactly the runs recorded in docs/report/."""
-    from teamnav.experiments.report.sections._trails_gap_fills import study_runs
+    from teamnav.papers.trails.report._trails_gap_fills import study_runs
 
     docs = Path(__file__).resolve().parents[1] / "docs" / "report"
     lines = []
@@ -132,7 +132,7 @@ def test_stored_study_runs_are_the_docs_jsonl(system, files):
 
 def test_try_configs_are_trail_share_columns():
     """``--system try``: the paper configuration is trail-share-v1's paper_rules column."""
-    from teamnav.control.coop.trail_share import TrailShareParams
+    from teamnav.papers.trails.brains.trail_share import TrailShareParams
 
     p = TrailShareParams(**gs.params_for("paper", "try")).model_dump(exclude={"paper_rules", "navigate"})
     q = TrailShareParams(**{**gs.SYSTEMS["try"][2], "paper_rules": True}).model_dump(exclude={"paper_rules", "navigate"})

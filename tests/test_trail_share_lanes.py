@@ -19,7 +19,7 @@ from _trail_brain_fakes import make_brains, make_obs
 def _swerved(monkeypatch, **params):
     """Source crumbs along the other lane (y = 0, x = 0..10, time to the source falling with x);
     the robot in its own lane swerves into a passing place: at (3, 1.4) heading 70 deg."""
-    from teamnav.control.coop import trail_share as TS
+    from teamnav.papers.trails.brains import trail_share as TS
 
     (b,) = make_brains(monkeypatch, TS, TS.TrailShare, 1, round=["home", "source"], lookahead_m=1.0,
                        broadcast_interval_s=600.0, **params)

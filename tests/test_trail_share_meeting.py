@@ -11,8 +11,8 @@ import pytest
 
 from _trail_brain_fakes import make_brains, make_obs
 from teamnav.control.check import synthetic_infos
-from teamnav.control.coop.blazing_trail import BlazingTrail
-from teamnav.control.coop.trail_share import TrailShare
+from teamnav.papers.trails.brains.blazing_trail import BlazingTrail
+from teamnav.papers.trails.brains.trail_share import TrailShare
 from teamnav.control.nav.navigate import Navigate
 from test_nav_navigate import INFO, MAX_R, cast, nav, observe, t_junction
 
@@ -127,7 +127,7 @@ def test_reversal_inside_the_reversal_memory_only_when_told(ignore, reverses):
 
 @pytest.mark.parametrize(("flag", "told"), [(False, False), (True, True)])
 def test_recover_reverse_tells_navigate_only_while_recovering(monkeypatch, flag, told):
-    from teamnav.control.coop import trail_share as TS
+    from teamnav.papers.trails.brains import trail_share as TS
 
     (b,) = make_brains(monkeypatch, TS, TS.TrailShare, 1, round=["home", "source"], radius_m=2.0,
                        lookahead_m=1.0, broadcast_interval_s=600.0, recover_reverse=flag)

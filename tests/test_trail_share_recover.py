@@ -12,7 +12,7 @@ from _trail_brain_fakes import make_brains, make_obs
 
 
 def _brain(monkeypatch, **params):
-    from teamnav.control.coop import trail_share as TS
+    from teamnav.papers.trails.brains import trail_share as TS
 
     (b,) = make_brains(monkeypatch, TS, TS.TrailShare, 1, round=["home", "source"], radius_m=2.0,
                        lookahead_m=1.0, broadcast_interval_s=600.0, **params)

@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from teamnav.control.coop.forager import PlaceRound
-from teamnav.control.coop.trails import Trail, TrailMessage, place_transform, temporary_trail
+from teamnav.papers.trails.brains.forager import PlaceRound
+from teamnav.papers.trails.brains.trails import Trail, TrailMessage, place_transform, temporary_trail
 from teamnav.geometry.similarity import Similarity
 
 from _trail_brain_fakes import make_brains, make_obs
@@ -176,7 +176,7 @@ _obs = make_obs
 
 
 def _brains(monkeypatch, n=2, **params):
-    from teamnav.control.coop import trail_share as TS
+    from teamnav.papers.trails.brains import trail_share as TS
 
     return make_brains(monkeypatch, TS, TS.TrailShare, n, **params)
 

@@ -13,6 +13,10 @@ from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
+from teamnav import _moved_paths  # noqa: E402  (old import paths of the papers' modules, one release)
+
+_moved_paths.install()
+
 __all__ = ["__version__", "load_scenario", "run", "sweep"]
 
 if TYPE_CHECKING:  # pragma: no cover

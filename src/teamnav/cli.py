@@ -227,15 +227,13 @@ def _declared_headlines() -> tuple[dict[str, tuple[tuple[str, str], ...]], dict[
     """``{metric name: ((key, unit), ...)}`` of the paper metric sets and of the general metrics,
     as :mod:`teamnav.experiments.metric_sets` declares them."""
     import importlib
-    import pkgutil
 
     from teamnav.experiments import metric_sets
     from teamnav.experiments import metrics as _registry  # noqa: F401  (imports every metric set)
 
     paper: dict[str, tuple[tuple[str, str], ...]] = {}
-    for info in sorted(pkgutil.iter_modules(metric_sets.__path__), key=lambda m: m.name):
-        if not info.name.startswith("_"):
-            paper.update(getattr(importlib.import_module(f"{metric_sets.__name__}.{info.name}"), "HEADLINE", {}))
+    for module in metric_sets.metric_set_modules().values():
+        paper.update(getattr(importlib.import_module(module), "HEADLINE", {}))
     return paper, dict(metric_sets.CORE_HEADLINE)
 
 

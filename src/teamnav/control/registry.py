@@ -165,29 +165,30 @@ def _not_a_controller(cls: Any) -> str | None:
     return None
 
 
-# Built-in controllers. Paper systems add theirs here as they land.
+# Built-in controllers of the core. Paper systems register theirs through the
+# ``teamnav.papers`` entry-point group (:mod:`teamnav.plugins`), loaded below.
 register("idle-v1", "teamnav.control.idle:Idle")
 register("wander-v1", "teamnav.control.nav.wander:Wander")
 register("wander-batched-v1", "teamnav.control.nav.wander:WanderBatched")
-
-# Trail experiments baseline (Vaughan et al.; helper H7): the single optimal robot
+# the single optimal robot that follows a planned route (the trail papers' baseline, a generic brain)
 register("route-follow-v1", "teamnav.control.nav.route_follow:RouteFollow")
-
-# Fox, Burgard, Kruppa & Thrun: collaborative multi-robot MCL (helper H5)
-register("mcl-wander-v1", "teamnav.control.localizing:MCLWander")
-
-# Vaughan et al. trail papers: low-level Navigate + Panic, random exploration (helper H3)
+# low-level Navigate + Panic with random exploration (Vaughan et al.'s, a generic brain)
 register("explore-v1", "teamnav.control.nav.explore:Explore")
 
-# Sgorbissa & Arkin: line-of-sight help, R1 explorer and patrolling helpers (helper H2)
-register("los-explorer-v1", "teamnav.control.coop.los_help.explorer:LosExplorer")
-register("los-helper-v1", "teamnav.control.coop.los_help.helper:LosHelper")
 
-# Vaughan et al. trail papers: Blazing a trail (2000) and Try to see it my way (2002) (helper H4)
-register("blazing-trail-v1", "teamnav.control.coop.blazing_trail:BlazingTrail")
-register("trail-share-v1", "teamnav.control.coop.trail_share:TrailShare")
+def _register_papers() -> None:
+    """Register every installed paper's brains (:attr:`teamnav.plugins.Paper.brains`)."""
+    from teamnav import plugins
 
-# Beyond the papers (issue 22): the systems combined
-register("localized-v1", "teamnav.control.beyond.localized:Localized")
-register("los-trail-explorer-v1", "teamnav.control.beyond.trail_memory:LosTrailExplorer")
-register("detecting-trails-v1", "teamnav.control.beyond.detecting:DetectingTrails")
+    for paper in plugins.papers().values():
+        for name, entry in paper.brains.items():
+            if name in _REGISTRY:
+                import warnings
+
+                warnings.warn(f"teamnav: paper {paper.key!r} registers controller {name!r}, which is taken "
+                              f"(at {_REGISTRY[name]}); skipped", stacklevel=2)
+                continue
+            register(name, entry)
+
+
+_register_papers()

@@ -1,6 +1,7 @@
 """Verdict rules fixed before the data: one versioned claim file per report section.
 
-``experiments/claims/<section>.yaml`` holds, for each claim a report section judges: the
+``claims/<section>.yaml`` in the folder of the paper that declares the section
+(:mod:`teamnav.plugins`; e.g. ``teamnav/papers/los_help/claims/los-help.yaml``) holds, for each claim a report section judges: the
 paper's statement (quote and section), the paper's number, the metric, the verdict rule (one or
 more conditions, all of which must hold: a metric, a comparison, a threshold and, for a relative
 rule, the metric it is relative to), the seeds (report seeds only; tuning uses seeds >= 1000,
@@ -34,10 +35,23 @@ from typing import Literal, Mapping
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-__all__ = ["CLAIMS_DIR", "Claim", "ClaimFile", "Condition", "TUNING_SEED_MIN", "judge", "load_claims", "rule_text"]
+__all__ = ["CLAIMS_DIR", "Claim", "claims_path", "ClaimFile", "Condition", "TUNING_SEED_MIN", "judge", "load_claims", "rule_text"]
 
 #: the folder of the claim files
-CLAIMS_DIR = Path(__file__).with_name("claims")
+CLAIMS_DIR = Path(__file__).with_name("claims")  #: claim files of sections the core adds itself (none today)
+
+
+def claims_path(section: str) -> Path:
+    """The claim file of ``section``: ``claims/<section>.yaml`` of the installed paper that
+    declares the section, else of :data:`CLAIMS_DIR`."""
+    from teamnav import plugins
+
+    for paper in plugins.papers().values():
+        if any(s.key == section for s in paper.sections):
+            folder = paper.folder()
+            if folder is not None:
+                return folder / "claims" / f"{section}.yaml"
+    return CLAIMS_DIR / f"{section}.yaml"
 #: seeds at or above this are tuning seeds; a claim's (report) seeds must lie below it
 TUNING_SEED_MIN = 1000
 
@@ -160,7 +174,8 @@ class ClaimFile(BaseModel):
 
 @lru_cache(maxsize=None)
 def load_claims(section: str, folder: str | None = None) -> ClaimFile:
-    """The claim file of report section ``section`` (``claims/<section>.yaml``), validated.
+    """The claim file of report section ``section`` (:func:`claims_path`, or
+    ``folder/<section>.yaml``), validated.
 
     Raises
     ------
@@ -171,7 +186,7 @@ def load_claims(section: str, folder: str | None = None) -> ClaimFile:
     """
     from teamnav.safe_yaml import safe_load
 
-    path = Path(folder) / f"{section}.yaml" if folder else CLAIMS_DIR / f"{section}.yaml"
+    path = Path(folder) / f"{section}.yaml" if folder else claims_path(section)
     data = safe_load(path.read_text(encoding="utf-8"))
     cf = ClaimFile.model_validate(data)
     if cf.section != section:

@@ -40,13 +40,13 @@ import time
 import traceback as _tb
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Iterator, Mapping, Protocol
 
+from teamnav.experiments.trial import Trial, TrialResult, TrialTask  # noqa: F401 - Trial: annotations
+
 if TYPE_CHECKING:  # pragma: no cover
     from teamnav.experiments.spec import Scenario
-    from teamnav.experiments.sweep import Trial
 
 __all__ = [
     "EXECUTORS",
@@ -65,59 +65,6 @@ __all__ = [
 EXECUTORS = ("local", "ray")
 
 RAY_MISSING = "executor='ray' needs Ray, which is not installed; expected it importable: pip install 'teamnav[ray]'"
-
-
-# ---------------------------------------------------------------------------- what travels
-@dataclass(frozen=True)
-class TrialTask:
-    """What a worker gets: the trial, the trial function (None: :func:`run_trial`) and the
-    run folder to write (None: none)."""
-
-    trial: "Trial"
-    trial_fn: Callable[..., Mapping[str, Any]] | None = None
-    artifacts_dir: str | None = None
-
-
-@dataclass(frozen=True)
-class TrialResult:
-    """What a worker sends back.
-
-    Attributes
-    ----------
-    trial_id : str
-    status : {"ok", "failed"}
-    metrics : dict of str to (int, float, bool, str or None), or None when failed
-    error : str or None
-        ``"TypeName: message"`` when failed.
-    traceback : str or None
-        The formatted traceback when failed.
-    wall_time_s : float
-        Wall time of the trial in the worker (scenario loading included) [s].
-    started_at, finished_at : str
-        ISO 8601 UTC timestamps.
-    host : str
-        Host name of the worker.
-    pid : int
-        Process id of the worker.
-    retries : int
-        Times the trial was started again because the worker or node running it was lost
-        (a Ray node that died, a worker process killed); 0 when the first start finished.
-    retry_errors : tuple of str
-        What each lost start ended with, in order.
-    """
-
-    trial_id: str
-    status: str
-    metrics: dict[str, Any] | None
-    error: str | None
-    traceback: str | None
-    wall_time_s: float
-    started_at: str
-    finished_at: str
-    host: str
-    pid: int
-    retries: int = 0
-    retry_errors: tuple[str, ...] = ()
 
 
 def _now() -> str:
@@ -398,7 +345,7 @@ def _import_ray():
     try:
         import ray
     except ImportError:
-        from teamnav.experiments.sweep import SweepError
+        from teamnav.experiments.sweep_spec import SweepError
 
         raise SweepError(RAY_MISSING) from None
     return ray
@@ -513,7 +460,7 @@ def make_executor(name: str, *, workers: int | None = None, address: str | None 
         Unknown name, ``workers`` not an integer >= 1, ``address`` without Ray, or Ray
         requested but not installed.
     """
-    from teamnav.experiments.sweep import SweepError
+    from teamnav.experiments.sweep_spec import SweepError
 
     if name not in EXECUTORS:
         raise SweepError(f"executor: expected one of {', '.join(map(repr, EXECUTORS))}, received {name!r}")

@@ -302,17 +302,16 @@ register("throughput", throughput, "robot-steps per wall-clock second, after the
 
 
 def _discover_metric_sets() -> None:
-    """Import every module of :mod:`teamnav.experiments.metric_sets` so that each paper's
-    metrics register themselves. A metric set's functions return ``{}`` for a run that lacks
-    their data (another paper's scenario), because a scenario with ``metrics: []`` computes all."""
+    """Import every installed paper's metric sets (:attr:`teamnav.plugins.Paper.metric_sets`,
+    in the order of their names) so that their metrics register themselves. A metric set's
+    functions return ``{}`` for a run that lacks their data (another paper's scenario), because
+    a scenario with ``metrics: []`` computes all."""
     import importlib
-    import pkgutil
 
-    from teamnav.experiments import metric_sets
+    from teamnav.experiments.metric_sets import metric_set_modules
 
-    for info in sorted(pkgutil.iter_modules(metric_sets.__path__), key=lambda m: m.name):
-        if not info.name.startswith("_"):
-            importlib.import_module(f"{metric_sets.__name__}.{info.name}")
+    for module in metric_set_modules().values():
+        importlib.import_module(module)
 
 
 #: keys each non-deterministic metric produces (for :func:`deterministic`)

@@ -1,7 +1,8 @@
 """Built-in scenarios found by name (STYLE habit 9).
 
-Every ``*.yaml`` file shipped in ``teamnav/experiments/scenarios/`` is a built-in scenario
-named after its stem (``demo.yaml`` is ``demo``). :func:`register` adds a scenario file from
+Every ``*.yaml`` file shipped in ``teamnav/experiments/scenarios/`` (the core's: ``demo``,
+``depot``, ``swarm``) or in an installed paper's ``scenarios/`` folder (:mod:`teamnav.plugins`)
+is a built-in scenario named after its stem (``demo.yaml`` is ``demo``). :func:`register` adds a scenario file from
 elsewhere under a new name; a second registration of a name raises, and an unknown name gets
 a "did you mean" hint.
 """
@@ -16,16 +17,22 @@ import yaml
 
 __all__ = ["SCENARIO_DIR", "describe", "names", "path", "register"]
 
-#: Folder of the scenario files shipped with the package.
+#: Folder of the core's scenario files (each paper's are in its own package folder).
 SCENARIO_DIR: Path = Path(str(resources.files("teamnav.experiments"))) / "scenarios"
 
 _EXTRA: dict[str, Path] = {}
 
 
 def _shipped() -> dict[str, Path]:
-    if not SCENARIO_DIR.is_dir():
-        return {}
-    return {p.stem: p for p in sorted(SCENARIO_DIR.glob("*.yaml"))}
+    """The core's scenario files, then every installed paper's; a name shipped twice keeps
+    the first."""
+    from teamnav import plugins
+
+    found = {p.stem: p for p in sorted(SCENARIO_DIR.glob("*.yaml"))} if SCENARIO_DIR.is_dir() else {}
+    for paper in plugins.papers().values():
+        for p in paper.files("scenarios"):
+            found.setdefault(p.stem, p)
+    return found
 
 
 def register(name: str, file: str | Path) -> None:

@@ -53,8 +53,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
 
 if TYPE_CHECKING:  # pragma: no cover
-    from teamnav.experiments.executors import TrialResult
-    from teamnav.experiments.sweep import Trial
+    from teamnav.experiments.trial import Trial, TrialResult
 
 __all__ = ["BASE_COLUMNS", "STORE_NAME", "ResultsStore", "StoreError", "check_store", "load_dataframe", "load_rows"]
 

@@ -46,6 +46,7 @@ from teamnav.experiments.sweep_spec import (  # noqa: F401 - re-exports
     parse_seeds,
     parse_set,
     resolve_spec,
+    sweep_files,
     sweep_names,
 )
 from teamnav.experiments.sweep_trials import Trial, config_hash, expand, trial_id  # noqa: F401 - re-exports
@@ -64,6 +65,7 @@ __all__ = [
     "parse_set",
     "resolve_spec",
     "sweep",
+    "sweep_files",
     "sweep_names",
 ]
 

@@ -53,7 +53,7 @@ __all__ = [
     "sweep_names",
 ]
 
-#: Folder of the named sweeps shipped with the package.
+#: Folder of the core's named sweeps (each paper's are in its own package folder).
 SWEEP_DIR: Path = Path(str(resources.files("teamnav.experiments"))) / "sweeps"
 
 #: Override keys that a grid or ``set`` may not use, and what to use instead.
@@ -375,9 +375,22 @@ def parse_seeds(value: int | str | Sequence[int] | None) -> int | list[int] | No
 
 
 # ---------------------------------------------------------------------------- named sweeps
+def sweep_files() -> dict[str, Path]:
+    """``{name: file}`` of the named sweeps: the core's (``teamnav/experiments/sweeps/``), then
+    every installed paper's ``sweeps/`` folder (:mod:`teamnav.plugins`); a name shipped twice
+    keeps the first."""
+    from teamnav import plugins
+
+    found = {p.stem: p for p in sorted(SWEEP_DIR.glob("*.yaml"))} if SWEEP_DIR.is_dir() else {}
+    for paper in plugins.papers().values():
+        for p in paper.files("sweeps"):
+            found.setdefault(p.stem, p)
+    return found
+
+
 def sweep_names() -> list[str]:
-    """Names of the sweeps shipped in ``teamnav/experiments/sweeps/``, sorted."""
-    return sorted(p.stem for p in SWEEP_DIR.glob("*.yaml")) if SWEEP_DIR.is_dir() else []
+    """Names of the named sweeps (:func:`sweep_files`), sorted."""
+    return sorted(sweep_files())
 
 
 def describe_sweep(name: str) -> str:
@@ -404,12 +417,13 @@ def load_sweep(name_or_path: str | os.PathLike) -> SweepSpec:
     if _looks_like_path(text) or Path(text).is_file():
         path = Path(text)
     else:
-        names = sweep_names()
-        if text not in names:
+        files = sweep_files()
+        if text not in files:
+            names = sorted(files)
             close = difflib.get_close_matches(text, names, n=1)
             hint = f"; did you mean {close[0]!r}?" if close else ""
             raise SweepError(f"sweep: unknown named sweep {text!r}{hint} (known: {', '.join(names) or 'none'})")
-        path = SWEEP_DIR / f"{text}.yaml"
+        path = files[text]
     data = _read_sweep_file(path)
     scenario = data.get("scenario")
     if isinstance(scenario, str) and _looks_like_path(scenario):

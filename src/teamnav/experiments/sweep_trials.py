@@ -19,10 +19,10 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
 from teamnav.experiments.sweep_spec import SweepError, SweepSpec, _canonical
+from teamnav.experiments.trial import Trial
 
 __all__ = ["Trial", "config_hash", "expand", "trial_id"]
 
@@ -30,64 +30,6 @@ __all__ = ["Trial", "config_hash", "expand", "trial_id"]
 # ---------------------------------------------------------------------------- trials
 def _hash(value: Any) -> str:
     return hashlib.sha256(_canonical(value).encode("utf-8")).hexdigest()[:16]
-
-
-@dataclass(frozen=True)
-class Trial:
-    """One run of a sweep.
-
-    Attributes
-    ----------
-    trial_id : str
-        16 hex digits, stable (see the module docstring).
-    sweep : str
-        The sweep's name.
-    scenario : str
-        The scenario as the sweep names it (built-in name or absolute file path).
-    scenario_name : str
-        The resolved scenario's ``name``.
-    params : dict of str to value
-        Every override of this trial: the fixed ``set``, this combination of grid values,
-        and ``duration_s`` when the sweep sets it.
-    seed : int
-    config_hash : str
-        16 hex digits: hash of the resolved scenario without seed, name and description.
-    grid_keys : tuple of str
-        Which keys of ``params`` vary across the sweep.
-    """
-
-    trial_id: str
-    sweep: str
-    scenario: str
-    scenario_name: str
-    params: dict[str, Any]
-    seed: int
-    config_hash: str
-    grid_keys: tuple[str, ...] = ()
-    #: robot-steps of the resolved scenario (robots x steps): the schedule's size estimate
-    work: float = 0.0
-
-    @property
-    def overrides(self) -> dict[str, Any]:
-        """``params`` without ``duration_s`` and the ``case`` label (what ``load_scenario(overrides=...)`` gets)."""
-        return {k: v for k, v in self.params.items() if k not in ("duration_s", "case")}
-
-    @property
-    def duration_s(self) -> float | None:
-        return self.params.get("duration_s")
-
-    def load(self):
-        """The trial's validated :class:`~teamnav.experiments.spec.Scenario`."""
-        from teamnav.experiments.spec import load_scenario
-
-        return load_scenario(self.scenario, overrides=self.overrides or None, seed=self.seed, duration_s=self.duration_s)
-
-    def label(self) -> str:
-        """``robots.0.count=4 seed=2`` (grid values and seed)."""
-        shown = " ".join(f"{k}={self.params[k]!r}" for k in self.grid_keys)
-        if "case" in self.params:
-            shown = f"case={self.params['case']} {shown}"
-        return f"{shown} seed={self.seed}".strip()
 
 
 def trial_id(scenario_name: str, params: Mapping[str, Any], seed: int) -> str:

@@ -713,7 +713,7 @@ class MCL(SampleSetState):
 
     def move_samples(self, poses) -> None:
         """Give every sample a new pose, weights kept (not in Fox et al.: delayed integration,
-        :mod:`teamnav.control.delayed_integration`, moves the set into the frame of a past
+        :mod:`teamnav.papers.collab_mcl.brains.delayed_integration`, moves the set into the frame of a past
         detection and back).
 
         Parameters

@@ -127,7 +127,7 @@ class SyncMessage:
     detected_s : float or None
         None: the tree describes the robots at the message's stamp (the detection was just made,
         §3.2). Else the time the detection was made: a detection integrated later (§7.2 "delayed
-        integration", :mod:`teamnav.control.delayed_integration`); the tree describes the robots
+        integration", :mod:`teamnav.papers.collab_mcl.brains.delayed_integration`); the tree describes the robots
         at that time and the receiver applies it to its samples moved back to it. A reply
         (``"inverse"``) carries the time of the detection it answers.
     """

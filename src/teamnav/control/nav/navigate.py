@@ -55,10 +55,10 @@ One step, in priority order:
 
 Meeting flags (gap-fills, all off by default, i.e. the rules above; for trail robots that meet
 at corners, where Panic or the wall follower tracing round the other robot leaves a robot facing
-a wrong branch; see :mod:`teamnav.control.coop.trail_share` for their measurements, all made
+a wrong branch; see :mod:`teamnav.papers.trails.brains.trail_share` for their measurements, all made
 before session 11 gave the trail brains ``box_reach_m = 2.0``; with Navigate's 1.2 m a robot in
 the oncoming lane of a 1.8 m corridor never saw its own wall, which was the larger part of those
-meetings: :data:`teamnav.control.coop.blazing_trail.NAVIGATE_DEFAULTS`):
+meetings: :data:`teamnav.papers.trails.brains.blazing_trail.NAVIGATE_DEFAULTS`):
 
 6. ``hint_skips_cooldown``: with a trail hint, the opening cool-down that follows a Panic or a
    sharp turn is ignored (an opening already decided keeps its own cool-down).

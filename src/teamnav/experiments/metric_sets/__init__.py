@@ -1,6 +1,9 @@
-"""Paper-specific metrics, one module per system, registered on import.
+"""Paper-specific metrics: the contract of a paper's metric set, and where the sets are found.
 
-Every module here is imported by :mod:`teamnav.experiments.metrics` and calls
+Each paper declares its metric sets (:attr:`teamnav.plugins.Paper.metric_sets`, ``{set name:
+module}``, e.g. ``teamnav.papers.los_help.metrics``); :mod:`teamnav.experiments.metrics`
+imports every installed paper's sets in the order of their names
+(:func:`metric_set_modules`), and each module calls
 :func:`teamnav.experiments.metrics.register` for its metrics. A metric function takes a
 :class:`~teamnav.experiments.metrics.RunData` and returns a flat dict of numbers (or a JSON
 string for a time series, key ending in ``_series``); it returns ``{}`` when the run lacks
@@ -31,3 +34,15 @@ CORE_HEADLINE: dict[str, tuple[tuple[str, str], ...]] = {
     "wall_time": (("wall_time_s", "s"),),
     "throughput": (("robot_steps_per_s", "robot-steps/s"),),
 }
+
+
+def metric_set_modules() -> dict[str, str]:
+    """``{metric set name: module}`` of every installed paper, sorted by set name (the order
+    in which they register, hence the order of a ``metrics: []`` run's ``metrics.json``)."""
+    from teamnav import plugins
+
+    found: dict[str, str] = {}
+    for paper in plugins.papers().values():
+        for name, module in paper.metric_sets.items():
+            found.setdefault(name, module)
+    return dict(sorted(found.items()))

@@ -2,9 +2,10 @@
 
 ``teamnav report EXPERIMENT|all --out DIR [--quick]`` and :func:`build_report` do the same:
 
-1. find the sections: every module of :mod:`teamnav.experiments.report.sections` that defines
-   ``SECTION`` (a :class:`~teamnav.experiments.report.model.SectionSpec`), plus sections added
-   with :func:`register_section` (tests, plug-ins);
+1. find the sections: every section an installed paper declares
+   (:attr:`teamnav.plugins.Paper.sections`, a module that defines ``SECTION``, a
+   :class:`~teamnav.experiments.report.model.SectionSpec`), plus sections added with
+   :func:`register_section` (tests);
 2. for each chosen section, call ``SECTION.build(ctx)`` with a
    :class:`~teamnav.experiments.report.context.SweepContext`; its ``ctx.sweep(...)`` runs the
    section's sweeps into ``DIR/sweeps/<sweep name>/results.sqlite`` or reuses the trials
@@ -15,9 +16,9 @@
    section, the sections still to come shown as pending, so a long full run can be read
    while it goes and a killed one leaves a truthful report of what it finished.
 
-The four papers of EXPERIMENTS.md are always in ``all`` (:data:`EXPECTED_SECTIONS`): while a
-paper's section module does not exist, the report shows it as missing ("system not built
-yet"), never as numbers. A section whose ``build`` raises is shown as missing with the error,
+Every section an installed paper declares is always in ``all`` (:func:`expected_sections`):
+while its module does not exist, the report shows it as missing ("system not built yet"),
+never as numbers. A section whose ``build`` raises is shown as missing with the error,
 the other sections still run, and :attr:`ReportResult.ok` is False (the CLI exits 1 after
 writing the report).
 
@@ -37,7 +38,6 @@ import difflib
 import importlib
 import json
 import os
-import pkgutil
 import sys
 import time
 import traceback
@@ -56,7 +56,7 @@ from teamnav.experiments.report.model import (
 )
 
 __all__ = [
-    "EXPECTED_SECTIONS",
+    "expected_sections",
     "MARKER_NAME",
     "ReportError",
     "ReportResult",
@@ -73,33 +73,30 @@ __all__ = [
 #: File that marks a folder as a teamnav report (so ``--out`` can be reused, and nothing else is).
 MARKER_NAME = "teamnav-report.json"
 
-#: The papers of ``shared/EXPERIMENTS.md``: key -> (title, paper file, order). ``report all``
-#: always has these four sections, as results or as missing.
-EXPECTED_SECTIONS: dict[str, tuple[str, str, int]] = {
-    "los-help": (
-        "Sgorbissa & Arkin: line-of-sight help",
-        "sgorbissa-arkin-local-navigation-strategies-for-a-team-of-robots.txt",
-        10,
-    ),
-    "collab-mcl": (
-        "Fox, Burgard, Kruppa & Thrun: collaborative multi-robot localization",
-        "fox-burgard-kruppa-thrun-collaborative-multi-robot-localization.txt",
-        20,
-    ),
-    "blazing-a-trail": (
-        "Vaughan et al.: Blazing a trail",
-        "vaughan-stoy-sukhatme-mataric-blazing-a-trail.txt",
-        30,
-    ),
-    "try-to-see-it-my-way": (
-        "Vaughan et al.: Try to see it my way",
-        "vaughan-stoy-sukhatme-mataric-try-to-see-it-my-way.txt",
-        40,
-    ),
-}
+def expected_sections() -> dict[str, tuple[str, str, int]]:
+    """Every section the installed papers declare: key -> (title, paper file, order). ``report
+    all`` always has them, as results or as missing."""
+    from teamnav import plugins
+
+    out: dict[str, tuple[str, str, int]] = {}
+    for paper in plugins.papers().values():
+        for s in paper.sections:
+            out.setdefault(s.key, (s.title or s.key, s.paper, s.order))
+    return dict(sorted(out.items(), key=lambda kv: (kv[1][2], kv[0])))
+
+
+def _declared_modules() -> dict[str, str]:
+    """Section key -> the module that defines its ``SECTION``, for every installed paper."""
+    from teamnav import plugins
+
+    out: dict[str, str] = {}
+    for paper in plugins.papers().values():
+        for s in paper.sections:
+            out.setdefault(s.key, s.module)
+    return out
+
 
 _BLOCK_TYPES = (Text, Table, Plot, MapView, Comparison, Missing)
-_SECTIONS_PACKAGE = "teamnav.experiments.report.sections"
 _registered: dict[str, SectionSpec] = {}
 
 
@@ -131,7 +128,7 @@ def unregister_section(key: str) -> None:
 
 def _broken_section(key: str, module: str, error: str) -> SectionSpec:
     """A stand-in for a section module that cannot be imported: its build raises the error."""
-    title, paper, order = EXPECTED_SECTIONS.get(key, (key, "", 100))
+    title, paper, order = expected_sections().get(key, (key, "", 100))
 
     def build(ctx: Any) -> list:
         raise ImportError(f"section module {module} could not be imported: {error}")
@@ -140,32 +137,32 @@ def _broken_section(key: str, module: str, error: str) -> SectionSpec:
 
 
 def discover_sections() -> dict[str, SectionSpec]:
-    """Every ``SECTION`` defined by a module of :mod:`teamnav.experiments.report.sections`.
+    """Every ``SECTION`` of the modules the installed papers declare (:func:`_declared_modules`).
 
     A module that fails to import, or has no valid ``SECTION``, becomes a section whose build
-    raises that error (so the report shows it instead of losing it). A module ``foo_bar`` with
-    no importable SECTION gets the key ``foo-bar``.
+    raises that error (so the report shows it instead of losing it); a module that does not
+    exist is left out (:func:`available_sections` shows its section as missing).
 
     Returns
     -------
     dict of str to SectionSpec
         By section key.
     """
-    pkg = importlib.import_module(_SECTIONS_PACKAGE)
     found: dict[str, SectionSpec] = {}
-    for info in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda m: m.name):
-        if info.name.startswith("_"):
-            continue
-        module = f"{_SECTIONS_PACKAGE}.{info.name}"
-        guess = info.name.replace("_", "-")
+    for key, module in _declared_modules().items():
         try:
             mod = importlib.import_module(module)
+        except ModuleNotFoundError as exc:
+            if exc.name is not None and module.startswith(exc.name):
+                continue  # the paper's section is not written yet: missing, not broken
+            found[key] = _broken_section(key, module, f"{type(exc).__name__}: {exc}")
+            continue
         except Exception as exc:  # noqa: BLE001 - a broken section must not break the others
-            found[guess] = _broken_section(guess, module, f"{type(exc).__name__}: {exc}")
+            found[key] = _broken_section(key, module, f"{type(exc).__name__}: {exc}")
             continue
         spec = getattr(mod, "SECTION", None)
         if not isinstance(spec, SectionSpec):
-            found[guess] = _broken_section(guess, module, f"expected SECTION = SectionSpec(...), found {type(spec).__name__}")
+            found[key] = _broken_section(key, module, f"expected SECTION = SectionSpec(...), found {type(spec).__name__}")
             continue
         found[spec.key] = spec
     return found
@@ -175,12 +172,13 @@ def available_sections() -> dict[str, SectionSpec | None]:
     """Every known section key, in report order: discovered or registered sections, and the
     expected paper sections whose module does not exist yet (value None)."""
     found = {**discover_sections(), **_registered}
-    keys = set(found) | set(EXPECTED_SECTIONS)
+    expected = expected_sections()
+    keys = set(found) | set(expected)
 
     def order(key: str) -> tuple[int, str]:
         spec = found.get(key)
-        if key in EXPECTED_SECTIONS:
-            return (EXPECTED_SECTIONS[key][2], key)
+        if key in expected:
+            return (expected[key][2], key)
         return (spec.order if spec is not None else 100, key)
 
     return {k: found.get(k) for k in sorted(keys, key=order)}
@@ -221,7 +219,7 @@ class SectionOutcome:
     Attributes
     ----------
     key, title, paper : str
-        From the SectionSpec (or :data:`EXPECTED_SECTIONS` for a paper not built yet).
+        From the SectionSpec (or :func:`expected_sections` for a paper not built yet).
     status : {"ok", "missing", "error", "pending"}
         ``missing``: no section module yet; ``error``: its build raised (the blocks then hold
         one Missing block with the error); ``pending``: not built yet in a report that is
@@ -327,7 +325,7 @@ def _check_blocks(blocks: Any, key: str) -> list:
 
 def _build_one(key: str, spec: SectionSpec | None, make_ctx: Callable[[str], Any], say: Callable[[str], None]) -> SectionOutcome:
     if spec is None:
-        title, paper, _ = EXPECTED_SECTIONS[key]
+        title, paper, _ = expected_sections()[key]
         return SectionOutcome(
             key, title, paper, "missing", [Missing(what="this paper's reproduction", why="system not built yet (no section module)")]
         )
@@ -444,7 +442,7 @@ def run_report(
 
 
 def _pending(key: str, spec: SectionSpec | None) -> SectionOutcome:
-    title, paper = (spec.title, spec.paper) if spec is not None else EXPECTED_SECTIONS[key][:2]
+    title, paper = (spec.title, spec.paper) if spec is not None else expected_sections()[key][:2]
     return SectionOutcome(key, title, paper, "pending", [Missing(what="this section", why="not built yet: the report is still running")])
 
 

@@ -1,7 +1,7 @@
 """What a paper's report section is made of (the contract between paper modules and the
 HTML writer).
 
-Every module in :mod:`teamnav.experiments.report.sections` defines ``SECTION``, a
+Every section module a paper declares (:attr:`teamnav.plugins.Paper.sections`) defines ``SECTION``, a
 :class:`SectionSpec`: a key (``los-help``, ``collab-mcl``, ``blazing-a-trail``,
 ``try-to-see-it-my-way``), a title, the paper file, and ``build(ctx) -> list[Block]``. The
 report runs (or reuses, through the resumable sweep store) the named sweeps a section asks

@@ -1,1 +1,0 @@
-"""One module per paper; each defines ``SECTION`` (a :class:`~teamnav.experiments.report.model.SectionSpec`)."""

@@ -1,0 +1,1 @@
+"""The ``beyond`` report section (:mod:`.section`) and its blocks, one module each."""

@@ -1,0 +1,1 @@
+"""The ``robustness`` report section (:mod:`.section`): each system with and without its faults."""

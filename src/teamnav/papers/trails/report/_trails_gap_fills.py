@@ -1,0 +1,133 @@
+"""What each gap-fill of ``blazing-trail-v1`` (and of ``trail-share-v1``) buys, and what keeps the 2000
+team from breaking down (issue 25 §4): the runs of ``scripts/trail_gap_fill_study.py``, shown as
+measured, not re-run by the report.
+
+Vaughan, Støy, Sukhatme & Matarić (2000) §5.1: 28 units in 30 min, then "the unbounded odometry
+error causes the system to break down completely at around 27 minutes". The study pairs seeds
+(same start spots, drift and noise draws in every configuration) on seeds 100-107, which are
+neither the report's (0-9) nor used to choose any value (nothing is tuned with them):
+
+- part ``gapfills``: the 30-min ``blazing-a-trail`` trial, ``paper`` (every gap-fill at the
+  paper's value, 0.25 m/s), ``teamnav`` (ours, 0.4 m/s), ``paper+G`` (the paper's rules with G
+  alone at our value) and ``teamnav-G`` (ours with G alone at the paper's value);
+- part ``drift``: 1 h at the ``blazing-drift`` cases (k x the 2002 paper's per-robot heading drift;
+  wheel slip, a heading random walk; wheel-scale errors) for ``paper``,
+  ``paper+reverse_carried_crumbs``, ``teamnav@0.25`` (our gap-fills at the paper's speed) and
+  ``teamnav``.
+
+The runs are package data, ``papers/trails/report/data/blazing-gap-fill-study.json`` (one dict per
+run, as the script writes them; ``docs/report/blazing-gap-fill-study.jsonl`` and
+``blazing-drift-study.jsonl`` hold the same lines; a test checks that they agree). The same
+``gapfills`` part for the 2002 brain (``--system try``: trail-share-v1 on ``try-to-see-it-my-way``,
+1-h runs) is ``try-gap-fill-study.json`` / ``docs/report/try-gap-fill-study.jsonl``, shown in the
+try-to-see-it-my-way section.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from teamnav.experiments.report.model import Missing, Table, Text
+
+__all__ = ["DATA_FILES", "HEADER", "STUDY_RUNS", "blocks", "cases", "study_runs", "table_rows"]
+
+_DATA = Path(__file__).resolve().parent / "data"
+#: system -> its package-data file of study runs (``--system`` of the script)
+DATA_FILES = {"blazing": "blazing-gap-fill-study.json", "try": "try-gap-fill-study.json"}
+#: system -> (brain, scenario) as the tables name them
+SYSTEM_NAMES = {"blazing": ("blazing-trail-v1", "blazing-a-trail"), "try": ("trail-share-v1", "try-to-see-it-my-way")}
+
+
+def study_runs(system: str = "blazing") -> tuple[dict, ...]:
+    """The stored runs of ``system`` (empty when the file is absent)."""
+    path = _DATA / DATA_FILES[system]
+    return tuple(json.loads(path.read_text(encoding="utf-8"))) if path.is_file() else ()
+
+
+#: the study's runs of blazing-trail-v1 (see the module docstring)
+STUDY_RUNS: tuple[dict, ...] = study_runs("blazing")
+
+#: what the paired column compares with: the first of these that the case ran
+REFERENCES = ("paper", "paper+reverse_carried_crumbs")
+
+HEADER = ["configuration", "units (mean ± std)",
+          "paired vs the reference; teamnav-G vs teamnav (mean ± s.e., seeds with more)",
+          "units in the 2nd half", "broke down", "median breakdown [min]", "CPU s / run"]
+
+
+def _ms(v: list[float]) -> str:
+    if len(v) > 1:
+        return f"{np.mean(v):.1f} ± {np.std(v, ddof=1):.1f}"
+    return f"{v[0]:.1f}" if v else "-"
+
+
+def _paired(rows: list[dict], base: dict[int, dict], key: str) -> str:
+    d = [r[key] - base[r["seed"]][key] for r in rows if r["seed"] in base]
+    if len(d) < 2:
+        return "-"
+    se = float(np.std(d, ddof=1)) / math.sqrt(len(d))
+    return f"{np.mean(d):+.1f} ± {se:.1f} ({sum(x > 0 for x in d)}/{len(d)})"
+
+
+def _order(config: str) -> tuple:
+    return (config != "paper", config != "paper+reverse_carried_crumbs", config != "teamnav",
+            config.startswith("teamnav"), config)
+
+
+def table_rows(runs, part: str, case: str) -> list[list[str]]:
+    """One row per configuration of ``part`` at drift ``case`` ("" for the scenario's own drift):
+    :data:`HEADER`'s columns; the paired difference is against the reference (the first of
+    :data:`REFERENCES` that ran at this case, marked "reference") on the same seed, and for a
+    ``teamnav-G`` row against ``teamnav`` (what leaving G out of ours costs)."""
+    rs = [r for r in runs if r["part"] == part and r["case"] == case]
+    ref = next((c for c in REFERENCES if any(r["config"] == c for r in rs)), None)
+    bases = {name: {r["seed"]: r for r in rs if r["config"] == name} for name in (ref, "teamnav")}
+    out = []
+    for c in sorted({r["config"] for r in rs}, key=_order):
+        g = [r for r in rs if r["config"] == c]
+        base = bases["teamnav" if c.startswith("teamnav-") else ref]
+        dur = g[0]["duration_s"]
+        broke = [r for r in g if not r["breakdown_censored"]]
+        med = float(np.median([r["duration_s"] if r["breakdown_censored"] else r["breakdown_s"] for r in g]))
+        out.append([c, _ms([r["units"] for r in g]), "reference" if c == ref else _paired(g, base, "units"),
+                    _ms([r["units_second_half"] for r in g]), f"{len(broke)}/{len(g)}",
+                    f"{med / 60:.0f}" + ("+" if med >= dur else ""), f"{np.mean([r['cpu_s'] for r in g]):.1f}"])
+    return out
+
+
+def cases(runs, part: str) -> list[str]:
+    """The drift cases of ``part`` in the study, in the order x0, x1, x4, x1-slip, x1-scale5."""
+    return sorted({r["case"] for r in runs if r["part"] == part}, key=lambda c: (len(c), c))
+
+
+def _seeds(runs) -> str:
+    s = sorted({r["seed"] for r in runs})
+    return f"{s[0]}-{s[-1]}" if s else "-"
+
+
+def blocks(runs=None, system: str = "blazing") -> list:
+    """The study's tables of ``system`` for its report section (both parts), or a Missing block."""
+    runs = list(study_runs(system) if runs is None else runs)
+    brain, scenario = SYSTEM_NAMES[system]
+    if not runs:
+        return [Missing(f"gap-fill study of {brain}", "no runs of scripts/trail_gap_fill_study.py stored")]
+    out: list = [Text(
+        f"Why the two columns of {brain} differ, taken apart (issue 25 §4; scripts/trail_gap_fill_study.py "
+        f"--system {system}, paired seeds "
+        f"{_seeds(runs)}, which are neither the report's nor used to choose anything; measured once and shown "
+        "as measured, not re-run here). 'paper+G': the paper's rules with gap-fill G alone at teamnav's value "
+        "(what G buys on its own); 'teamnav-G': ours with G alone at the paper's value (what G is worth among "
+        "the others); 'teamnav@0.25': every gap-fill of ours at the paper's cruise speed.")]
+    for case in cases(runs, "gapfills"):
+        rs = [r for r in runs if r["part"] == "gapfills" and r["case"] == case]
+        out.append(Table(f"Each gap-fill alone: {scenario}, {rs[0]['duration_s'] / 60:g} min, the scenario's drift",
+                         HEADER, table_rows(runs, "gapfills", case)))
+    for case in cases(runs, "drift"):
+        rs = [r for r in runs if r["part"] == "drift" and r["case"] == case]
+        out.append(Table(f"Drift case {case}: {rs[0]['duration_s'] / 60:g} min, paper / paper with homebound crumbs "
+                         "reversed / our gap-fills at 0.25 m/s / ours", HEADER, table_rows(runs, "drift", case)))
+    return out
