@@ -47,9 +47,11 @@ from typing import Any, Callable, Iterable, Sequence
 
 from teamnav.experiments.report.model import (
     Comparison,
+    Ledger,
     MapView,
     Missing,
     Plot,
+    Precondition,
     SectionSpec,
     Table,
     Text,
@@ -96,7 +98,7 @@ def _declared_modules() -> dict[str, str]:
     return out
 
 
-_BLOCK_TYPES = (Text, Table, Plot, MapView, Comparison, Missing)
+_BLOCK_TYPES = (Text, Table, Plot, MapView, Comparison, Missing, Ledger, Precondition)
 _registered: dict[str, SectionSpec] = {}
 
 
@@ -356,8 +358,11 @@ def _outcome_json(s: SectionOutcome) -> dict[str, Any]:
         "error": s.error or None,
         "traceback": s.traceback or None,
         "comparisons": [
-            {"claim": c.claim, "paper": c.paper, "ours": c.ours, "holds": c.holds, "differs": c.differs} for c in s.comparisons
+            {"claim": c.claim, "column": c.column, "paper": c.paper, "ours": c.ours, "holds": c.holds,
+             "differs": c.differs} for c in s.comparisons
         ],
+        "ledger": [row.record() for b in s.blocks if isinstance(b, Ledger) for row in b.rows],
+        "precondition": [b.record() for b in s.blocks if isinstance(b, Precondition)],
         "missing": [{"what": b.what, "why": b.why} for b in s.blocks if isinstance(b, Missing)],
         "sweeps": s.sweeps,
     }

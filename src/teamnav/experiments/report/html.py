@@ -28,7 +28,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, Table, Text
+from teamnav.experiments.report.model import COLUMNS, Comparison, Ledger, MapView, Missing, Plot, Precondition, Table, Text
 
 __all__ = ["CSP", "git_commit", "render_report"]
 
@@ -144,15 +144,31 @@ def _draw(block: Plot | MapView) -> str:
 def _comparisons(comps: Sequence[Comparison]) -> str:
     if not comps:
         return ""
+    with_column = any(c.column for c in comps)
     rows = []
     for c in comps:
         mark, cls, word = _HOLDS.get(c.holds, _HOLDS[None])
+        column = f"<td>{_e(COLUMNS.get(c.column, ''))}</td>" if with_column else ""
         rows.append(
-            f"<tr><td>{_e(c.claim)}</td><td>{_e(c.paper)}</td><td>{_e(c.ours)}</td>"
+            f"<tr><td>{_e(c.claim)}</td>{column}<td>{_e(c.paper)}</td><td>{_e(c.ours)}</td>"
             f'<td class="holds {cls}" title="{word}">{mark}</td><td>{_e(c.differs)}</td></tr>'
         )
-    head = "<tr><th>claim</th><th>paper</th><th>ours</th><th>holds</th><th>where we differ</th></tr>"
+    column_head = "<th>column</th>" if with_column else ""
+    head = f"<tr><th>claim</th>{column_head}<th>paper</th><th>ours</th><th>holds</th><th>where we differ</th></tr>"
     return f'<table class="comparisons"><thead>{head}</thead><tbody>{"".join(rows)}</tbody></table>'
+
+
+def _ledger(block: Ledger) -> str:
+    rows = [[COLUMNS[r.column], r.name, r.value, r.source, r.ref] for r in block.rows]
+    return _table(Table(title=block.title, columns=["column", "parameter", "value", "source", "where from"],
+                        rows=rows, note=block.note))
+
+
+def _precondition(block: Precondition) -> str:
+    mark, cls, word = _HOLDS.get(block.holds, _HOLDS[None])
+    needs = f" (needed by {', '.join(block.claims)})" if block.claims else ""
+    return (f'<p class="precondition"><b>precondition</b>{_e(needs)}: {_e(block.what)} — checked on {_e(block.seeds)}: '
+            f'{_e(block.result)} <span class="holds {cls}" title="{word}">{mark}</span></p>')
 
 
 def _verdicts(comps: Sequence[Comparison]) -> str:
@@ -196,6 +212,10 @@ def _section_html(s: Any) -> str:
             out.append(_missing(block.what, block.why, error=s.status == "error"))
         elif isinstance(block, Table):
             out.append(_table(block))
+        elif isinstance(block, Ledger):
+            out.append(_ledger(block))
+        elif isinstance(block, Precondition):
+            out.append(_precondition(block))
         elif isinstance(block, (Plot, MapView)):
             out.append(_draw(block))
         elif isinstance(block, Text):
