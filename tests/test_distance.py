@@ -74,3 +74,18 @@ def test_likelihood_field():
 def test_bad_input(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_a_repeated_field_is_the_same_and_each_caller_owns_its_copy():
+    # distance_field keeps its last field (a run asks for its map's twice): the second answer
+    # is equal, and writing into one answer changes neither the other nor the next
+    b = np.zeros((5, 7), np.uint8)
+    b[2, 3] = 1
+    first = distance_field(b, 0.1)
+    second = distance_field(b, 0.1)
+    np.testing.assert_array_equal(first, second)
+    second[:] = -1.0
+    np.testing.assert_array_equal(distance_field(b, 0.1), first)
+    b[0, 0] = 1  # the caller's mask changed: computed afresh
+    assert distance_field(b, 0.1)[0, 0] == 0.0 and first[0, 0] > 0.0
+    assert distance_field(b, 0.2)[2, 1] == 0.2 * 2

@@ -34,6 +34,7 @@ import datetime as _dt
 import json
 import math
 import os
+from collections.abc import MutableMapping
 from pathlib import Path
 from typing import Any, Iterator, List, Optional
 
@@ -70,6 +71,78 @@ class _Group(typer.core.TyperGroup):
             if getattr(param, "param_type_name", "") == "argument" and hasattr(param, "display_type_rich"):
                 param.display_type_rich = _no_type
         return cmd
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.commands = _Commands(self.commands)
+
+    def list_commands(self, ctx):  # type: ignore[override]
+        return list(self.commands)  # the names only: loads nothing
+
+    def format_commands(self, ctx, formatter):  # type: ignore[override]
+        # As click's, except that a command not loaded yet shows its one-line help from
+        # _LAZY_COMMANDS: `teamnav --help` imports none of them.
+        rows = []
+        for name in self.list_commands(ctx):
+            if not self.commands.loaded(name):
+                rows.append((name, _LAZY_COMMANDS[name][2]))
+                continue
+            cmd = self.get_command(ctx, name)
+            if cmd is not None and not cmd.hidden:
+                rows.append((name, cmd))
+        if rows:
+            limit = formatter.width - 6 - max(len(name) for name, _ in rows)
+            with formatter.section("Commands"):
+                formatter.write_dl([(name, c if isinstance(c, str) else c.get_short_help_str(limit)) for name, c in rows])
+
+
+#: Commands whose module is imported only when the command runs (or shows its own help), so
+#: `teamnav --help`, `list` and `run` never import the report machinery:
+#: name -> (module, function, the one-line help `teamnav --help` shows; a test checks that it
+#: is the command's own).
+_LAZY_COMMANDS: dict[str, tuple[str, str, str]] = {
+    "report": ("teamnav.experiments.report.cli", "report_command",
+               "Write an HTML report: each paper's claims beside our numbers."),
+}
+
+
+class _Commands(MutableMapping):
+    """The group's commands by name: the registered ones, then those of :data:`_LAZY_COMMANDS`,
+    each built (its module imported) the first time it is looked up."""
+
+    def __init__(self, commands: dict) -> None:
+        self._loaded = dict(commands)
+
+    def loaded(self, name: str) -> bool:
+        return name in self._loaded
+
+    def __getitem__(self, name: str) -> Any:
+        if name not in self._loaded and name in _LAZY_COMMANDS:
+            self._loaded[name] = _load_lazy_command(name)
+        return self._loaded[name]
+
+    def __setitem__(self, name: str, cmd: Any) -> None:
+        self._loaded[name] = cmd
+
+    def __delitem__(self, name: str) -> None:
+        del self._loaded[name]
+
+    def __iter__(self) -> Iterator[str]:
+        yield from self._loaded
+        yield from (n for n in _LAZY_COMMANDS if n not in self._loaded)
+
+    def __len__(self) -> int:
+        return len(set(self._loaded) | set(_LAZY_COMMANDS))
+
+
+def _load_lazy_command(name: str) -> Any:
+    """The click command of lazy command ``name``, built by typer as ``app.command`` would."""
+    import importlib
+
+    module, attr, _ = _LAZY_COMMANDS[name]
+    one = typer.Typer(rich_markup_mode=None, add_completion=False)
+    one.command(name)(getattr(importlib.import_module(module), attr))
+    return typer.main.get_command(one)
 
 
 app = typer.Typer(
@@ -463,9 +536,7 @@ from teamnav.experiments.sweep_cli import sweep_command  # noqa: E402  (after th
 
 app.command("sweep")(sweep_command)
 
-from teamnav.experiments.report.cli import report_command  # noqa: E402
-
-app.command("report")(report_command)
+# `report` is registered lazily: see _LAZY_COMMANDS
 
 
 def main() -> None:  # pragma: no cover - console entry for `python -m teamnav`

@@ -22,12 +22,14 @@ umask (folders ``0o777 & ~umask``, files ``0o666 & ~umask``), like any file a to
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
 import re
 import shutil
 import socket
+import sys
 import tempfile
 import time
 from dataclasses import dataclass
@@ -55,6 +57,10 @@ __all__ = [
 
 #: a progress bar appears once a run has taken this long [s]
 PROGRESS_AFTER_S = 2.0
+#: what the progress line says while numba compiles a kernel (the cache is empty or stale);
+#: the time is the first run of the built-in scenarios on a 2-core machine (demo ~20 s, the
+#: MCL ones more; measured by benchmarks/bench_startup.py)
+COMPILING = "compiling numba kernels (first run only, ~20-60 s; later runs load them from the cache)"
 
 
 class OutputDirError(ValueError):
@@ -387,9 +393,10 @@ def run(
                     except OSError as exc:
                         raise OutputDirError(f"output folder {out if out is not None else folder}: cannot write in "
                                              f"{folder} ({exc.strerror or exc}); choose another --out") from None
-                report.phase("first step: numba compiles (first run) or loads its kernels")
+                report.phase("first step: loading numba's cached kernels")
                 t0 = time.perf_counter()
-                sim.run(n_steps, progress=report.step, is_finished=all_finished if scenario.stop_when_finished else None)
+                with report.watching_compiles():
+                    sim.run(n_steps, progress=report.step, is_finished=all_finished if scenario.stop_when_finished else None)
                 wall_s = time.perf_counter() - t0
                 warmup_s = (report.t_first - t0) if report.t_first is not None else 0.0  # the first step
                 report.stepped()
@@ -431,6 +438,7 @@ class _Progress:
         from teamnav.experiments.progress import PlainProgress, stderr_is_terminal
 
         self.t_first: float | None = None  # perf_counter() at the end of the first step
+        self.told_compiling = False
         self.bar: _LazyBar | None = None
         self.plain: PlainProgress | None = None
         self.user: Callable[[int], None] | None = progress if callable(progress) else None
@@ -457,6 +465,44 @@ class _Progress:
     def phase(self, text: str) -> None:
         if self.plain is not None:
             self.plain.phase(text)
+
+    @contextlib.contextmanager
+    def watching_compiles(self):
+        """While stepping: when numba really compiles a kernel (not a load from its cache: that
+        sends no event), say so, once on a terminal, in the plain lines while it lasts."""
+        if self.plain is None and self.bar is None:
+            yield
+            return
+        from numba.core import event
+
+        progress = self
+        depth = [0]
+
+        class _Compiles(event.Listener):
+            def on_start(self, ev) -> None:
+                depth[0] += 1
+                if depth[0] == 1:
+                    progress.compiling(True)
+
+            def on_end(self, ev) -> None:
+                depth[0] -= 1
+                if depth[0] == 0:
+                    progress.compiling(False)
+
+        with event.install_listener("numba:compile", _Compiles()):
+            yield
+
+    def compiling(self, now: bool) -> None:
+        """numba started (``now``) or finished compiling a kernel, outside any other."""
+        if self.plain is not None:
+            self.plain.phase(COMPILING if now else ("" if self.t_first is not None else "first step"))
+        elif now and self.bar is not None and not self.told_compiling:
+            self.told_compiling = True
+            line = f"{self.bar.label}: {COMPILING}"
+            if self.bar.bar is not None:
+                self.bar.bar.console.print(line, markup=False)
+            else:
+                print(line, file=sys.stderr, flush=True)
 
     def stepped(self) -> None:
         """Stepping is over: the bar goes, the plain lines say what comes next."""

@@ -121,6 +121,14 @@ def _draw_map(ax, grid: OccupancyGrid) -> None:
     ax.set_ylabel("y [m]")
 
 
+def _tight_layout_once(fig, **kwargs) -> None:
+    """``fig.tight_layout(**kwargs)``, then no layout engine: matplotlib would otherwise keep a
+    placeholder engine, and every ``savefig`` (every GIF frame) would draw the whole figure
+    once more, map image included, before drawing it for real. The picture is the same."""
+    fig.tight_layout(**kwargs)
+    fig.set_layout_engine(None)
+
+
 def _poses(ax, pose: np.ndarray, radius_m: np.ndarray, colours: np.ndarray) -> None:
     """Final poses as discs with a heading tick."""
     discs = [Circle((x, y), r) for (x, y, _), r in zip(pose, radius_m)]
@@ -189,7 +197,7 @@ def plot_trajectories(
             ax.plot([], [], "k-", lw=1.2, label="true path")
             ax.plot([], [], "k--", lw=0.8, label="odometry (anchored at start)")
             ax.legend(loc="best", fontsize=8, framealpha=0.8)
-        fig.tight_layout()
+        _tight_layout_once(fig)
         path = Path(path)
         fig.savefig(path, dpi=dpi)
     finally:
@@ -277,7 +285,7 @@ def save_gif(run_dir: str | Path, path: str | Path | None = None, *, fps: int = 
         dots = ax.scatter(pose[0, :, 0], pose[0, :, 1], s=np.maximum(size, 4.0), c=colours, edgecolors="black", linewidths=0.3, zorder=4)
         label = ax.text(0.01, 0.99, "", transform=ax.transAxes, va="top", ha="left", fontsize=9,
                         bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "none"}, zorder=6)
-        fig.tight_layout(pad=0.2)
+        _tight_layout_once(fig, pad=0.2)
         out = Path(path) if path is not None else run_dir / "run.gif"
         writer = PillowWriter(fps=fps)
         # the writer loop directly (not FuncAnimation, which draws every frame twice)

@@ -8,7 +8,6 @@ traded for when speed matters) and potential-field navigation (Sgorbissa & Arkin
 from __future__ import annotations
 
 import numpy as np
-from scipy import ndimage
 
 from teamnav.world.grid import OccupancyGrid
 from teamnav.world.raycast import _check_blocking, _check_positive
@@ -54,10 +53,23 @@ def distance_field(grid_or_blocking, resolution_m: float | None = None) -> np.nd
             raise ValueError("resolution_m must be a finite number > 0 when a blocking mask is given, got None")
         blocking = _check_blocking(grid_or_blocking)
         res = _check_positive("resolution_m", resolution_m)
+    last = _LAST[0]
+    if last is not None and last[1] == res and last[0].shape == blocking.shape and np.array_equal(last[0], blocking):
+        return last[2].copy()
     free = blocking == 0
     if free.all():
         return np.full(blocking.shape, np.inf)
-    return ndimage.distance_transform_edt(free, sampling=res)
+    from scipy import ndimage  # here: scipy.ndimage alone takes ~0.3 s to import
+
+    field = ndimage.distance_transform_edt(free, sampling=res)
+    _LAST[0] = (np.array(blocking, copy=True), res, field.copy())
+    return field
+
+
+#: the last blocking mask, resolution and field :func:`distance_field` computed: a run asks
+#: for its map's field twice (start poses, then the collision metric), 0.15 s each on a
+#: 1200 x 1200 map; a copy of each is kept, so what a caller does with its field stays its own
+_LAST: list = [None]
 
 
 def likelihood_field(distance_m: np.ndarray, sigma_m: float, max_distance_m: float | None = None) -> np.ndarray:

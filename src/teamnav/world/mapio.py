@@ -581,12 +581,12 @@ def save_map(
     except OSError as exc:
         raise MapError(yaml_path, "<file>", "a path in a folder that can be created and written",
                        _Described(f"{type(exc).__name__}: {exc.strerror or exc}")) from None
-    names = np.asarray(grid.materials, dtype=object)
-    cell_names = names[grid.cells]
-    image = np.full(grid.shape, px_occupied, dtype=np.uint8)
-    image[cell_names == "free"] = px_free
-    image[cell_names == "unknown"] = px_unknown
-    special = ~np.isin(cell_names, ("free", "wall", "unknown"))
+    # per material id, then one lookup per cell (not a string per cell: 0.2 s on 1200 x 1200)
+    lut = np.array([px_free if m == "free" else px_unknown if m == "unknown" else px_occupied for m in grid.materials],
+                   dtype=np.uint8)
+    is_special = np.array([m not in ("free", "wall", "unknown") for m in grid.materials], dtype=bool)
+    image = lut[grid.cells]
+    special = is_special[grid.cells]
 
     image_name = yaml_path.stem + ".pgm"
     doc: dict[str, Any] = {

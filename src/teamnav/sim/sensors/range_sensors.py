@@ -419,7 +419,9 @@ def _sense_serial(cast, hits, beams, even, bodies, noise, out):
     all_r)`` are hashed once per call."""
     all_x, all_y, all_r = bodies
     hsh = _hash_or_none(hits[0], all_x, all_y, all_r, hits[6])
-    _sense_rows(0, out.shape[0], cast, hits, beams, even, hsh, noise, out)
+    # np.int64(0), not 0: a literal 0 would make numba compile _sense_rows a second time, for
+    # Literal[int](0), beside the int64 one _sense_parallel uses (~13 s on 2 cores)
+    _sense_rows(np.int64(0), out.shape[0], cast, hits, beams, even, hsh, noise, out)
 
 
 @njit(cache=True, parallel=True)
