@@ -65,11 +65,13 @@ MODE_OPEN_ADVANCE = 3
 MODE_OPEN_TURN = 4
 
 # ----------------------------------------------------------------- draw indices k
-K_OPEN_LEFT = 0
-K_OPEN_RIGHT = 1
-K_TIE_SIGN = 2
-K_EXTRA_TURN = 3
-K_BACKOFF_SIGN = 4
+# np.int64, not int: numba types a plain int global as a literal, and compiled uniform01 once
+# per index (five specializations on a first run); an int64 constant shares one.
+K_OPEN_LEFT = np.int64(0)
+K_OPEN_RIGHT = np.int64(1)
+K_TIE_SIGN = np.int64(2)
+K_EXTRA_TURN = np.int64(3)
+K_BACKOFF_SIGN = np.int64(4)
 N_DRAWS = 8  # draws reserved per (robot, step); indices above are < N_DRAWS
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
