@@ -149,7 +149,6 @@ def test_parse_seeds_and_set():
         ({"scenario": "demo", "seeds": [1, 2, 1]}, ["seeds", "distinct", "1"]),
         ({"scenario": "demo", "seeds": [-1]}, ["seeds", "-1"]),
         ({"scenario": "demo", "grid": {"robots.0.count": []}}, ["grid robots.0.count", "non-empty", "[]"]),
-        ({"scenario": "demo", "grid": {"robots.0.count": [2, 2]}}, ["grid robots.0.count", "distinct", "2"]),
         ({"scenario": "demo", "grid": {"seed": [1, 2]}}, ["seed", "use seeds"]),
         ({"scenario": "demo", "grid": {"a": [1]}, "set": {"a": 2}}, ["'a'", "only one of grid and set"]),
         ({"scenario": "demo", "duration_s": -1}, ["duration_s", "-1"]),

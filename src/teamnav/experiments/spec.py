@@ -70,6 +70,7 @@ __all__ = [
     "Scenario",
     "apply_overrides",
     "build_grid",
+    "canonical_key",
     "check_controllers",
     "load_scenario",
     "package_maps",
@@ -525,6 +526,25 @@ def _pretty(parts: Sequence[str]) -> str:
     return out
 
 
+def canonical_key(key: str) -> str:
+    """The one spelling of a dotted override key, as :func:`apply_overrides` reads it.
+
+    :func:`apply_overrides` takes a key with blanks around it (``" robots.0.count"``) and reads
+    a part made of decimal digits as a list index by its value, so ``robots.00.count``,
+    ``robots.\u0660.count`` (an Arabic-Indic zero) and ``robots.\uff10.count`` (a full-width
+    zero) all set ``robots[0].count``. This returns that key once: stripped, every all-digit
+    part written as a plain ASCII number without leading zeros. Sweeps compare and store keys
+    in this spelling, so two spellings of one field are seen as the same key. Anything else
+    (an empty part, blanks inside a part, brackets) is returned as it is, for the caller's
+    checks to refuse.
+
+    >>> canonical_key(" robots.007.count"), canonical_key("radio.p_loss")
+    ('robots.7.count', 'radio.p_loss')
+    """
+    parts = str(key).strip().split(".")
+    return ".".join(str(int(p)) if p.isdecimal() else p for p in parts)
+
+
 def apply_overrides(data: dict, overrides: Mapping[str, Any] | Sequence[str] | None, file: str = "<scenario>") -> dict[str, str]:
     """Set dotted-path overrides in the raw scenario ``data`` (in place).
 
@@ -533,7 +553,8 @@ def apply_overrides(data: dict, overrides: Mapping[str, Any] | Sequence[str] | N
     data : dict
         The scenario as read from YAML.
     overrides : dict of str to value, or list of "key=value" strings, or None
-        ``"robots.0.count=10"``, ``"radio.p_loss=0.1"``: dotted keys, integers index lists;
+        ``"robots.0.count=10"``, ``"radio.p_loss=0.1"``: dotted keys, integers index lists
+        (read as :func:`canonical_key` writes them: ``robots.00.count`` is ``robots.0.count``);
         string values of ``"key=value"`` items are parsed as YAML (``0.1``, ``true``, ``[1, 2]``).
     file : str
         The scenario file, for messages.
@@ -572,7 +593,7 @@ def apply_overrides(data: dict, overrides: Mapping[str, Any] | Sequence[str] | N
         # a copy: a later dotted key writes into what this one set, never into the caller's object
         # (a sweep's `set` dict shared by all its cases leaked one case's value into every case)
         value = copy.deepcopy(value)
-        parts = key.split(".")
+        parts = canonical_key(key).split(".")
         if not key or any(not p for p in parts):
             raise ScenarioError.one(file, "--set", "expected a dotted key such as robots.0.count", key)
         node: Any = data
@@ -580,7 +601,7 @@ def apply_overrides(data: dict, overrides: Mapping[str, Any] | Sequence[str] | N
             last = depth == len(parts) - 1
             here = _pretty(parts[: depth + 1])
             if isinstance(node, list):
-                if not part.isdigit() or int(part) >= len(node):
+                if not part.isdecimal() or int(part) >= len(node):
                     raise ScenarioError.one(
                         file,
                         f"--set {key}",
@@ -597,7 +618,7 @@ def apply_overrides(data: dict, overrides: Mapping[str, Any] | Sequence[str] | N
                     node[part] = value
                 elif part in node and node[part] is not None:
                     node = node[part]
-                elif parts[depth + 1].isdigit():
+                elif parts[depth + 1].isdecimal():
                     raise ScenarioError.one(
                         file,
                         f"--set {key}",

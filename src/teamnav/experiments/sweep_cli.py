@@ -22,7 +22,9 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import os
+import warnings
 from pathlib import Path
 from typing import List, Optional
 
@@ -81,21 +83,22 @@ def sweep_command(
 
     err = Console(stderr=True, highlight=False, soft_wrap=True)
     try:
-        result = sweep(
-            name_or_file,
-            out_dir=out,
-            grid=grid or None,
-            seeds=seeds,
-            set=set_ or None,
-            duration_s=duration,
-            name=name,
-            executor=executor,
-            workers=workers,
-            address=address,
-            progress=not quiet,
-            retry_failed=retry_failed,
-            artifacts=artifacts,
-        )
+        with _warnings_printed(err):
+            result = sweep(
+                name_or_file,
+                out_dir=out,
+                grid=grid or None,
+                seeds=seeds,
+                set=set_ or None,
+                duration_s=duration,
+                name=name,
+                executor=executor,
+                workers=workers,
+                address=address,
+                progress=not quiet,
+                retry_failed=retry_failed,
+                artifacts=artifacts,
+            )
     except (SweepError, ScenarioError, StoreError, MapError, OutputDirError) as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(EXIT_BAD_INPUT) from None
@@ -114,3 +117,23 @@ def sweep_command(
             if len(result.failures) > 10:
                 err.print(f"  ... and {len(result.failures) - 10} more (see the error column of the store)", markup=False)
         raise typer.Exit(EXIT_TRIALS_FAILED)
+
+
+@contextlib.contextmanager
+def _warnings_printed(err: Console):
+    """Print each :class:`~teamnav.experiments.sweep_spec.SweepWarning` raised inside as one
+    ``warning: ...`` line on ``err`` (other warnings go their usual way)."""
+    from teamnav.experiments.sweep_spec import SweepWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", SweepWarning)
+        shown = warnings.showwarning
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if issubclass(category, SweepWarning):
+                err.print(f"warning: {message}", markup=False)
+            else:
+                shown(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = show
+        yield

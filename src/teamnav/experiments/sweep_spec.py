@@ -26,6 +26,26 @@ A sweep can be written as YAML; the files shipped in ``teamnav/experiments/sweep
 overrides applied together, for keys that a grid cannot tie (a navigator and the sharing flags
 that go with it; a per-robot drift pattern). Trials are cases x grid x seeds; a trial's
 ``params`` carry the case label under ``case`` and its overrides.
+
+One key, one place
+------------------
+Keys are compared in their canonical spelling (:func:`~teamnav.experiments.spec.canonical_key`:
+``robots.00.count`` and `` robots.0.count`` are ``robots.0.count``) and stored that way. A trial
+applies ``set``, then its case, then the grid axes in order, so a key given in two places
+would run the later value while the earlier one still labelled the trial. That is refused,
+naming both spellings: two spellings of one key in one layer, a key in two layers, and a key
+that replaces what another one set (``robots.0`` and ``robots.0.count``). One exception,
+said in the file: ``cases_replace_set: [KEY, ...]`` lists ``set`` keys that a case may
+replace (``set`` then gives the value of the cases that do not)::
+
+    set: {robots.0.params: {cruise_speed_mps: 0.4}}
+    cases_replace_set: [robots.0.params]
+    cases:
+      - {case: slow}
+      - {case: fast, robots.0.params: {cruise_speed_mps: 0.8}}
+
+Grid values that run the same scenario (``2`` and ``2.0``) and cases with the same overrides
+run once, under the first, with a :class:`SweepWarning` (:func:`~teamnav.experiments.sweep_trials.expand`).
 """
 
 from __future__ import annotations
@@ -44,6 +64,7 @@ __all__ = [
     "SWEEP_DIR",
     "SweepError",
     "SweepSpec",
+    "SweepWarning",
     "describe_sweep",
     "load_sweep",
     "parse_grid",
@@ -60,6 +81,11 @@ SWEEP_DIR: Path = Path(str(resources.files("teamnav.experiments"))) / "sweeps"
 _RESERVED_KEYS = {"seed": "use seeds (a count N for seeds 0..N-1, or a list)"}
 
 _NAME_CHARS = "A-Za-z0-9_.-"
+
+
+class SweepWarning(UserWarning):
+    """A sweep runs, but not quite as written: two grid values or two cases run the same
+    scenario, so the later one is left out. ``teamnav sweep`` prints it as ``warning: ...``."""
 
 
 class SweepError(ValueError):
@@ -80,8 +106,9 @@ class SweepSpec(BaseModel):
         A built-in scenario name (``"demo"``) or a scenario YAML file.
     grid : dict of str to list
         Dotted override key (``robots.0.count``, same syntax as ``--set``) to the values to try,
-        in order. Every value list is non-empty and has no repeated value. Default: no grid
-        (one combination).
+        in order. Every value list is non-empty; a value that runs the same scenario as an
+        earlier one (``2`` after ``2``, ``2.0`` after ``2``) runs once, with a warning. Default:
+        no grid (one combination).
     seeds : int or list of int
         ``N`` runs seeds ``0..N-1``; a list runs exactly those seeds. Default 1 (seed 0).
     set : dict of str to value
@@ -95,6 +122,12 @@ class SweepSpec(BaseModel):
     cases : list of dict
         Named bundles of overrides (``{"case": label, key: value, ...}``), an axis before
         the grid; labels are distinct and a case may not use a grid key. Default: none.
+    cases_replace_set : list of str
+        Keys of ``set`` that a case may replace (see "One key, one place" in the module
+        docstring); without it a case setting a ``set`` key is refused. Default: none.
+
+    Every key of ``grid``, ``set``, ``cases`` and ``cases_replace_set`` is stored in its
+    canonical spelling (:func:`~teamnav.experiments.spec.canonical_key`).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True)
@@ -107,6 +140,12 @@ class SweepSpec(BaseModel):
     name: str | None = Field(None, min_length=1, max_length=100, pattern=rf"^[{_NAME_CHARS}]+$")
     description: str = ""
     cases: list[dict[str, Any]] = Field(default_factory=list)
+    cases_replace_set: list[str] = Field(default_factory=list)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _one_spelling_one_place(cls, data: Any) -> Any:
+        return _canonical_layers(data) if isinstance(data, Mapping) else data
 
     @field_validator("cases")
     @classmethod
@@ -133,12 +172,6 @@ class SweepSpec(BaseModel):
             _check_key(key, "grid")
             if not values:
                 raise ValueError(f"grid {key}: expected a non-empty list of values, received []")
-            seen: list[str] = []
-            for v in values:
-                text = _canonical(v)
-                if text in seen:
-                    raise ValueError(f"grid {key}: expected distinct values, received {v!r} twice")
-                seen.append(text)
         return grid
 
     @field_validator("set")
@@ -168,15 +201,16 @@ class SweepSpec(BaseModel):
         return seeds
 
     @model_validator(mode="after")
-    def _grid_and_set_apart(self) -> "SweepSpec":
-        both = sorted(set(self.grid) & set(self.set))
-        if both:
-            raise ValueError(f"set: key {both[0]!r} is also a grid key; expected each key in only one of grid and set")
-        in_cases = sorted({key for case in self.cases for key in case} & set(self.grid))
-        if in_cases:
-            raise ValueError(f"cases: key {in_cases[0]!r} is also a grid key; expected each key in only one of cases and grid")
-        if "duration_s" in self.grid and self.duration_s is not None:
-            raise ValueError("duration_s: expected either duration_s or a grid over duration_s, received both")
+    def _duration_once(self) -> "SweepSpec":
+        if self.duration_s is not None:
+            where = ["grid"] * ("duration_s" in self.grid) + ["set"] * ("duration_s" in self.set)
+            where += [f"case {c['case']!r}" for c in self.cases if "duration_s" in c]
+            if where:
+                raise ValueError(f"duration_s: expected either duration_s or the key duration_s in {where[0]}, received both")
+        for key in self.cases_replace_set:
+            if key not in self.set:
+                raise ValueError(f"cases_replace_set: expected keys of set (that a case may replace), received {key!r}, "
+                                 f"which set does not give")
         return self
 
     @property
@@ -205,6 +239,129 @@ def _check_key(key: str, where: str) -> None:
         raise ValueError(f"{where}: expected a dotted key such as robots.0.count, received {key!r}")
     if key in _RESERVED_KEYS:
         raise ValueError(f"{where}: key {key!r} cannot be swept here; {_RESERVED_KEYS[key]}")
+
+
+def _canonical_layers(data: Mapping[str, Any]) -> dict[str, Any]:
+    """``data`` with every key of grid, set, cases and cases_replace_set in its canonical
+    spelling, refusing a key given twice (two spellings of it, or in two layers that a trial
+    applies one after the other) unless ``cases_replace_set`` lets a case replace a set key.
+
+    What is not a mapping of string keys is left as it is, for the field validators to report.
+    """
+    from teamnav.experiments.spec import canonical_key
+
+    data = dict(data)
+
+    def one_layer(layer: Any, where: str, skip: tuple[str, ...] = ()) -> tuple[Any, dict[str, str]]:
+        if not isinstance(layer, Mapping) or not all(isinstance(k, str) for k in layer):
+            return layer, {}
+        out: dict[str, Any] = {}
+        spelt: dict[str, str] = {}
+        for key, value in layer.items():
+            canon = key if key in skip else canonical_key(key)
+            if canon in out:
+                raise ValueError(f"{where}: {_twice(spelt[canon], key, canon)}")
+            out[canon], spelt[canon] = value, key
+        return out, spelt
+
+    grid, grid_spelt = one_layer(data.get("grid"), "grid")
+    fixed, set_spelt = one_layer(data.get("set"), "set")
+    if "grid" in data:
+        data["grid"] = grid
+    if "set" in data:
+        data["set"] = fixed
+    cases_in = data.get("cases")
+    cases: list[tuple[str, Mapping[str, Any], dict[str, str]]] = []
+    if isinstance(cases_in, list):
+        out_cases = []
+        for k, case in enumerate(cases_in):
+            label = case.get("case") if isinstance(case, Mapping) else None
+            where = f"cases[{k}]" + (f" ({label!r})" if isinstance(label, str) else "")
+            canon, spelt = one_layer(case, where, skip=("case",))
+            out_cases.append(canon)
+            if isinstance(canon, Mapping):
+                cases.append((where, canon, spelt))
+        data["cases"] = out_cases
+    replace = data.get("cases_replace_set")
+    if isinstance(replace, list) and all(isinstance(k, str) for k in replace):
+        replace = [canonical_key(k) for k in replace]
+        data["cases_replace_set"] = replace
+    replaceable = set(replace) if isinstance(replace, list) else set()
+
+    # what one trial applies, in order: set, its case, the grid axes (each grid axis: any of its values)
+    def entries(layer: Any, spelt: dict[str, str], where: str, many: bool = False) -> list[tuple[str, str, list[str], list]]:
+        if not isinstance(layer, Mapping):
+            return []
+        out = []
+        for key, value in layer.items():
+            if key == "case" and where.startswith("cases["):
+                continue
+            values = list(value) if many and isinstance(value, list) else [value]
+            out.append((where, spelt.get(key, key), key.split("."), values))
+        return out
+
+    head = entries(fixed, set_spelt, "set")
+    tail = entries(grid, grid_spelt, "grid", many=True)
+    for case in cases or [("", {}, {})]:
+        order = head + entries(case[1], case[2], case[0]) + tail
+        for j, later in enumerate(order):
+            for earlier in order[:j]:
+                problem = _overlap(earlier, later, replaceable)
+                if problem:
+                    raise ValueError(problem)
+    return data
+
+
+def _twice(first: str, second: str, canon: str) -> str:
+    """The message for a key given twice, in one spelling or two."""
+    what = f"key {first!r} is given twice" if first == second else f"keys {first!r} and {second!r} are two spellings of {canon}"
+    return f"{what}; expected each key once (a trial would run the last one's value): remove one"
+
+
+def _reaches(value: Any, parts: Sequence[str]) -> bool:
+    """Whether ``value`` (an override's value) holds something at the path ``parts``."""
+    for p in parts:
+        if isinstance(value, Mapping) and p in value:
+            value = value[p]
+        elif isinstance(value, list) and p.isdecimal() and int(p) < len(value):
+            value = value[int(p)]
+        else:
+            return False
+    return True
+
+
+def _overlap(earlier: tuple, later: tuple, replaceable: set[str]) -> str | None:
+    """Why ``later`` (applied after ``earlier`` in one trial) throws away what ``earlier`` set, or None."""
+    where_a, spell_a, parts_a, values_a = earlier
+    where_b, spell_b, parts_b, _ = later
+    n = min(len(parts_a), len(parts_b))
+    if parts_a[:n] != parts_b[:n]:
+        return None
+    if len(parts_a) < len(parts_b) and not any(_reaches(v, parts_b[n:]) for v in values_a):
+        return None  # the later key only adds inside what the earlier one set
+    if where_a == "set" and where_b.startswith("cases[") and ".".join(parts_a) in replaceable:
+        return None  # the file says that cases replace it
+    canon_a, canon_b = ".".join(parts_a), ".".join(parts_b)
+    if canon_a == canon_b:
+        what = f"both set {canon_a}"
+    elif len(parts_b) < len(parts_a):
+        what = f"{canon_b} replaces all of {canon_a}"
+    else:
+        what = f"{canon_a} holds a value for {canon_b}"
+    layer_a, layer_b = (w.split(" ")[0].split("[")[0] for w in (where_a, where_b))
+    if layer_a == "set" and layer_b == "cases":
+        fix = (f"list {canon_a} under cases_replace_set: in the sweep file to let the cases' values win, "
+               f"or remove it from set or from the case")
+    elif layer_b == "grid" and layer_a != "grid":
+        fix = f"remove it from {layer_a} (the grid gives it in every trial) or from the grid"
+    else:
+        fix = "remove one of them"
+    once = "once" if layer_a == layer_b else f"in only one of {' and '.join(sorted((layer_a, layer_b), key=lambda x: x != 'grid'))}"
+    if layer_b == "grid" and layer_a != "grid":
+        head = f"{where_a}: key {spell_a!r} is also a grid key ({spell_b!r}; {what})"
+    else:
+        head = f"{where_b}: key {spell_b!r} overrides {where_a} key {spell_a!r} ({what})"
+    return f"{head}, so a trial would silently drop what {where_a} gives; expected each key {once}: {fix}"
 
 
 def _looks_like_path(s: str) -> bool:
@@ -277,26 +434,39 @@ def parse_grid(items: Sequence[str] | Mapping[str, Sequence[Any]] | None) -> dic
     Returns
     -------
     dict of str to list
-        In the order given.
+        In the order given, keys in their canonical spelling
+        (:func:`~teamnav.experiments.spec.canonical_key`).
 
     Raises
     ------
     SweepError
-        An item without ``=``, an empty key or value list, an empty value, or a key given twice.
+        An item without ``=``, an empty key or value list, an empty value, or a key given twice
+        (in any two spellings: ``robots.0.count`` and ``robots.00.count`` are one key).
 
     Examples
     --------
     >>> parse_grid(["robots.0.count=2,4,8", "radio.mode=range,los"])
     {'robots.0.count': [2, 4, 8], 'radio.mode': ['range', 'los']}
     """
+    from teamnav.experiments.spec import canonical_key
+
     if items is None:
         return {}
+    spelt: dict[str, str] = {}
+
+    def once(key: str, where: str) -> str:
+        canon = canonical_key(key)
+        if canon in spelt:
+            raise SweepError(f"{where} {canon}: {_twice(spelt[canon], key, canon)}")
+        spelt[canon] = key
+        return canon
+
     if isinstance(items, Mapping):
         out: dict[str, list[Any]] = {}
         for key, values in items.items():
             if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
                 raise SweepError(f"grid {key}: expected a list of values, received {values!r}")
-            out[str(key)] = list(values)
+            out[once(str(key), "grid")] = list(values)
         return out
     if isinstance(items, str):
         items = [items]
@@ -313,27 +483,36 @@ def parse_grid(items: Sequence[str] | Mapping[str, Sequence[Any]] | None) -> dic
         values = _read_value(f"[{text}]", "--grid", key, text)
         if any(v is None for v in values) or not values:
             raise SweepError(f"--grid {key}: expected no empty values between commas, received {text!r}")
-        if key in grid:
-            raise SweepError(f"--grid {key}: expected each key once, received it twice")
-        grid[key] = values
+        grid[once(key, "--grid")] = values
     return grid
 
 
 def parse_set(items: Sequence[str] | Mapping[str, Any] | None) -> dict[str, Any]:
-    """Parse ``--set KEY=VALUE`` options (values read as YAML) into a dict of fixed overrides."""
+    """Parse ``--set KEY=VALUE`` options (values read as YAML) into a dict of fixed overrides,
+    keys in their canonical spelling; a key given twice (in any two spellings) is refused."""
+    from teamnav.experiments.spec import canonical_key
+
     if items is None:
         return {}
     if isinstance(items, Mapping):
-        return {str(k): v for k, v in items.items()}
-    if isinstance(items, str):
-        items = [items]
+        pairs = [(str(k), v) for k, v in items.items()]
+    else:
+        if isinstance(items, str):
+            items = [items]
+        pairs = []
+        for item in items:
+            if not isinstance(item, str) or "=" not in item:
+                raise SweepError(f"--set: expected KEY=VALUE (e.g. radio.p_loss=0.1), received {item!r}")
+            key, _, text = item.partition("=")
+            key = key.strip()
+            pairs.append((key, _read_value(text, "--set", key) if text.strip() else None))
     out: dict[str, Any] = {}
-    for item in items:
-        if not isinstance(item, str) or "=" not in item:
-            raise SweepError(f"--set: expected KEY=VALUE (e.g. radio.p_loss=0.1), received {item!r}")
-        key, _, text = item.partition("=")
-        key = key.strip()
-        out[key] = _read_value(text, "--set", key) if text.strip() else None
+    spelt: dict[str, str] = {}
+    for key, value in pairs:
+        canon = canonical_key(key)
+        if canon in out:
+            raise SweepError(f"--set {canon}: {_twice(spelt[canon], key, canon)}")
+        out[canon], spelt[canon] = value, key
     return out
 
 
@@ -474,7 +653,8 @@ def resolve_spec(
     ``name_or_spec`` is looked up in this order: a :class:`SweepSpec`; a named sweep; a YAML
     file with a top-level ``scenario`` key (a sweep file); otherwise a scenario name or file.
     ``grid`` entries are added to (or replace, key by key) the spec's grid, ``set`` entries
-    to its fixed overrides; ``seeds``, ``duration_s`` and ``name`` replace the spec's.
+    to its fixed overrides (keys compared in their canonical spelling; a key may not be in both
+    ``grid`` and ``set``); ``seeds``, ``duration_s`` and ``name`` replace the spec's.
     """
     if isinstance(name_or_spec, SweepSpec):
         base = name_or_spec
@@ -490,11 +670,16 @@ def resolve_spec(
             base = _validate_spec({"scenario": text}, f"of scenario {text!r}")
     data = base.model_dump()
     extra_grid = parse_grid(grid)
+    extra_set = parse_set(set)
+    both = [key for key in extra_grid if key in extra_set]
+    if both:
+        raise SweepError(f"--set {both[0]}: the key is also a --grid axis; expected it in only one of --grid and --set")
     if extra_grid:
         data["grid"] = {**data["grid"], **extra_grid}
         for key in extra_grid:
             data["set"].pop(key, None)
-    extra_set = parse_set(set)
+            if key in data["cases_replace_set"]:
+                data["cases_replace_set"].remove(key)
     if extra_set:
         data["set"] = {**data["set"], **extra_set}
         for key in extra_set:

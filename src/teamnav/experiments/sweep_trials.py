@@ -10,18 +10,27 @@ Trial identity
 no spaces) of ``{"scenario": <scenario name>, "params": <every override of the trial, fixed
 ones and grid values, plus duration_s when given>, "seed": <seed>}``. It depends only on what
 the user asked for, so it is the same in every process and on every machine, and a rerun
-recognises the trials it already has. Values count as written: ``2`` and ``2.0`` are different
-trials. ``config_hash`` is the hash of the fully resolved scenario without its seed, name and
-description: trials that simulate the same configuration share it, whatever the seed.
+recognises the trials it already has. Keys count in their canonical spelling
+(:func:`~teamnav.experiments.spec.canonical_key`), values as written. ``config_hash`` is the
+hash of the fully resolved scenario without its seed, name and description: trials that
+simulate the same configuration share it, whatever the seed.
+
+Duplicates
+----------
+Two combinations that resolve to the same scenario (grid values ``2`` and ``2.0``, two cases
+with the same overrides) would run the same trials twice under two labels; :func:`expand`
+keeps the first and leaves the later one out, with one :class:`~teamnav.experiments.sweep_spec.SweepWarning`
+naming them.
 """
 
 from __future__ import annotations
 
 import hashlib
 import itertools
+import warnings
 from typing import Any, Mapping, Sequence
 
-from teamnav.experiments.sweep_spec import SweepError, SweepSpec, _canonical
+from teamnav.experiments.sweep_spec import SweepError, SweepSpec, SweepWarning, _canonical
 from teamnav.experiments.trial import Trial
 
 __all__ = ["Trial", "config_hash", "expand", "trial_id"]
@@ -72,10 +81,13 @@ def expand(spec: SweepSpec) -> list[Trial]:
     Each combination is loaded and validated with :func:`~teamnav.experiments.spec.load_scenario`
     first, so a bad value fails here, before any trial runs.
 
+    A combination that resolves to the same scenario as an earlier one (see "Duplicates" in
+    the module docstring) is left out, with a :class:`~teamnav.experiments.sweep_spec.SweepWarning`.
+
     Returns
     -------
     list of Trial
-        ``spec.n_trials`` trials with distinct ``trial_id``.
+        ``spec.n_trials`` trials (fewer by the duplicates) with distinct ``trial_id``.
 
     Raises
     ------
@@ -92,6 +104,8 @@ def expand(spec: SweepSpec) -> list[Trial]:
     trials: list[Trial] = []
     bad: dict[tuple[str, str], str] = {}
     cases = spec.cases or [{}]
+    first: dict[str, str] = {}  # config hash -> the combination that has it
+    repeats: list[str] = []
     for case, combo in itertools.product(cases, itertools.product(*(spec.grid[k] for k in keys))):
         values = dict(zip(keys, combo))
         bundle = {k: v for k, v in case.items() if k != "case"}
@@ -114,6 +128,11 @@ def expand(spec: SweepSpec) -> list[Trial]:
         if case:
             params["case"] = case["case"]
         chash = config_hash(scn)
+        shown = " ".join(([f"case {case['case']!r}"] if case else []) + [f"{k}={v!r}" for k, v in values.items()])
+        if chash in first:
+            repeats.append(f"{shown} runs the same scenario as {first[chash]}")
+            continue
+        first[chash] = shown
         for seed in seeds:
             trials.append(
                 Trial(
@@ -133,6 +152,10 @@ def expand(spec: SweepSpec) -> list[Trial]:
         if len(lines) == 1:
             raise SweepError(f"sweep {spec.sweep_name!r}: {lines[0]}")
         raise SweepError(f"sweep {spec.sweep_name!r} has {len(lines)} invalid grid values:\n" + "\n".join(f"  {x}" for x in lines))
+    if repeats:
+        more = f" (and {len(repeats) - 5} more)" if len(repeats) > 5 else ""
+        warnings.warn(f"sweep {spec.sweep_name!r}: {len(repeats)} combination(s) left out, each runs once under the first: "
+                      + "; ".join(repeats[:5]) + more, SweepWarning, stacklevel=2)
     ids = [t.trial_id for t in trials]
     if len(set(ids)) != len(ids):  # pragma: no cover - distinct values make distinct ids
         raise SweepError(f"sweep {spec.sweep_name!r}: two trials share an id; expected distinct grid values")
