@@ -483,10 +483,12 @@ def validate(
         scn = load_scenario(scenario, overrides=set_ or None)
         grid = build_grid(scn)
     groups = ", ".join(f"{g.count} x {g.controller}" for g in scn.robots)
+    simulated = scn.n_steps * scn.dt_s  # whole steps: what a run simulates when dt_s does not divide duration_s
+    exact = "" if abs(simulated - scn.duration_s) <= 1e-9 * scn.duration_s else f" (simulates {simulated:g} s)"
     h, w = grid.shape
     _out().print(
         f"ok: {scn.source}\n  {scn.name}: {scn.n_robots} robots ({groups}), map {scn.map.describe()} "
-        f"({w} x {h} cells at {grid.resolution_m:g} m), {scn.duration_s:g} s = {scn.n_steps} steps of {scn.dt_s:g} s, "
+        f"({w} x {h} cells at {grid.resolution_m:g} m), {scn.duration_s:g} s = {scn.n_steps} steps of {scn.dt_s:g} s{exact}, "
         f"seed {scn.seed}",
         markup=False,
     )

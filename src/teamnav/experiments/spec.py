@@ -65,6 +65,8 @@ from teamnav.world.mapio import IMAGE_SUFFIXES, YAML_SUFFIXES, MapError, load_ma
 
 __all__ = [
     "ArenaSpec",
+    "MAX_STEPS_PER_RUN",
+    "MAX_STEPS_RAISED",
     "MapSpec",
     "PACKAGE_MAP_DIR",
     "Scenario",
@@ -79,6 +81,17 @@ __all__ = [
 
 #: Folder of the maps shipped with teamnav (``map: {package: ...}`` is relative to it).
 PACKAGE_MAP_DIR: Path = Path(str(resources.files("teamnav.world"))) / "maps"
+
+#: Most steps a run may take (``duration_s / dt_s``), 10^8: about 116 days of robot time at
+#: the usual 0.1 s, and days of wall time for one robot. A scenario asking for more (a
+#: ``dt_s`` of 1e-9 s, say) is refused when it is loaded, before anything is allocated, unless
+#: it raises its own ceiling with ``max_steps: N`` (``--set max_steps=N``) to run that long on
+#: purpose.
+MAX_STEPS_PER_RUN: int = 100_000_000
+
+#: The highest ``max_steps`` a scenario may give, 10^12: past it a run would not end in a
+#: lifetime, whatever the machine.
+MAX_STEPS_RAISED: int = 1_000_000_000_000
 
 _MAP_SUFFIXES = YAML_SUFFIXES + IMAGE_SUFFIXES  # the map loader's (map_server YAML, PNG, PGM, BMP)
 
@@ -258,7 +271,8 @@ class Scenario(SimConfig):
         What the scenario shows; its first line is listed by ``teamnav list``.
     map : MapSpec
     duration_s : float
-        Simulated time [s], in (0, 1e7]; the run takes ``round(duration_s / dt_s)`` steps.
+        Simulated time [s], in (0, 1e7] and at least ``dt_s``; the run takes
+        ``round(duration_s / dt_s)`` steps, at most :data:`MAX_STEPS_PER_RUN` (or ``max_steps``).
     metrics : tuple of str
         Metric names (:func:`teamnav.experiments.metrics.names`); empty means all.
     give_map : bool
@@ -267,6 +281,10 @@ class Scenario(SimConfig):
         End the run before ``duration_s`` once every brain that reports ``finished`` (a
         controller attribute: its task is done, e.g. R1 reached its last target) says so;
         ``duration_s`` is then the step budget. Default False.
+    max_steps : int, optional
+        The most steps this scenario may take, in place of :data:`MAX_STEPS_PER_RUN`, up to
+        :data:`MAX_STEPS_RAISED`; for a run meant to be that long. Left out of the resolved
+        scenario when absent (config hashes unchanged).
     """
 
     name: str = Field(min_length=1, max_length=100, pattern=r"^[A-Za-z0-9][A-Za-z0-9_.\-]*$")
@@ -280,7 +298,8 @@ class Scenario(SimConfig):
     #: ``teamnav run`` ignores them, so one file serves both. Left out of the resolved scenario
     #: when absent (config hashes of scenarios without it are unchanged).
     env: dict[str, Any] | None = None
-    _OMIT_WHEN_NONE: ClassVar[tuple[str, ...]] = ("env",)
+    max_steps: int | None = Field(None, ge=1, le=MAX_STEPS_RAISED)
+    _OMIT_WHEN_NONE: ClassVar[tuple[str, ...]] = ("env", "max_steps")
 
     _source: str = PrivateAttr(default="<code>")
 
@@ -364,6 +383,25 @@ class Scenario(SimConfig):
                 robots.append(g)
             data["robots"] = robots
         return data
+
+    @model_validator(mode="after")
+    def _steps_fit(self) -> "Scenario":
+        """``dt_s`` no longer than ``duration_s``, and no more steps than the limit (counted, not made)."""
+        if self.dt_s > self.duration_s:
+            raise ValueError(
+                f"dt_s: expected a time step no longer than duration_s ({self.duration_s:g} s), got {self.dt_s:g} s "
+                f"(a run is whole steps, so it would simulate {self.dt_s:g} s); shorten dt_s or lengthen duration_s"
+            )
+        steps = self.duration_s / self.dt_s
+        limit = self.max_steps if self.max_steps is not None else MAX_STEPS_PER_RUN
+        if round(steps) > limit:
+            which = "max_steps" if self.max_steps is not None else "teamnav.experiments.spec.MAX_STEPS_PER_RUN"
+            raise ValueError(
+                f"dt_s: duration_s {self.duration_s:g} s in steps of {self.dt_s:g} s is {steps:.3g} steps; expected at "
+                f"most {limit:,} ({which}); lengthen dt_s or shorten duration_s, or set max_steps (up to "
+                f"{MAX_STEPS_RAISED:,}) to run that many on purpose"
+            )
+        return self
 
     @field_validator("metrics")
     @classmethod

@@ -61,6 +61,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 __all__ = [
+    "MAX_TRIALS_PER_SWEEP",
     "SWEEP_DIR",
     "SweepError",
     "SweepSpec",
@@ -76,6 +77,13 @@ __all__ = [
 
 #: Folder of the core's named sweeps (each paper's are in its own package folder).
 SWEEP_DIR: Path = Path(str(resources.files("teamnav.experiments"))) / "sweeps"
+
+#: Most trials a sweep may have (cases x grid combinations x seeds), 10^5; also the most seeds
+#: one ``seeds`` / ``--seeds`` may name. Counted from the lengths before anything is made, so
+#: a grid of 10^6 combinations or a seed range up to 10^11 is refused at once (one message)
+#: instead of hanging in expansion or dying of MemoryError. A bigger study is several sweeps
+#: (into one store if you like: each keeps its own name).
+MAX_TRIALS_PER_SWEEP: int = 100_000
 
 #: Override keys that a grid or ``set`` may not use, and what to use instead.
 _RESERVED_KEYS = {"seed": "use seeds (a count N for seeds 0..N-1, or a list)"}
@@ -150,14 +158,14 @@ class SweepSpec(BaseModel):
     @field_validator("cases")
     @classmethod
     def _check_cases(cls, cases: list[dict[str, Any]]) -> list[dict[str, Any]]:
-        labels: list[str] = []
+        labels: set[str] = set()
         for k, case in enumerate(cases):
             label = case.get("case")
             if not isinstance(label, str) or not label:
                 raise ValueError(f"cases[{k}]: expected a non-empty string label under 'case', received {label!r}")
             if label in labels:
                 raise ValueError(f"cases[{k}]: expected distinct labels, received {label!r} twice")
-            labels.append(label)
+            labels.add(label)
             keys = [key for key in case if key != "case"]
             if not keys:
                 raise ValueError(f"cases[{k}] ({label!r}): expected at least one override besides 'case'")
@@ -187,15 +195,20 @@ class SweepSpec(BaseModel):
         if isinstance(seeds, bool):
             raise ValueError(f"seeds: expected a count >= 1 or a list of seeds, received {seeds!r}")
         if isinstance(seeds, int):
-            if not 1 <= seeds <= 1_000_000:
-                raise ValueError(f"seeds: expected a count in [1, 1000000] or a list of seeds, received {seeds}")
+            if not 1 <= seeds <= MAX_TRIALS_PER_SWEEP:
+                raise ValueError(f"seeds: expected a count in [1, {MAX_TRIALS_PER_SWEEP}] (MAX_TRIALS_PER_SWEEP) or a list "
+                                 f"of seeds, received {seeds}")
             return seeds
         if not seeds:
             raise ValueError("seeds: expected a count >= 1 or a non-empty list of seeds, received []")
+        if len(seeds) > MAX_TRIALS_PER_SWEEP:
+            raise ValueError(f"seeds: expected at most {MAX_TRIALS_PER_SWEEP} seeds (MAX_TRIALS_PER_SWEEP), received "
+                             f"a list of {len(seeds)}")
         for s in seeds:
             if not 0 <= s <= 2**63 - 1:
                 raise ValueError(f"seeds: expected every seed in [0, 2**63 - 1], received {s}")
-        dup = sorted({s for s in seeds if seeds.count(s) > 1})
+        seen: set[int] = set()
+        dup = sorted({s for s in seeds if s in seen or seen.add(s)})
         if dup:
             raise ValueError(f"seeds: expected distinct seeds, received {dup[0]} more than once")
         return seeds
@@ -227,10 +240,8 @@ class SweepSpec(BaseModel):
 
     @property
     def n_trials(self) -> int:
-        n = len(self.seed_list) * max(1, len(self.cases))
-        for values in self.grid.values():
-            n *= len(values)
-        return n
+        """Cases x grid combinations x seeds, counted (nothing is made)."""
+        return _count_trials(len(self.cases), self.grid, self.seeds)
 
 
 def _check_key(key: str, where: str) -> None:
@@ -251,6 +262,9 @@ def _canonical_layers(data: Mapping[str, Any]) -> dict[str, Any]:
     from teamnav.experiments.spec import canonical_key
 
     data = dict(data)
+    too_many = _too_many(data)
+    if too_many:
+        raise ValueError(too_many)
 
     def one_layer(layer: Any, where: str, skip: tuple[str, ...] = ()) -> tuple[Any, dict[str, str]]:
         if not isinstance(layer, Mapping) or not all(isinstance(k, str) for k in layer):
@@ -310,6 +324,31 @@ def _canonical_layers(data: Mapping[str, Any]) -> dict[str, Any]:
                 if problem:
                     raise ValueError(problem)
     return data
+
+
+def _count_trials(n_cases: int, grid: Mapping[str, Sequence[Any]], seeds: int | Sequence[int]) -> int:
+    n = max(1, n_cases) * (seeds if isinstance(seeds, int) else len(seeds))
+    for values in grid.values():
+        n *= len(values)
+    return n
+
+
+def _too_many(data: Mapping[str, Any]) -> str | None:
+    """Why the raw sweep ``data`` has too many trials (:data:`MAX_TRIALS_PER_SWEEP`), or None;
+    what is malformed is left for the field validators."""
+    grid, cases, seeds = data.get("grid", {}), data.get("cases", []), data.get("seeds", 1)
+    if not (isinstance(grid, Mapping) and all(isinstance(v, (list, tuple)) for v in grid.values())
+            and isinstance(cases, (list, tuple)) and (isinstance(seeds, (list, tuple)) or type(seeds) is int)):
+        return None
+    if type(seeds) is int and not 1 <= seeds <= MAX_TRIALS_PER_SWEEP:
+        return None  # the seeds validator says why
+    n = _count_trials(len(cases), grid, seeds)
+    if n <= MAX_TRIALS_PER_SWEEP:
+        return None
+    sizes = [f"{len(cases)} cases"] * bool(cases) + [f"{len(v)} {k}" for k, v in grid.items()]
+    sizes.append(f"{seeds if isinstance(seeds, int) else len(seeds)} seeds")
+    return (f"expected at most {MAX_TRIALS_PER_SWEEP} trials in a sweep (MAX_TRIALS_PER_SWEEP), received "
+            f"{' x '.join(sizes)} = {n} trials; use fewer values or seeds, or split the study into several sweeps")
 
 
 def _twice(first: str, second: str, canon: str) -> str:
@@ -531,18 +570,24 @@ def parse_seeds(value: int | str | Sequence[int] | None) -> int | list[int] | No
         text = value.strip()
         try:
             if "," in text or "-" in text.lstrip("-"):
-                out: list[int] = []
+                spans: list[range] = []
                 for part in (t.strip() for t in text.split(",")):
                     a, sep, b = part.partition("-") if not part.startswith("-") else (part, "", "")
                     if sep:
                         lo, hi = int(a), int(b)
                         if hi < lo:
                             raise ValueError
-                        out.extend(range(lo, hi + 1))
+                        spans.append(range(lo, hi + 1))
                     else:
-                        out.append(int(part))
-                return out
+                        spans.append(range(int(part), int(part) + 1))
+                count = sum(len(r) for r in spans)  # counted before any list is made
+                if count > MAX_TRIALS_PER_SWEEP:
+                    raise SweepError(f"--seeds: expected at most {MAX_TRIALS_PER_SWEEP} seeds (MAX_TRIALS_PER_SWEEP), "
+                                     f"received {value!r}, which names {count} seeds")
+                return [s for r in spans for s in r]
             return int(text)
+        except SweepError:
+            raise
         except ValueError:
             raise SweepError(f"--seeds: expected a count N (seeds 0..N-1), a list such as 1,4,9 or a range such as "
                              f"1000-1009, received {value!r}") from None
