@@ -104,6 +104,29 @@ def test_local_executor_keeps_at_most_workers_in_flight(trials):
     assert time.perf_counter() - t0 >= 0.6  # 4 trials x 0.3 s on 2 workers
 
 
+def test_a_kept_local_pool_serves_several_runs_with_the_same_workers(trials, tmp_path, monkeypatch):
+    """keep_pool (a report's sweeps share it): the second run reuses the first run's worker
+    processes; a worker that dies is replaced and the run goes on; close() ends them."""
+    monkeypatch.setenv("TEAMNAV_TEST_MARKERS", str(tmp_path))
+    runner = LocalExecutor(workers=2, keep_pool=True)
+    try:
+        first, second = [], []
+        runner.run([TrialTask(t, slow_trial) for t in trials[:2]], first.append)
+        runner.run([TrialTask(t, slow_trial) for t in trials[2:]], second.append)
+        assert all(r.status == "ok" for r in first + second)
+        assert {r.pid for r in second} <= {r.pid for r in first}  # no new worker processes
+        third = []
+        runner.run([TrialTask(t, dies_once_trial) for t in trials[:2]], third.append)
+        assert [r.status for r in third] == ["ok", "ok"] and all(r.retries == 1 for r in third)
+        fourth = []
+        runner.run([TrialTask(trials[0], ok_trial)], fourth.append)
+        assert fourth[0].status == "ok" and fourth[0].pid not in {r.pid for r in first}
+    finally:
+        runner.close()
+    assert runner._kept is None
+    runner.close()  # twice is fine
+
+
 def test_local_and_ray_executors_give_identical_metrics(tmp_path):
     ray = pytest.importorskip("ray")
     grid = {"robots.0.count": [1, 3]}

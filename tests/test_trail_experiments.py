@@ -390,7 +390,7 @@ def test_blazing_three_times_is_judged_against_the_route_follow_robot(solo_trip_
     # quick mode: one seed of the one-robot baseline at the quick duration
     SECTION.build(_FakeCtx(table, quick=True))
     (solo_call,) = [kw for key, kw in _FakeCtx.last.calls if key == "trail-solo-blazing"]
-    assert solo_call == {"seeds": 1, "duration_s": 450.0}
+    assert solo_call == {"seeds": 1, "duration_s": 300.0}
 
 
 def _drift_runs(k, last, broke_min):

@@ -243,13 +243,31 @@ class LocalExecutor:
         Processes; default :func:`default_workers`.
     start_method : {"spawn", "forkserver"}
         Default ``"spawn"``.
+    keep_pool : bool
+        Keep the worker processes between :meth:`run` calls (a report's many short sweeps then
+        pay the workers' start-up, imports and numba cache loads once, not once per sweep);
+        :meth:`close` ends them. Default False: each run starts and ends its own pool.
     """
 
-    def __init__(self, workers: int | None = None, start_method: str = "spawn") -> None:
+    def __init__(self, workers: int | None = None, start_method: str = "spawn", keep_pool: bool = False) -> None:
         if start_method not in ("spawn", "forkserver"):
             raise ValueError(f"start_method: expected 'spawn' or 'forkserver', received {start_method!r}")
         self.workers = workers
         self.start_method = start_method
+        self.keep_pool = bool(keep_pool)
+        self._kept: ProcessPoolExecutor | None = None
+
+    def close(self) -> None:
+        """End the kept worker processes (if any); a later :meth:`run` starts new ones."""
+        pool, self._kept = self._kept, None
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+    def __enter__(self) -> "LocalExecutor":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     def _pool(self, n: int) -> ProcessPoolExecutor:
         # a spawned worker's parent is this process; a forkserver's is the server (which ends with us)
@@ -263,9 +281,13 @@ class LocalExecutor:
         in_flight: dict[Future, tuple[TrialTask, str]] = {}
         again: list[tuple[TrialTask, str]] = []  # trials lost with a dead worker, to start first
         lost: dict[str, list[str]] = {}  # trial id -> errors of its lost starts
-        pool = self._pool(n)
+        pool, self._kept = self._kept, None
+        if pool is None or getattr(pool, "_max_workers", n) != n:
+            if pool is not None:
+                pool.shutdown(wait=True, cancel_futures=True)
+            pool = self._pool(n)
 
-        known: dict = {}  # pid -> process of the current pool, kept while the pool may drop them
+        known: dict = dict(getattr(pool, "_processes", None) or {})  # pid -> process of the current pool
 
         def renew() -> None:
             nonlocal pool
@@ -329,7 +351,10 @@ class LocalExecutor:
         except BaseException:  # Ctrl-C, SIGTERM (signals.Terminated), a failing on_result
             _stop_workers(pool)  # stop the trials in flight: nothing keeps running behind us
             raise
-        pool.shutdown(wait=True)
+        if self.keep_pool:
+            self._kept = pool
+        else:
+            pool.shutdown(wait=True)
 
 
 #: Times a local trial whose worker process died is started again before it counts as failed.

@@ -31,7 +31,7 @@ import pickle
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
 # The spec and the trials live in their own modules; every name they had here stays importable
 # from here (config_hash, trial_id and _validate_spec too: tests and scripts import them).
@@ -51,6 +51,9 @@ from teamnav.experiments.sweep_spec import (  # noqa: F401 - re-exports
     sweep_names,
 )
 from teamnav.experiments.sweep_trials import Trial, config_hash, expand, trial_id  # noqa: F401 - re-exports
+
+if TYPE_CHECKING:
+    from teamnav.experiments.executors import Executor
 
 __all__ = [
     "SWEEP_DIR",
@@ -141,7 +144,7 @@ def sweep(
     set: Sequence[str] | Mapping[str, Any] | None = None,  # noqa: A002 - mirrors --set
     duration_s: float | None = None,
     name: str | None = None,
-    executor: str = "local",
+    executor: "str | Executor" = "local",
     workers: int | None = None,
     address: str | None = None,
     progress: bool = True,
@@ -168,9 +171,11 @@ def sweep(
         Simulated time of every trial [s].
     name : str, optional
         Replaces the sweep's name.
-    executor : {"local", "ray"}
+    executor : {"local", "ray"} or Executor
         ``"local"``: worker processes on this machine (default); ``"ray"``: Ray tasks on the
-        cluster at ``address``, or on a local Ray started for this sweep.
+        cluster at ``address``, or on a local Ray started for this sweep; or an executor object
+        (:mod:`teamnav.experiments.executors`, e.g. a ``LocalExecutor(keep_pool=True)`` that
+        several sweeps share; ``workers`` and ``address`` are then its own).
     workers : int, optional
         Trials running at once; default ``os.cpu_count()`` (local) or the cluster's CPUs (Ray).
     address : str, optional
@@ -196,17 +201,22 @@ def sweep(
         Bad sweep, grid, seeds, option, or a store holding other results under the same ids;
         raised before any trial runs.
     """
-    from teamnav.experiments.executors import TrialTask, make_executor
+    from teamnav.experiments.executors import LocalExecutor, TrialTask, make_executor
     from teamnav.experiments.store import STORE_NAME, ResultsStore, check_store
 
     t0 = time.perf_counter()
     if out_dir is None or not os.fspath(out_dir):
         raise SweepError("out_dir: expected a folder for results.sqlite, received None")
     spec = resolve_spec(name_or_spec, grid=grid, seeds=seeds, set=set, duration_s=duration_s, name=name)
-    runner = make_executor(executor, workers=workers, address=address)  # checks options, starts nothing
+    if isinstance(executor, str):
+        runner = make_executor(executor, workers=workers, address=address)  # checks options, starts nothing
+    elif callable(getattr(executor, "run", None)):
+        runner = executor
+    else:
+        raise SweepError(f"executor: expected 'local', 'ray' or an executor object, received {executor!r}")
     if trial_fn is not None and not callable(trial_fn):
         raise SweepError(f"trial_fn: expected a callable or None, received {trial_fn!r}")
-    if trial_fn is not None and executor == "local":
+    if trial_fn is not None and isinstance(runner, LocalExecutor):
         try:
             pickle.dumps(trial_fn)
         except Exception:  # noqa: BLE001 - any pickling failure means the workers cannot get it

@@ -391,7 +391,7 @@ def run_report(
         Unknown section name, an output folder that is not a report's, a bad executor option;
         raised before anything is written.
     """
-    from teamnav.experiments.executors import make_executor
+    from teamnav.experiments.executors import LocalExecutor, make_executor
     from teamnav.experiments.report.context import SweepContext
     from teamnav.experiments.sweep import SweepError
 
@@ -413,8 +413,14 @@ def run_report(
         if progress:
             print(msg, file=sys.stderr, flush=True)
 
+    # local workers start once for the whole report, not once per sweep: a quick report is dozens
+    # of sweeps of a few short trials, where the workers' start-up (imports, numba cache loads)
+    # would otherwise cost more than the trials
+    shared = LocalExecutor(workers, keep_pool=True) if executor == "local" else None
+
     def make_ctx(key: str) -> SweepContext:
-        return SweepContext(out, quick=quick, executor=executor, workers=workers, address=address, progress=progress, section=key)
+        return SweepContext(out, quick=quick, executor=executor, workers=workers, address=address, progress=progress,
+                            section=key, runner=shared)
 
     index = out / "index.html"
     outcomes: list[SectionOutcome] = []
@@ -441,6 +447,8 @@ def run_report(
     finally:
         if heartbeat is not None:
             heartbeat.close()
+        if shared is not None:
+            shared.close()
     if not keys:  # pragma: no cover - resolve_names never returns an empty list
         _write_outputs(out, index, [], quick, executor, workers, address, time.perf_counter() - t_start)
     return ReportResult(index=index, sections=outcomes, quick=quick, wall_s=time.perf_counter() - t_start)

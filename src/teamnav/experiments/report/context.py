@@ -62,6 +62,10 @@ class SweepContext:
         Show the sweeps' progress bars.
     section : str
         The key of the section being built (for messages).
+    runner : Executor, optional
+        An executor object every sweep of this context uses instead of a new ``executor`` per
+        sweep (``run_report`` shares one ``LocalExecutor(keep_pool=True)`` across the report's
+        sweeps, so the worker processes start once per report, not once per sweep).
 
     Attributes
     ----------
@@ -80,6 +84,7 @@ class SweepContext:
         address: str | None = None,
         progress: bool = False,
         section: str = "",
+        runner: Any = None,
     ) -> None:
         self.out_dir = Path(out_dir)
         self.quick = bool(quick)
@@ -88,6 +93,7 @@ class SweepContext:
         self.address = address
         self.progress = bool(progress)
         self.section = section
+        self.runner = runner
         self.sweeps: list[dict[str, Any]] = []
 
     @property
@@ -134,7 +140,7 @@ class SweepContext:
         res = sweep(
             spec,
             out_dir=folder,
-            executor=self.executor,
+            executor=self.runner if self.runner is not None else self.executor,
             workers=self.workers,
             address=self.address,
             progress=self.progress,

@@ -16,8 +16,9 @@ two, and the section measures what the second buys against the systems it is bui
    ``papers/beyond/claims/beyond.yaml``'s ``localized-trails-drift``, judged on full-length
    (1 h) runs only.
 
-Quick mode (CI): k = 0 and 4, the claim's two quick seeds, 5-min runs (the trail sections'
-quick drift runs, so ``report all --quick`` reuses the odometric ones): the pipeline works;
+Quick mode (CI): k = 0 and 4, the claim's two quick seeds, 5-min runs, 100 samples per
+localized robot (the trail sections' quick drift runs are seed 0's odometric ones, which
+``report all --quick`` reuses): the pipeline works;
 no verdict (the rule needs 1-h runs). Full mode: k = 0, 1, 4, seeds 0-9, 1 h each
 (30 localized runs, about 35 CPU-s each on this machine), and the particle counts (50 runs).
 
@@ -63,6 +64,9 @@ LOCALIZED_SWEEP = "beyond-localized-trails"
 PARTS = (("blazing-trail-v1, odometry", "blazing-drift"), ("trail-share-v1, odometry", "try-drift"))
 LOCALIZED_LABEL = "localized-v1 (MCL) + blazing-trail-v1"
 PARTICLES_SWEEP = "beyond-localized-particles"
+#: quick mode (CI): MCL samples per localized robot (full: the scenario's 500), the filter's cost
+#: being most of a localized run's
+QUICK_PARTICLES = 100
 
 
 def particle_count(row: dict) -> int | None:
@@ -149,14 +153,17 @@ def _localized_trails(ctx) -> list:
     missing = T.brains_missing(["localized-v1", "blazing-trail-v1", "trail-share-v1"])
     if missing is not None:
         return [missing]
-    loc = T.by_scale(T.ok(ctx.sweep(T.drift_spec(LOCALIZED_SWEEP, scales), seeds=seeds, duration_s=dur)))
+    quick_set = {f"robots.{i}.params.particles": QUICK_PARTICLES for i in range(4)} if quick else {}
+    loc = T.by_scale(T.ok(ctx.sweep(T.drift_spec(LOCALIZED_SWEEP, scales), seeds=seeds, duration_s=dur,
+                                    **({"set": quick_set} if quick else {}))))
     parts = {label: T.by_scale(T.ok(ctx.sweep(T.drift_spec(name, scales), seeds=seeds, duration_s=dur)))
              for label, name in PARTS}
     blocks: list = [Text(
         f"Combination 1, localized trails: {LOCALIZED_LABEL} against its parts, the 2000 and 2002 trail "
         f"algorithms on odometry, on the 2002 office with the 2002 team's drift pattern k x ({T.DRIFT_TEXT}), "
         f"k = {', '.join(f'{k:g}' for k in scales)}, seeds {seeds[0]}-{seeds[-1]}, {dur / 60:g} min per run. "
-        "The localized robots are given the map; their filter reads only their own laser and odometry.")]
+        "The localized robots are given the map; their filter reads only their own laser and odometry."
+        + (f" Quick mode: {QUICK_PARTICLES} samples per localized robot (full: 500)." if quick else ""))]
     rows = []
     for k in scales:
         for label, data in ((LOCALIZED_LABEL, loc), *((lab, parts[lab]) for lab, _ in PARTS)):
