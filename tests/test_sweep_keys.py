@@ -108,7 +108,6 @@ def test_one_field_in_two_places_is_refused_naming_both_spellings_and_the_file(t
 @pytest.mark.parametrize("earlier,later", [
     ({"set": {"robots.0.count": 3}}, {"grid": {"robots.0": [{"count": 2}]}}),            # the grid replaces set's field
     ({"grid": {"robots.0.params": [{"cruise_speed_mps": 0.3}]}}, {"grid": {"robots.0.params.cruise_speed_mps": [0.4]}}),
-    ({"set": {"robots.0.params": {"cruise_speed_mps": 0.3}}}, {"cases": [{"case": "a", "robots.0.params.cruise_speed_mps": 0.4}]}),
 ])
 def test_a_key_that_replaces_what_another_set_is_refused(earlier, later):
     data = {"scenario": "demo", **earlier}
@@ -122,6 +121,24 @@ def _spec(data):
     from teamnav.experiments.sweep_spec import _validate_spec
 
     return _validate_spec(data, "test")
+
+
+@pytest.mark.parametrize("later", [
+    {"grid": {"robots.0.params.cruise_speed_mps": [0.4, 0.5]}},
+    {"cases": [{"case": "a", "robots.0.params.cruise_speed_mps": 0.4}, {"case": "b", "robots.0.count": 2}]},
+])
+def test_a_grid_axis_or_case_may_refine_a_field_inside_a_set_dict(later):
+    """set: is the base; a deeper key in the grid or a case wins inside it, in every trial."""
+    from teamnav.experiments.sweep_trials import expand
+
+    spec = _spec({"scenario": "demo", "set": {"robots.0.params": {"cruise_speed_mps": 0.3}}, "duration_s": 1, **later})
+    ran = {}
+    for t in expand(spec):
+        key = "robots.0.params.cruise_speed_mps"
+        ran[t.params.get(key, t.params.get("case"))] = t.load().robots[0].params["cruise_speed_mps"]
+    assert all(label == value for label, value in ran.items() if label not in ("b",)), ran
+    if "cases" in later:
+        assert ran["b"] == 0.3  # a case that names nothing keeps set's value
 
 
 def test_a_key_that_only_adds_inside_another_is_fine():
