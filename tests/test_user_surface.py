@@ -10,18 +10,22 @@ sweeps, report sections and claims, and ``teamnav list --json``, must stay as us
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
-
-from _user_surface import gather
 
 RECORDED = json.loads((Path(__file__).parent / "data" / "user_surface.json").read_text())
 
 
 @pytest.fixture(scope="module")
 def now() -> dict:
-    return json.loads(json.dumps(gather()))
+    """Gathered in a fresh process: other tests register controllers and sections in theirs."""
+    out = subprocess.run([sys.executable, str(Path(__file__).with_name("_user_surface.py"))], capture_output=True,
+                         text=True, timeout=900)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout)
 
 
 @pytest.mark.parametrize("key", ["controllers", "metrics", "sections", "claims", "list_json"])

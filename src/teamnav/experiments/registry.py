@@ -22,6 +22,10 @@ SCENARIO_DIR: Path = Path(str(resources.files("teamnav.experiments"))) / "scenar
 
 _EXTRA: dict[str, Path] = {}
 
+#: libyaml's safe loader when PyYAML has it (a safe loader either way): `teamnav list` reads
+#: every scenario file, and the pure-Python one takes ~1 s for them all
+_FAST_SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
 
 def _shipped() -> dict[str, Path]:
     """The core's scenario files, then every installed paper's; a name shipped twice keeps
@@ -76,9 +80,7 @@ def path(name: str) -> Path:
 def describe(name: str) -> str:
     """The first line of scenario ``name``'s ``description`` (``""`` if it has none)."""
     try:
-        # libyaml's loader when PyYAML has it: `teamnav list` reads every scenario file, and the
-        # pure-Python one takes ~1 s for them all
-        data = yaml.load(path(name).read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+        data = yaml.load(path(name).read_text(encoding="utf-8"), Loader=_FAST_SAFE_LOADER)
     except (OSError, yaml.YAMLError):
         return "(unreadable)"
     text = str(data.get("description", "")) if isinstance(data, dict) else ""

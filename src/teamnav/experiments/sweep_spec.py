@@ -378,10 +378,10 @@ def _overlap(earlier: tuple, later: tuple, replaceable: set[str]) -> str | None:
         return None
     if len(parts_a) < len(parts_b) and not any(_reaches(v, parts_b[n:]) for v in values_a):
         return None  # the later key only adds inside what the earlier one set
-    if len(parts_a) < len(parts_b) and where_a == "set" and not where_b.startswith("set"):
-        # set: is the base every trial starts from; a grid axis or a case naming a field inside
-        # one of its dicts refines it, and its own column stores what ran (the report's
-        # paper-rules sweeps give the brain's params in set: and vary one of them in the grid)
+    if len(parts_a) < len(parts_b) and where_a == "set":
+        # set: is the base every trial starts from; a later set: key, a grid axis or a case naming
+        # a field inside one of its dicts refines it, and its own column stores what ran (the
+        # report's paper-rules sweeps give the brain's params in set: and set or vary one of them)
         return None
     if where_a == "set" and where_b.startswith("cases[") and ".".join(parts_a) in replaceable:
         return None  # the file says that cases replace it
