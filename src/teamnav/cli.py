@@ -156,8 +156,12 @@ app = typer.Typer(
     pretty_exceptions_show_locals=False,
 )
 
-#: exit status for bad input (as click uses for usage errors)
+#: exit status for bad input (as click uses for usage errors); also a controller that cannot be
+#: built (its module fails to import, its Params refuse the parameters, its constructor raises)
 EXIT_BAD_INPUT = 2
+#: exit status for a controller that fails mid-run (its step raises, returns no action, or
+#: takes longer than --brain-timeout)
+EXIT_BRAIN_FAILED = 3
 
 
 def _out() -> Console:
@@ -169,19 +173,31 @@ def _err() -> Console:
 
 
 @contextlib.contextmanager
-def _bad_input_exits() -> Iterator[None]:
-    """Turn bad-input exceptions into one message on stderr and exit status 2."""
+def _bad_input_exits(debug: bool = False) -> Iterator[None]:
+    """Turn bad-input exceptions into one message on stderr and exit status 2; a controller
+    that fails mid-run into one message naming it, the robot and the step, and exit status 3
+    (with ``debug``, the controller's own traceback first)."""
+    from teamnav.control.guard import BrainBuildError, BrainError
     from teamnav.experiments.errors import ScenarioError
     from teamnav.experiments.runner import OutputDirError
     from teamnav.world.mapio import MapError
 
+    debug = debug or bool(os.environ.get("TEAMNAV_DEBUG"))
     try:
         yield
+    except BrainError as exc:
+        err = _err()
+        if debug:
+            err.print(exc.brain_traceback().rstrip(), markup=False, highlight=False)
+        err.print(f"error: {exc}", markup=False)
+        if not debug:
+            err.print("(run with --debug to see the controller's traceback)", markup=False, style="dim")
+        raise typer.Exit(EXIT_BAD_INPUT if isinstance(exc, BrainBuildError) else EXIT_BRAIN_FAILED) from None
     except (ScenarioError, MapError, OutputDirError) as exc:
         _err().print(f"error: {exc}", markup=False)
         raise typer.Exit(EXIT_BAD_INPUT) from None
     except ValueError as exc:
-        if os.environ.get("TEAMNAV_DEBUG"):
+        if debug:
             raise
         _err().print(f"error: {exc}", markup=False)
         _err().print("(set TEAMNAV_DEBUG=1 to see where this came from)", markup=False, style="dim")
@@ -365,6 +381,12 @@ def metrics_table(rows, title: str) -> Table:
     return table
 
 
+def _positive_seconds(value: Optional[float]) -> Optional[float]:
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise typer.BadParameter(f"must be a number of seconds > 0, got {value:g}")
+    return value
+
+
 @app.command()
 def run(
     scenario: str = typer.Argument(
@@ -388,12 +410,26 @@ def run(
         help="Run your own Controller class for every group, or for one group as GROUP=MODULE:CLASS "
              "(a module on the path or in this folder, or path/to/file.py:CLASS). Repeatable.",
     ),
+    brain_timeout: Optional[float] = typer.Option(
+        None, "--brain-timeout", metavar="SECONDS", callback=_positive_seconds,
+        help="Stop the run when one controller call (a robot's step) takes longer than SECONDS.",
+    ),
+    debug: bool = typer.Option(
+        False, "--debug", help="On a failure, show the traceback (a controller's own, when it failed).",
+    ),
 ) -> None:
-    """Run a scenario, write its run folder and print its metrics."""
+    """Run a scenario, write its run folder and print its metrics.
+
+    Exit status: 0 done; 2 bad input, including a controller that cannot be built (its module
+    fails to import or exits, its parameters are refused, its constructor raises); 3 a
+    controller failed during the run (its step raised, returned no Action, or took longer than
+    --brain-timeout). On a failure one error line names the controller, the robot and the
+    step, and nothing is written to --out.
+    """
     from teamnav.experiments.runner import run as run_scenario
     from teamnav.experiments.spec import load_scenario
 
-    with _bad_input_exits():
+    with _bad_input_exits(debug):
         if controller:  # the controllers first, so --set can give the new ones their parameters
             base = load_scenario(scenario, seed=seed, duration_s=duration)
             swap = [f"{k}={json.dumps(v)}" for k, v in controller_overrides(base, controller).items()]
@@ -401,7 +437,8 @@ def run(
         else:
             scn = load_scenario(scenario, overrides=set_ or None, seed=seed, duration_s=duration)
         target = out if out is not None else _default_out(scn.name)
-        result = run_scenario(scn, out_dir=target, progress=False if quiet else None, gif=gif, force=force)
+        result = run_scenario(scn, out_dir=target, progress=False if quiet else None, gif=gif, force=force,
+                              brain_timeout_s=brain_timeout)
         if html:
             from teamnav.viz.replay import build_replay
 

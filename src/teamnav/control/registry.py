@@ -138,8 +138,14 @@ def _resolve_entry_point(name: str) -> Any:
     except ModuleNotFoundError as exc:
         raise KeyError(f"controller {name!r}: cannot import module {module!r} ({exc}); put it on the Python path "
                        "(PYTHONPATH), in the current folder, or give a file as 'path/to/file.py:Class'") from None
-    except Exception as exc:  # noqa: BLE001 - the user's module failed while importing: say so in one line
-        raise KeyError(f"controller {name!r}: importing {module!r} failed: {type(exc).__name__}: {exc}") from None
+    except BaseException as exc:  # noqa: BLE001 - the user's module failed while importing: say so in one line
+        # even sys.exit() or a KeyboardInterrupt raised by the module itself (they used to end
+        # the run with nothing written, sys.exit(0) with exit status 0); SIGTERM stays SIGTERM
+        if isinstance(exc, KeyboardInterrupt) and type(exc) is not KeyboardInterrupt:
+            raise
+        from teamnav.control.guard import describe
+
+        raise KeyError(f"controller {name!r}: importing {module!r} failed: {describe(exc)}") from None
     cls = getattr(mod, attr, None)
     if cls is None:
         public = sorted(n for n, v in vars(mod).items() if isinstance(v, type) and not n.startswith("_"))

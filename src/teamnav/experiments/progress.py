@@ -99,6 +99,10 @@ class PlainProgress:
     quiet_if_recent : bool
         Skip a line when another reporter printed one within the period (for an outer
         reporter whose inner work reports itself).
+    waiting : callable, optional
+        Returns what the work is stuck on now (``"waiting on controller X, robot Y, step 3
+        for 12 s"``) or ""; called in the thread, and when it says something the line shows
+        it instead of the phase (which may be stale: "compiling" while a brain hangs).
 
     Use :meth:`start`, then :meth:`update` (cheap: call it as often as you like) and
     :meth:`phase`, then :meth:`close`.
@@ -106,9 +110,10 @@ class PlainProgress:
 
     def __init__(self, label: str, total: int | None = None, unit: str = "steps", *,
                  details: Callable[[], str] | None = None, period: float | None = None,
-                 quiet_if_recent: bool = False) -> None:
+                 quiet_if_recent: bool = False, waiting: Callable[[], str] | None = None) -> None:
         self.label, self.total, self.unit = label, total, unit
         self.details = details
+        self.waiting = waiting
         self.period = period_s() if period is None else float(period)
         self.quiet_if_recent = quiet_if_recent
         self.done = 0
@@ -190,8 +195,14 @@ class PlainProgress:
         if math.isfinite(left) and done < (self.total or 0):
             parts.append(f"~{format_duration(left)} left")
         text = f"{self.label}: " + ", ".join(parts)
-        if self._phase:
-            text += f" ({self._phase})"
+        phase = self._phase
+        if self.waiting is not None:
+            try:
+                phase = self.waiting() or phase
+            except Exception:  # noqa: BLE001 - a progress line must never break the work
+                pass
+        if phase:
+            text += f" ({phase})"
         return text
 
     def _loop(self) -> None:

@@ -31,6 +31,7 @@ import shutil
 import socket
 import sys
 import tempfile
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,6 +39,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from teamnav.control.guard import BrainError
 from teamnav.experiments import metrics as metric_registry
 from teamnav.experiments.errors import Problem, ScenarioError
 from teamnav.experiments.spec import (
@@ -57,6 +59,8 @@ __all__ = [
 
 #: a progress bar appears once a run has taken this long [s]
 PROGRESS_AFTER_S = 2.0
+#: the progress line names the brain a step waits on once one call has lasted this long [s]
+BRAIN_WAIT_S = 2.0
 #: what the progress line says while numba compiles a kernel (the cache is empty or stale);
 #: the time is the first run of the built-in scenarios on a 2-core machine (demo ~20 s, the
 #: MCL ones more; measured by benchmarks/bench_startup.py)
@@ -153,23 +157,43 @@ class _LazyBar:
         self.t0 = time.perf_counter()
         self.bar = None
         self.task = None
+        self._lock = threading.Lock()  # the brain watch (another thread) may start the bar
 
     def __call__(self, done: int) -> None:
         if self.bar is None:
             if not self.show or time.perf_counter() - self.t0 < PROGRESS_AFTER_S:
                 return
-            from rich.console import Console
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
-
-            self.bar = Progress(
-                TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                console=Console(stderr=True), transient=True,
-            )
-            self.bar.start()
-            self.task = self.bar.add_task(self.label, total=self.total)
+            with self._lock:
+                if self.bar is None and self.show:
+                    self._start()
+            if self.bar is None:
+                return
         self.bar.update(self.task, completed=int(done))
 
+    def _start(self) -> None:
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+        bar = Progress(
+            TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+            console=Console(stderr=True), transient=True,
+        )
+        bar.start()
+        self.task = bar.add_task(self.label, total=self.total)
+        self.bar = bar
+
+    def describe(self, text: str) -> None:
+        """Show ``text`` as the bar's description (from any thread; the bar appears if it has
+        not yet)."""
+        with self._lock:
+            if self.bar is None and self.show:
+                self._start()
+            if self.bar is not None:
+                self.bar.update(self.task, description=text)
+
     def close(self) -> None:
+        with self._lock:
+            self.show = False
         if self.bar is not None:
             self.bar.stop()
 
@@ -314,6 +338,7 @@ def run(
     progress: bool | None | Callable[[int], None] = None,
     gif: bool = False,
     force: bool = False,
+    brain_timeout_s: float | None = None,
 ) -> RunResult:
     """Run ``scenario`` for ``duration_s`` and compute its metrics; optionally write a run folder.
 
@@ -331,6 +356,9 @@ def run(
         Also write ``run.gif`` (needs ``out_dir``).
     force : bool
         Replace a non-empty ``out_dir`` instead of refusing.
+    brain_timeout_s : float, optional
+        Stop the run when one brain call (``step``/``step_batch``) takes longer than this
+        [s] (:meth:`Simulation.brain_time_limit`); None: no limit.
 
     Returns
     -------
@@ -342,6 +370,10 @@ def run(
         The scenario is invalid (before anything runs).
     OutputDirError
         ``out_dir`` exists and is not empty, and ``force`` is False (before anything runs).
+    teamnav.control.guard.BrainError
+        A brain could not be built (:class:`~teamnav.control.guard.BrainBuildError`, before
+        anything runs), or failed, returned no action or ran past ``brain_timeout_s`` during
+        the run (:class:`~teamnav.control.guard.BrainStepError`); nothing is written.
 
     Examples
     --------
@@ -371,7 +403,7 @@ def run(
         grid = build_grid(scenario)
         try:
             sim = Simulation(grid, scenario, known_map=grid if scenario.give_map else None)
-        except ScenarioError:
+        except (ScenarioError, BrainError):  # a brain that cannot be built names itself
             raise
         except ValueError as exc:
             raise ScenarioError(scenario.source, [Problem("", f"the simulator cannot set up this scenario: {exc}")]) from None
@@ -395,7 +427,9 @@ def run(
                                              f"{folder} ({exc.strerror or exc}); choose another --out") from None
                 report.phase("first step: loading numba's cached kernels")
                 t0 = time.perf_counter()
-                with report.watching_compiles():
+                report.sim = sim  # the progress line says when a step waits on a brain
+                report.watch_brains()
+                with report.watching_compiles(), sim.brain_time_limit(brain_timeout_s):
                     sim.run(n_steps, progress=report.step, is_finished=all_finished if scenario.stop_when_finished else None)
                 wall_s = time.perf_counter() - t0
                 warmup_s = (report.t_first - t0) if report.t_first is not None else 0.0  # the first step
@@ -439,6 +473,8 @@ class _Progress:
 
         self.t_first: float | None = None  # perf_counter() at the end of the first step
         self.told_compiling = False
+        self.sim: Any = None  # the Simulation once built: waiting_on() says which brain a step waits on
+        self._watch_stop: Any = None
         self.bar: _LazyBar | None = None
         self.plain: PlainProgress | None = None
         self.user: Callable[[int], None] | None = progress if callable(progress) else None
@@ -446,8 +482,44 @@ class _Progress:
             if stderr_is_terminal():
                 self.bar = _LazyBar(n_steps, f"{scenario.name} ({scenario.n_robots} robots)")
             else:
-                self.plain = PlainProgress(f"teamnav run {scenario.name}", n_steps, "steps").start()
+                self.plain = PlainProgress(f"teamnav run {scenario.name}", n_steps, "steps",
+                                           waiting=self.waiting).start()
                 self.plain.phase("setting up")
+
+    def waiting(self) -> str:
+        """``"waiting on controller X, robot G[K] (id I), step S for N s"`` while a brain call
+        has lasted :data:`BRAIN_WAIT_S` or more, else "" (called from the progress thread)."""
+        sim = self.sim
+        at = sim.waiting_on() if sim is not None else None
+        if at is None or at[3] < BRAIN_WAIT_S:
+            return ""
+        from teamnav.experiments.progress import format_duration
+
+        controller, robot, step, seconds = at
+        return f"waiting on controller {controller}, robot {robot}, step {step} for {format_duration(seconds)}"
+
+    def watch_brains(self) -> None:
+        """On a terminal: a thread that shows on the bar when a step waits on a brain (the bar
+        is redrawn only when steps finish)."""
+        if self.bar is None or self._watch_stop is not None:
+            return
+        import threading
+
+        stop = self._watch_stop = threading.Event()
+        bar = self.bar
+
+        def loop() -> None:
+            shown = False
+            while not stop.wait(0.5):
+                text = self.waiting()
+                if text:
+                    bar.describe(f"{bar.label}: {text}")
+                    shown = True
+                elif shown:
+                    bar.describe(bar.label)
+                    shown = False
+
+        threading.Thread(target=loop, name="teamnav brain watch", daemon=True).start()
 
     def step(self, k: int) -> None:
         """The engine's ``progress(k)`` callback."""
@@ -506,12 +578,18 @@ class _Progress:
 
     def stepped(self) -> None:
         """Stepping is over: the bar goes, the plain lines say what comes next."""
+        self._stop_watch()
         if self.bar is not None:
             self.bar.close()
             self.bar = None
         self.phase("scoring and writing the run folder")
 
+    def _stop_watch(self) -> None:
+        if self._watch_stop is not None:
+            self._watch_stop.set()
+
     def close(self) -> None:
+        self._stop_watch()
         if self.bar is not None:
             self.bar.close()
             self.bar = None

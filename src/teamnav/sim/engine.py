@@ -57,14 +57,19 @@ nothing: they see only the observations the faults shaped.
 
 from __future__ import annotations
 
+import contextlib
 import math
+import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 from pydantic import ValidationError
 
 from teamnav.control import registry
+from teamnav.control.guard import (
+    BrainBuildError, BrainReturnError, BrainStepError, BrainTimeoutError, BrainTimer, TimeUp, describe, robot_label,
+)
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, BatchAction, BatchObservation, Message, Observation, RangeScan
 from teamnav.sim.collisions import move_discs
@@ -80,6 +85,15 @@ from teamnav.world.distance import distance_field
 from teamnav.world.grid import OccupancyGrid
 
 __all__ = ["Simulation"]
+
+
+_now = time.perf_counter
+
+
+def _short(value: Any) -> str:
+    """A returned value, briefly: its type and, when short, its repr."""
+    text = repr(value)
+    return f"{type(value).__name__} {text}" if len(text) <= 60 else type(value).__name__
 
 
 def _sensor_factories():
@@ -241,17 +255,20 @@ class Simulation:
                 raise ValueError(f"{label}: invalid parameters for controller {g.controller!r}: {problems}") from None
             batched = bool(getattr(cls, "batched", False))
             rngs = [np.random.default_rng(robot_ss[i]) for i in range(sl.start, sl.stop)]
-            try:
+            if batched and g.kinematics != "unicycle":
+                raise ValueError(f"{label}: controller {g.controller!r}: batched controllers command (v, omega) and "
+                                 f"need kinematics 'unicycle', got {g.kinematics!r}")
+            k = None
+            try:  # the brain's own code: whatever it raises (even sys.exit) is reported as its failure
                 if batched:
-                    if g.kinematics != "unicycle":
-                        raise ValueError(
-                            f"batched controllers command (v, omega) and need kinematics 'unicycle', got {g.kinematics!r}"
-                        )
                     brain = cls(params, rngs, infos)
                 else:
-                    brain = [cls(params, rngs[k], infos[k]) for k in range(g.count)]
-            except ValueError as exc:
-                raise ValueError(f"{label}: controller {g.controller!r}: {exc}") from None
+                    brain = []
+                    for k in range(g.count):
+                        brain.append(cls(params, rngs[k], infos[k]))
+            except (Exception, SystemExit) as exc:
+                raise BrainBuildError(str(g.controller), robot_label(g.name, k, sl.start + k if k is not None else None),
+                                      None, describe(exc)) from exc
             sens_rngs = [np.random.default_rng(s) for s in sens_group_ss[gi].spawn(len(sensors))]
             grp = _Group(index=gi, cfg=g, sl=sl, ids=np.arange(sl.start, sl.stop, dtype=np.int64), batched=batched,
                          brain=brain)
@@ -313,6 +330,10 @@ class Simulation:
         #: its ``step`` is not called, its robots keep the commands last stored
         #: (:meth:`set_commands`), and it reads this instead.
         self.observed: tuple | None = None
+        #: ``(group index, index in group or None for a batched call, step, perf_counter at the
+        #: call)`` while a brain is being called, else None (see :meth:`waiting_on`)
+        self.calling: tuple | None = None
+        self._brain_timer: BrainTimer | None = None
         self._pre_hooks: list[Callable] = []
         self._post_hooks: list[Callable] = []
 
@@ -618,7 +639,10 @@ class Simulation:
             for g in self._groups:
                 if g.has_log:
                     for k, brain in enumerate(g.brain):
-                        logs[g.sl.start + k] = brain.log()
+                        try:
+                            logs[g.sl.start + k] = brain.log()
+                        except (Exception, SystemExit) as exc:  # the brain's own code
+                            raise self._brain_failed(g, k, self.step_index, exc) from exc
         s = self.state
         self.recorder.record(self.step_index, self.time_s, s.poses(), self.odometry.pose, s.stalled, logs)
 
@@ -636,6 +660,7 @@ class Simulation:
         self.observed = (step, odom, delta, scans_of, inboxes, events, dets_of)
         fx = self.faults
         omit = None
+        timer = self._brain_timer
         for grp in self._groups:
             sl = grp.sl
             gx, gy, gth = xs[sl], ys[sl], ths[sl]
@@ -651,8 +676,13 @@ class Simulation:
                 )
                 if self._rec_sensing and self.recorder.wants(step):
                     self._record_sensing(grp, [(sensor.name, ranges)], None)
-                act = grp.brain.step_batch(obs)
-                self._apply_batch(grp, act)
+                self.calling = (grp.index, None, step, _now())
+                try:
+                    act = grp.brain.step_batch(obs) if timer is None else timer.call(grp.brain.step_batch, obs)
+                    self.calling = None
+                except (Exception, SystemExit) as exc:
+                    raise self._brain_failed(grp, None, step, exc) from exc
+                self._apply_batch(grp, act, step)
                 continue
             readings = [
                 (sensor.name,
@@ -688,19 +718,21 @@ class Simulation:
                     inbox=inboxes[i] if inboxes is not None else (),
                     events=events[i] if events is not None else (),
                 )
-                out = brain.step(obs)
+                self.calling = (grp.index, k, step, _now())
+                try:  # the brain's own code: whatever it raises (even sys.exit) is reported as its failure
+                    out = brain.step(obs) if timer is None else timer.call(brain.step, obs)
+                    self.calling = None
+                except (Exception, SystemExit) as exc:
+                    raise self._brain_failed(grp, k, step, exc) from exc
                 if not (isinstance(out, tuple) and len(out) == 2 and isinstance(out[0], Action)):
-                    raise ValueError(
-                        f"robot {i}: controller {grp.cfg.controller!r} step() must return (Action, list of Message), "
-                        f"got {type(out).__name__}"
-                    )
+                    raise self._bad_return(grp, k, step, "step() must return (Action, list of Message), got "
+                                           f"{_short(out)}")
                 action, outbox = out
                 self._v_cmd[i] = action.v_mps
                 self._w_cmd[i] = action.omega_radps
                 self._dir_cmd[i] = np.nan if action.direction_rad is None else action.direction_rad
                 if action.direction_rad is not None and not math.isfinite(action.direction_rad):
-                    raise ValueError(f"robot {i}: controller {grp.cfg.controller!r} direction_rad must be finite or None, "
-                                     f"got {action.direction_rad!r}")
+                    raise self._bad_return(grp, k, step, f"direction_rad must be finite or None, got {action.direction_rad!r}")
                 if outbox:
                     for m in outbox:
                         outgoing.append((i, m))
@@ -708,10 +740,10 @@ class Simulation:
             fx.zero_commands(self._v_cmd, self._w_cmd, self._dir_cmd)
         if not (np.isfinite(self._v_cmd).all() and np.isfinite(self._w_cmd).all()):
             bad = int(np.flatnonzero(~(np.isfinite(self._v_cmd) & np.isfinite(self._w_cmd)))[0])
-            raise ValueError(
-                f"robot {bad}: controller {self.config.robots[self.group_of[bad]].controller!r} must command finite "
-                f"v_mps and omega_radps, got ({self._v_cmd[bad]!r}, {self._w_cmd[bad]!r})"
-            )
+            grp = self._groups[self.group_of[bad]]
+            raise self._bad_return(grp, None if grp.batched else bad - grp.sl.start, step,
+                                   f"must command finite v_mps and omega_radps, got ({self._v_cmd[bad]!r}, "
+                                   f"{self._w_cmd[bad]!r}) for robot id {bad}")
         if outgoing:
             if fx is None:
                 self.radio.send(outgoing, xs, ys, step=step)
@@ -719,16 +751,58 @@ class Simulation:
                 self.radio.send(outgoing, xs, ys, muted=fx.radio_off if fx.any_radio_off else None, blocked=fx.blackout,
                                 step=step)
 
-    def _apply_batch(self, grp: _Group, act) -> None:
+    def _robot(self, grp: _Group, k: int | None) -> str:
+        return robot_label(grp.cfg.name, k, None if k is None else grp.sl.start + k)
+
+    def _brain_failed(self, grp: _Group, k: int | None, step: int, exc: BaseException) -> BrainStepError:
+        """The error for a brain call that raised ``exc`` (a :class:`TimeoutError` of the
+        brain timer: it ran past the limit)."""
+        self.calling = None
+        if isinstance(exc, TimeUp):
+            return BrainTimeoutError(str(grp.cfg.controller), self._robot(grp, k), step, str(exc))
+        return BrainStepError(str(grp.cfg.controller), self._robot(grp, k), step, describe(exc))
+
+    def _bad_return(self, grp: _Group, k: int | None, step: int, what: str) -> BrainReturnError:
+        self.calling = None
+        return BrainReturnError(str(grp.cfg.controller), self._robot(grp, k), step, what)
+
+    def waiting_on(self) -> tuple[str, str, int, float] | None:
+        """``(controller, robot, step, seconds)`` of the brain call in progress, None between
+        calls (safe to call from another thread: a progress line reads it)."""
+        at = self.calling
+        if at is None:
+            return None
+        gi, k, step, t0 = at
+        grp = self._groups[gi]
+        return str(grp.cfg.controller), self._robot(grp, k), step, _now() - t0
+
+    @contextlib.contextmanager
+    def brain_time_limit(self, seconds: float | None) -> Iterator[None]:
+        """While inside, each brain call that takes longer than ``seconds`` stops the run with a
+        :class:`~teamnav.control.guard.BrainTimeoutError` (None: no limit, nothing armed). Uses
+        ``SIGALRM`` in the main thread (:class:`~teamnav.control.guard.BrainTimer`)."""
+        if seconds is None:
+            yield
+            return
+        with BrainTimer(seconds) as timer:
+            self._brain_timer = timer
+            try:
+                yield
+            finally:
+                self._brain_timer = None
+
+    def _apply_batch(self, grp: _Group, act, step: int) -> None:
         n = grp.cfg.count
         if not isinstance(act, BatchAction):
-            raise ValueError(f"controller {grp.cfg.controller!r} step_batch() must return a BatchAction, got "
-                             f"{type(act).__name__}")
-        v = np.asarray(act.v_mps, dtype=np.float64)
-        w = np.asarray(act.omega_radps, dtype=np.float64)
+            raise self._bad_return(grp, None, step, f"step_batch() must return a BatchAction, got {_short(act)}")
+        try:
+            v = np.asarray(act.v_mps, dtype=np.float64)
+            w = np.asarray(act.omega_radps, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise self._bad_return(grp, None, step, f"v_mps and omega_radps must be float arrays ({exc})") from None
         if v.shape != (n,) or w.shape != (n,):
-            raise ValueError(f"controller {grp.cfg.controller!r} must return v_mps and omega_radps of shape ({n},), "
-                             f"got {v.shape} and {w.shape}")
+            raise self._bad_return(grp, None, step, f"must return v_mps and omega_radps of shape ({n},), "
+                                   f"got {v.shape} and {w.shape}")
         self._v_cmd[grp.sl] = v
         self._w_cmd[grp.sl] = w
 
