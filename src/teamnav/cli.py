@@ -173,11 +173,13 @@ def _bad_input_exits() -> Iterator[None]:
     """Turn bad-input exceptions into one message on stderr and exit status 2."""
     from teamnav.experiments.errors import ScenarioError
     from teamnav.experiments.runner import OutputDirError
+    from teamnav.files import ClaimError
+    from teamnav.viz.run_folder import OutputPathError
     from teamnav.world.mapio import MapError
 
     try:
         yield
-    except (ScenarioError, MapError, OutputDirError) as exc:
+    except (ScenarioError, MapError, OutputDirError, ClaimError, OutputPathError) as exc:
         _err().print(f"error: {exc}", markup=False)
         raise typer.Exit(EXIT_BAD_INPUT) from None
     except ValueError as exc:
@@ -383,6 +385,7 @@ def run(
     force: bool = typer.Option(False, "--force", help="Replace --out if it exists and is not empty."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no table; print only the run folder."),
     html: bool = typer.Option(False, "--html", help="Also write replay.html (see `teamnav replay`)."),
+    wait: bool = typer.Option(False, "--wait", help="If another teamnav process is writing the same --out folder, wait for it instead of refusing."),
     controller: Optional[List[str]] = typer.Option(
         None, "--controller", metavar="MODULE:CLASS",
         help="Run your own Controller class for every group, or for one group as GROUP=MODULE:CLASS "
@@ -401,7 +404,7 @@ def run(
         else:
             scn = load_scenario(scenario, overrides=set_ or None, seed=seed, duration_s=duration)
         target = out if out is not None else _default_out(scn.name)
-        result = run_scenario(scn, out_dir=target, progress=False if quiet else None, gif=gif, force=force)
+        result = run_scenario(scn, out_dir=target, progress=False if quiet else None, gif=gif, force=force, wait=wait)
         if html:
             from teamnav.viz.replay import build_replay
 
@@ -503,6 +506,7 @@ def replay(
     max_frames: int = typer.Option(5000, "--max-frames", metavar="N", help="At most N frames (--every grows to fit)."),
     max_points: int = typer.Option(300, "--max-points", metavar="N", help="At most N points per sample of a points layer."),
     no_scans: bool = typer.Option(False, "--no-scans", help="Leave recorded range scans out (smaller file)."),
+    wait: bool = typer.Option(False, "--wait", help="If another teamnav process is writing the same HTML file, wait for it instead of refusing."),
 ) -> None:
     """Write a self-contained HTML replay of a run.
 
@@ -511,7 +515,8 @@ def replay(
     from teamnav.viz.replay import build_replay
 
     with _bad_input_exits():
-        stats = build_replay(run_dir, out, every=every, max_frames=max_frames, max_points=max_points, scans=not no_scans)
+        stats = build_replay(run_dir, out, every=every, max_frames=max_frames, max_points=max_points, scans=not no_scans,
+                             wait=wait)
     _out().print(f"{stats.path}  ({stats.bytes / 1e6:.2f} MB, {stats.n_frames} frames of {stats.n_robots} robots; "
                  f"layers: {', '.join(stats.layers)})", markup=False)
 
@@ -521,6 +526,7 @@ def export(
     run_dir: Path = typer.Argument(..., metavar="RUN_DIR", help="A run folder (written by `teamnav run`)."),
     mcap: Path = typer.Option(..., "--mcap", metavar="FILE", help="MCAP file to write (opens in Foxglove)."),
     force: bool = typer.Option(False, "--force", help="Replace the MCAP file if it exists."),
+    wait: bool = typer.Option(False, "--wait", help="If another teamnav process is writing the same MCAP file, wait for it instead of refusing."),
 ) -> None:
     """Export a run to MCAP, to open in Foxglove.
 
@@ -529,7 +535,7 @@ def export(
     from teamnav.viz.mcap_export import export_mcap
 
     with _bad_input_exits():
-        stats = export_mcap(run_dir, mcap, force=force)
+        stats = export_mcap(run_dir, mcap, force=force, wait=wait)
     _out().print(f"{stats.path}  ({stats.bytes / 1e6:.2f} MB, {stats.messages} messages on {stats.channels} channels)",
                  markup=False)
 

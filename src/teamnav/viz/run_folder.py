@@ -36,6 +36,8 @@ import math
 import os
 import re
 import secrets
+import stat
+import sys
 import zipfile
 import zlib
 from pathlib import Path
@@ -43,7 +45,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from teamnav.files import file_mode
+from teamnav.files import HOST, claim, destination_problem, file_mode
 from teamnav.sim.recorder import LAYER_KINDS, Layer, RunRecord, Scan
 
 #: Files a run folder holds (``teamnav run``); an output path must not be one of them.
@@ -52,7 +54,7 @@ RUN_FILES: frozenset[str] = frozenset({
     "metrics.json", "scenario.yaml", "map.yaml", "map.pgm", "map_materials.pgm", "trajectories.png", "run.gif",
 })
 
-__all__ = ["MAX_RUN_BYTES", "RUN_FILES", "OutputPathError", "RunFolderError", "atomic_output", "read_map", "read_run_folder", "scenario_name"]
+__all__ = ["MAX_RUN_BYTES", "RUN_FILES", "OutputPathError", "RunFolderError", "atomic_output", "clean_stale_tmp", "read_map", "read_run_folder", "scenario_name"]
 
 #: Most memory [bytes] the arrays of a run folder (trajectories.npz + layers.npz) may take once
 #: decompressed (2 GiB); larger folders are refused before anything is decompressed.
@@ -450,8 +452,35 @@ def read_map(run_dir: str | os.PathLike):
 
 
 # ---------------------------------------------------------------------------- writing
+#: ``.NAME.HOST-PID.XXXXXXXX.tmp``: the temporary file of :func:`atomic_output`
+_TMP = re.compile(r"^\.(?P<name>.+)\.(?P<host>[A-Za-z0-9-]{1,32})-(?P<pid>\d+)\.[0-9a-f]{8}\.tmp$")
+
+
+def clean_stale_tmp(path: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files of :func:`atomic_output` for ``path`` that processes of this
+    host left behind when they were killed outright (SIGKILL, a power cut): their pid is gone."""
+    from teamnav.experiments.signals import pid_alive
+
+    path = Path(path)
+    removed: list[Path] = []
+    try:
+        entries = list(os.scandir(path.parent))
+    except OSError:
+        return removed
+    for entry in entries:
+        m = _TMP.match(entry.name)
+        if m is None or m["name"] != path.name or m["host"] != HOST or pid_alive(int(m["pid"])):
+            continue
+        with contextlib.suppress(OSError):
+            if entry.is_file(follow_symlinks=False) or entry.is_symlink():
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+    return removed
+
+
 @contextlib.contextmanager
-def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: str | os.PathLike | None = None) -> Iterator[Path]:
+def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: str | os.PathLike | None = None,
+                  force: bool | None = None, wait: bool = False, command: str = "") -> Iterator[Path]:
     """Yield a temporary path in ``path``'s folder; on success rename it to ``path``.
 
     Folders missing above ``path`` are made; on any failure the temporary file and the folders
@@ -459,13 +488,32 @@ def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: s
     (``what``: "HTML file", "MCAP file"; ``option``: the CLI option to change). With
     ``run_dir``, a ``path`` that is one of that run folder's own files (:data:`RUN_FILES`) is
     refused: writing the replay over ``trajectories.npz`` would destroy the run it shows.
+
+    ``path`` is claimed for the whole write (:func:`teamnav.files.claim`): a second writer of
+    the same ``path`` raises :class:`~teamnav.files.ClaimError` (or waits, with ``wait``).
+    With ``force=False``, an existing ``path`` is refused, checked again once the claim is
+    held (another writer may have just finished it). Temporary files of writers of ``path``
+    that were killed outright are removed; SIGTERM removes this one's as Ctrl-C does. A
+    ``path`` that is a symbolic link, or below a file, a dangling link or a read-only folder,
+    is refused before anything is made.
     """
+    from teamnav.experiments.signals import sigterm_deferred, sigterm_raises
+
     path = Path(path)
     todo = f"choose another {option}"
-    if path.is_dir():
+    if path.is_dir() and not path.is_symlink():
         raise OutputPathError(f"{what} {path}: expected a file path, found a folder; {todo}")
+    problem = destination_problem(path, folder=False)
+    if problem is not None:
+        raise OutputPathError(f"{what} {path}: {problem}; {todo}")
     if run_dir is not None and path.name in RUN_FILES and path.exists() and path.parent.resolve() == Path(run_dir).resolve():
         raise OutputPathError(f"{what} {path}: expected a new file, found the run folder's own {path.name}; {todo}")
+
+    def refuse_existing() -> None:
+        if force is False and (path.exists() or path.is_symlink()):
+            raise OutputPathError(f"{what} {path}: exists; {todo} or pass --force")
+
+    refuse_existing()
     parent = path.parent
     made: list[Path] = []
     p = parent
@@ -482,20 +530,33 @@ def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: s
             with contextlib.suppress(OSError):
                 d.rmdir()
 
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        name = parent / f".{path.name}.{secrets.token_hex(4)}.tmp"
-        os.close(os.open(name, os.O_WRONLY | os.O_CREAT | os.O_EXCL, file_mode()))
-        tmp = name
-    except OSError as exc:
-        undo()
-        raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    except OSError as exc:
-        undo()
-        raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
-    except BaseException:
-        undo()
-        raise
+    with sigterm_raises(), contextlib.ExitStack() as held:  # SIGTERM: as Ctrl-C, then the process ends
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            held.enter_context(claim(path, what, command=command, wait=wait,
+                                     say=lambda line: print(line, file=sys.stderr, flush=True)))
+            refuse_existing()
+            clean_stale_tmp(path)
+            name = parent / f".{path.name}.{HOST}-{os.getpid()}.{secrets.token_hex(4)}.tmp"
+            with sigterm_deferred():  # no SIGTERM between creating the file and knowing its name
+                os.close(os.open(name, os.O_WRONLY | os.O_CREAT | os.O_EXCL, file_mode()))
+                tmp = name
+        except OSError as exc:
+            held.close()
+            undo()
+            raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
+        except BaseException:
+            held.close()
+            undo()
+            raise
+        try:
+            yield tmp
+            os.replace(tmp, path)
+        except OSError as exc:
+            held.close()
+            undo()
+            raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
+        except BaseException:
+            held.close()
+            undo()
+            raise
