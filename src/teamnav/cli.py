@@ -174,12 +174,12 @@ def _bad_input_exits() -> Iterator[None]:
     from teamnav.experiments.errors import ScenarioError
     from teamnav.experiments.runner import OutputDirError
     from teamnav.files import ClaimError
-    from teamnav.viz.run_folder import OutputPathError
+    from teamnav.viz.run_folder import OutputPathError, RunFolderError
     from teamnav.world.mapio import MapError
 
     try:
         yield
-    except (ScenarioError, MapError, OutputDirError, ClaimError, OutputPathError) as exc:
+    except (ScenarioError, MapError, OutputDirError, ClaimError, OutputPathError, RunFolderError) as exc:
         _err().print(f"error: {exc}", markup=False)
         raise typer.Exit(EXIT_BAD_INPUT) from None
     except ValueError as exc:

@@ -223,7 +223,7 @@ def destination_problem(path: str | os.PathLike, *, folder: bool) -> str | None:
     """
     path = Path(path)
     if path.is_symlink():
-        return f"{path} {_link_words(path)}; give the real {'folder' if folder else 'file'}"
+        return f"{path} {_link_words(path)}"
     if not folder and path.is_dir():
         return f"{path} is a folder, not a file"
     parent = path.parent

@@ -267,7 +267,7 @@ def _check_out_dir(out: Path, force: bool) -> None:
     if problem is None and out.is_dir() and not os.access(out, os.W_OK | os.X_OK):
         problem = f"{out} is read-only"  # replacing it moves it, which needs its write permission
     if problem is not None:
-        raise OutputDirError(f"output folder {out}: {problem}; choose another --out")
+        raise OutputDirError(f"output folder {out}: cannot be written ({problem}); choose another --out")
     if out.exists() and not force:
         if not out.is_dir():
             raise OutputDirError(f"output folder {out} exists and is a file; choose another --out or pass --force")

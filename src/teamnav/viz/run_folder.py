@@ -54,11 +54,17 @@ RUN_FILES: frozenset[str] = frozenset({
     "metrics.json", "scenario.yaml", "map.yaml", "map.pgm", "map_materials.pgm", "trajectories.png", "run.gif",
 })
 
-__all__ = ["MAX_RUN_BYTES", "RUN_FILES", "OutputPathError", "RunFolderError", "atomic_output", "clean_stale_tmp", "read_map", "read_run_folder", "scenario_name"]
+__all__ = ["MAX_JSON_BYTES", "MAX_RUN_BYTES", "MAX_TEXT_BYTES", "RUN_FILES", "OutputPathError", "RunFolderError", "atomic_output", "clean_stale_tmp", "read_map", "read_run_folder", "scenario_name"]
 
 #: Most memory [bytes] the arrays of a run folder (trajectories.npz + layers.npz) may take once
 #: decompressed (2 GiB); larger folders are refused before anything is decompressed.
 MAX_RUN_BYTES = 2 * 1024**3
+
+#: Largest JSON file of a run folder [bytes] (logs.json of a long run is a few MiB); larger
+#: ones are refused before they are read.
+MAX_JSON_BYTES = 256 * 1024**2
+#: Largest scenario.yaml or map.yaml read from a run folder [bytes].
+MAX_TEXT_BYTES = 16 * 1024**2
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,63}$")  # layer and scan names (as the recorder allows)
 _FRAMES = ("world", "odom")
@@ -106,6 +112,52 @@ def _dtype_word(a: np.ndarray) -> str:
     return f"{a.dtype} array of shape {tuple(a.shape)}"
 
 
+_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a named pipe (FIFO)"), (stat.S_ISSOCK, "a socket"),
+          (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"))
+
+
+def checked_file(run_dir: str | os.PathLike, path: str | os.PathLike, limit: int, *, file: str | None = None) -> Path | None:
+    """``path`` (relative to ``run_dir``, or absolute) if it is safe to read as a file of the run
+    folder, None when it does not exist.
+
+    Refused, before a byte is read: a symbolic link (or a path) that leads out of ``run_dir``
+    (a run folder handed over must not make teamnav read ``~/.ssh/id_rsa`` into a page),
+    anything but a regular file (a named pipe would hang the read, a device never ends), and a
+    file larger than ``limit`` bytes (a huge or sparse file would exhaust memory).
+
+    Raises
+    ------
+    RunFolderError
+        Naming the file and what it is.
+    """
+    run_dir = Path(run_dir)
+    full = run_dir / path
+    label = file or str(path)
+    try:
+        st = os.lstat(full)
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        raise RunFolderError(run_dir, label, "", "a readable file", _short(exc.strerror or exc)) from None
+    if not full.resolve().is_relative_to(run_dir.resolve()):  # a link (or a link above it) out of the folder
+        where = os.readlink(full) if stat.S_ISLNK(st.st_mode) else str(full.resolve())
+        raise RunFolderError(run_dir, label, "", "a file inside the run folder",
+                             f"a path leading out of it, to {_short(where)} (teamnav does not follow it)")
+    try:
+        st = os.stat(full)
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        raise RunFolderError(run_dir, label, "", "a readable file", _short(exc.strerror or exc)) from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = next((word for test, word in _KINDS if test(st.st_mode)), "not a regular file")
+        raise RunFolderError(run_dir, label, "", "a regular file", kind)
+    if st.st_size > limit:
+        raise RunFolderError(run_dir, label, "", f"a file of at most {limit / 1024**2:.0f} MiB",
+                             f"{st.st_size / 1024**2:.0f} MiB")
+    return full
+
+
 class _Folder:
     """The run folder being read, for messages."""
 
@@ -118,8 +170,10 @@ class _Folder:
     # ------------------------------------------------------------------ arrays
     def npz(self, name: str, budget: list[int]) -> dict[str, np.ndarray]:
         """Every array of ``name`` (an .npz), numbers only, with ``allow_pickle=False``."""
-        path = self.dir / name
         expected = "a NumPy .npz archive as `teamnav run` writes it"
+        path = checked_file(self.dir, name, MAX_RUN_BYTES)
+        if path is None:
+            raise self.error(name, "", "a readable file", "nothing: it does not exist")
         try:
             with open(path, "rb") as fh:
                 head = fh.read(4)
@@ -184,8 +238,8 @@ class _Folder:
     # ------------------------------------------------------------------ JSON
     def json(self, name: str) -> Any:
         """The parsed JSON of ``name`` (None when the file is absent)."""
-        path = self.dir / name
-        if not path.exists():
+        path = checked_file(self.dir, name, MAX_JSON_BYTES)
+        if path is None:
             return None
         try:
             text = path.read_text(encoding="utf-8")
@@ -417,8 +471,11 @@ def scenario_name(run_dir: str | os.PathLike) -> str:
 
     from teamnav.experiments.spec import read_yaml
 
-    path = Path(run_dir) / "scenario.yaml"
-    if not path.is_file():
+    try:
+        path = checked_file(run_dir, "scenario.yaml", MAX_TEXT_BYTES)
+    except RunFolderError:
+        return ""  # a link out, a pipe, a huge file: no title from it
+    if path is None:
         return ""
     try:
         doc = read_yaml(path.read_text(encoding="utf-8"))
@@ -442,9 +499,17 @@ def read_map(run_dir: str | os.PathLike):
     from teamnav.experiments.spec import map_file_problem
     from teamnav.world.mapio import load_map
 
-    path = Path(run_dir) / "map.yaml"
-    if not path.is_file():
+    from teamnav.world.mapio import read_map_yaml
+
+    if (Path(run_dir) / "map.yaml").is_dir():
         return None
+    path = checked_file(run_dir, "map.yaml", MAX_TEXT_BYTES)
+    if path is None:
+        return None
+    meta = read_map_yaml(path)
+    for image in (meta.image, meta.materials_image):  # the images it names: inside the folder, regular files
+        if image is not None:
+            checked_file(run_dir, Path(os.path.abspath(image)), MAX_RUN_BYTES, file=f"map.yaml's image {Path(image).name}")
     problem = map_file_problem(path)
     if problem:
         raise RunFolderError(run_dir, "map.yaml", "", "a map small enough to load", problem)
@@ -505,7 +570,7 @@ def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: s
         raise OutputPathError(f"{what} {path}: expected a file path, found a folder; {todo}")
     problem = destination_problem(path, folder=False)
     if problem is not None:
-        raise OutputPathError(f"{what} {path}: {problem}; {todo}")
+        raise OutputPathError(f"{what} {path}: cannot be written ({problem}); {todo}")
     if run_dir is not None and path.name in RUN_FILES and path.exists() and path.parent.resolve() == Path(run_dir).resolve():
         raise OutputPathError(f"{what} {path}: expected a new file, found the run folder's own {path.name}; {todo}")
 

@@ -284,7 +284,7 @@ def _check_out_dir(out_dir: Path) -> None:
     if problem is None and out_dir.is_dir() and not os.access(out_dir, os.W_OK | os.X_OK):
         problem = f"{out_dir} is read-only"
     if problem is not None:
-        raise ReportError(f"--out {out_dir}: {problem}; choose another --out")
+        raise ReportError(f"--out {out_dir}: cannot be written ({problem}); choose another --out")
     if out_dir.exists() and not out_dir.is_dir():
         raise ReportError(f"--out {out_dir}: expected a folder for the report, received an existing file")
     if out_dir.is_dir() and any(out_dir.iterdir()) and not (out_dir / MARKER_NAME).is_file():
