@@ -42,6 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
+from teamnav.files import destination_problem
 from teamnav.viz.replay import odom_anchor, read_run
 from teamnav.viz.run_folder import OutputPathError, atomic_output
 
@@ -140,6 +141,9 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
     path = Path(path)
     if path.is_dir():
         raise OutputPathError(f"MCAP file {path}: expected a file path, found a folder; choose another --mcap")
+    problem = destination_problem(path, folder=False)
+    if problem is not None:
+        raise OutputPathError(f"MCAP file {path}: cannot be written ({problem}); choose another --mcap")
     if (path.exists() or path.is_symlink()) and not force:
         raise OutputPathError(f"MCAP file {str(path)!r} exists; choose another --mcap or pass --force")
     T, N = rec.true_pose.shape[:2]
