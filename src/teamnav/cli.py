@@ -180,6 +180,8 @@ def _bad_input_exits(debug: bool = False) -> Iterator[None]:
     from teamnav.control.guard import BrainBuildError, BrainError
     from teamnav.experiments.errors import ScenarioError
     from teamnav.experiments.runner import OutputDirError
+    from teamnav.files import ClaimError
+    from teamnav.viz.run_folder import OutputPathError, RunFolderError
     from teamnav.world.mapio import MapError
 
     debug = debug or bool(os.environ.get("TEAMNAV_DEBUG"))
@@ -193,7 +195,7 @@ def _bad_input_exits(debug: bool = False) -> Iterator[None]:
         if not debug:
             err.print("(run with --debug to see the controller's traceback)", markup=False, style="dim")
         raise typer.Exit(EXIT_BAD_INPUT if isinstance(exc, BrainBuildError) else EXIT_BRAIN_FAILED) from None
-    except (ScenarioError, MapError, OutputDirError) as exc:
+    except (ScenarioError, MapError, OutputDirError, ClaimError, OutputPathError, RunFolderError) as exc:
         _err().print(f"error: {exc}", markup=False)
         raise typer.Exit(EXIT_BAD_INPUT) from None
     except ValueError as exc:
@@ -405,6 +407,7 @@ def run(
     force: bool = typer.Option(False, "--force", help="Replace --out if it exists and is not empty."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar and no table; print only the run folder."),
     html: bool = typer.Option(False, "--html", help="Also write replay.html (see `teamnav replay`)."),
+    wait: bool = typer.Option(False, "--wait", help="If another teamnav process is writing the same --out folder, wait for it instead of refusing."),
     controller: Optional[List[str]] = typer.Option(
         None, "--controller", metavar="MODULE:CLASS",
         help="Run your own Controller class for every group, or for one group as GROUP=MODULE:CLASS "
@@ -438,7 +441,7 @@ def run(
             scn = load_scenario(scenario, overrides=set_ or None, seed=seed, duration_s=duration)
         target = out if out is not None else _default_out(scn.name)
         result = run_scenario(scn, out_dir=target, progress=False if quiet else None, gif=gif, force=force,
-                              brain_timeout_s=brain_timeout)
+                              brain_timeout_s=brain_timeout, wait=wait)
         if html:
             from teamnav.viz.replay import build_replay
 
@@ -540,6 +543,7 @@ def replay(
     max_frames: int = typer.Option(5000, "--max-frames", metavar="N", help="At most N frames (--every grows to fit)."),
     max_points: int = typer.Option(300, "--max-points", metavar="N", help="At most N points per sample of a points layer."),
     no_scans: bool = typer.Option(False, "--no-scans", help="Leave recorded range scans out (smaller file)."),
+    wait: bool = typer.Option(False, "--wait", help="If another teamnav process is writing the same HTML file, wait for it instead of refusing."),
 ) -> None:
     """Write a self-contained HTML replay of a run.
 
@@ -548,7 +552,8 @@ def replay(
     from teamnav.viz.replay import build_replay
 
     with _bad_input_exits():
-        stats = build_replay(run_dir, out, every=every, max_frames=max_frames, max_points=max_points, scans=not no_scans)
+        stats = build_replay(run_dir, out, every=every, max_frames=max_frames, max_points=max_points, scans=not no_scans,
+                             wait=wait)
     _out().print(f"{stats.path}  ({stats.bytes / 1e6:.2f} MB, {stats.n_frames} frames of {stats.n_robots} robots; "
                  f"layers: {', '.join(stats.layers)})", markup=False)
 
@@ -558,6 +563,7 @@ def export(
     run_dir: Path = typer.Argument(..., metavar="RUN_DIR", help="A run folder (written by `teamnav run`)."),
     mcap: Path = typer.Option(..., "--mcap", metavar="FILE", help="MCAP file to write (opens in Foxglove)."),
     force: bool = typer.Option(False, "--force", help="Replace the MCAP file if it exists."),
+    wait: bool = typer.Option(False, "--wait", help="If another teamnav process is writing the same MCAP file, wait for it instead of refusing."),
 ) -> None:
     """Export a run to MCAP, to open in Foxglove.
 
@@ -566,7 +572,7 @@ def export(
     from teamnav.viz.mcap_export import export_mcap
 
     with _bad_input_exits():
-        stats = export_mcap(run_dir, mcap, force=force)
+        stats = export_mcap(run_dir, mcap, force=force, wait=wait)
     _out().print(f"{stats.path}  ({stats.bytes / 1e6:.2f} MB, {stats.messages} messages on {stats.channels} channels)",
                  markup=False)
 

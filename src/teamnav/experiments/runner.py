@@ -50,7 +50,7 @@ from teamnav.experiments.spec import (
     load_scenario,
     scenario_to_yaml,
 )
-from teamnav.files import current_umask  # noqa: F401 (re-exported: teamnav.env uses it)
+from teamnav.files import ClaimError, claim, current_umask, destination_problem  # noqa: F401 (current_umask: teamnav.env uses it)
 from teamnav.world.mapio import YAML_SUFFIXES, read_map_yaml, save_map
 
 __all__ = [
@@ -285,6 +285,13 @@ def _staging_place(out: Path | None) -> tuple[Path, str]:
 
 
 def _check_out_dir(out: Path, force: bool) -> None:
+    """Refuse, before any work, an ``out`` teamnav cannot or must not write (see
+    :func:`teamnav.files.destination_problem`), and one that holds something (without ``force``)."""
+    problem = destination_problem(out, folder=True)
+    if problem is None and out.is_dir() and not os.access(out, os.W_OK | os.X_OK):
+        problem = f"{out} is read-only"  # replacing it moves it, which needs its write permission
+    if problem is not None:
+        raise OutputDirError(f"output folder {out}: cannot be written ({problem}); choose another --out")
     if out.exists() and not force:
         if not out.is_dir():
             raise OutputDirError(f"output folder {out} exists and is a file; choose another --out or pass --force")
@@ -339,6 +346,7 @@ def run(
     gif: bool = False,
     force: bool = False,
     brain_timeout_s: float | None = None,
+    wait: bool = False,
 ) -> RunResult:
     """Run ``scenario`` for ``duration_s`` and compute its metrics; optionally write a run folder.
 
@@ -359,6 +367,10 @@ def run(
     brain_timeout_s : float, optional
         Stop the run when one brain call (``step``/``step_batch``) takes longer than this
         [s] (:meth:`Simulation.brain_time_limit`); None: no limit.
+    wait : bool
+        When another process is writing ``out_dir`` (it holds its claim, ``.NAME.lock`` beside
+        it: :func:`teamnav.files.claim`), wait for it to finish instead of refusing; then
+        ``out_dir`` is checked again (without ``force``, the other run's folder is kept).
 
     Returns
     -------
@@ -369,7 +381,10 @@ def run(
     ScenarioError
         The scenario is invalid (before anything runs).
     OutputDirError
-        ``out_dir`` exists and is not empty, and ``force`` is False (before anything runs).
+        ``out_dir`` exists and is not empty, and ``force`` is False; or it cannot be written
+        (read-only, a symbolic link, a file above it); before anything runs.
+    ClaimError
+        Another process is writing ``out_dir`` and ``wait`` is False (before anything runs).
     teamnav.control.guard.BrainError
         A brain could not be built (:class:`~teamnav.control.guard.BrainBuildError`, before
         anything runs), or failed, returned no action or ran past ``brain_timeout_s`` during
@@ -414,8 +429,16 @@ def run(
             except OSError as exc:
                 raise OutputDirError(f"output folder {out}: its parent {out.parent} cannot be created "
                                      f"({exc.strerror or exc}); choose another --out") from None
-        with sigterm_raises():  # SIGTERM: the staging folder is removed, then the process ends
+        with sigterm_raises(), contextlib.ExitStack() as held:  # SIGTERM: staging and claim removed, then the process ends
             staging: Path | None = None
+            if out is not None:  # one writer per run folder, from here to the end
+                try:
+                    held.enter_context(claim(out, "output folder", command="teamnav run", wait=wait,
+                                             say=lambda line: print(line, file=sys.stderr, flush=True)))
+                except OSError as exc:
+                    raise OutputDirError(f"output folder {out}: cannot write in {out.parent} "
+                                         f"({exc.strerror or exc}); choose another --out") from None
+                _check_out_dir(out, force)  # what a writer that held it before us left there
             try:
                 folder, prefix = _staging_place(out)
                 clean_stale_staging(folder)

@@ -42,6 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
+from teamnav.files import destination_problem
 from teamnav.viz.replay import odom_anchor, read_run
 from teamnav.viz.run_folder import OutputPathError, atomic_output
 
@@ -88,7 +89,7 @@ def _uniform(angles: np.ndarray) -> bool:
     return bool(np.allclose(d, d[0], atol=1e-6) and d[0] > 0)
 
 
-def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: bool = False) -> McapStats:
+def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: bool = False, wait: bool = False) -> McapStats:
     """Write ``path`` (an MCAP file) from the run folder ``run_dir`` (topics in the module docstring).
 
     Parameters
@@ -97,6 +98,9 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
     path : str or Path
     force : bool, default False
         Replace ``path`` if it exists.
+    wait : bool, default False
+        When another process is writing ``path`` (it holds its claim: :func:`teamnav.files.claim`),
+        wait for it instead of refusing.
 
     Returns
     -------
@@ -105,7 +109,9 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
     Raises
     ------
     ValueError
-        Not a run folder, or ``path`` exists and ``force`` is False.
+        Not a run folder, or ``path`` exists and ``force`` is False, or cannot be written
+        (:class:`~teamnav.viz.run_folder.OutputPathError`), or another process is writing it
+        (:class:`~teamnav.files.ClaimError`).
     """
     import foxglove
     from foxglove.channels import FrameTransformsChannel, GridChannel, LaserScanChannel, PoseInFrameChannel, SceneUpdateChannel
@@ -135,8 +141,11 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
     path = Path(path)
     if path.is_dir():
         raise OutputPathError(f"MCAP file {path}: expected a file path, found a folder; choose another --mcap")
-    if path.exists() and not force:
-        raise ValueError(f"MCAP file {str(path)!r} exists; choose another --mcap or pass --force")
+    problem = destination_problem(path, folder=False)
+    if problem is not None:
+        raise OutputPathError(f"MCAP file {path}: cannot be written ({problem}); choose another --mcap")
+    if (path.exists() or path.is_symlink()) and not force:
+        raise OutputPathError(f"MCAP file {str(path)!r} exists; choose another --mcap or pass --force")
     T, N = rec.true_pose.shape[:2]
     true = np.asarray(rec.true_pose, float)
     odom = np.asarray(rec.odom_pose, float)
@@ -160,7 +169,8 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
     ctx = foxglove.Context()
     # written under a temporary name in the target folder, renamed once complete; a path that
     # cannot be written is an OutputPathError naming it, and nothing is left behind
-    with atomic_output(path, "MCAP file", "--mcap", run_dir=run_dir) as tmp:
+    # (claimed: a second export into ``path`` refuses or waits; SIGTERM removes the temporary file)
+    with atomic_output(path, "MCAP file", "--mcap", run_dir=run_dir, force=force, wait=wait, command="teamnav export") as tmp:
         with foxglove.open_mcap(tmp, allow_overwrite=True, context=ctx):
             def log(ch, msg, ns):
                 ch.log(msg, log_time=int(ns))

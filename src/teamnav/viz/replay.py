@@ -302,6 +302,7 @@ def build_replay(
     scans: bool = True,
     title: str | None = None,
     compress_level: int = 6,
+    wait: bool = False,
 ) -> ReplayStats:
     """Write the HTML replay of the run folder ``run_dir``.
 
@@ -326,6 +327,9 @@ def build_replay(
         Page title (default: the scenario name and the folder name).
     compress_level : int, default 6
         zlib level of the inlined data.
+    wait : bool, default False
+        When another process is writing ``out`` (it holds its claim: :func:`teamnav.files.claim`),
+        wait for it instead of refusing (:class:`~teamnav.files.ClaimError`).
 
     Returns
     -------
@@ -487,7 +491,7 @@ def build_replay(
     fill = {"TITLE": html.escape(meta["title"]), "META": _script_json(meta), "DATA": payload,
             "CSP": html.escape(_script_csp(page))}
     page = re.sub(r"\{\{(TITLE|META|DATA|CSP)\}\}", lambda m: fill[m.group(1)], page)  # one pass: data never re-scanned
-    with atomic_output(out, "HTML file", "--out", run_dir=run_dir) as tmp:  # nothing half-written, even on /proc or a full disk
+    with atomic_output(out, "HTML file", "--out", run_dir=run_dir, wait=wait, command="teamnav replay") as tmp:  # nothing half-written, even on /proc or a full disk
         tmp.write_text(page, encoding="utf-8")
     names = ["map", "true", "trails", "belief"] + (["scans"] if scans_meta else []) + [m["name"] for m in layers_meta]
     names += ["events"] if events else []

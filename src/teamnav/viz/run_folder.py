@@ -36,6 +36,8 @@ import math
 import os
 import re
 import secrets
+import stat
+import sys
 import zipfile
 import zlib
 from pathlib import Path
@@ -43,7 +45,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from teamnav.files import file_mode
+from teamnav.files import HOST, claim, destination_problem, file_mode
 from teamnav.sim.recorder import LAYER_KINDS, Layer, RunRecord, Scan
 
 #: Files a run folder holds (``teamnav run``); an output path must not be one of them.
@@ -52,11 +54,17 @@ RUN_FILES: frozenset[str] = frozenset({
     "metrics.json", "scenario.yaml", "map.yaml", "map.pgm", "map_materials.pgm", "trajectories.png", "run.gif",
 })
 
-__all__ = ["MAX_RUN_BYTES", "RUN_FILES", "OutputPathError", "RunFolderError", "atomic_output", "read_map", "read_run_folder", "scenario_name"]
+__all__ = ["MAX_JSON_BYTES", "MAX_RUN_BYTES", "MAX_TEXT_BYTES", "RUN_FILES", "OutputPathError", "RunFolderError", "atomic_output", "clean_stale_tmp", "read_map", "read_run_folder", "scenario_name"]
 
 #: Most memory [bytes] the arrays of a run folder (trajectories.npz + layers.npz) may take once
 #: decompressed (2 GiB); larger folders are refused before anything is decompressed.
 MAX_RUN_BYTES = 2 * 1024**3
+
+#: Largest JSON file of a run folder [bytes] (logs.json of a long run is a few MiB); larger
+#: ones are refused before they are read.
+MAX_JSON_BYTES = 256 * 1024**2
+#: Largest scenario.yaml or map.yaml read from a run folder [bytes].
+MAX_TEXT_BYTES = 16 * 1024**2
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,63}$")  # layer and scan names (as the recorder allows)
 _FRAMES = ("world", "odom")
@@ -104,6 +112,52 @@ def _dtype_word(a: np.ndarray) -> str:
     return f"{a.dtype} array of shape {tuple(a.shape)}"
 
 
+_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a named pipe (FIFO)"), (stat.S_ISSOCK, "a socket"),
+          (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"))
+
+
+def checked_file(run_dir: str | os.PathLike, path: str | os.PathLike, limit: int, *, file: str | None = None) -> Path | None:
+    """``path`` (relative to ``run_dir``, or absolute) if it is safe to read as a file of the run
+    folder, None when it does not exist.
+
+    Refused, before a byte is read: a symbolic link (or a path) that leads out of ``run_dir``
+    (a run folder handed over must not make teamnav read ``~/.ssh/id_rsa`` into a page),
+    anything but a regular file (a named pipe would hang the read, a device never ends), and a
+    file larger than ``limit`` bytes (a huge or sparse file would exhaust memory).
+
+    Raises
+    ------
+    RunFolderError
+        Naming the file and what it is.
+    """
+    run_dir = Path(run_dir)
+    full = run_dir / path
+    label = file or str(path)
+    try:
+        st = os.lstat(full)
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        raise RunFolderError(run_dir, label, "", "a readable file", _short(exc.strerror or exc)) from None
+    if not full.resolve().is_relative_to(run_dir.resolve()):  # a link (or a link above it) out of the folder
+        where = os.readlink(full) if stat.S_ISLNK(st.st_mode) else str(full.resolve())
+        raise RunFolderError(run_dir, label, "", "a file inside the run folder",
+                             f"a path leading out of it, to {_short(where)} (teamnav does not follow it)")
+    try:
+        st = os.stat(full)
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        raise RunFolderError(run_dir, label, "", "a readable file", _short(exc.strerror or exc)) from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = next((word for test, word in _KINDS if test(st.st_mode)), "not a regular file")
+        raise RunFolderError(run_dir, label, "", "a regular file", kind)
+    if st.st_size > limit:
+        raise RunFolderError(run_dir, label, "", f"a file of at most {limit / 1024**2:.0f} MiB",
+                             f"{st.st_size / 1024**2:.0f} MiB")
+    return full
+
+
 class _Folder:
     """The run folder being read, for messages."""
 
@@ -116,8 +170,10 @@ class _Folder:
     # ------------------------------------------------------------------ arrays
     def npz(self, name: str, budget: list[int]) -> dict[str, np.ndarray]:
         """Every array of ``name`` (an .npz), numbers only, with ``allow_pickle=False``."""
-        path = self.dir / name
         expected = "a NumPy .npz archive as `teamnav run` writes it"
+        path = checked_file(self.dir, name, MAX_RUN_BYTES)
+        if path is None:
+            raise self.error(name, "", "a readable file", "nothing: it does not exist")
         try:
             with open(path, "rb") as fh:
                 head = fh.read(4)
@@ -182,8 +238,8 @@ class _Folder:
     # ------------------------------------------------------------------ JSON
     def json(self, name: str) -> Any:
         """The parsed JSON of ``name`` (None when the file is absent)."""
-        path = self.dir / name
-        if not path.exists():
+        path = checked_file(self.dir, name, MAX_JSON_BYTES)
+        if path is None:
             return None
         try:
             text = path.read_text(encoding="utf-8")
@@ -415,8 +471,11 @@ def scenario_name(run_dir: str | os.PathLike) -> str:
 
     from teamnav.experiments.spec import read_yaml
 
-    path = Path(run_dir) / "scenario.yaml"
-    if not path.is_file():
+    try:
+        path = checked_file(run_dir, "scenario.yaml", MAX_TEXT_BYTES)
+    except RunFolderError:
+        return ""  # a link out, a pipe, a huge file: no title from it
+    if path is None:
         return ""
     try:
         doc = read_yaml(path.read_text(encoding="utf-8"))
@@ -440,9 +499,17 @@ def read_map(run_dir: str | os.PathLike):
     from teamnav.experiments.spec import map_file_problem
     from teamnav.world.mapio import load_map
 
-    path = Path(run_dir) / "map.yaml"
-    if not path.is_file():
+    from teamnav.world.mapio import read_map_yaml
+
+    if (Path(run_dir) / "map.yaml").is_dir():
         return None
+    path = checked_file(run_dir, "map.yaml", MAX_TEXT_BYTES)
+    if path is None:
+        return None
+    meta = read_map_yaml(path)
+    for image in (meta.image, meta.materials_image):  # the images it names: inside the folder, regular files
+        if image is not None:
+            checked_file(run_dir, Path(os.path.abspath(image)), MAX_RUN_BYTES, file=f"map.yaml's image {Path(image).name}")
     problem = map_file_problem(path)
     if problem:
         raise RunFolderError(run_dir, "map.yaml", "", "a map small enough to load", problem)
@@ -450,8 +517,35 @@ def read_map(run_dir: str | os.PathLike):
 
 
 # ---------------------------------------------------------------------------- writing
+#: ``.NAME.HOST-PID.XXXXXXXX.tmp``: the temporary file of :func:`atomic_output`
+_TMP = re.compile(r"^\.(?P<name>.+)\.(?P<host>[A-Za-z0-9-]{1,32})-(?P<pid>\d+)\.[0-9a-f]{8}\.tmp$")
+
+
+def clean_stale_tmp(path: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files of :func:`atomic_output` for ``path`` that processes of this
+    host left behind when they were killed outright (SIGKILL, a power cut): their pid is gone."""
+    from teamnav.experiments.signals import pid_alive
+
+    path = Path(path)
+    removed: list[Path] = []
+    try:
+        entries = list(os.scandir(path.parent))
+    except OSError:
+        return removed
+    for entry in entries:
+        m = _TMP.match(entry.name)
+        if m is None or m["name"] != path.name or m["host"] != HOST or pid_alive(int(m["pid"])):
+            continue
+        with contextlib.suppress(OSError):
+            if entry.is_file(follow_symlinks=False) or entry.is_symlink():
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+    return removed
+
+
 @contextlib.contextmanager
-def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: str | os.PathLike | None = None) -> Iterator[Path]:
+def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: str | os.PathLike | None = None,
+                  force: bool | None = None, wait: bool = False, command: str = "") -> Iterator[Path]:
     """Yield a temporary path in ``path``'s folder; on success rename it to ``path``.
 
     Folders missing above ``path`` are made; on any failure the temporary file and the folders
@@ -459,13 +553,32 @@ def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: s
     (``what``: "HTML file", "MCAP file"; ``option``: the CLI option to change). With
     ``run_dir``, a ``path`` that is one of that run folder's own files (:data:`RUN_FILES`) is
     refused: writing the replay over ``trajectories.npz`` would destroy the run it shows.
+
+    ``path`` is claimed for the whole write (:func:`teamnav.files.claim`): a second writer of
+    the same ``path`` raises :class:`~teamnav.files.ClaimError` (or waits, with ``wait``).
+    With ``force=False``, an existing ``path`` is refused, checked again once the claim is
+    held (another writer may have just finished it). Temporary files of writers of ``path``
+    that were killed outright are removed; SIGTERM removes this one's as Ctrl-C does. A
+    ``path`` that is a symbolic link, or below a file, a dangling link or a read-only folder,
+    is refused before anything is made.
     """
+    from teamnav.experiments.signals import sigterm_deferred, sigterm_raises
+
     path = Path(path)
     todo = f"choose another {option}"
-    if path.is_dir():
+    if path.is_dir() and not path.is_symlink():
         raise OutputPathError(f"{what} {path}: expected a file path, found a folder; {todo}")
+    problem = destination_problem(path, folder=False)
+    if problem is not None:
+        raise OutputPathError(f"{what} {path}: cannot be written ({problem}); {todo}")
     if run_dir is not None and path.name in RUN_FILES and path.exists() and path.parent.resolve() == Path(run_dir).resolve():
         raise OutputPathError(f"{what} {path}: expected a new file, found the run folder's own {path.name}; {todo}")
+
+    def refuse_existing() -> None:
+        if force is False and (path.exists() or path.is_symlink()):
+            raise OutputPathError(f"{what} {path}: exists; {todo} or pass --force")
+
+    refuse_existing()
     parent = path.parent
     made: list[Path] = []
     p = parent
@@ -482,20 +595,33 @@ def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: s
             with contextlib.suppress(OSError):
                 d.rmdir()
 
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        name = parent / f".{path.name}.{secrets.token_hex(4)}.tmp"
-        os.close(os.open(name, os.O_WRONLY | os.O_CREAT | os.O_EXCL, file_mode()))
-        tmp = name
-    except OSError as exc:
-        undo()
-        raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    except OSError as exc:
-        undo()
-        raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
-    except BaseException:
-        undo()
-        raise
+    with sigterm_raises(), contextlib.ExitStack() as held:  # SIGTERM: as Ctrl-C, then the process ends
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            held.enter_context(claim(path, what, command=command, wait=wait,
+                                     say=lambda line: print(line, file=sys.stderr, flush=True)))
+            refuse_existing()
+            clean_stale_tmp(path)
+            name = parent / f".{path.name}.{HOST}-{os.getpid()}.{secrets.token_hex(4)}.tmp"
+            with sigterm_deferred():  # no SIGTERM between creating the file and knowing its name
+                os.close(os.open(name, os.O_WRONLY | os.O_CREAT | os.O_EXCL, file_mode()))
+                tmp = name
+        except OSError as exc:
+            held.close()
+            undo()
+            raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
+        except BaseException:
+            held.close()
+            undo()
+            raise
+        try:
+            yield tmp
+            os.replace(tmp, path)
+        except OSError as exc:
+            held.close()
+            undo()
+            raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
+        except BaseException:
+            held.close()
+            undo()
+            raise

@@ -33,6 +33,7 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import difflib
 import importlib
@@ -275,7 +276,15 @@ class ReportResult:
 
 # ---------------------------------------------------------------------------- output folder
 def _check_out_dir(out_dir: Path) -> None:
-    """``out_dir`` must be missing, empty, or a folder an earlier report wrote (it has the marker)."""
+    """``out_dir`` must be missing, empty, or a folder an earlier report wrote (it has the marker),
+    and writable: not a symbolic link, not below a file or a read-only folder."""
+    from teamnav.files import destination_problem
+
+    problem = destination_problem(out_dir, folder=True)
+    if problem is None and out_dir.is_dir() and not os.access(out_dir, os.W_OK | os.X_OK):
+        problem = f"{out_dir} is read-only"
+    if problem is not None:
+        raise ReportError(f"--out {out_dir}: cannot be written ({problem}); choose another --out")
     if out_dir.exists() and not out_dir.is_dir():
         raise ReportError(f"--out {out_dir}: expected a folder for the report, received an existing file")
     if out_dir.is_dir() and any(out_dir.iterdir()) and not (out_dir / MARKER_NAME).is_file():
@@ -377,8 +386,13 @@ def run_report(
     workers: int | None = None,
     address: str | None = None,
     progress: bool = True,
+    wait: bool = False,
 ) -> ReportResult:
     """Build the report and say how each section went (see :func:`build_report`).
+
+    The report folder is claimed for the whole build (:func:`teamnav.files.claim`): a second
+    report into the same folder refuses (:class:`~teamnav.files.ClaimError`), or waits with
+    ``wait``; the claim goes on every way out (Ctrl-C and SIGTERM included).
 
     Returns
     -------
@@ -391,9 +405,10 @@ def run_report(
         Unknown section name, an output folder that is not a report's, a bad executor option;
         raised before anything is written.
     """
-    from teamnav.experiments.executors import LocalExecutor, make_executor
-    from teamnav.experiments.report.context import SweepContext
+    from teamnav.experiments.executors import make_executor
+    from teamnav.experiments.signals import sigterm_raises
     from teamnav.experiments.sweep import SweepError
+    from teamnav.files import claim
 
     t_start = time.perf_counter()
     if out_dir is None or not os.fspath(out_dir):
@@ -406,7 +421,25 @@ def run_report(
     sections = available_sections()
     keys = resolve_names(names, sections)
     _check_out_dir(out)
-    out.mkdir(parents=True, exist_ok=True)
+    with contextlib.ExitStack() as held:
+        held.enter_context(sigterm_raises())  # SIGTERM: the claim goes, then the process ends
+        try:
+            out.parent.mkdir(parents=True, exist_ok=True)
+            held.enter_context(claim(out, "report folder", command="teamnav report", wait=wait,
+                                     say=lambda line: print(line, file=sys.stderr, flush=True)))
+            _check_out_dir(out)  # what a report that held it before us left there
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ReportError(f"--out {out}: cannot be written ({exc.strerror or exc}); choose another --out") from None
+        return _run_report_claimed(out, keys, sections, quick, executor, workers, address, progress, t_start)
+
+
+def _run_report_claimed(out: Path, keys: list[str], sections: dict, quick: bool, executor: str, workers: int | None,
+                        address: str | None, progress: bool, t_start: float) -> ReportResult:
+    """:func:`run_report` once the report folder is claimed."""
+    from teamnav.experiments.executors import LocalExecutor
+    from teamnav.experiments.report.context import SweepContext
+
     _write_marker(out, quick)
 
     def say(msg: str) -> None:
@@ -484,6 +517,7 @@ def build_report(
     workers: int | None = None,
     address: str | None = None,
     progress: bool = True,
+    wait: bool = False,
 ) -> Path:
     """Run (or reuse) the sweeps of the named sections and write ``out_dir/index.html``.
 
@@ -504,6 +538,9 @@ def build_report(
         Ray cluster address, with ``executor="ray"``.
     progress : bool
         Progress bars and one line per section on stderr.
+    wait : bool
+        When another process is writing ``out_dir`` (it holds its claim, ``.NAME.lock`` beside
+        it), wait for it instead of refusing.
 
     Returns
     -------
@@ -516,4 +553,5 @@ def build_report(
     ReportError
         See :func:`run_report`.
     """
-    return run_report(names, out_dir, quick=quick, executor=executor, workers=workers, address=address, progress=progress).index
+    return run_report(names, out_dir, quick=quick, executor=executor, workers=workers, address=address, progress=progress,
+                      wait=wait).index

@@ -67,6 +67,7 @@ def report_command(
     ),
     workers: Optional[int] = typer.Option(None, "--workers", "-j", metavar="N", help="Trials at once (default: all CPUs)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bars or section lines; print only the report's path."),
+    wait: bool = typer.Option(False, "--wait", help="If another teamnav report is writing the same --out folder, wait for it instead of refusing."),
 ) -> None:
     """Write an HTML report: each paper's claims beside our numbers.
 
@@ -74,11 +75,13 @@ def report_command(
     """
     from teamnav.experiments.report import ReportError, run_report
     from teamnav.experiments.sweep import SweepError
+    from teamnav.files import ClaimError
 
     err = Console(stderr=True, highlight=False, soft_wrap=True)
     try:
-        result = run_report(experiments, out, quick=quick, executor=executor, workers=workers, address=address, progress=not quiet)
-    except (ReportError, SweepError) as exc:
+        result = run_report(experiments, out, quick=quick, executor=executor, workers=workers, address=address, progress=not quiet,
+                            wait=wait)
+    except (ReportError, SweepError, ClaimError) as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(EXIT_BAD_INPUT) from None
     con = Console(highlight=False, soft_wrap=True)
