@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 
+import pytest
 from hypothesis import settings
 
 # parent: Hypothesis' own defaults (else a profile inherits from whichever profile is loaded)
@@ -32,3 +33,19 @@ def _default_profile() -> str:
 
 
 settings.load_profile(_default_profile())
+
+
+@pytest.fixture
+def memo_scenario_yaml(monkeypatch):
+    """Parse each scenario YAML text once per test (each caller gets its own deep copy).
+
+    For tests that expand hundreds of trials of the same few scenario files (a report section's
+    full build with faked sweeps): the pure-Python YAML parse of the same text is most of their
+    time and none of what they check."""
+    import copy
+    import functools
+
+    from teamnav.experiments import spec
+
+    parse = functools.lru_cache(maxsize=None)(spec.read_yaml)
+    monkeypatch.setattr(spec, "read_yaml", lambda text: copy.deepcopy(parse(text)))
