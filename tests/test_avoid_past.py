@@ -89,6 +89,7 @@ def test_avoid_past_finds_the_door_the_potential_field_misses(room, start, door_
     assert pf.run(1500) is None
 
 
+@pytest.mark.slow  # two runs of up to 18,000 steps: a reproduction of issue 7
 def test_trip_memory_reaches_a_sequence_the_robot_memory_does_not():
     """Issue 7, R1 alone on office_simple (``los-help-simple``, task 1's first 12 targets, budget
     1500 steps each, pinned here: the scenario's own budget is 6000 since session 8, and with

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import decimal
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from teamnav.geometry.angles import wrap_angle
@@ -80,15 +81,65 @@ def test_wrap_matches_geometry_wrap_angle(a, b, c):
         assert wrap(v) == wrap_angle(v)
 
 
+def _dsin_dcos(a: decimal.Decimal) -> tuple[decimal.Decimal, decimal.Decimal]:
+    """sin and cos of ``a`` (|a| < 8) by their Taylor series in the current decimal context."""
+    s = c = decimal.Decimal(0)
+    term = decimal.Decimal(1)  # a^k / k!
+    k = 0
+    eps = decimal.Decimal(10) ** (-decimal.getcontext().prec - 5)
+    while abs(term) > eps or k < 4:
+        if k % 4 == 0:
+            c += term
+        elif k % 4 == 1:
+            s += term
+        elif k % 4 == 2:
+            c -= term
+        else:
+            s -= term
+        k += 1
+        term = term * a / k
+    return s, c
+
+
+def exact_arc_end(x, y, th, v, w, dt):
+    """End of the unicycle arc by eq. 5.9 of Probabilistic Robotics, evaluated in 60-digit
+    decimal arithmetic from the exact values of the float inputs: the cancellation of
+    ``sin(th + w dt) - sin(th)`` costs at most ~12 of the 60 digits for |w dt| >= 1e-12
+    (an independent check of the chord form the simulator uses; below that, a straight line
+    whose error is < 1e-24 m)."""
+    with decimal.localcontext() as ctx:
+        ctx.prec = 60
+        X, Y, TH, V, W, DT = (decimal.Decimal(float(a)) for a in (x, y, th, v, w, dt))
+        phi = W * DT
+        if abs(phi) < decimal.Decimal("1e-12"):
+            s0, c0 = _dsin_dcos(TH)
+            return float(X + V * DT * c0), float(Y + V * DT * s0)
+        s0, c0 = _dsin_dcos(TH)
+        s1, c1 = _dsin_dcos(TH + phi)
+        rho = V / W
+        return float(X + rho * (s1 - s0)), float(Y - rho * (c1 - c0))
+
+
+def test_exact_reference_is_exact_on_a_quarter_circle():
+    ex, ey = exact_arc_end(0.0, 0.0, 0.0, 1.0, math.pi / 2, 1.0)
+    assert (ex, ey) == pytest.approx((2 / math.pi, 2 / math.pi), abs=1e-15)
+
+
 @settings(max_examples=200, deadline=None)
 @given(
     st.floats(-5, 5), st.floats(-5, 5), st.floats(-math.pi, math.pi),
-    st.floats(-2, 2), st.floats(-4, 4), st.floats(0.01, 1.0),
+    st.floats(-2, 2), st.one_of(st.floats(-4, 4), st.floats(-1e-6, 1e-6)), st.floats(0.01, 1.0),
 )
+@example(0.0, 0.0, 1.0, 1.0, 3.9e-11, 1.0)  # eq. 5.9 in floats: 1.8e-6 m off (cancellation)
+@example(0.0, 0.0, 1.0, 1.0, 1.0000001e-12, 1.0)  # just above the former straight-line cutoff
+@example(3.0, -2.0, -2.5, -2.0, 2e-9, 0.37)
 def test_arc_end_matches_reference_and_fine_euler(x, y, th, v, w, dt):
     px, py, pth = arc_point(x, y, th, v * dt, w * dt, 1.0)
+    # 1e-9 m of the exact arc for every turn rate in [-4, 4] rad/s, tiny ones included
+    np.testing.assert_allclose([px, py], exact_arc_end(x, y, th, v, w, dt), rtol=0, atol=1e-9)
+    assert pth == th + w * dt
     ref = unicycle_arc_reference(x, y, th, v, w, dt)
-    np.testing.assert_allclose([px, py, wrap(pth)], ref, atol=1e-9)
+    np.testing.assert_allclose([px, py, wrap(pth)], ref, rtol=0, atol=1e-12)  # NumPy's twin
     # exact integration == the limit of many tiny Euler steps
     k = 2000
     ex, ey, eth = x, y, th

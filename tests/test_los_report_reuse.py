@@ -6,9 +6,6 @@ scenario with the same seed (``_los_reuse.reused_rows``)."""
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
 import pytest
 
 from teamnav.papers.los_help.report import _los_reuse as RU
@@ -70,7 +67,7 @@ class _AnyMetric(dict):
         return 1
 
 
-def test_full_build_asks_for_no_simulation_twice_and_reads_the_duplicates_from_the_tables():
+def test_full_build_asks_for_no_simulation_twice_and_reads_the_duplicates_from_the_tables(memo_scenario_yaml, tmp_path):
     """Full mode: 780 trials asked before issue 21 §5, 75 of them the same simulation as another
     (noise err_max = 0: 2 maps x 3 algorithms x 5 tasks x 2 columns; ablation: 3 x 5); now 705,
     every (config_hash, seed) once, and the noise figures still get err_max 0 for every algorithm,
@@ -110,7 +107,7 @@ def test_full_build_asks_for_no_simulation_twice_and_reads_the_duplicates_from_t
 
     S.run_noise = run_noise
     try:
-        available_sections()["los-help"].build(Listing(Path(tempfile.mkdtemp()), quick=False, section="los-help"))
+        available_sections()["los-help"].build(Listing(tmp_path, quick=False, section="los-help"))
     finally:
         S.run_noise = orig
     assert not twice

@@ -139,7 +139,9 @@ def _points_msg(xy) -> Message:
 
 
 def test_a_frame_without_the_teammate_weighs_down_the_samples_that_would_see_it():
-    a = _brain(0)
+    # neg_when_concentrated: the 2.5 m rule alone decides below, not whether the random cloud
+    # happens to have shrunk under neg_max_spread_m by step 30 (the next test covers that rule)
+    a = _brain(0, neg_when_concentrated=True)
     _frame(a, 0)  # first filter update (uniform belief: its weights come from the scan only)
     before = a.mcl.weights.copy()
     parts = a.mcl.particles.copy()

@@ -38,6 +38,9 @@ import math
 import numpy as np
 from numba import njit
 
+# Compiled into move_discs' cached machine code: numba's on-disk cache keys on this file
+# alone, so a change to these functions must change this file too (or clear __pycache__),
+# else an old move_discs keeps running the old arc (the chord form of arc_point, for one).
 from teamnav.sim.kinematics import arc_point, wrap
 
 __all__ = ["SUBSTEP_FRACTION", "discs_hit_walls", "move_discs"]
