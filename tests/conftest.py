@@ -49,3 +49,17 @@ def memo_scenario_yaml(monkeypatch):
 
     parse = functools.lru_cache(maxsize=None)(spec.read_yaml)
     monkeypatch.setattr(spec, "read_yaml", lambda text: copy.deepcopy(parse(text)))
+
+
+@pytest.fixture(scope="module")
+def run_folder(tmp_path_factory):
+    """A real, tiny run folder (2 robots, 1 s) for the tests that read or probe one."""
+    from typer.testing import CliRunner
+
+    from teamnav.cli import app
+
+    out = tmp_path_factory.mktemp("run") / "demo"
+    res = CliRunner().invoke(app, ["run", "demo", "--duration", "1", "--set", "robots.0.count=2", "--out", str(out),
+                                   "--quiet"])
+    assert res.exit_code == 0, res.output
+    return out

@@ -95,13 +95,7 @@ def test_corpus_covers_every_scenario_class():
 
 
 # ---------------------------------------------------------------------------- run folders (corpus)
-@pytest.fixture(scope="module")
-def run_folder(tmp_path_factory) -> Path:
-    """A real, tiny run folder (2 robots, 1 s)."""
-    out = tmp_path_factory.mktemp("run") / "demo"
-    res = runner.invoke(app, ["run", "demo", "--duration", "1", "--set", "robots.0.count=2", "--out", str(out), "--quiet"])
-    assert res.exit_code == 0, res.output
-    return out
+# run_folder: tests/conftest.py (a real, tiny run folder)
 
 
 def _run_cases() -> list[Path]:

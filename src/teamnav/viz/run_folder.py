@@ -596,7 +596,22 @@ def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: s
                 d.rmdir()
 
     with sigterm_raises(), contextlib.ExitStack() as held:  # SIGTERM: as Ctrl-C, then the process ends
-        try:
+
+        @contextlib.contextmanager
+        def undone_on_failure():
+            """On any failure: release the claim, remove the temporary; an OSError becomes one line."""
+            try:
+                yield
+            except OSError as exc:
+                held.close()
+                undo()
+                raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
+            except BaseException:
+                held.close()
+                undo()
+                raise
+
+        with undone_on_failure():
             parent.mkdir(parents=True, exist_ok=True)
             held.enter_context(claim(path, what, command=command, wait=wait,
                                      say=lambda line: print(line, file=sys.stderr, flush=True)))
@@ -606,22 +621,6 @@ def atomic_output(path: str | os.PathLike, what: str, option: str, *, run_dir: s
             with sigterm_deferred():  # no SIGTERM between creating the file and knowing its name
                 os.close(os.open(name, os.O_WRONLY | os.O_CREAT | os.O_EXCL, file_mode()))
                 tmp = name
-        except OSError as exc:
-            held.close()
-            undo()
-            raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
-        except BaseException:
-            held.close()
-            undo()
-            raise
-        try:
+        with undone_on_failure():
             yield tmp
             os.replace(tmp, path)
-        except OSError as exc:
-            held.close()
-            undo()
-            raise OutputPathError(f"{what} {path}: cannot be written ({exc.strerror or exc}); {todo}") from None
-        except BaseException:
-            held.close()
-            undo()
-            raise
