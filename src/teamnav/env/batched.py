@@ -9,9 +9,17 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from teamnav.env import _checks
+from teamnav.env._checks import action_meaning, batch_memory_problem, check_batch, first_not_finite
 from teamnav.env._core import EnvCore, Seeds, make_setup
 
-__all__ = ["BatchedEnv"]
+__all__ = ["BatchedEnv", "MAX_BATCH_BYTES"]
+
+#: Most memory [bytes] the copies of one BatchedEnv may need together (16 GiB), estimated from
+#: each copy's map cells, robots and observation (:func:`teamnav.env._checks.batch_bytes`); more
+#: is refused before any copy is allocated, naming the number of copies, the estimate and this
+#: limit. Raise it (``teamnav.env.batched.MAX_BATCH_BYTES = ...``) on a machine with the memory.
+MAX_BATCH_BYTES: int = _checks.MAX_BATCH_BYTES
 
 
 class BatchedEnv(VectorEnv):
@@ -55,8 +63,14 @@ class BatchedEnv(VectorEnv):
         self.setup = st = make_setup(scenario, agents_from=agents_from, reward=reward, terminate_on=terminate_on,
                                      observe_truth=observe_truth, max_inbox=max_inbox, max_detections=max_detections,
                                      dtype=dtype, seed=seed, duration_s=duration_s, overrides=overrides, fields=fields)
+        obs_bytes = sum(int(np.prod(sp.shape)) * sp.dtype.itemsize for a in st.agent_names
+                        for sp in st.obs_spaces[a].spaces.values())
+        problem = batch_memory_problem(int(st.grid.cells.size), st.n_robots, obs_bytes, int(num_envs), MAX_BATCH_BYTES)
+        if problem is not None:  # refused before any copy is allocated
+            raise ValueError(problem)
         self.num_envs = int(num_envs)
         self.agents = list(st.agent_names)
+        self._meanings = [action_meaning(h) for h in st.holonomic.tolist()]
         self.single_observation_space = self._stacked_obs_space()
         self.single_action_space = spaces.Box(
             np.concatenate([np.broadcast_to(b.act_space.low, (b.rows.stop - b.rows.start, 2)) for b in st.blocks]),
@@ -108,9 +122,19 @@ class BatchedEnv(VectorEnv):
     def step(self, actions):
         """Step every copy once; returns ``(observations, rewards, terminations, truncations, infos)``."""
         st = self.setup
-        a = np.asarray(actions, dtype=np.float64)
-        if a.shape != (self.num_envs, st.n_agents, 2):
-            raise ValueError(f"actions must have shape ({self.num_envs}, {st.n_agents}, 2), got {a.shape}")
+        if type(actions) is np.ndarray and actions.dtype == np.float64 and actions.shape == (self.num_envs, st.n_agents, 2):
+            a = actions
+        else:  # a real array of that shape, or one error naming the copy and the agent
+            a = check_batch(actions, self.num_envs, self.agents, self._meanings)
+        # every copy's actions are checked before any copy steps, so a refused step leaves them all in step:
+        # the rows that count are those of live agents in copies that are not resetting
+        check = np.array([c.live for c in self._cores])
+        check[self._autoreset] = False
+        bad = first_not_finite(a, check)
+        if bad is not None:
+            e, j = bad
+            raise ValueError(f"copy {e}, agent {self.agents[j]!r}: action must be finite, got {a[e, j].tolist()}; "
+                             "no copy was stepped")
         obs = self._new_obs()
         rewards = np.zeros(self.num_envs)
         terminated = np.zeros(self.num_envs, dtype=bool)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -11,6 +12,7 @@ import numpy as np
 from gymnasium import logger
 from pettingzoo import ParallelEnv as _PZParallelEnv
 
+from teamnav.env._checks import action_meaning, as_action
 from teamnav.env._core import EnvCore, Seeds, make_setup
 from teamnav.env._proxy import RobotPort
 
@@ -149,16 +151,27 @@ class ParallelEnv(_PZParallelEnv):
         st = self.setup
         row = self._row
         a = np.zeros((st.n_agents, 2))
+        if not isinstance(actions, Mapping):
+            raise ValueError(f"actions must be a dict {{agent: action of shape (2,)}} for the live agents "
+                             f"{live[:5]}{' ...' if len(live) > 5 else ''}, got {type(actions).__name__}")
         try:
             for ag in live:
-                a[row[ag]] = actions[ag]
+                v = actions[ag]
+                if type(v) is np.ndarray and v.shape == (2,) and v.dtype.kind in "fiub":
+                    a[row[ag]] = v
+                else:  # anything else: a real array of two values, or one error naming the agent
+                    a[row[ag]] = as_action(v, ag, action_meaning(bool(st.holonomic[row[ag]])))
         except KeyError:
             missing = [ag for ag in live if ag not in actions]
-            raise ValueError(f"actions are missing for live agents {missing[:5]}{' ...' if len(missing) > 5 else ''}") from None
+            extra = [ag for ag in actions if ag not in row]
+            also = f"; unknown agents {extra[:5]} in actions" if extra else ""
+            raise ValueError(f"actions are missing for live agents {missing[:5]}{' ...' if len(missing) > 5 else ''}"
+                             f" (each an action of shape (2,)){also}") from None
         if len(actions) > len(live):
             extra = [ag for ag in actions if ag not in row]
             if extra:
-                raise ValueError(f"unknown agents {extra[:5]} in actions (agents: {', '.join(self.possible_agents[:8])} ...)")
+                raise ValueError(f"unknown agents {extra[:5]} in actions (agents: {', '.join(self.possible_agents[:8])}"
+                                 f"{' ...' if len(self.possible_agents) > 8 else ''}; each an action of shape (2,))")
         core = self._core
         res = core.step(a)
         step = core.sim.step_index

@@ -9,6 +9,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from teamnav.env._checks import action_meaning, as_action
 from teamnav.env._core import EnvCore, make_setup
 from teamnav.env._proxy import RobotPort
 
@@ -82,9 +83,10 @@ class SingleRobotEnv(gym.Env):
         """Returns ``(observation, reward, terminated, truncated, info)``."""
         if self._done:
             raise RuntimeError("the episode is over: call reset()")
-        a = np.asarray(action, dtype=np.float64).reshape(1, -1)
-        if a.shape != (1, 2):
-            raise ValueError(f"action must have shape (2,), got {np.shape(action)}")
+        if type(action) is np.ndarray and action.shape == (2,) and action.dtype.kind in "fiub":
+            a = action.astype(np.float64, copy=False).reshape(1, 2)
+        else:  # anything else: a real array of two values, or one error naming the agent
+            a = as_action(action, self.agent, action_meaning(bool(self.setup.holonomic[0]))).reshape(1, 2)
         res = self._core.step(a)
         terminated = bool(res.terminated[0])
         truncated = bool(res.truncated)
