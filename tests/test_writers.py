@@ -206,6 +206,57 @@ def test_an_interrupted_export_leaves_nothing_once_the_next_one_ran(sig, run_fol
     assert _leftovers(tmp_path) == [] and dest.stat().st_size > 0
 
 
+# ---------------------------------------------------------------------------- two real writers at once
+_SLOWED_EXPORT = (
+    "import sys, time, foxglove\n"
+    "real = foxglove.open_mcap\n"
+    "def slowed(*a, **k):\n"
+    "    print('writing', flush=True)\n"
+    "    time.sleep(3)\n"
+    "    return real(*a, **k)\n"
+    "foxglove.open_mcap = slowed\n"
+    "from teamnav.cli import app\n"
+    "app(['export', sys.argv[1], '--mcap', sys.argv[2]], prog_name='teamnav')\n"
+)
+
+
+def _slowed_report(out: Path) -> list[str]:
+    code = (
+        "import time\n"
+        "from teamnav.experiments import report\n"
+        "from teamnav.experiments.report.model import SectionSpec, Text\n"
+        "def build(ctx):\n"
+        "    print('building', flush=True)\n"
+        "    time.sleep(3)\n"
+        "    return [Text('the first report')]\n"
+        "report.register_section(SectionSpec(key='fake-writers', title='t', paper='p.txt', build=build))\n"
+        "from teamnav.cli import app\n"
+        f"app(['report', 'fake-writers', '--quick', '--quiet', '--out', {str(out)!r}], prog_name='teamnav')\n"
+    )
+    return [sys.executable, "-c", code]
+
+
+@pytest.mark.parametrize("kind", ["export", "report"])
+def test_two_real_writers_at_once_one_wins_one_refuses(kind, run_folder, tmp_path):
+    """Two processes into one destination at once: the one that started first finishes and keeps
+    its result; the other refuses in one line naming it, and writes nothing."""
+    dest = tmp_path / KINDS[kind]
+    first_cmd = ([sys.executable, "-c", _SLOWED_EXPORT, str(run_folder), str(dest)] if kind == "export"
+                 else _slowed_report(dest))
+    first = subprocess.Popen(first_cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert first.stdout.readline().strip() in ("writing", "building"), first.communicate()
+    second = subprocess.run(_second_writer(kind, run_folder, dest), capture_output=True, text=True, timeout=300)
+    _one_line_refusal(second, str(dest), f"process {first.pid}")
+    assert first.poll() is None  # the refusal came while the first one worked
+    _out, err = first.communicate(timeout=300)
+    assert first.returncode == 0, err
+    if kind == "export":
+        assert dest.stat().st_size > 0
+    else:
+        assert "the first report" in (dest / "index.html").read_text(encoding="utf-8")
+    assert not claim_path(dest).exists() and _leftovers(tmp_path) == []
+
+
 # ---------------------------------------------------------------------------- destinations
 def _run_into(out: Path):
     return runner.invoke(app, ["run", "demo", "--duration", "1", "--set", "robots.0.count=2", "--out", str(out), "--quiet"])
