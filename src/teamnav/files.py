@@ -21,13 +21,15 @@ import json
 import os
 import re
 import secrets
+import shutil
 import socket
 import threading
 import time
 from pathlib import Path
 from typing import Callable, Iterator
 
-__all__ = ["HOST", "ClaimError", "claim", "claim_path", "current_umask", "destination_problem", "dir_mode", "file_mode"]
+__all__ = ["HOST", "LOW_SPACE_BYTES", "ClaimError", "claim", "claim_path", "current_umask", "destination_problem", "dir_mode",
+           "file_mode", "write_cause"]
 
 _UMASK_LOCK = threading.Lock()
 
@@ -240,3 +242,22 @@ def destination_problem(path: str | os.PathLike, *, folder: bool) -> str | None:
     if not os.access(parent, os.W_OK | os.X_OK):
         return f"{parent} is read-only" + ("" if os.access(parent, os.X_OK) else " (and cannot be searched)")
     return None
+
+
+#: below this much free space in a file's folder, a writer's vague error (SQLite's "disk I/O
+#: error", the MCAP writer's "I/O error") is read as a full disk
+LOW_SPACE_BYTES = 1 << 20
+
+
+def write_cause(exc: BaseException, path: str | os.PathLike) -> str:
+    """Why writing ``path`` failed, in words. SQLite says "disk I/O error" (or "database or disk
+    is full") and the MCAP writer "I/O error" for a full disk, so the folder's free space is read
+    to say "no space left on device"."""
+    """Why writing ``path`` failed, in words: SQLite says "disk I/O error" (or "database or disk
+    is full") for a full disk, so the folder's free space is read to say "no space left on device"."""
+    text = getattr(exc, "strerror", None) or str(exc)
+    try:
+        free = shutil.disk_usage(Path(path).parent).free
+    except OSError:
+        return text
+    return f"no space left on device: {free} bytes free in {Path(path).parent}" if free < LOW_SPACE_BYTES else text

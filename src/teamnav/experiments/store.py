@@ -52,6 +52,8 @@ import sqlite3
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
 
+from teamnav.files import write_cause
+
 if TYPE_CHECKING:  # pragma: no cover
     from teamnav.experiments.trial import Trial, TrialResult
 
@@ -248,7 +250,8 @@ class ResultsStore:
             self._con.execute("BEGIN IMMEDIATE")
         except sqlite3.Error as exc:  # a read-only folder, a store locked by another process for a minute
             self._con.close()
-            raise StoreError(f"results store {self.path}: cannot be written ({exc}); use --out with another folder") from None
+            raise StoreError(f"results store {self.path}: cannot be written ({write_cause(exc, self.path)}); "
+                             "use --out with another folder") from None
         try:
             for stmt in _SCHEMA.split(";"):
                 if stmt.strip():

@@ -28,6 +28,8 @@ from __future__ import annotations
 import math
 import os
 import pickle
+import shutil
+import sqlite3
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -201,8 +203,9 @@ def sweep(
         Bad sweep, grid, seeds, option, or a store holding other results under the same ids;
         raised before any trial runs.
     """
-    from teamnav.experiments.executors import LocalExecutor, TrialTask, make_executor
-    from teamnav.experiments.store import STORE_NAME, ResultsStore, check_store
+    from teamnav.experiments.executors import LocalExecutor, make_executor
+    from teamnav.experiments.store import STORE_NAME, StoreError, check_store
+    from teamnav.files import write_cause
 
     t0 = time.perf_counter()
     if out_dir is None or not os.fspath(out_dir):
@@ -229,15 +232,37 @@ def sweep(
     if out.exists() and not out.is_dir():
         raise SweepError(f"out_dir: expected a folder, received the file {out}")
     check_store(out / STORE_NAME)  # a results.sqlite that is not a teamnav store: refused before any trial
+    created = not os.path.lexists(out)  # removed again if it cannot be written before any trial is stored
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise SweepError(f"out_dir: cannot create or write the folder {out} ({exc.strerror or exc}); "
                          "use --out with another folder") from None
     result = SweepResult(spec.sweep_name, out / STORE_NAME, len(trials))
-    from teamnav.experiments.signals import sigterm_raises
-
     # SIGTERM as Ctrl-C: the workers are stopped and the store closed before the process ends
+    try:
+        _run_into_store(out, spec, trials, runner, trial_fn, artifacts, retry_failed, progress, result, t0)
+    except (StoreError, sqlite3.Error, OSError) as exc:
+        # a full disk or a folder that cannot be written: one line, and a folder this call made
+        # and stored nothing in is not left behind (a store with results stays: it resumes)
+        if created and result.done + result.failed == 0:
+            shutil.rmtree(out, ignore_errors=True)
+        if isinstance(exc, StoreError):
+            raise
+        raise StoreError(f"results store {out / STORE_NAME}: cannot be written ({write_cause(exc, out / STORE_NAME)}); "
+                         "use --out with another folder" + ("" if created and result.done + result.failed == 0 else
+                                                            f"; the {result.done + result.failed} trials stored are kept "
+                                                            "and a rerun into it resumes")) from None
+    return result
+
+
+def _run_into_store(out: Path, spec: Any, trials: list[Trial], runner: Any, trial_fn: Any, artifacts: bool,
+                    retry_failed: bool, progress: bool, result: "SweepResult", t0: float) -> None:
+    """:func:`sweep`'s work once the folder exists: skip what the store holds, run the rest."""
+    from teamnav.experiments.executors import TrialTask
+    from teamnav.experiments.signals import sigterm_raises
+    from teamnav.experiments.store import STORE_NAME, ResultsStore
+
     with sigterm_raises(), ResultsStore(out / STORE_NAME) as store:
         previous = store.existing()
         clash = [t for t in trials if t.trial_id in previous and previous[t.trial_id][1] != t.config_hash]
@@ -274,7 +299,6 @@ def sweep(
         finally:
             bar.close()
             result.elapsed_s = time.perf_counter() - t0
-    return result
 
 
 def longest_first(todo: list[Trial], trials: list[Trial], rows: list[dict[str, Any]]) -> list[Trial]:

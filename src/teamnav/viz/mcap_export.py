@@ -35,14 +35,17 @@ topic                          schema                     what
 from __future__ import annotations
 
 import colorsys
+import contextlib
+import errno
 import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 
-from teamnav.files import destination_problem
+from teamnav.files import destination_problem, write_cause
 from teamnav.viz.replay import odom_anchor, read_run
 from teamnav.viz.run_folder import OutputPathError, atomic_output
 
@@ -87,6 +90,18 @@ def _uniform(angles: np.ndarray) -> bool:
         return True
     d = np.diff(angles)
     return bool(np.allclose(d, d[0], atol=1e-6) and d[0] > 0)
+
+
+@contextlib.contextmanager
+def _writer_io_errors(tmp: str | os.PathLike) -> Iterator[None]:
+    """The MCAP writer reports a failed write (a full disk) as a RuntimeError; make it the OSError
+    :func:`~teamnav.viz.run_folder.atomic_output` turns into one line, naming the cause."""
+    try:
+        yield
+    except RuntimeError as exc:
+        if "I/O error" not in str(exc):
+            raise
+        raise OSError(errno.EIO, write_cause(exc, tmp)) from None
 
 
 def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: bool = False, wait: bool = False) -> McapStats:
@@ -170,7 +185,8 @@ def export_mcap(run_dir: str | os.PathLike, path: str | os.PathLike, *, force: b
     # written under a temporary name in the target folder, renamed once complete; a path that
     # cannot be written is an OutputPathError naming it, and nothing is left behind
     # (claimed: a second export into ``path`` refuses or waits; SIGTERM removes the temporary file)
-    with atomic_output(path, "MCAP file", "--mcap", run_dir=run_dir, force=force, wait=wait, command="teamnav export") as tmp:
+    with atomic_output(path, "MCAP file", "--mcap", run_dir=run_dir, force=force, wait=wait, command="teamnav export") as tmp, \
+            _writer_io_errors(tmp):
         with foxglove.open_mcap(tmp, allow_overwrite=True, context=ctx):
             def log(ch, msg, ns):
                 ch.log(msg, log_time=int(ns))
