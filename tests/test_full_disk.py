@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
@@ -59,4 +58,16 @@ def test_an_export_on_a_full_disk_says_so_and_leaves_no_temporary(tiny_disk, run
     res = subprocess.run(PY + ["export", str(run_folder), "--mcap", str(dest)], capture_output=True, text=True, timeout=300)
     line = _one_error_line(res)
     assert str(dest) in line
+    assert list(tiny_disk.iterdir()) == []
+
+
+@pytest.mark.parametrize("tiny_disk", ["1520k"], indirect=True)
+def test_a_gif_that_does_not_fit_says_so_and_leaves_no_staging(tiny_disk):
+    """The run folder fits (about 1.49 MB: the map's 1.44 MB image, arrays, figure) but its GIF
+    does not: the run stops with one line, and its staging folder is removed."""
+    out = tiny_disk / "run"
+    res = subprocess.run(PY + ["run", "demo", "--duration", "5", "--set", "robots.0.count=2", "--gif", "--out", str(out),
+                               "-q"], capture_output=True, text=True, timeout=300)
+    line = _one_error_line(res)
+    assert "no space left on device" in line.lower() and str(out) in line
     assert list(tiny_disk.iterdir()) == []

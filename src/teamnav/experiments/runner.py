@@ -50,7 +50,7 @@ from teamnav.experiments.spec import (
     load_scenario,
     scenario_to_yaml,
 )
-from teamnav.files import ClaimError, claim, current_umask, destination_problem  # noqa: F401 (current_umask: teamnav.env uses it)
+from teamnav.files import ClaimError, claim, current_umask, destination_problem, write_cause  # noqa: F401 (current_umask: teamnav.env uses it)
 from teamnav.world.mapio import YAML_SUFFIXES, read_map_yaml, save_map
 
 __all__ = [
@@ -431,6 +431,7 @@ def run(
                                      f"({exc.strerror or exc}); choose another --out") from None
         with sigterm_raises(), contextlib.ExitStack() as held:  # SIGTERM: staging and claim removed, then the process ends
             staging: Path | None = None
+            writing = False
             if out is not None:  # one writer per run folder, from here to the end
                 try:
                     held.enter_context(claim(out, "output folder", command="teamnav run", wait=wait,
@@ -458,6 +459,7 @@ def run(
                 warmup_s = (report.t_first - t0) if report.t_first is not None else 0.0  # the first step
                 report.stepped()
                 sim.record_last_step()
+                writing = True  # from here on an OSError is the disk's (full, gone), not the run's
                 sim.recorder.save(staging)
                 data = run_data(staging, scenario, grid, int(sim.step_index), wall_s,
                                 finished=bool(scenario.stop_when_finished and all_finished(sim)), warmup_s=warmup_s)
@@ -478,6 +480,13 @@ def run(
                 _apply_umask(staging, umask)
                 with sigterm_deferred():  # the old folder out and the new one in, not half of it
                     _move_into_place(staging, out)
+            except OSError as exc:
+                if staging is not None:
+                    shutil.rmtree(staging, ignore_errors=True)
+                if not writing:
+                    raise
+                raise OutputDirError(f"output folder {out if out is not None else staging}: cannot be written "
+                                     f"({write_cause(exc, staging)}); nothing was kept, choose another --out") from None
             except BaseException:
                 if staging is not None:
                     shutil.rmtree(staging, ignore_errors=True)
