@@ -117,7 +117,9 @@ def test_a_kept_local_pool_serves_several_runs_with_the_same_workers(trials, tmp
         assert {r.pid for r in second} <= {r.pid for r in first}  # no new worker processes
         third = []
         runner.run([TrialTask(t, dies_once_trial) for t in trials[:2]], third.append)
-        assert [r.status for r in third] == ["ok", "ok"] and all(r.retries == 1 for r in third)
+        # each trial kills its worker once; a death also loses the trial running beside it in the
+        # same pool, so a trial is started again once or twice, never more, and both end ok
+        assert [r.status for r in third] == ["ok", "ok"] and all(1 <= r.retries <= 2 for r in third), third
         fourth = []
         runner.run([TrialTask(trials[0], ok_trial)], fourth.append)
         assert fourth[0].status == "ok" and fourth[0].pid not in {r.pid for r in first}
