@@ -68,8 +68,11 @@ def test_a_terminal_gets_one_line(monkeypatch):
 
 
 @pytest.mark.parametrize("progress", [False, lambda k: None])
-def test_no_progress_no_listener(progress):
+def test_no_progress_no_listener(progress, capsys):
+    """Without a progress display (quiet, or the caller's own callback) a compile says nothing."""
     rep = runner._Progress(progress, 10, SCN)
     with rep.watching_compiles():
-        _fresh_kernel()(1)
+        assert _fresh_kernel()(1) == 2
     rep.close()
+    assert rep.bar is None and rep.plain is None and not rep.told_compiling
+    assert "compiling" not in capsys.readouterr().err
