@@ -12,7 +12,8 @@ system of the child) of each, and ratios against peers measured in the same run:
   dependencies: without IR-SIM the interpreter floor and numpy are the only peers.
 
 The warm demo run uses a numba cache filled by one unmeasured run first; each cold run gets a
-fresh, empty ``NUMBA_CACHE_DIR`` (numba compiles every kernel the demo calls). Python's bytecode
+fresh, empty ``NUMBA_CACHE_DIR`` (numba compiles every kernel the demo calls) and
+``TEAMNAV_CACHE_DIR`` (the map's distance field is computed). Python's bytecode
 cache is on (``PYTHONDONTWRITEBYTECODE`` is dropped for the children, as for an installed
 teamnav): the unmeasured run writes the ``.pyc`` files of the tree measured.
 
@@ -69,9 +70,10 @@ def main(argv: list[str] | None = None) -> int:
     tmp = Path(tempfile.mkdtemp(prefix="bench-startup-"))
     # bytecode caching on (PYTHONDONTWRITEBYTECODE dropped), as an installed teamnav has it
     base_env = {k: v for k, v in os.environ.items()
-                if k not in ("NUMBA_CACHE_DIR", "PYTHONPATH", "TEAMNAV_DEBUG", "PYTHONDONTWRITEBYTECODE")}
+                if k not in ("NUMBA_CACHE_DIR", "TEAMNAV_CACHE_DIR", "PYTHONPATH", "TEAMNAV_DEBUG",
+                             "PYTHONDONTWRITEBYTECODE")}
     base_env["PYTHONPATH"] = str(args.src.resolve())
-    warm_env = {**base_env, "NUMBA_CACHE_DIR": str(tmp / "numba-warm")}
+    warm_env = {**base_env, "NUMBA_CACHE_DIR": str(tmp / "numba-warm"), "TEAMNAV_CACHE_DIR": str(tmp / "teamnav-warm")}
     demo = ["-m", "teamnav", "run", "demo", "--duration", "1", "--out", str(tmp / "run"), "--force"]
     cases: dict[str, tuple[list[str], dict[str, str]]] = {
         "python -c pass (interpreter floor)": ([py, "-c", "pass"], base_env),
@@ -101,7 +103,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.cold > 0:
             walls[cold], cpus[cold] = [], []
             for k in range(args.cold):
-                env = {**base_env, "NUMBA_CACHE_DIR": str(tmp / f"numba-cold-{k}")}
+                env = {**base_env, "NUMBA_CACHE_DIR": str(tmp / f"numba-cold-{k}"),
+                       "TEAMNAV_CACHE_DIR": str(tmp / f"teamnav-cold-{k}")}
                 w, c = timed([py, *demo], env)
                 walls[cold].append(w)
                 cpus[cold].append(c)

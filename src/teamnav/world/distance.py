@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from teamnav.world import field_cache
 from teamnav.world.grid import OccupancyGrid
 from teamnav.world.raycast import _check_blocking, _check_positive
 
@@ -59,9 +60,12 @@ def distance_field(grid_or_blocking, resolution_m: float | None = None) -> np.nd
     free = blocking == 0
     if free.all():
         return np.full(blocking.shape, np.inf)
-    from scipy import ndimage  # here: scipy.ndimage alone takes ~0.3 s to import
+    field = field_cache.load(blocking, res)  # large maps: computed once per machine, kept on disk
+    if field is None:
+        from scipy import ndimage  # here: scipy.ndimage alone takes ~0.3 s to import
 
-    field = ndimage.distance_transform_edt(free, sampling=res)
+        field = ndimage.distance_transform_edt(free, sampling=res)
+        field_cache.store(blocking, res, field)
     _LAST[0] = (np.array(blocking, copy=True), res, field.copy())
     return field
 
