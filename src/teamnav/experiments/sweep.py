@@ -278,7 +278,7 @@ def _run_into_store(out: Path, spec: Any, trials: list[Trial], runner: Any, tria
         result.skipped = len(trials) - len(todo)
         store.register_sweep(spec.sweep_name, spec.model_dump(mode="json"))
         art = out / "trials" if artifacts else None
-        todo = longest_first(todo, trials, store.rows())  # both cores busy to the end (issue 27 §2)
+        todo = longest_first(todo, trials, store.rows())  # both cores busy to the end: the longest trials start first
         tasks = [TrialTask(t, trial_fn, str(art / t.trial_id) if art is not None else None) for t in todo]
         by_id = {t.trial_id: t for t in todo}
         bar = _Bar(spec.sweep_name, len(todo), result.skipped, show=progress and bool(todo))

@@ -236,8 +236,8 @@ class RadioConfig(Model):
     message sent at step k is delivered at step k+1.
 
     ``bandwidth_bps`` (bytes per second per sender; None, the default, is unlimited: every
-    paper's rule, none of the four papers caps its radio) is ours (issue 22, "restricted radio
-    for every system"): a token bucket per sender, full at the start, refilled every step by
+    paper's rule, none of the four papers caps its radio) is ours (a restricted radio for every
+    system, added 2026-11-27): a token bucket per sender, full at the start, refilled every step by
     ``bandwidth_bps * dt_s`` up to a burst of ``bandwidth_burst_s`` seconds of the cap
     (default 1 s; it must hold the largest message a system sends, or that message never
     goes out: a trail robot's 100-B crumb needs ``bandwidth_bps * bandwidth_burst_s >= 100``). Each

@@ -33,8 +33,8 @@ observer, what that observer perceives. Rules, from :class:`~teamnav.sim.config.
      ``err_max = 0`` is perfect sensing: exact range *and* bearing (Sgorbissa & Arkin §6.1
      call Tables 1-2 "perfect sensing"; eqs. 1-2 apply only in the noise figures 16-17, and
      their err_max = 0 point is the tables' configuration). The draws are still taken, so
-     the detector's random stream is the same at every err_max. Before issue 21 §2 the
-     bearing carried eq. 2's error at ``err_max = 0`` too.
+     the detector's random stream is the same at every err_max. Before commit 7915eb8
+     (2026-11-27) the bearing carried eq. 2's error at ``err_max = 0`` too.
 5. *False negatives*: each true detection is dropped with ``p_false_negative``.
 6. *False positives*: with ``p_false_positive`` per observer per step, one phantom at a
    range uniform in ``(0, max_range_m]`` and a bearing uniform over the field of view.
@@ -251,7 +251,7 @@ class RobotDetector:
         m = d_r.shape[0]
         if cfg.noise_model == "occlusion":
             if cfg.err_max == 0.0:
-                # perfect sensing (Tables 1-2, §6.1; issue 21 §2): exact range and bearing; the
+                # perfect sensing (Tables 1-2, §6.1): exact range and bearing; the
                 # draws of _draw_noise were taken all the same (the same random stream)
                 return d_r, a_r
             # Sgorbissa & Arkin §6.1 eqs. 1-2: d_p = d_r + d_r d_noise, alpha_p = alpha_r +
