@@ -12,7 +12,10 @@ Usage::
     (``benchmarks/peers/irsim_peer.py``; same PNG, lidar, robot radius and step).
 (b) ``swarm``: N robots with 7 short-range proximity rays (ProximityConfig defaults: 14 cm) in
     a walled square arena of side 1 m x sqrt(N), beside Enki's Thymio II
-    (``benchmarks/peers/enki_peer.py``).
+    (``benchmarks/peers/enki_peer.py``). Its per-robot Python rows: ``wander-v1`` (form
+    ``python``) and Enki's own Python ``Avoider`` rule as a teamnav brain (form ``avoider``,
+    ``benchmarks/swarm_avoider.py``, loaded as an outside brain is), compared with Enki's Python
+    controllers by CPU time: the same rule on both sides.
 
 Peers run as subprocesses in their own interpreters, found by ``--irsim-python`` /
 ``$TEAMNAV_BENCH_IRSIM_PYTHON`` (default ``/tmp/irsim-venv/bin/python``) and ``--enki-python``
@@ -93,7 +96,9 @@ def build_sim(case: str, form: str, n: int, seed: int = 0):
     from teamnav.sim.engine import Simulation
     from teamnav.world.mapio import load_map
 
-    controller = {"python": "wander-v1", "batched": "wander-batched-v1"}[form]
+    controller = {"python": "wander-v1", "batched": "wander-batched-v1", "avoider": "swarm_avoider:Avoider"}[form]
+    if form == "avoider" and case != "swarm":
+        raise ValueError("the 'avoider' form (Enki's Python rule) is a swarm cell only")
     if case == "laser":
         grid = load_map(BASEMENT.with_suffix(".yaml"))
         group = RobotGroupConfig(count=n, radius_m=0.2, controller=controller,
@@ -102,7 +107,8 @@ def build_sim(case: str, form: str, n: int, seed: int = 0):
         grid = swarm_arena(n)
         # Thymio-sized: radius 8 cm, 0.2 m/s; the wanderer caps its thresholds to the 14 cm range.
         group = RobotGroupConfig(count=n, radius_m=0.08, max_v_mps=0.2, controller=controller,
-                                 params={"cruise_speed_mps": 0.15}, sensors=(ProximityConfig(),))
+                                 params={} if form == "avoider" else {"cruise_speed_mps": 0.15},
+                                 sensors=(ProximityConfig(),))
     cfg = SimConfig(robots=(group,), seed=seed, record_every=1_000_000)
     return Simulation(grid, cfg)
 
@@ -116,13 +122,15 @@ def measure_teamnav(case: str, form: str, n: int, steps: int, warmup: int, repea
     start = _positions(sim)
     for _ in range(warmup):
         sim.step()
-    best = math.inf
+    best = cpu = math.inf
     for _ in range(repeats):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         sim.run(steps)
         best = min(best, time.perf_counter() - t0)
+        cpu = min(cpu, time.process_time() - c0)
     moved = float(np.mean(np.hypot(*(_positions(sim) - start).T)))
-    return {"robot_steps_per_s": n * steps / best, "seconds": best, "steps": steps, "mean_displacement_m": moved}
+    return {"robot_steps_per_s": n * steps / best, "seconds": best, "steps": steps, "mean_displacement_m": moved,
+            "robot_steps_per_cpu_s": n * steps / cpu}
 
 
 def measure_cpu(case: str, form: str, n: int, steps: int, warmup: int, repeats: int) -> dict:
@@ -242,6 +250,16 @@ def print_table(title: str, peer: str, rows: list[dict], targets: dict[int, str]
               f"{_ratio(r.get('batched'), r.get('peer'))} | {_ratio(r.get('python'), r.get('peer'))} | "
               f"{targets.get(r['n'], '')} |")
     print("\n(robot-steps per second, best of repeats, JIT warm-up excluded)")
+    if any("avoider" in r for r in rows):
+        print(f"\n#### the same Python rule on both sides (Enki's Avoider; benchmarks/swarm_avoider.py), CPU time\n")
+        print(f"| robots | teamnav per-robot Python, robot-steps per CPU-s | {peer} Python, per CPU-s | teamnav / {peer} | "
+              "target |")
+        print("|---:|---:|---:|---:|---|")
+        for r in rows:
+            if "avoider" in r:
+                print(f"| {r['n']} | {_fmt(r['avoider_cpu'])} | {_fmt(r.get('peer_cpu'))} | "
+                      f"{_ratio(r['avoider_cpu'], r.get('peer_cpu'))} | ≥ 2× |")
+        print("\n(CPU time of the stepping loop, best of repeats: a fair reading on a shared machine)")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -249,7 +267,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="fewer steps and repeats")
     ap.add_argument("--cases", default="laser,swarm", help="comma list of laser, swarm")
     ap.add_argument("--robots", default="10,100,1000", help="comma list of team sizes")
-    ap.add_argument("--forms", default="python,batched", help="comma list of python, batched")
+    ap.add_argument("--forms", default="python,avoider,batched",
+                    help="comma list of python (wander-v1), avoider (Enki's Python rule, swarm only), batched")
     ap.add_argument("--irsim-python", default=os.environ.get("TEAMNAV_BENCH_IRSIM_PYTHON", "/tmp/irsim-venv/bin/python"))
     ap.add_argument("--enki-python", default=os.environ.get("TEAMNAV_BENCH_ENKI_PYTHON", "/usr/bin/python3"))
     ap.add_argument("--no-peers", action="store_true", help="measure teamnav only")
@@ -270,8 +289,8 @@ def main(argv: list[str] | None = None) -> int:
         if c not in ("laser", "swarm"):
             raise SystemExit(f"--cases must list 'laser' and/or 'swarm', got {c!r}")
     for f in forms:
-        if f not in ("python", "batched"):
-            raise SystemExit(f"--forms must list 'python' and/or 'batched', got {f!r}")
+        if f not in ("python", "avoider", "batched"):
+            raise SystemExit(f"--forms must list 'python', 'avoider' and/or 'batched', got {f!r}")
     if any(n < 1 for n in sizes):
         raise SystemExit(f"--robots must list positive team sizes, got {a.robots!r}")
     if a.threads is not None:
@@ -309,8 +328,11 @@ def main(argv: list[str] | None = None) -> int:
         for n in sizes:
             row: dict = {"n": n}
             for form in forms:
+                if form == "avoider" and case != "swarm":
+                    continue
                 res = measure_teamnav(case, form, n, _steps(plan.teamnav_steps, n), plan.warmup, plan.teamnav_repeats)
                 row[form] = res["robot_steps_per_s"]
+                row[f"{form}_cpu"] = res["robot_steps_per_cpu_s"]
                 print(f"  {case:5s} teamnav {form:7s} N={n:5d}: {res['robot_steps_per_s']:>14,.0f} robot-steps/s "
                       f"({res['steps']} steps in {res['seconds']:.3f} s; mean displacement {res['mean_displacement_m']:.2f} m)",
                       flush=True)
@@ -319,6 +341,7 @@ def main(argv: list[str] | None = None) -> int:
                                timeout_s=900)
                 if res is not None:
                     row["peer"] = res["robot_steps_per_s"]
+                    row["peer_cpu"] = res.get("robot_steps_per_cpu_s")
                     print(f"  {case:5s} {label:15s} N={n:5d}: {res['robot_steps_per_s']:>14,.0f} robot-steps/s "
                           f"({res['steps']} steps in {res['seconds']:.3f} s; mean displacement "
                           f"{res.get('mean_displacement_m', float('nan')):.2f} m)", flush=True)

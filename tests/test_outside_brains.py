@@ -69,6 +69,18 @@ class NaNs(Fine):
         return Action(v_mps=float("nan"), omega_radps=0.0), []
 
 
+class Words(Fine):
+    def step(self, obs):
+        if self.id == 2:
+            return Action(v_mps="fast", omega_radps=0.0), []
+        return super().step(obs)
+
+
+class BadDirection(Fine):
+    def step(self, obs):
+        return Action(direction_rad="left"), []
+
+
 class Forever(Fine):
     def step(self, obs):
         if obs.step == 2 and self.id == 0:
@@ -128,6 +140,8 @@ def assert_failed(proc, out: Path, status: int, *fragments: str, debug: bool = F
         ("StepExits", 3, ["robot wanderer[0] (id 0)", "at step 3", "SystemExit: sys.exit(0) called"]),
         ("Garbage", 3, ["robot wanderer[0] (id 0)", "at step 0", "must return (Action, list of Message)", "str"]),
         ("NaNs", 3, ["robot wanderer[0] (id 0)", "at step 0", "finite"]),
+        ("Words", 3, ["robot wanderer[2] (id 2)", "at step 0", "real numbers", "'fast'"]),
+        ("BadDirection", 3, ["robot wanderer[0] (id 0)", "at step 0", "direction_rad must be finite or None", "'left'"]),
     ],
 )
 def test_failing_brain_one_line_and_status(brains, tmp_path, cls, status, fragments):

@@ -59,6 +59,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import numbers
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterator
@@ -88,6 +89,16 @@ __all__ = ["Simulation"]
 
 
 _now = time.perf_counter
+
+
+def _real_number(x) -> bool:
+    """``x`` is a real number (a Python or numpy int or float; a NaN is one here: the
+    finiteness check that follows names it), not a bool, a string, an array or None."""
+    return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
+
+
+def _finite_number(x) -> bool:
+    return _real_number(x) and math.isfinite(float(x))
 
 
 def _short(value: Any) -> str:
@@ -702,40 +713,62 @@ class Simulation:
             if grp.whole and fx is None:
                 continue  # its controller reads self.observed
             stalled = s.stalled[sl].tolist()
+            # Per robot, only what must be per robot (an outside Python brain pays this path on
+            # every step): row views, one Observation, the call; commands go into Python lists,
+            # written to the command arrays once per group.
+            rows = [(name, list(r), a, m) for name, r, a, m in readings]
+            odom_rows = list(odom[sl])
+            delta_rows = list(delta[sl])
+            g_inbox = inboxes[sl] if inboxes is not None else None
+            g_events = events[sl] if events is not None else None
+            dead = fx.dead[sl].tolist() if fx is not None else None
+            vs = self._v_cmd[sl].tolist()
+            ws = self._w_cmd[sl].tolist()
+            ds = self._dir_cmd[sl].tolist()
+            gi = grp.index
+            i0 = sl.start
             for k, brain in enumerate(grp.brain):
-                i = sl.start + k
-                if fx is not None and fx.dead[i]:
+                if dead is not None and dead[k]:
                     continue  # a dead robot's brain is off (its commands are zeroed below)
-                scans = {name: RangeScan(r[k], a, m) for name, r, a, m in readings}
+                if len(rows) == 1:
+                    name, r, a, m = rows[0]
+                    scans = {name: RangeScan(r[k], a, m)}
+                else:
+                    scans = {name: RangeScan(r[k], a, m) for name, r, a, m in rows}
                 if omit is not None and omit[k]:
                     for name in omit[k]:
                         del scans[name]  # a sensor that publishes nothing this step
                 obs = Observation(
-                    robot_id=i, step=step, time_s=t, odom_pose=odom[i], odom_delta=delta[i],
-                    scans=scans,
-                    detections=tuple(dets[k]) if dets is not None else (),
-                    stalled=stalled[k],
-                    inbox=inboxes[i] if inboxes is not None else (),
-                    events=events[i] if events is not None else (),
+                    i0 + k, step, t, odom_rows[k], delta_rows[k], scans,
+                    tuple(dets[k]) if dets is not None else (),
+                    stalled[k],
+                    g_inbox[k] if g_inbox is not None else (),
+                    g_events[k] if g_events is not None else (),
                 )
-                self.calling = (grp.index, k, step, _now())
+                self.calling = (gi, k, step, _now())
                 try:  # the brain's own code: whatever it raises (even sys.exit) is reported as its failure
                     out = brain.step(obs) if timer is None else timer.call(brain.step, obs)
                     self.calling = None
                 except (Exception, SystemExit) as exc:
                     raise self._brain_failed(grp, k, step, exc) from exc
-                if not (isinstance(out, tuple) and len(out) == 2 and isinstance(out[0], Action)):
-                    raise self._bad_return(grp, k, step, "step() must return (Action, list of Message), got "
-                                           f"{_short(out)}")
+                if not (type(out) is tuple and len(out) == 2 and isinstance(out[0], Action)):
+                    if not (isinstance(out, tuple) and len(out) == 2 and isinstance(out[0], Action)):
+                        raise self._bad_return(grp, k, step, "step() must return (Action, list of Message), got "
+                                               f"{_short(out)}")
                 action, outbox = out
-                self._v_cmd[i] = action.v_mps
-                self._w_cmd[i] = action.omega_radps
-                self._dir_cmd[i] = np.nan if action.direction_rad is None else action.direction_rad
-                if action.direction_rad is not None and not math.isfinite(action.direction_rad):
-                    raise self._bad_return(grp, k, step, f"direction_rad must be finite or None, got {action.direction_rad!r}")
+                vs[k] = action.v_mps
+                ws[k] = action.omega_radps
+                d = action.direction_rad
+                if d is None:
+                    ds[k] = math.nan
+                else:
+                    ds[k] = d
+                    if not (type(d) is float and math.isfinite(d)) and not _finite_number(d):
+                        raise self._bad_return(grp, k, step, f"direction_rad must be finite or None, got {d!r}")
                 if outbox:
-                    for m in outbox:
-                        outgoing.append((i, m))
+                    for msg in outbox:
+                        outgoing.append((i0 + k, msg))
+            self._write_commands(grp, step, vs, ws, ds)
         if fx is not None:
             fx.zero_commands(self._v_cmd, self._w_cmd, self._dir_cmd)
         if not (np.isfinite(self._v_cmd).all() and np.isfinite(self._w_cmd).all()):
@@ -750,6 +783,21 @@ class Simulation:
             else:
                 self.radio.send(outgoing, xs, ys, muted=fx.radio_off if fx.any_radio_off else None, blocked=fx.blackout,
                                 step=step)
+
+    def _write_commands(self, grp: _Group, step: int, vs: list, ws: list, ds: list) -> None:
+        """A per-robot group's commands, from its brains' Actions, into the command arrays; a
+        value that is not a real number names the robot that commanded it."""
+        sl = grp.sl
+        try:
+            self._v_cmd[sl] = vs
+            self._w_cmd[sl] = ws
+            self._dir_cmd[sl] = ds
+        except (TypeError, ValueError):
+            for k, (v, w) in enumerate(zip(vs, ws)):
+                if not (_real_number(v) and _real_number(w)):
+                    raise self._bad_return(grp, k, step, f"must command real numbers v_mps and omega_radps, got "
+                                           f"({_short(v)}, {_short(w)})") from None
+            raise
 
     def _robot(self, grp: _Group, k: int | None) -> str:
         return robot_label(grp.cfg.name, k, None if k is None else grp.sl.start + k)
