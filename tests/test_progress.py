@@ -1,4 +1,4 @@
-"""Long work reports progress when stderr is not a terminal (issue 20 §5), and the first
+"""Long work reports progress when stderr is not a terminal, and the first
 step's numba warm-up is measured apart from the throughput.
 
 Off a terminal (CI, nohup, a pipe) runs, sweeps and reports print a plain line every
@@ -106,11 +106,23 @@ def test_a_piped_run_prints_plain_progress_lines(tmp_path):
 
 
 def test_a_short_piped_run_at_the_default_period_prints_no_progress(tmp_path):
-    proc = subprocess.run(
-        [sys.executable, "-m", "teamnav", "run", "demo", "--duration", "1", "--out", str(tmp_path / "r")],
-        env=_env(tmp_path, None), capture_output=True, text=True, timeout=120,
-    )
-    assert proc.returncode == 0 and "teamnav run demo:" not in proc.stderr, proc.stderr
+    """A run that ends before the first period prints nothing. A run that takes longer (numba
+    compiling after a kernel's source changed, a machine at load 10) may rightly print a line:
+    it is run once more, warm; only a run shorter than the period is judged."""
+    for attempt in range(2):
+        t0 = time.monotonic()
+        proc = subprocess.run(
+            [sys.executable, "-m", "teamnav", "run", "demo", "--duration", "1", "--out", str(tmp_path / f"r{attempt}")],
+            env=_env(tmp_path, None), capture_output=True, text=True, timeout=120,
+        )
+        took = time.monotonic() - t0
+        assert proc.returncode == 0, proc.stderr
+        if took < P.DEFAULT_PERIOD_S:
+            break
+    else:
+        pytest.skip(f"a 1-s demo run took {took:.0f} s twice here, longer than the default period "
+                    f"({P.DEFAULT_PERIOD_S:g} s): nothing to judge")
+    assert "teamnav run demo:" not in proc.stderr, proc.stderr
 
 
 def test_a_piped_sweep_prints_plain_progress_lines_and_a_final_count(tmp_path):
