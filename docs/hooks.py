@@ -1,6 +1,6 @@
 """MkDocs hooks of the teamnav site (``hooks:`` in ``mkdocs.yml``).
 
-Three things a plain MkDocs build cannot do:
+Four things a plain MkDocs build cannot do:
 
 - ``{{ include "src/teamnav/papers/los_help/README.md" }}`` on a line of its own puts a file of
   the repository into the page, so that each paper's README stays the one place its rules are
@@ -12,6 +12,8 @@ Three things a plain MkDocs build cannot do:
   not carry the source; one that lands nowhere is left alone, so ``mkdocs build --strict``
   fails on it. The pages under ``docs/report/`` are shown as they are written: only their
   links are read this way, at build time, never rewritten on disk.
+- ``{{ paper-rules "module:ParamsClass" }}`` becomes a table of that brain's gap-fills
+  (``PAPER_RULES``): each flag, teamnav's default and the paper's value.
 - ``{{ teamnav-cli-help }}`` becomes the ``--help`` text of ``teamnav`` and of every one of its
   commands, taken from the installed command at build time, so the reference cannot fall behind.
 """
@@ -27,6 +29,7 @@ DOCS = ROOT / "docs"
 
 _INCLUDE = re.compile(r'^\{\{ include "(?P<path>[^"]+)" \}\}[ \t]*$', re.MULTILINE)
 _CLI = re.compile(r"^\{\{ teamnav-cli-help \}\}[ \t]*$", re.MULTILINE)
+_RULES = re.compile(r'^\{\{ paper-rules "(?P<entry>[\w.]+:\w+)" \}\}[ \t]*$', re.MULTILINE)
 # [text](target) and ![alt](target), not inside inline code; a target has no spaces
 _LINK = re.compile(r"(?P<bang>!?)\[(?P<text>[^\]\n]*)\]\((?P<target>[^)\s]+)\)")
 _FENCE = re.compile(r"^(```|~~~).*?^\1[ \t]*$", re.MULTILINE | re.DOTALL)
@@ -94,9 +97,32 @@ def cli_help() -> str:
     return "\n".join(parts)
 
 
+def _value(v) -> str:
+    return f"`{v!r}`" if not isinstance(v, str) else f"`{v}`"
+
+
+def paper_rules_table(entry: str) -> str:
+    """A Params class's gap-fills (its ``PAPER_RULES``): each flag, teamnav's default and the
+    paper's value, which ``paper_rules: true`` sets."""
+    import importlib
+
+    module, _, name = entry.partition(":")
+    params = getattr(importlib.import_module(module), name)
+    rules = getattr(params, "PAPER_RULES", None)
+    if not rules:
+        raise RuntimeError(f"{entry} declares no PAPER_RULES")
+    rows = ["| parameter | teamnav's default | the paper's value (`paper_rules: true`) |", "| --- | --- | --- |"]
+    for key, paper_value in rules.items():
+        field = params.model_fields.get(key)
+        default = _value(field.default) if field is not None else "—"
+        rows.append(f"| `{key}` | {default} | {_value(paper_value)} |")
+    return "\n".join(rows) + "\n"
+
+
 def on_page_markdown(markdown: str, page, config, files) -> str:
     src = Path(page.file.abs_src_path)
     markdown = _INCLUDE.sub(lambda m: _include(m, src.parent), markdown)
+    markdown = _RULES.sub(lambda m: paper_rules_table(m.group("entry")), markdown)
     if _CLI.search(markdown):
         markdown = _CLI.sub(lambda m: cli_help(), markdown)
     return relink(markdown, src.parent, src.parent)
