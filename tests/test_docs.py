@@ -54,3 +54,19 @@ def test_links_are_read_against_the_file_that_wrote_them(tmp_path):
     assert "[gone](nowhere.md)" in out  # broken: left for the strict build to report
     assert "[web](https://example.org)" in out and "[here](#anchor)" in out
     assert "[in a fence](brains/__init__.py)" in out  # code blocks are shown as written
+
+
+def test_the_readme_opens_with_the_two_commands_and_its_links_resolve():
+    """The README is one screen that links into the site: its two set-up commands come first, as
+    ``.ci/run`` runs the second one, and every relative link it makes lands on a file."""
+    import re
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```bash\n(.*?)```", text, re.S)
+    assert [b.strip() for b in blocks[:2]] == [
+        "pip install . && teamnav run demo",
+        "pip install '.[test]' && python -m pytest -x -q -n auto --hypothesis-profile=ci"]
+    assert blocks[1].strip() in (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+    targets = [t for t in re.findall(r"\]\(([^)\s#]+)", text) if not re.match(r"^[a-z]+:", t)]
+    assert targets, "the README links into the site"
+    assert [t for t in targets if not (ROOT / t).exists()] == []
