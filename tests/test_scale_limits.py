@@ -21,7 +21,8 @@ from teamnav.experiments.errors import ScenarioError
 from teamnav.experiments.spec import MAX_STEPS_PER_RUN, MAX_STEPS_RAISED, load_scenario
 from teamnav.experiments.sweep_spec import MAX_TRIALS_PER_SWEEP, SweepError, SweepSpec, parse_seeds, resolve_spec
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+#: the page that documents the size limits (it was a section of the README before the site)
+LIMITS_PAGE = Path(__file__).resolve().parents[1] / "docs" / "reference" / "scenario-files.md"
 
 
 def invoke(*args: str):
@@ -29,9 +30,9 @@ def invoke(*args: str):
 
 
 # ---------------------------------------------------------------------------- steps per run
-def test_the_limits_are_what_the_readme_says():
+def test_the_limits_are_what_the_docs_say():
     assert (MAX_STEPS_PER_RUN, MAX_STEPS_RAISED, MAX_TRIALS_PER_SWEEP) == (10**8, 10**12, 10**5)
-    text = README.read_text(encoding="utf-8")
+    text = LIMITS_PAGE.read_text(encoding="utf-8")
     for name in ("MAX_STEPS_PER_RUN", "MAX_STEPS_RAISED", "MAX_TRIALS_PER_SWEEP", "max_steps"):
         assert name in text
 

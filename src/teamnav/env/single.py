@@ -33,6 +33,8 @@ class SingleRobotEnv(gym.Env):
     dtype, seed, duration_s, overrides, **fields
         As for :class:`~teamnav.env.ParallelEnv`.
 
+    Notes
+    -----
     Observation and action spaces are the agent's of :class:`~teamnav.env.ParallelEnv`
     (a ``Dict`` of Boxes; a ``Box`` (2,)), and so are the timing, the episode ends and the
     seeding: ``reset(seed=s)`` is the episode of the scenario with seed ``s``, bit for bit;
