@@ -1,4 +1,4 @@
-"""Stand-alone ``beyond-*`` scenarios for issue 22's items that a sweep case defines (generated files).
+"""Stand-alone ``beyond-*`` scenarios for the beyond section's items that a sweep case defines (generated files).
 
 Fox, Burgard, Kruppa & Thrun's own future work (§7.2) is measured by sweeps that override the
 collab-mcl section's scenarios (``beyond-negative-detections-{hallway,hexagon}``,

@@ -1,4 +1,4 @@
-"""Scenarios and sweeps of issue 22's combination 2, "localized LOS help" (generated files).
+"""Scenarios and sweeps of the beyond section's combination 2, "localized LOS help" (generated files).
 
 The LOS help experiment of :mod:`teamnav.papers.los_help.tasks` (Sgorbissa & Arkin §6: R1
 reaches room-centre targets helped by R2..R4 patrolling the corridors, VisBug-21 on both maps,

@@ -1,6 +1,6 @@
 """Brain ``detecting-trails-v1``: a trail robot that corrects its pose when it sees a teammate.
 
-Issue 22, combination 3 ("detections help the trail team"). The trail papers' robots have only
+Beyond the papers, combination 3 ("detections help the trail team"). The trail papers' robots have only
 drifting odometry and no map (Vaughan et al. 2000 §4.1, §5.1; 2002 §3.6); collaborative MCL's
 robots share beliefs when one detects another (Fox et al. §2.3, §3.2, eqs. 13-14). This brain
 composes the two, without a map and without copying either:

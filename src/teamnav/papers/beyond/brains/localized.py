@@ -1,6 +1,6 @@
 """Brain ``localized-v1``: any brain, driven by a Monte Carlo localization pose instead of odometry.
 
-Issue 22, combination 1 ("localized trails"): the trail papers' robots have only drifting
+Beyond the papers, combination 1 ("localized trails"): the trail papers' robots have only drifting
 odometry, and their trails break down as the frames drift apart (Vaughan et al. 2000 §5.1,
 2002 §3.6); Fox et al.'s robots localize against a map and do nothing else. This brain composes
 the two without copying either:

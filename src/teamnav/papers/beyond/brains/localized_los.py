@@ -1,4 +1,4 @@
-"""Issue 22, combination 2, "localized LOS help": the LOS helpers' relative frames from MCL poses.
+"""Beyond the papers, combination 2, "localized LOS help": the LOS helpers' relative frames from MCL poses.
 
 Which paper rules this composes (no copies; each stays in its own module):
 

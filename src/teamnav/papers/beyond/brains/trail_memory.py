@@ -1,6 +1,6 @@
 """Brain ``los-trail-explorer-v1``: R1 of the line-of-sight help system with a Trail of its viewpoints.
 
-Issue 22, combination 4 ("trails as LOS memory"): Sgorbissa & Arkin's R1 forgets where it saw
+Beyond the papers, combination 4 ("trails as LOS memory"): Sgorbissa & Arkin's R1 forgets where it saw
 its goal as soon as it loses sight of it (the owner of a goal keeps no §4.3 viewpoint: it falls
 back to its navigator A, :mod:`~teamnav.papers.los_help.brains.goal_sharing`), and its tasks
 send it to the same rooms again and again (§6: 200 targets among the rooms' centres). Vaughan

@@ -1,4 +1,4 @@
-"""The ``beyond`` section's block for combination 3: detections help the trail team (issue 22).
+"""The ``beyond`` section's block for combination 3: detections help the trail team.
 
 The brain is ``detecting-trails-v1`` (:mod:`teamnav.papers.beyond.brains.detecting`) over
 ``blazing-trail-v1``: the 2000 paper's crumbs and trail following (Blazing §4.1) laid and followed

@@ -1,4 +1,4 @@
-"""The ``beyond`` section's block on combination 2, localized LOS help (issue 22).
+"""The ``beyond`` section's block on combination 2, localized LOS help.
 
 The LOS help system (Sgorbissa & Arkin; VisBug-21, R1 helped by R2..R4, goal sharing, the
 line-of-sight radio) with every brain on an MCL pose (``localized-v1``, Fox et al. §3.1), and
@@ -149,7 +149,7 @@ def localized_los(ctx) -> list:
         return [missing]
     quick = bool(ctx.quick)
     blocks: list = [Text(
-        "Combination 2, localized LOS help (issue 22): the LOS help system with every brain on an MCL pose "
+        "Combination 2, localized LOS help: the LOS help system with every brain on an MCL pose "
         "(localized-v1: Fox et al. §3.1, the laser through the likelihood field, the map given, tracking from the "
         "known start), and the frame between sender and receiver from the mutual bearings (Sgorbissa & Arkin §3.1, "
         "θ21 = 180° + α21 − α12), from the two robots' MCL poses (sent in each message; no sighting needed), or "

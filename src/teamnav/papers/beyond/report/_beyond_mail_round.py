@@ -1,4 +1,4 @@
-"""The ``beyond`` section's N-places block: a mail round of N = 2..5 places (issue 22).
+"""The ``beyond`` section's N-places block: a mail round of N = 2..5 places.
 
 Vaughan, Støy, Sukhatme & Matarić, "Try to see it my way" (2002): §2.1 "We have since generalized
 the method to handle N places by recording N trails (though we will only present results here for

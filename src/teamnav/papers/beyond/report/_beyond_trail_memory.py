@@ -1,4 +1,4 @@
-"""The ``beyond`` section's block on trails as LOS memory (issue 22, combination 4).
+"""The ``beyond`` section's block on trails as LOS memory (combination 4).
 
 ``los-trail-explorer-v1`` (:mod:`teamnav.papers.beyond.brains.trail_memory`) is Sgorbissa & Arkin's R1
 with a Trail (Vaughan et al. 2002 §2.1) of the places from which it saw its targets; with its
@@ -193,7 +193,7 @@ def trail_memory(ctx) -> list:
             plain.append(f"{nav}, {team_text}: {_verdict_line(d_reached, d_spt)}")
     tasks = f"task 1's first {n_targets} targets" if quick else f"the first {n_targets} targets of tasks 1-{len(grid)}"
     blocks: list = [Text(
-        "Combination 4, trails as LOS memory (issue 22): Sgorbissa & Arkin's R1 keeps a Trail (Vaughan et al. 2002 "
+        "Combination 4, trails as LOS memory: Sgorbissa & Arkin's R1 keeps a Trail (Vaughan et al. 2002 "
         "§2.1: one Place per target, a Crumb where a target came into view, its value the straight distance to it) "
         "and, with its goal out of sight and no teammate or ghost leading it, heads for the remembered viewpoint in "
         "sight with the shortest D = dist(R1, crumb) + crumb-to-goal (§4.3's estimate through a 'ghost robot', applied "

@@ -1,4 +1,4 @@
-"""The ``beyond`` section's block on a restricted radio for every system (issue 22; ours).
+"""The ``beyond`` section's block on a restricted radio for every system (ours).
 
 Each of the four systems runs on its own scenario with the radio restricted, one case per
 restriction (the named sweeps ``beyond-radio-los``, ``-collab-mcl``, ``-blazing``, ``-try``):
@@ -38,7 +38,7 @@ than 2 standard errors of the per-seed paired difference (:func:`loss_reversals`
 Quick mode (CI): cases p0 and p0.9 of each system, seed 0, 3 LOS targets, 60-s MCL and 5-min
 trail runs (eight short runs, about 1 CPU-min): the pipeline works; no verdict. Full mode: the
 sweep files, seeds 0-9, 350 runs: about 1500 CPU-s on a 2-core EPYC (try 401, blazing 390,
-collab-mcl 562, los 169; docs/report/beyond.md, session 15, has the numbers).
+collab-mcl 562, los 169; docs/report/beyond.md has the numbers, commit e8cee29, 2026-11-27).
 """
 
 from __future__ import annotations
@@ -280,7 +280,7 @@ def restricted_radio(ctx) -> list:
     if missing is not None:
         return [missing]
     blocks: list = [Text(
-        "The papers' future work, a restricted radio for every system (issue 22; Blazing §6 names \u201crestricting "
+        "The papers' future work, a restricted radio for every system (Blazing §6 names \u201crestricting "
         "the communication range\u201d): each system's headline metric as deliveries are lost (p_loss 0-1, where 1 "
         "is no radio), as the radio's range shrinks, and under one bandwidth cap per system (ours: a token bucket "
         "per sender, over-cap messages dropped, RadioConfig.bandwidth_bps; half of what each robot offers, measured "

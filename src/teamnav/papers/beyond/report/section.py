@@ -1,4 +1,4 @@
-"""Report section ``beyond``: the four systems combined, each beside its parts (issue 22).
+"""Report section ``beyond``: the four systems combined, each beside its parts.
 
 Each paper gives its robots one kind of help and assumes the others away; here one team gets
 two, and the section measures what the second buys against the systems it is built from.
@@ -24,7 +24,7 @@ no verdict (the rule needs 1-h runs). Full mode: k = 0, 1, 4, seeds 0-9, 1 h eac
 
 Full mode also runs ``beyond-localized-particles``: the localized team at k = 4 with 25, 50,
 100, 200 and 500 samples per robot, and names the cheapest count none of whose runs broke
-down (issue 22: "the cheapest particle count that removes the 2000 algorithm's breakdown").
+down (the question asked: "the cheapest particle count that removes the 2000 algorithm's breakdown").
 
 The papers' future work, **a moving resource** (Vaughan et al. 2000 §6; the motion is ours,
 :class:`~teamnav.sim.config.PlaceMotion`; scenario and sweep ``beyond-moving-resource``):
@@ -35,17 +35,17 @@ mode: the 8 cases x seeds 0-9 x 1 h (about 9 CPU-s per run here), and blazing-tr
 ``beyond-moving-resource-blazing``: 3 motions x crumbs that never expire, the paper, or expire
 after 300 s, ``global_crumb_ttl_s``, beyond it; 60 runs).
 
-The papers' future work, **a restricted radio for every system** (issue 22; the cases and the
+The papers' future work, **a restricted radio for every system** (the cases and the
 bandwidth cap are ours; sweeps ``beyond-radio-<system>``): each system's headline metric against
 loss, range and one bandwidth cap, with two verdict rules per system (claims ``radio-*``);
 :mod:`~teamnav.papers.beyond.report._radio_beyond` owns the block and documents it.
 
-Also built (issue 22), each in its own module: combination 2, localized LOS help
+Also built, each in its own module: combination 2, localized LOS help
 (:mod:`._beyond_localized_los`); combination 3, detections help the trail team
 (:mod:`._beyond_detecting_trails`); combination 4, trails as LOS memory (:mod:`._beyond_trail_memory`);
 Fox et al. §7's negative detections and anonymous robots (:mod:`._beyond_negative_detections`).
 
-Cost of the full section, measured whole (session 17, fresh folder, nothing reused): 1110 trials,
+Cost of the full section, measured whole (commit a4b747e, 2026-11-27, fresh folder, nothing reused): 1110 trials,
 2.07 CPU-h, 79 min on 2 workers; the cost of each sweep is in ``docs/report/beyond.md``.
 """
 
@@ -243,7 +243,7 @@ def motion_speed_mps(start_xy: tuple[float, float], motion: dict | None) -> floa
 
 
 def _moving_resource(ctx) -> list:
-    """Issue 22, the papers' future work: a moving resource (Vaughan et al. 2000 §6; the motion is ours).
+    """The papers' future work: a moving resource (Vaughan et al. 2000 §6; the motion is ours).
 
     trail-share-v1 (the 2002 algorithm: Places updated on task events, crumbs expire after 4 min,
     Try §3) forages while the source stays, jumps or glides between two spots of C3; units per hour
@@ -322,7 +322,7 @@ def _moving_blazing(ctx, seeds: list[int], dur: float, speed: dict[str, float]) 
 
 
 def build(ctx) -> list:
-    """The section's blocks: the four combinations and the papers' future work (issue 22)."""
+    """The section's blocks: the four combinations and the papers' future work."""
     blocks: list = [Text(
         "Each paper gives its robots one kind of help; here a team gets two, measured against the systems it is "
         "built from. Every combination is a registered brain composing the papers' rules (no copies); its module "
@@ -349,7 +349,7 @@ SECTION = SectionSpec(
     title="Beyond the papers: the systems combined",
     paper=PAPER,
     build=build,
-    summary="The four systems combined, each beside its parts, and the papers' future work (issue 22).",
+    summary="The four systems combined, each beside its parts, and the papers' future work.",
     order=95,
     tags=("trails", "localization", "beyond"),
 )

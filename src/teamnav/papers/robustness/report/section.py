@@ -1,5 +1,5 @@
 """Report section ``robustness``: faults injected and survived, the papers' own robustness claims
-measured (issue 20 §3).
+measured.
 
 Each paper system runs without faults and with the faults that matter to it, on the same seeds,
 as overrides of its built-in scenario (the named sweeps ``robustness-blazing``,
@@ -25,12 +25,12 @@ Verdict rules
 Written here before any number was run (the constants below); a claim holds or not by its rule,
 on the ratio of the means over seeds (fault / fault-free), whatever the spread:
 
-- **a robot dies** (trail teams): the team keeps >= :data:`DEATH_KEEP` (50 %, the issue's
-  rule) of its fault-free delivery rate after the death; and, judged separately, >=
-  :data:`DEATH_KEEP_PROPORTIONAL` (75 %: three robots of four still work, so a loss costs no
-  more than the dead robot's own share: Blazing §1 "a supply column robust with respect to loss
-  of individual robots", Try §3.6 "the gradient of the total trip curve decreases as robots
-  fail, as would be expected");
+- **a robot dies** (trail teams): the team keeps >= :data:`DEATH_KEEP` (50 %, our rule, fixed
+  in commit ba13a46, 2026-11-27) of its fault-free delivery rate after the death; and, judged
+  separately, >= :data:`DEATH_KEEP_PROPORTIONAL` (75 %: three robots of four still work, so a
+  loss costs no more than the dead robot's own share: Blazing §1 "a supply column robust with
+  respect to loss of individual robots", Try §3.6 "the gradient of the total trip curve
+  decreases as robots fail, as would be expected");
 - **a helper dies** (LOS help): R1 keeps >= :data:`DEATH_KEEP` of its speed: steps per target
   at most 1 / 0.5 = 2 x the fault-free ones;
 - **a radio blackout**: >= :data:`BLACKOUT_KEEP` (80 %) of the fault-free performance after
@@ -61,7 +61,7 @@ import numpy as np
 from teamnav.experiments.report.model import Comparison, Missing, Plot, SectionSpec, Series, Table, Text
 
 #: a trail team keeps at least this share of its fault-free delivery rate after a robot dies
-#: (issue 20's rule); LOS help: R1 keeps at least this share of its speed when a helper dies
+#: (our rule, commit ba13a46); LOS help: R1 keeps at least this share of its speed when a helper dies
 DEATH_KEEP = 0.5
 #: a trail team of 4 keeps at least this share after one death (3 robots of 4 still work)
 DEATH_KEEP_PROPORTIONAL = 0.75
@@ -203,7 +203,7 @@ def _trails(ctx, sweep: str, system: str, dead: str) -> list:
              _units_curve(free, "fault-free", dur) + _units_curve(death, "one dead at 10 min", dur)
              + _units_curve(black, "blackout 1-10 min", dur)),
         Comparison(f"{system}: the team keeps >= {DEATH_KEEP:.0%} of its delivery rate with one robot of four dead",
-                   "issue 20's rule (the papers: robust to the loss of individual robots)", ours_dead,
+                   "our rule (the papers: robust to the loss of individual robots)", ours_dead,
                    _holds(r_dead, DEATH_KEEP), "the dead robot stays in the corridor: the others must pass it"),
         Comparison(f"{system}: the loss costs no more than the dead robot's share (>= "
                    f"{DEATH_KEEP_PROPORTIONAL:.0%} kept)",
@@ -356,7 +356,7 @@ def _mcl(ctx) -> list:
 # ---------------------------------------------------------------------------- section
 def build(ctx) -> list:
     rules = [
-        ["a trail robot dies", f"units/h after the death >= {DEATH_KEEP:.0%} of fault-free (issue 20); >= "
+        ["a trail robot dies", f"units/h after the death >= {DEATH_KEEP:.0%} of fault-free (ours); >= "
                                f"{DEATH_KEEP_PROPORTIONAL:.0%} (its own share only)", "Blazing §1, Try §3.6"],
         ["a LOS helper dies", f"R1's steps per target <= {1 / DEATH_KEEP:.2g} x fault-free", "Table 1 (help helps)"],
         ["radio blackout", f">= {BLACKOUT_KEEP:.0%} of fault-free performance after it (units/h; speed; runs "
