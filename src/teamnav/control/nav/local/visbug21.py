@@ -455,7 +455,7 @@ class VisBug21(VisBugReference):
         straight wall the target lies a metre or two ahead) and that lies at least one step
         away; None when there is none (the reactive follower steers this step).
 
-        Speed (issue 21 §5): the part after the bearings in one kernel (``_boundary_pick``: it
+        Speed (commit 8e3551b, 2026-11-27): the part after the bearings in one kernel (``_boundary_pick``: it
         stops at the first visible candidate instead of testing all of them), with the arithmetic
         of :meth:`VisBugReference._boundary_target_numpy`; equal bit for bit
         (``tests/test_los_speed_equivalence.py``)."""

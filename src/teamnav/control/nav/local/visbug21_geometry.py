@@ -356,7 +356,7 @@ def _leave_candidates(x, y, pts, cand, t, gx, gy, d_max, mgx, mgy, ux, uy, r_vis
 
 @njit(cache=True)
 def _boundary_pick(x, y, fx, fy, delta, follow_m, step_m, px, py, r_safe, reach_m, slack_rad):
-    """Step 2's boundary target (``boundary_shortcut``) after its bearings (numba): issue 21 §5.
+    """Step 2's boundary target (``boundary_shortcut``) after its bearings (numba; commit 8e3551b, 2026-11-27).
 
     The arithmetic of :meth:`~teamnav.control.nav.local.visbug21_reference.VisBugReference._boundary_target_numpy`
     from its stood-off points on: per followed point ``k`` (``fx``, ``fy``) the chord through its
