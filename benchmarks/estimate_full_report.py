@@ -1,6 +1,6 @@
 """What a full-mode report would cost, section by section, measured on a sample of its trials.
 
-A full ``teamnav report all`` takes hours, so the 30-minute goal of issue 27 cannot be checked
+A full ``teamnav report all`` takes hours, so the goal of a full report in 30 minutes cannot be checked
 by running it after every change. This script builds each section in full mode through a
 report context whose ``sweep`` runs, of each sweep the section asks for, only the first
 ``--seeds-kept`` seeds of every configuration (same scenarios, same durations, same grid and

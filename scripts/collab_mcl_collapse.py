@@ -1,9 +1,9 @@
-"""Why does the paper-rules MCL collapse? One factor at a time, on tuning seeds (issue 26 §2).
+"""Why does the paper-rules MCL collapse? One factor at a time, on tuning seeds.
 
 Fox, Burgard, Kruppa & Thrun (2000) §5.1 / Fig. 10(a): when Marian sees Robin, Robin's belief is
 "centered along the main axis of the corridor", "still highly uncertain about its exact location
 within the corridor and even does not know its global heading direction"; eq. 14 then reweights it.
-In teamnav's ``paper_rules: true`` column (issue 26 §1) Robin's belief is instead 500 samples within
+In teamnav's ``paper_rules: true`` column Robin's belief is instead 500 samples within
 a few decimetres when the tree arrives. This script changes one filter setting at a time on top of
 ``paper_rules: true`` (:data:`FACTORS`) and measures, per run:
 
@@ -17,7 +17,7 @@ a few decimetres when the tree arrives. This script changes one filter setting a
   robots of the first time the error is < 1.5 m, censored at the duration) alone and together.
 
 ``--column teamnav`` runs the scenarios as they are (the report's teamnav column) with the
-variants of :data:`TEAMNAV_CHECKS` instead: issue 26 §3's re-check of the values chosen on report
+variants of :data:`TEAMNAV_CHECKS` instead: a re-check of the values chosen on report
 seeds, on tuning seeds.
 
 Seeds must be tuning seeds (>= 1000, never used by the report; ``claims/collab-mcl.yaml``).
@@ -73,7 +73,7 @@ FACTORS: dict[str, tuple[str, dict, str]] = {
     "ess": ("resample only when ESS < 50 % (teamnav's)", {"resample_ess_fraction": 0.5}, "not the paper (§3.1)"),
 }
 
-#: issue 26 §3: the teamnav column's values chosen on report seeds, and their alternatives.
+#: the teamnav column's values chosen on report seeds, and their alternatives.
 #: name -> (scenario, what it checks, params merged into the given robot groups' params)
 TEAMNAV_CHECKS: dict[str, tuple[str, str, dict[int, dict]]] = {
     "detection": ("collab-mcl-detection", "§5.1 as the scenario is (lost prior 0.3)", {}),
