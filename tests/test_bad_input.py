@@ -1,6 +1,6 @@
 """Bad input: one message, exit 2, the file and field named, no traceback, nothing half-written.
 
-Issue 20 §1. Every case goes through the command line (typer's CliRunner on ``teamnav.cli.app``)
+Every case goes through the command line (typer's CliRunner on ``teamnav.cli.app``)
 and is checked the same way: exit status 2, exactly one ``error:`` message on stderr naming the
 file (and the field where there is one), no traceback and no exception escaping, and no output
 file or folder left behind. The cases:

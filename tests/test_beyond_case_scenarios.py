@@ -1,4 +1,4 @@
-"""The generated ``beyond-*`` scenarios of sweep cases (issue 22, Fox et al. §7.2's future work).
+"""The generated ``beyond-*`` scenarios of sweep cases (Fox et al. §7.2's future work).
 
 Each file must be exactly its sweep case: same resolved configuration (config hash), so
 ``teamnav run`` of the file reproduces a trial of the named sweep. (test_scenarios.py runs every

@@ -1,4 +1,4 @@
-"""Issue 22, combination 3: ``detecting-trails-v1`` (a map-less belief synced on detections) and its belief."""
+"""Beyond the papers, combination 3: ``detecting-trails-v1`` (a map-less belief synced on detections) and its belief."""
 
 from __future__ import annotations
 

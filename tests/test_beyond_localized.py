@@ -1,4 +1,4 @@
-"""Issue 22, combination 1: ``localized-v1`` (MCL pose under any brain) and the beyond section's claim."""
+"""Beyond the papers, combination 1: ``localized-v1`` (MCL pose under any brain) and the beyond section's claim."""
 
 from __future__ import annotations
 

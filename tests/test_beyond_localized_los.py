@@ -1,4 +1,4 @@
-"""Issue 22, combination 2 (localized LOS help): frames from MCL poses, fused frames, and the
+"""Beyond the papers, combination 2 (localized LOS help): frames from MCL poses, fused frames, and the
 paper's bearing rule left as it was (teamnav.papers.beyond.brains.localized_los)."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""N places, a mail round (issue 22; Vaughan et al. 2002 §2.1 and §4 future work): the legs the
+"""N places, a mail round (Vaughan et al. 2002 §2.1 and §4 future work): the legs the
 block counts follow the round as the brain does, the efficiency is the §3.6 measure, bad input is
 named, the scenario's places lie in order on one loop, and the block runs quick and full."""
 

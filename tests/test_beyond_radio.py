@@ -1,4 +1,4 @@
-"""The beyond section's restricted-radio block (issue 22): its sweeps, claims and numbers."""
+"""The beyond section's restricted-radio block: its sweeps, claims and numbers."""
 
 from __future__ import annotations
 

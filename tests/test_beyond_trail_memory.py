@@ -1,4 +1,4 @@
-"""Issue 22, combination 4: ``los-trail-explorer-v1``, R1 with a Trail of its goals' viewpoints
+"""Beyond the papers, combination 4: ``los-trail-explorer-v1``, R1 with a Trail of its goals' viewpoints
 (teamnav.papers.beyond.brains.trail_memory): where crumbs are laid, which one R1 heads for, that
 ``goal_memory: "off"`` is ``los-explorer-v1`` exactly, and that bad values are refused."""
 

@@ -310,8 +310,8 @@ def _hallway_brain(**over) -> MCLWander:
 
 
 def test_a_lost_robots_uniform_belief_is_not_concentrated():
-    """Issue found in session 17: a uniform belief over the connected hallway is one 0.5-m-cell cluster
-    of weight 1, so the weight alone (None, the session 15-16 rule) calls a lost robot sure."""
+    """Found 2026-11-27 (commit 349d51d): a uniform belief over the connected hallway is one 0.5-m-cell cluster
+    of weight 1, so the weight alone (None, the rule before 349d51d) calls a lost robot sure."""
     b = _hallway_brain()
     est = b.mcl.estimate()
     assert est.n_clusters == 1 and est.cluster_weight > 0.99 and est.cluster_spread_m > 5.0

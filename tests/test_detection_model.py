@@ -88,7 +88,7 @@ def test_fit_rejects_malformed_samples():
 
 
 def test_documented_training_command_reproduces_the_shipped_model(tmp_path):
-    """Issue 26 §5: the command in detection_training's docstring, with its defaults, writes the
+    """Commit 882fcf3 (2026-11-27): the command in detection_training's docstring, with its defaults, writes the
     shipped detection-default.json byte for byte (it needed --duration 1200 before)."""
     from teamnav.papers.collab_mcl.brains.localizing import MODEL_DIR
     from teamnav.papers.collab_mcl.detection_training import main

@@ -332,7 +332,7 @@ def test_small_team_kernel_equals_spatial_hash(seed, n, which):
 
 
 def test_occlusion_at_err_max_zero_is_perfect_sensing_and_keeps_the_stream():
-    """Issue 21 §2: Sgorbissa & Arkin's Tables 1-2 are "perfect sensing": the occlusion model at
+    """Commit 7915eb8 (2026-11-27): Sgorbissa & Arkin's Tables 1-2 are "perfect sensing": the occlusion model at
     err_max = 0 returns the exact range and bearing (eq. 2's bearing error only in the noise
     figures, err_max > 0), and draws its uniforms all the same (the same random stream)."""
     xs, ys, th = _ring(200, 3.0)

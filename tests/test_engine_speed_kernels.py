@@ -1,4 +1,4 @@
-"""The one-pass sensing kernel (issue 27 §2) against the former cast -> robot bodies -> noise path.
+"""The one-pass sensing kernel against the former cast -> robot bodies -> noise path.
 
 ``RangeSensor._pass`` casts each robot's rays only up to the nearest other robot's disc met
 first, in one numba loop per robot; everything here checks that it gives the former ranges
@@ -279,7 +279,7 @@ def test_a_far_box_anywhere_reads_only_the_hash_grid(seed, bx, by, side):
 
     Runs the kernel as plain Python (``py_func``), where an index past an array raises:
     compiled, the read past ``start`` was silent or, now and then, a segfault that killed
-    sweep workers (issue 27's "sporadic worker deaths")."""
+    sweep workers (the sporadic worker deaths that da79e90, 2026-11-27, fixed)."""
     rng = np.random.default_rng(seed)
     n_all, all_x, all_y, all_r, angles, plan, hsh = _random_discs_and_fan(rng, seed, 40, 61, 20)
     nb = angles.shape[0]

@@ -1,4 +1,4 @@
-"""teamnav as an environment (issue 23): PettingZoo / Gymnasium conformance, timing, seeding,
+"""teamnav as an environment: PettingZoo / Gymnasium conformance, timing, seeding,
 what agents observe, rewards, recording, batched copies and `teamnav run --controller`.
 
 Every environment here runs a few simulated seconds; the examples' reproduction of the built-in

@@ -1,5 +1,5 @@
 """The environment's observation arrays are the observation objects the engine hands the
-agents' proxies, whichever way they are built (issue 23's speed work).
+agents' proxies, whichever way they are built (commit 31c052f, 2026-11-27).
 
 ``EnvCore.encode`` reads the engine's whole-group arrays (``Simulation.observed``: one copy per
 group and key) when the run has no faults, and the observation objects one robot at a time

@@ -1,4 +1,4 @@
-"""Moving places (issue 22, a moving resource; Vaughan et al. 2000 §6 future work): the motion's
+"""Moving places (a moving resource; Vaughan et al. 2000 §6 future work): the motion's
 interpolation and jumps, its validation, and events fired where the place is now, not where it was."""
 
 from __future__ import annotations

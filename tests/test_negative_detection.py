@@ -1,4 +1,4 @@
-"""Negative detections (Fox et al. §7.2 future work, issue 22): the likelihood over the detector's
+"""Negative detections (Fox et al. §7.2 future work): the likelihood over the detector's
 range, field of view and line of sight, checked against the simulator's own detector, and the
 brain's use of it (broadcast points, the frame rule, the 2.5 m rate rule, the paper's default)."""
 

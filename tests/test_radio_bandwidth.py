@@ -1,4 +1,4 @@
-"""The radio's bandwidth cap (ours, issue 22): a token bucket per sender, over-cap messages dropped
+"""The radio's bandwidth cap (ours): a token bucket per sender, over-cap messages dropped
 at the sender and counted; no cap (the papers' rule) leaves the radio bit-identical."""
 
 from __future__ import annotations

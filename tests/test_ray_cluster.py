@@ -1,4 +1,4 @@
-"""A real two-node Ray cluster on one machine loses a node mid-sweep (issue 27 §4).
+"""A real two-node Ray cluster on one machine loses a node mid-sweep.
 
 ``scripts/ray_cluster.py lost-node`` starts ``ray start --head`` and a second node with
 ``ray start --address``, runs ``teamnav sweep ... --executor ray --address`` on both, and

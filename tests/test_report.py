@@ -231,7 +231,7 @@ def test_a_figure_that_cannot_be_drawn_becomes_a_missing_box(tmp_path, sections)
 
 @pytest.mark.slow
 def test_report_all_quick_has_every_paper_section(tmp_path):
-    """The check of issue 4: `teamnav report all --quick` writes a report in which each of
+    """The whole-report check: `teamnav report all --quick` writes a report in which each of
     the four papers is present, as results or as missing, and no section raised. It runs every
     section's quick sweeps (6-11 min on 2 cores), so it is in the slow set."""
     out = tmp_path / "quick"

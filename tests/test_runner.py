@@ -211,7 +211,7 @@ def test_metric_registry_refuses_duplicates_and_unknown():
 
 def test_run_folder_map_keeps_the_source_maps_thresholds_and_cells(tmp_path):
     """The run folder's map.yaml is written with the thresholds its map file was read with
-    (depot: free_thresh 0.25) and loads back to the same cells (issue 24)."""
+    (depot: free_thresh 0.25) and loads back to the same cells (commit cd4f30d, 2026-11-27)."""
     from teamnav.experiments.runner import run as run_scenario
     from teamnav.experiments.spec import PACKAGE_MAP_DIR, build_grid, load_scenario
     from teamnav.world.mapio import load_map, read_map_yaml

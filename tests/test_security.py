@@ -1,4 +1,4 @@
-"""Security (issue 20 §4): hostile strings from scenario files and run folders never run as
+"""Security: hostile strings from scenario files and run folders never run as
 script in the HTML replay or the report; no pickle is loaded from user files; YAML is only
 ever safe-loaded; nothing listens on a network port.
 

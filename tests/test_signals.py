@@ -1,6 +1,6 @@
 """Kills and signals leave nothing behind; run folders get the user's umask.
 
-Real signals to real ``python -m teamnav`` subprocesses (issue 20 §2):
+Real signals to real ``python -m teamnav`` subprocesses:
 
 - SIGKILL or SIGTERM of a sweep: its worker processes end with it (none is left running,
   reparented to PID 1); SIGTERM stops the pool cleanly and leaves the store consistent.
@@ -8,7 +8,7 @@ Real signals to real ``python -m teamnav`` subprocesses (issue 20 §2):
 - SIGKILL of a run leaves its staging folder; the next run into the same parent folder
   removes it because its owner is dead, and keeps the staging folders of live runs.
 
-And (issue 24) a run folder and its files have the modes the umask asks for, not mkdtemp's
+And (commit c101e89, 2026-11-27) a run folder and its files have the modes the umask asks for, not mkdtemp's
 0700 and mkstemp's 0600.
 
 Processes are followed through ``/proc`` (pid, parent pid, start time), so these tests run on
@@ -236,7 +236,7 @@ def test_a_killed_replacement_puts_the_old_run_folder_back(tmp_path):
     assert (tmp_path / "mine" / "metrics.json").is_file() and not old.exists() and not stale.exists()
 
 
-# ---------------------------------------------------------------------------- modes (issue 24)
+# ---------------------------------------------------------------------------- modes
 _RUN_WITH_UMASK = """
 import os, sys
 os.umask(int(sys.argv[1], 8))

@@ -518,7 +518,7 @@ def test_cli_name_option_names_the_sweep(tmp_path):
 
 
 def test_trials_are_scheduled_longest_first_from_recorded_times_or_robot_steps():
-    """issue 27 §2: the longest expected trials go first (measured wall time of the same
+    """The longest expected trials go first (commit 6dbc5ab, 2026-11-27) (measured wall time of the same
     configuration where the store has one, else robot-steps at the measured rate), ties in the
     sweep's order."""
     from teamnav.experiments.sweep import longest_first

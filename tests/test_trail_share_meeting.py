@@ -1,4 +1,4 @@
-"""Meeting flags of Navigate / trail-share-v1 (all off by default since session 11): gap-fills for robots that
+"""Meeting flags of Navigate / trail-share-v1 (all off by default since dfcab8a, 2026-11-26): gap-fills for robots that
 meet at corners (trail_share module docstring). Hand-made situations: synthetic scans and
 odometry poses fed step by step, the fake Navigate for the brain-level flag."""
 
@@ -204,8 +204,9 @@ def test_meet_guard_starts_when_an_obstacle_appears_ahead():
 
 @pytest.mark.parametrize(("navigate", "expected_s"), [({}, 0.0), ({"give_way_s": 3.0}, 3.0)])
 def test_both_trail_brains_drive_without_give_way_by_default(navigate, expected_s):
-    # Sessions 7-10 turned give_way_s = 3 on for trail-share-v1 only; session 11's lane fix
-    # (box_reach_m = 2.0) made it cost, so both brains drive with the same Navigate again.
+    # ff866a4 (2026-11-23) turned give_way_s = 3 on for trail-share-v1 only; the lane fix of
+    # 8a4187d (box_reach_m = 2.0, 2026-11-26) made it cost, so both brains drive with the same
+    # Navigate again (dfcab8a).
     info = synthetic_infos(1)[0]
     share = TrailShare(TrailShare.Params(navigate=navigate), np.random.default_rng(0), info)
     assert share.nav.params.give_way_s == expected_s
