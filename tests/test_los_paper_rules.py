@@ -18,7 +18,7 @@ BRAINS = (LosExplorerParams, LosHelperParams)
 #: the gap-fills issue 21 §3 names, and the three flags it asks for
 ISSUE_LIST = ("see_past_teammates", "keep_direct_view", "report_margin_steps", "slide_when_blocked",
               "trust_direct_promise", "trouble_helper_towards_goal", "trouble_drop_stalled_helper",
-              "trouble_sighting_at_send", "navigator_params.turn", "relay_hop_limit", "drop_stalled_ghost",
+              "keep_trouble_helper", "navigator_params.turn", "relay_hop_limit", "drop_stalled_ghost",
               "navigator_params.boundary_shortcut")
 
 

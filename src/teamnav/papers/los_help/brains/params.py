@@ -207,6 +207,10 @@ class _CommonParams(BaseModel):
         "via_in_sight": "moot without share_via",
     }
 
+    #: Behaviours of our simulator the paper does not have, fixed in both columns (FIDELITY §1):
+    #: {field: what it removes}; the brains extend it (the ledger's ``artifact-fix`` rows).
+    ARTIFACT_FIXES: ClassVar[dict[str, str]] = {}
+
     @model_validator(mode="before")
     @classmethod
     def _paper_rules(cls, data: Any) -> Any:

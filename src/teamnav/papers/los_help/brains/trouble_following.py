@@ -95,8 +95,12 @@ class _TroubleFollowing:
                     # on to where it was last seen first (see ``trouble_release_to_helper``)
                     self._release_xy, self._release_stall = self._seen_now[tt[0]], 0
                 tt = self._trouble_target = None  # it turned away from the goal: let it go
-        if tt is not None and tt[0] in self._seen_now:
-            tt = self._trouble_target = (tt[0], self._seen_now[tt[0]])
+        # in V(R_i): seen now, or (``trouble_sighting_at_send``) seen at the step it sent the Tr
+        # bit that arrived now; without ``keep_trouble_helper`` (the paper column, §5 rule 3:
+        # R_j in V(R_i)) a helper is followed only while it is in V(R_i) in this sense
+        visible = self._seen_now if p.keep_trouble_helper else seen
+        if tt is not None and tt[0] in visible:
+            tt = self._trouble_target = (tt[0], visible[tt[0]])
         elif tt is None or math.hypot(tt[1][0] - self._pose[0], tt[1][1] - self._pose[1]) <= near:
             helper = choose_helper(True, self._me_xy(), cands)
             tt = self._trouble_target = None if helper is None else (helper, seen[helper])
@@ -105,7 +109,7 @@ class _TroubleFollowing:
                 hist = self._mate_goal_d.get(helper)
                 self._tt_best_d = hist[-1][1] if hist else math.hypot(seen[helper][0] - goal[0],
                                                                       seen[helper][1] - goal[1])
-        if tt is not None and (tt[0] in self._seen_now or p.keep_trouble_helper):
+        if tt is not None and (tt[0] in visible or p.keep_trouble_helper):
             self.mode = "trouble_follow"
             action, towards = self._head_to(tt[1], ("helper", tt[0]), stop_within_m=near, end_margin_m=near)
             if p.trouble_drop_stalled_helper:
