@@ -199,3 +199,68 @@ def test_the_paper_column_follows_a_trouble_helper_only_while_it_is_in_sight(mon
         assert set(modes) == {"own_goal"} and a.direction_rad == pytest.approx(0.0)
     else:
         assert set(modes) == {"trouble_follow"} and a.direction_rad == pytest.approx(math.pi / 2)
+
+
+# ---------------------------------------------------------------------------- the fills' rules
+def test_half_life_rule_takes_the_longest_value_that_finishes_every_tuning_task_and_must_bracket_it():
+    from teamnav.papers.los_help.tasks import HALF_LIFE_GRID, choose_half_life
+
+    grid = HALF_LIFE_GRID
+    # a value fails at its first unfinished task; the longest value finishing all 5 wins
+    got = {4000.0: (0, 1), 2000.0: (2, 3), 1000.0: (0, 1), 500.0: (4, 5), 250.0: (5, 5), 125.0: (5, 5), None: (0, 1)}
+    assert choose_half_life(got, grid) == 250.0
+    with pytest.raises(ValueError, match="extend the grid up"):
+        choose_half_life({h: (5, 5) for h in grid}, grid)
+    with pytest.raises(ValueError, match="extend the grid down"):
+        choose_half_life({**{h: (0, 1) for h in grid}, grid[0]: (5, 5)}, grid)
+    with pytest.raises(ValueError, match="not run"):
+        choose_half_life({250.0: (5, 5), 4000.0: (0, 1)}, grid)
+    with pytest.raises(ValueError, match="no half-life"):
+        choose_half_life({h: (4, 5) for h in grid}, grid)
+    # four of five finished is not "every tuning task"
+    assert choose_half_life({**{h: (0, 1) for h in grid}, 64.0: (5, 5), 125.0: (4, 5), 32.0: (5, 5)}, grid) == 64.0
+
+
+def test_turn_rule_counts_finished_tasks_first_then_steps_then_keeps_left():
+    from teamnav.papers.los_help.tasks import choose_turn
+
+    assert choose_turn({"left": {1: None, 2: 500.0}, "right": {1: 900.0, 2: 800.0}}) == "right"
+    assert choose_turn({"left": {1: 400.0, 2: 500.0}, "right": {1: 300.0, 2: None}}) == "left"
+    assert choose_turn({"left": {1: 400.0, 2: 500.0}, "right": {1: 300.0, 2: 590.0}}) == "right"
+    assert choose_turn({"left": {1: 400.0}, "right": {1: 400.0}}) == "left"
+    with pytest.raises(ValueError, match="both turns"):
+        choose_turn({"left": {1: 1.0}})
+
+
+@pytest.mark.parametrize("navigator", ["visbug21", "avoid_past"])
+def test_the_tuning_sweeps_run_r1_with_the_paper_columns_settings(navigator):
+    """The tuning runs set the paper column's values explicitly (a fill under test cannot ride on
+    ``paper_rules: true``, which refuses a second value): with the rules' own values they are the
+    paper column exactly."""
+    from teamnav.control.nav.local import NAVIGATORS
+    from teamnav.papers.los_help.tasks import paper_column_r1
+
+    sets = paper_column_r1(navigator)
+    params = {k.removeprefix("robots.0.params."): v for k, v in sets.items()}
+    explicit = LosExplorerParams(**params)
+    ruled = LosExplorerParams(paper_rules=True, navigator=navigator)
+    for field in LosExplorerParams.model_fields:
+        if field in ("paper_rules", "navigator_params"):
+            continue
+        assert getattr(explicit, field) == getattr(ruled, field), field
+    nav_cls = NAVIGATORS[navigator].Params
+    a, b = nav_cls(**explicit.navigator_params), nav_cls(**ruled.navigator_params)
+    assert {f: getattr(a, f) for f in nav_cls.model_fields if f != "paper_rules"} == \
+        {f: getattr(b, f) for f in nav_cls.model_fields if f != "paper_rules"}
+
+
+def test_the_tuning_sweeps_use_tuning_tasks_only():
+    from teamnav.experiments.sweep import load_sweep
+    from teamnav.papers.los_help import tasks as L
+
+    for name in ("los-avoid-past-half-life", "los-visbug-turn"):
+        spec = load_sweep(name)
+        assert spec.grid["robots.0.params.targets_xy"] == [L.task_targets_xy("simple", t) for t in L.TUNING_TASKS]
+        assert all(t >= 1001 for t in L.TUNING_TASKS)
+        for case in spec.cases:
+            assert case["robots.1.count"] == case["robots.2.count"] == case["robots.3.count"] == 0
