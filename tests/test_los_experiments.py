@@ -593,16 +593,19 @@ def test_verdict_rules_are_read_from_the_claim_file(monkeypatch):
 def test_verdicts_are_the_paper_as_written_columns_and_the_teamnav_column_says_what_gap_fills_add():
     # the paper-rules runs rise with helpers, the teamnav runs fall: the verdict follows the paper's column
     blocks = S.build(_FakeCtx(quick=False, paper_falling=False))
-    comps = {b.claim: b for b in blocks if isinstance(b, Comparison)}
-    ap = comps["Table 1: Av. Past steps fall as helpers are added (R1, R1,2, R1,2,3, R1,2,3,4)"]
-    assert ap.holds is False
-    assert ap.ours.startswith("paper as written: 502 → 552 → 602 → 652") and "| teamnav: 502 → 252 → 169 → 128" in ap.ours
-    assert "teamnav (our gap-fills): holds" in ap.differs
+    comps = {(b.claim, b.column): b for b in blocks if isinstance(b, Comparison)}
+    assert {b.column for b in blocks if isinstance(b, Comparison)} == {"paper", "teamnav"}
+    key = "Table 1: Av. Past steps fall as helpers are added (R1, R1,2, R1,2,3, R1,2,3,4)"
+    ap, ap_tn = comps[(key, "paper")], comps[(key, "teamnav")]
+    assert ap.holds is False and ap_tn.holds is True
+    assert ap.ours.startswith("502 → 552 → 602 → 652") and ap_tn.ours.startswith("502 → 252 → 169 → 128")
+    assert "the verdict" in ap.differs and "not judged" in ap_tn.differs
     claims = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Claims:")][0]
     row = next(r for r in claims.rows if r[0].startswith("Table 1: Av. Past"))
     assert "(does not hold)" in row[3] and "(holds)" in row[4]
     # and the other way round: a paper column that falls holds whatever teamnav does
-    assert comps["Table 1: the potential field alone fails, and finishes with helpers (state + goal sharing)"].holds is True
+    assert comps[("Table 1: the potential field alone fails, and finishes with helpers (state + goal sharing)",
+                  "paper")].holds is True
 
 
 @needs_brains

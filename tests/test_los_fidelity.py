@@ -264,3 +264,66 @@ def test_the_tuning_sweeps_use_tuning_tasks_only():
         assert all(t >= 1001 for t in L.TUNING_TASKS)
         for case in spec.cases:
             assert case["robots.1.count"] == case["robots.2.count"] == case["robots.3.count"] == 0
+
+
+# ---------------------------------------------------------------------------- the ledger
+def test_every_quote_of_the_ledger_is_the_papers_own_words():
+    from teamnav.papers.los_help.report import _los_ledger as G
+
+    try:
+        text = G._paper_text()
+    except FileNotFoundError:
+        pytest.skip("the paper's text (shared/papers) is not beside this checkout")
+    quotes = [q for _s, q in G.QUOTES.values()] + [q for *_x, q in G.STATED_SETUP]
+    missing = [q for q in quotes if not G.quote_found(q, text)]
+    assert not missing
+    assert not G.quote_found("R_j in V(R_i) when R_i reads its Tr bit", text)  # a paraphrase is caught
+
+
+def test_the_ledger_covers_every_paper_rule_and_artifact_fix_in_the_model_shape():
+    from teamnav.control.nav.local import NAVIGATORS
+    from teamnav.experiments.report.model import LEDGER_SOURCES, Ledger
+    from teamnav.papers.los_help.brains.helper import LosHelperParams
+    from teamnav.papers.los_help.report._los_ledger import ledger_blocks, ledger_rows
+
+    rows = ledger_rows()
+    paper = {r.name.split(" (")[0]: r for r in rows if r.column == "paper"}
+    for key, value in {**LosHelperParams.PAPER_RULES, **LosExplorerParams.PAPER_RULES}.items():
+        assert paper[key].value == value and paper[key].source == "stated" and '"' in paper[key].ref, key
+    for nav, cls in NAVIGATORS.items():
+        for key in cls.Params.PAPER_RULES:
+            assert f"navigator_params.{key}" in paper, (nav, key)
+    assert paper["navigator_params.turn"].source == "fill" and "tuning tasks 1001-1005" in paper["navigator_params.turn"].ref
+    for col in ("paper", "teamnav"):
+        mine = {r.name: r for r in rows if r.column == col}
+        for key in ("drop_unreachable_ghost", "trouble_sighting_at_send", "restart_navigator_on_give_up"):
+            assert mine[key].source == "artifact-fix" and mine[key].value is True, (col, key)
+        assert mine["navigator_params.memory_half_life_steps (avoid_past)"].source == "fill"
+    assert all(r.source in LEDGER_SOURCES for r in rows)
+    blocks = ledger_blocks()
+    assert [type(b) for b in blocks] == [Ledger, Ledger]
+    assert {r.column for r in blocks[0].rows} == {"paper"} and {r.column for r in blocks[1].rows} == {"teamnav"}
+    rec = blocks[0].rows[0].record()
+    assert set(rec) == {"column", "name", "value", "source", "ref"}
+
+
+def test_a_precondition_not_met_reads_so_in_the_paper_column_never_fails(monkeypatch):
+    from teamnav.experiments.claims import load_claims
+    from teamnav.experiments.report.model import Comparison
+    from teamnav.papers.los_help.report import _los_ledger as G
+    from teamnav.papers.los_help.report.section import _preconditions_on
+
+    claims = load_claims("los-help")
+    comps = [Comparison("Table 1: Av. Past steps fall as helpers are added (R1, R1,2)", "554 -> 257", "x", False,
+                        column="paper"),
+             Comparison("Table 1: Av. Past steps fall as helpers are added (R1, R1,2)", "554 -> 257", "x", False,
+                        column="teamnav"),
+             Comparison("Table 1: VisBug steps fall as helpers are added (R1, R1,2)", "840 -> 201", "y", False,
+                        column="paper")]
+    monkeypatch.setitem(G.PRECONDITIONS, "avoid_past", (False, "3 of 5 tasks finished"))
+    monkeypatch.setitem(G.PRECONDITIONS, "visbug21", (True, "5 of 5 tasks finished"))
+    out = _preconditions_on(comps, claims)
+    assert out[0].holds is None and out[0].differs.startswith("precondition not met") and "3 of 5" in out[0].differs
+    assert out[1].holds is False and out[2].holds is False  # teamnav is no verdict; VisBug's precondition holds
+    blocks = G.precondition_blocks()
+    assert [b.holds for b in blocks] == [False, True] and "table1-avoid-past-falls" in blocks[0].claims

@@ -37,8 +37,11 @@ def test_the_issue_list_is_covered_and_the_defaults_are_ours():
         assert fills[name].teamnav_value != fills[name].paper_value, name
     assert fills["navigator_params.turn"].paper_value == "left"
     assert fills["report_margin_steps"].paper_value == 0.0
+    # Avoid-Past's memory lifetime is a fill the same in both columns, not a paper rule
     ap = {g.field: g for g in los_gap_fills(LosExplorerParams, "avoid_past")}
-    assert ap["navigator_params.memory_scope"].paper_value == "robot"
+    assert not any(f.startswith("navigator_params.memory") for f in ap)
+    # the same-step sighting is an artifact fix in both columns, not a paper rule
+    assert "trouble_sighting_at_send" not in fills and LosExplorerParams(paper_rules=True).trouble_sighting_at_send
     # a helper has no explorer-only rule
     assert "trust_direct_promise" not in {g.field for g in los_gap_fills(LosHelperParams, "potential_field")}
 
@@ -64,7 +67,7 @@ def test_paper_rules_sets_every_listed_field_and_the_navigator_as_written(cls, n
     {"relay_hop_limit": True},
     {"navigator": "visbug21", "navigator_params": {"turn": "nearer_end"}},
     {"navigator": "visbug21", "navigator_params": {"paper_rules": False}},
-    {"navigator": "avoid_past", "navigator_params": {"memory_scope": "goal"}},
+    {"keep_trouble_helper": True},
 ])
 def test_a_mix_is_an_error_naming_the_field(kwargs):
     name = next(iter(kwargs.get("navigator_params", kwargs)))

@@ -633,8 +633,10 @@ def test_visbug_boundary_target_is_the_farthest_visible_point_ahead():
 
 
 def test_avoid_past_as_written_keeps_one_memory():
+    """The memory's lifetime is a fill the same in both columns (the paper gives none): paper_rules
+    keeps the default and lets an ablation choose another lifetime."""
     nav = nav_of("avoid_past", {"paper_rules": True})
     assert nav.params.memory_scope == "robot"
-    with pytest.raises(ValueError, match="memory_scope"):
-        nav_of("avoid_past", {"paper_rules": True, "memory_scope": "goal"})
+    assert nav.params.memory_half_life_steps == nav_of("avoid_past").params.memory_half_life_steps
+    assert nav_of("avoid_past", {"paper_rules": True, "memory_scope": "goal"}).params.memory_scope == "goal"
     assert nav_of("potential_field", {"paper_rules": True}).params.paper_rules

@@ -6,8 +6,9 @@ Split from :mod:`.section` (no behaviour change). The rules are read from the cl
 its claim names and calls :func:`~teamnav.experiments.claims.judge`; no threshold lives here.
 
 Two columns (issue 21 §3): the verdicts are computed on each column's rows and merged by
-:func:`column_comparisons`, which keeps the paper-as-written column's verdict (every claim is
-``judged: paper_rules``) and reports the teamnav one beside it. Table 2's verdicts read the mean
+:func:`column_comparisons`, which gives each claim a comparison per column (``column`` of the
+report model): the paper-as-written one is the verdict (every claim is ``judged:
+paper_rules``), the teamnav one stands beside it. Table 2's verdicts read the mean
 over the route plans of :data:`._los_common.ROUTE_PLANS` (issue 21 §4; ``plans`` of
 :func:`table_comparisons`, :func:`_plan_means`).
 """
@@ -339,10 +340,11 @@ COLUMNS = (("paper_rules", "paper as written"), ("teamnav", "teamnav"))
 
 
 def column_comparisons(by_col: dict[str, list[Comparison]]) -> list[Comparison]:
-    """One :class:`Comparison` per claim from the same claims judged on each column's runs
-    (``{"paper_rules": [...], "teamnav": [...]}``, in the same order): the verdict is the
-    paper-as-written column's (every claim of claims/los-help.yaml is ``judged: paper_rules``);
-    "ours" reads both columns, and "differs" says what the teamnav column (our gap-fills) gives.
+    """Each claim judged on both columns' runs (``{"paper_rules": [...], "teamnav": [...]}``, in the
+    same order, from the same calls): for every claim its paper-as-written comparison
+    (``column="paper"``, the verdict: every claim of claims/los-help.yaml is ``judged:
+    paper_rules``), then its teamnav comparison (``column="teamnav"``, what our gap-fills give;
+    not a verdict). Report models and ``report.json`` carry the column of each (FIDELITY §2).
 
     Raises
     ------
@@ -352,14 +354,12 @@ def column_comparisons(by_col: dict[str, list[Comparison]]) -> list[Comparison]:
     pr, tn = by_col["paper_rules"], by_col["teamnav"]
     if [c.claim for c in pr] != [c.claim for c in tn]:
         raise ValueError("the two columns' verdicts name different claims")
-    word = {True: "holds", False: "does not hold", None: "not judged"}
     out = []
     for a, b in zip(pr, tn):
-        ours = a.ours if a.ours == b.ours else f"paper as written: {a.ours} | teamnav: {b.ours}"
-        differs = "; ".join(x for x in (
-            a.differs,
-            f"judged on the paper-as-written column (claims/los-help.yaml); teamnav (our gap-fills): {word[b.holds]}"
-            + (f" ({b.differs})" if b.differs and b.holds is False and b.differs != a.differs else ""),
-        ) if x)
-        out.append(Comparison(a.claim, a.paper, ours, a.holds, differs))
+        out.append(Comparison(a.claim, a.paper, a.ours, a.holds,
+                              "; ".join(x for x in (a.differs, "the verdict (claims/los-help.yaml)") if x),
+                              column="paper"))
+        out.append(Comparison(b.claim, b.paper, b.ours, b.holds,
+                              "; ".join(x for x in (b.differs, "our gap-fills beside the verdict, not judged") if x),
+                              column="teamnav"))
     return out

@@ -388,6 +388,7 @@ def build(ctx) -> list:
         comps += column_comparisons({col: noise_comparisons(m, nmeans[col], alone[col][m], rows[col], record=record[col])
                                      for col in COLS})
     claims = load_claims("los-help")
+    comps = _preconditions_on(comps, claims)
     vals = {col: {cid: v for cid, (v, _j) in record[col].items()} for col in COLS}
     verdicts = {col: {cid: j for cid, (_v, j) in record[col].items()} for col in COLS}
     blocks.append(Table("Claims: the paper, the paper as written, teamnav",
@@ -396,6 +397,10 @@ def build(ctx) -> list:
                         note="verdicts judged on the paper-as-written column (claims/los-help.yaml); the teamnav column "
                              "is what the gap-fills buy; Table 2's claims read the mean over the route plans"
                              + ("; quick mode: indicative only" if quick else "")))
+    from teamnav.papers.los_help.report._los_ledger import ledger_blocks, precondition_blocks
+
+    blocks += ledger_blocks()
+    blocks += precondition_blocks()
     blocks.append(Text("The tables below are the teamnav column's runs (our gap-fills): the ablation, where R1's "
                        "steps and path go, and the traffic."))
     if quick:
@@ -407,7 +412,8 @@ def build(ctx) -> list:
     blocks.append(traffic_block({m: tables["teamnav"][m].get(3, []) for m in maps}))
     if quick:
         note = "quick mode: one target per cell, not 5 tasks of 200; the verdict is indicative only"
-        comps = [Comparison(c.claim, c.paper, c.ours, c.holds, "; ".join(x for x in (c.differs, note) if x))
+        comps = [Comparison(c.claim, c.paper, c.ours, c.holds, "; ".join(x for x in (c.differs, note) if x),
+                            column=c.column)
                  if c.holds is not None else c for c in comps]
     failed = [(s["name"], s["failed"]) for s in getattr(ctx, "sweeps", []) if s.get("failed")]
     if failed:
@@ -418,6 +424,25 @@ def build(ctx) -> list:
         blocks.append(Text(f"Sweeps of this section took {wall:.0f} s of wall time here (trials found in the store "
                            "are reused and cost nothing)."))
     return blocks + comps
+
+
+def _preconditions_on(comps: list[Comparison], claims: Any) -> list[Comparison]:
+    """The paper column's verdicts whose precondition (:data:`._los_ledger.PRECONDITIONS`) did not
+    hold on the tuning tasks read "precondition not met" (FIDELITY §1), never "fails"."""
+    from teamnav.papers.los_help.report._los_ledger import PRECONDITION_CLAIMS, PRECONDITIONS
+
+    title = {c.id: c.title for c in claims.claims}
+    unmet = {title[cid]: PRECONDITIONS[nav][1] for nav, ids in PRECONDITION_CLAIMS.items()
+             if PRECONDITIONS[nav][0] is False for cid in ids if cid in title}
+    out = []
+    for c in comps:
+        why = next((w for t, w in unmet.items() if c.claim.startswith(t)), None)
+        if c.column == "paper" and why is not None:
+            c = Comparison(c.claim, c.paper, c.ours, None,
+                           f"precondition not met (R1 alone on the tuning tasks: {why}); " + c.differs,
+                           column="paper")
+        out.append(c)
+    return out
 
 
 SECTION = SectionSpec(
