@@ -26,7 +26,7 @@ def test_default_memory_is_the_robots_own_decayed_by_the_fill_in_both_columns():
     """The robot's memory, never reset at a goal, decays with the half-life that the fill's rule
     chose on tuning tasks; the paper gives no lifetime, so paper_rules leaves the same value."""
     assert AvoidPastParams().memory_scope == "robot" and AvoidPastParams().memory_radius_m == 3.0
-    assert AvoidPastParams().memory_half_life_steps == 125.0
+    assert AvoidPastParams().memory_half_life_steps == 1000.0  # HALF_LIFE_RULE on tuning tasks 1001-1005
     assert AvoidPastParams(paper_rules=True).memory_half_life_steps == AvoidPastParams().memory_half_life_steps
     assert AvoidPastParams(paper_rules=True).memory_scope == "robot"
     with pytest.raises(ValueError):
