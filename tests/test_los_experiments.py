@@ -768,3 +768,32 @@ def test_table1_trend_fails_when_no_task_is_finished_by_every_team_that_finished
     a[0][1]["metrics"]["los_finished"] = 1
     assert next(x for x in S.table_comparisons("simple", S.table_block("simple", a)[1], a)
                 if "Av. Past" in x.claim).holds is True
+
+
+def test_a_paired_trend_on_fewer_pairs_than_the_claim_file_fixes_is_not_judged(monkeypatch):
+    """FIDELITY §3: ``min_pairs`` of a claim; the two tasks of ``_by_team`` are 2 pairs, fewer than 5."""
+    from teamnav.experiments.claims import load_claims
+    from teamnav.papers.los_help.report import _los_verdicts as V
+
+    cf = load_claims("los-help")
+    by_team = _by_team(True)
+    means = S.table_block("simple", by_team)[1]
+    assert [c.holds for c in S.table_comparisons("simple", means, by_team)][:3] == [True, True, True]
+    five = {c.id: c.model_copy(update={"min_pairs": 5}) for c in cf.claims}
+    monkeypatch.setattr(V, "_claim", lambda cid: five[cid])
+    record: dict = {}
+    comps = S.table_comparisons("simple", means, by_team, record=record)
+    assert [c.holds for c in comps][:3] == [None, None, None]
+    assert comps[1].differs.startswith("not judged (n = 2)")
+    assert record["table1-avoid-past-falls"][1] == (None, "not judged (n = 2)")
+    with pytest.raises(Exception, match="min_pairs"):
+        type(cf.claims[0])(**{**cf.claims[0].model_dump(), "min_pairs": 3})  # fewer than 5 is refused
+
+
+def test_claim_tasks_are_report_tasks_below_the_tuning_range():
+    from teamnav.experiments.claims import load_claims
+
+    c = load_claims("los-help").claims[0]
+    assert type(c)(**{**c.model_dump(), "tasks": "11-20"}).task_list == list(range(11, 21))
+    with pytest.raises(Exception, match="tuning"):
+        type(c)(**{**c.model_dump(), "tasks": "1001-1005"})

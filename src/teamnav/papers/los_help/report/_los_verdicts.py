@@ -135,6 +135,12 @@ def _plan_means(plans: Sequence[dict[int, list[dict]]], nav: str, hs: Sequence[i
     return means, "; ".join(text)
 
 
+def _fewest_pairs(plans: Sequence[dict[int, list[dict]]], nav: str, hs: Sequence[int]) -> int | None:
+    """The fewest tasks paired across the teams ``hs`` in any route plan (None: rows name no tasks)."""
+    ks = [got[1] for p in plans if (got := paired_means(p, nav, hs)) is not None]
+    return min(ks) if ks else None
+
+
 #: the route plans' labels, in the order the section passes them (plan A first: the table's own runs)
 PLAN_LABELS = ("plan A", "plan B", "plan C")
 
@@ -172,12 +178,20 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         elif paired is not None:
             ms, k, n = paired
             note = f" (paired: the {k} of {n} tasks finished with every team that finished one)"
+        pairs = _fewest_pairs(plans, nav, ok_hs) if multi and ok_hs else (paired[1] if paired is not None else None)
         p = [paper[nav][h][0] for h in hs if paper[nav][h] is not None]
         fails_first = not failing or not ok_hs or max(failing) < min(ok_hs)
         cid = f"table{tab}-{nav.replace('_', '-')}-falls"
         plan_gap = multi and bool(ok_hs) and not all(np.isfinite(ms))
         no_common = False
-        if plan_gap:
+        min_pairs = _claim(cid).min_pairs
+        too_few = min_pairs is not None and pairs is not None and 0 < pairs < min_pairs and len(ms) >= 2
+        if too_few:
+            # FIDELITY §3: a paired verdict on fewer pairs than the claim file fixes is no verdict
+            holds = None
+            if record is not None:
+                record[cid] = ({"pairs": float(pairs)}, (None, f"not judged (n = {pairs})"))
+        elif plan_gap:
             # claims/los-help.yaml's plan rule: a plan without a paired mean at a team (it finished no
             # task common to the teams that finished one) makes the trend fail
             holds = _failed(cid, "a route plan has no paired mean at some team", record)
@@ -206,6 +220,7 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         out.append(Comparison(
             f"Table {tab}: {NAV_LABEL[nav]} steps fall as helpers are added ({', '.join(TEAM_LABEL[h] for h in hs)})",
             " → ".join(f"{v:.1f}" for v in p), ours + ratio + note, holds,
+            f"not judged (n = {pairs}): the claim file fixes at least {min_pairs} pairs" if too_few else
             "" if holds or holds is None else
             "a route plan has no paired mean at some team (no task finished by every team that finished one in "
             "that plan), which fails the trend (claims/los-help.yaml)" if plan_gap else
