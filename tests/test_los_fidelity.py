@@ -327,3 +327,14 @@ def test_a_precondition_not_met_reads_so_in_the_paper_column_never_fails(monkeyp
     assert out[1].holds is False and out[2].holds is False  # teamnav is no verdict; VisBug's precondition holds
     blocks = G.precondition_blocks()
     assert [b.holds for b in blocks] == [False, True] and "table1-avoid-past-falls" in blocks[0].claims
+
+
+def test_the_units_note_states_the_budget_relative_to_each_maps_longest_path():
+    from teamnav.papers.los_help import tasks as L
+    from teamnav.papers.los_help.report.section import units_note
+
+    note = units_note()
+    for m in L.MAPS:
+        k = L.budget_over_longest_leg(m)
+        assert 10 < k < 100 and f"({k:.0f} times its longest room-to-room shortest path)" in note
+    assert "never judged" in note and "not measured" in note

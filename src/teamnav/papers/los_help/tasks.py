@@ -431,6 +431,20 @@ def shortest_steps_per_target(map_key: str, task: int, n_targets: int = N_TARGET
     return shortest_steps_for_targets(map_key, task_targets_world(map_key, task, n_targets))
 
 
+def budget_over_longest_leg(map_key: str) -> float:
+    """The step budget per target (:data:`BUDGET_STEPS_PER_TARGET`) as a multiple of the longest
+    shortest path between two room centres of the map, in steps: the budget in units that carry
+    over to another step length or map scale (FIDELITY §3).
+
+    Examples
+    --------
+    >>> 30 < budget_over_longest_leg("simple") < 40
+    True
+    """
+    _names, _pts, between, _start = _room_paths(map_key)
+    return BUDGET_STEPS_PER_TARGET[map_key] / (float(np.max(between)) / STEP_LENGTH_M)
+
+
 def shortest_steps_for_targets(map_key: str, targets_world) -> float:
     """:func:`shortest_steps_per_target` for any sequence of room centres (world [m], shape (n, 2)).
 

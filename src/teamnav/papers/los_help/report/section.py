@@ -322,6 +322,22 @@ COMPLEX_MAP_NOTE = ("Table 2's map is ours. The paper gives no layout for Fig. 1
 COLS = tuple(c for c, _ in COLUMNS)
 
 
+def units_note() -> str:
+    """What carries over from the paper's units to ours (FIDELITY §3), with the budget as a
+    multiple of each map's longest room-to-room path."""
+    budget = " and ".join(f"{L.BUDGET_STEPS_PER_TARGET[m]} steps on {L.MAPS[m]} ({L.budget_over_longest_leg(m):.0f} "
+                          "times its longest room-to-room shortest path)" for m in L.MAPS)
+    return ("Units. The paper gives no robot size, step length, sensing range or map, so its steps and ours are "
+            f"different units (ours: {L.STEP_LENGTH_M} m a step). Every verdict reads a unit-free quantity: the order "
+            "of the mean steps per target as helpers are added (paired by task), the last team over the first beside "
+            "the paper's same ratio, R1 alone finishing or not, the best over the worst algorithm, steps with noise "
+            "over steps without, and the help kept at err_max 0.4 over the help at 0. An absolute comparison (our 545 "
+            "steps per target for R1 alone with Avoid-Past on the tuning tasks against the paper's 554.2) assumes the "
+            "paper's step and map scale were ours, which nothing says; it is shown, never judged. The budget per "
+            f"target is {budget}: a task given up is one where R1 walked that many longest paths without reaching "
+            "one target; whether the verdicts move with the budget was not measured.")
+
+
 def build(ctx) -> list:
     from teamnav.control import registry
     from teamnav.experiments.claims import load_claims
@@ -350,6 +366,7 @@ def build(ctx) -> list:
         "claims/los-help.yaml; the teamnav column says what our gap-fills add. Where the paper gives no rule at "
         "all, both columns use the same value (the second gap-fill table). Measured effects of the gap-fills: "
         + GAP_FILLS_NOTE + " " + FULL_CPU_NOTE)]
+    blocks.append(Text(units_note()))
     blocks += gap_fill_blocks()
     tables: dict[str, dict[str, dict[int, list[dict]]]] = {col: {} for col in COLS}
     comps: list[Comparison] = []
