@@ -102,7 +102,7 @@ def _ghost_behind_a_wall_line(drop: bool, paper_rules: bool = True):
 
 
 def test_a_ghost_visbug_calls_unreachable_freezes_r1_in_the_paper_column_unless_dropped():
-    """The frozen ghost, reproduced with VisBug-21 as the paper column runs it (``turn="left"``,
+    """The frozen ghost, reproduced with VisBug-21 as the paper column runs it (one fixed turn,
     no gap-fill dropping a stalled ghost): VisBug walks round the wall line to the ghost and
     declares it unreachable (Bug2's test); without the fix R1 then stands still for good, the
     ghost kept (§4.2: headed for until reached or replaced). With it the ghost is dropped as a

@@ -35,7 +35,7 @@ def test_the_issue_list_is_covered_and_the_defaults_are_ours():
     for name in ISSUE_LIST:
         assert name in fills, name
         assert fills[name].teamnav_value != fills[name].paper_value, name
-    assert fills["navigator_params.turn"].paper_value == "left"
+    assert fills["navigator_params.turn"].paper_value == "right"  # a fill of the paper column (TURN_RULE)
     assert fills["report_margin_steps"].paper_value == 0.0
     # Avoid-Past's memory lifetime is a fill the same in both columns, not a paper rule
     ap = {g.field: g for g in los_gap_fills(LosExplorerParams, "avoid_past")}

@@ -163,7 +163,7 @@ class _CommonParams(BaseModel):
         ``"fused"`` only: eq. 2's robot size [m]; None: twice the robot's own radius.
     paper_rules : bool
         Every gap-fill of :attr:`PAPER_RULES` at the paper's value, and ``navigator_params``
-        with ``paper_rules: true`` (the navigator's own, e.g. VisBug-21's ``turn="left"``);
+        with ``paper_rules: true`` (the navigator's own, e.g. VisBug-21's ``boundary_shortcut``);
         setting one of them to another value as well is an error
         (:mod:`teamnav.control.paper_rules`). The report's "paper as written" column.
     """

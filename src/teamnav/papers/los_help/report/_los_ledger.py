@@ -170,7 +170,9 @@ def ledger_rows() -> list[LedgerRow]:
 
 
 #: What the fills' rules gave on the tuning tasks (filled in by the commit that ran them).
-TURN_RESULT = "not run yet: left, the value before this rule, stands"
+TURN_RESULT = ("right (2026-11-29, sweep los-visbug-turn, paper column's R1 alone, steps per target on tasks "
+               "1001-1005): left 5/5, 768 / 704 / 671 / 757 / 776 (mean 735); right 5/5, 503 / 537 / 554 / 476 / 513 "
+               "(mean 517): the same count, fewer steps to the right.")
 HALF_LIFE_RESULT = ("1000 steps (2026-11-29, sweep los-avoid-past-half-life, paper column's R1 alone, steps per "
                     "target): 4000 and 2000 fail on task 1001 (58, 57 targets reached); 1000 finishes 5/5 (mean 545); "
                     "an inner point of the grid. Below it 64 finishes 5/5 (mean 341), 32 and 16 fail on task 1001 "
@@ -199,7 +201,8 @@ def ledger_blocks() -> list[Ledger]:
 PRECONDITIONS: dict[str, tuple[bool | None, str]] = {
     "avoid_past": (True, "with the 1000-step half-life (the fill): 5 of 5 tuning tasks finished, 555 / 520 / 546 / "
                          "565 / 538 steps per target, mean 545 (the paper's R1 alone: 554.2 on its own scale)"),
-    "visbug21": (None, "not checked yet"),
+    "visbug21": (True, "with the right turn (the fill): 5 of 5 tuning tasks finished, mean 517 steps per target "
+                       "(the paper's R1 alone: 840.6 on its own scale); left also finished 5 of 5 (mean 735)"),
 }
 #: The claims each precondition carries (claims/los-help.yaml ids).
 PRECONDITION_CLAIMS: dict[str, tuple[str, ...]] = {
