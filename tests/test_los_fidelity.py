@@ -338,3 +338,14 @@ def test_the_units_note_states_the_budget_relative_to_each_maps_longest_path():
         k = L.budget_over_longest_leg(m)
         assert 10 < k < 100 and f"({k:.0f} times its longest room-to-room shortest path)" in note
     assert "never judged" in note and "not measured" in note
+
+
+def test_every_claim_quotes_the_paper_word_for_word():
+    from teamnav.experiments.claims import load_claims
+    from teamnav.papers.los_help.report import _los_ledger as G
+
+    try:
+        text = G._paper_text()
+    except FileNotFoundError:
+        pytest.skip("the paper's text (shared/papers) is not beside this checkout")
+    assert [c.id for c in load_claims("los-help").claims if not G.quote_found(c.statement.quote, text)] == []
