@@ -423,6 +423,24 @@ def test_noise_growth_is_judged_on_the_tasks_finished_at_both_noise_levels():
     assert S.paired_noise(rows, "avoid_past", (0.0, 0.4)) == ([200.0, 150.0], 1)
 
 
+def test_noise_growth_on_fewer_pairs_than_the_claim_file_fixes_is_not_judged(monkeypatch):
+    from teamnav.experiments.claims import load_claims
+    from teamnav.papers.los_help.report import _los_verdicts as V
+
+    cf = load_claims("los-help")
+    five = {c.id: c.model_copy(update={"min_pairs": 5}) for c in cf.claims}
+    monkeypatch.setattr(V, "_claim", lambda cid: five[cid])
+    alone = {"avoid_past": 900.0}
+    rows = [_row("avoid_past", s, **{S.ERR_KEY: e, S.TARGETS_KEY: [[float(t), 0.0]] * 20})
+            for t in range(4) for e, s in ((0.0, 200 + t), (0.4, 300 + t))]
+    _plot, means = S.noise_plot("simple", rows, alone)
+    grow = S.noise_comparisons("simple", means, alone, rows)[0]
+    assert grow.holds is None and grow.differs.startswith("not judged (n = 4)")
+    rows += [_row("avoid_past", s, **{S.ERR_KEY: e, S.TARGETS_KEY: [[9.0, 0.0]] * 20}) for e, s in ((0.0, 200), (0.4, 300))]
+    _plot, means = S.noise_plot("simple", rows, alone)
+    assert S.noise_comparisons("simple", means, alone, rows)[0].holds is True  # 5 pairs: judged
+
+
 class _FakeCtx:
     """A ctx whose sweeps return hand-made rows (no simulation); ``paper_falling``: whether the
     paper-rules column's table rows fall with helpers (the teamnav column's always do)."""

@@ -309,22 +309,32 @@ def noise_comparisons(map_key: str, means: dict[str, dict[float, float]], alone:
     (:func:`paired_noise`); ``record`` as in :func:`table_comparisons`."""
     out: list[Comparison] = []
     fig = 16 if map_key == "simple" else 17
-    grow, text = [], []
+    grow, text, pairs = [], [], []
     for nav, per in means.items():
         if 0.0 in per and 0.4 in per and np.isfinite(per[0.0]) and np.isfinite(per[0.4]):
             pn = paired_noise(rows, nav, (0.0, 0.4)) if rows else None
             if pn is not None and pn[1] > 0:
                 (a, b), k = pn
+                pairs.append(k)
                 grow.append(b - a)
                 text.append(f"{NAV_LABEL[nav]} {a:.0f} → {b:.0f} (paired, {k} tasks)")
             else:
                 grow.append(per[0.4] - per[0.0])
                 text.append(f"{NAV_LABEL[nav]} {per[0.0]:.0f} → {per[0.4]:.0f}")
-    gholds = _judged(f"fig{fig}-noise-grows", {"min_growth": min(grow) if grow else math.nan}, record) if grow else None
+    min_pairs = _claim(f"fig{fig}-noise-grows").min_pairs
+    few = min(pairs) if pairs and min_pairs is not None and min(pairs) < min_pairs else None
+    if few is not None:
+        # FIDELITY §3: fewer pairs than the claim file fixes is no verdict
+        gholds = None
+        if record is not None:
+            record[f"fig{fig}-noise-grows"] = ({"pairs": float(few)}, (None, f"not judged (n = {few})"))
+    else:
+        gholds = _judged(f"fig{fig}-noise-grows", {"min_growth": min(grow) if grow else math.nan}, record) if grow else None
     out.append(Comparison(f"Fig. {fig}: steps grow with err_max (0 → 0.4), R2..R4 present",
                           "performance decreases for every algorithm as err_max grows",
                           "; ".join(text) or "not run", gholds,
-                          "" if (not grow or gholds) else "some algorithms did not get slower with noise"))
+                          f"not judged (n = {few}): the claim file fixes at least {min_pairs} pairs" if few is not None
+                          else "" if (not grow or gholds) else "some algorithms did not get slower with noise"))
     navs = [n for n in means if n in alone and np.isfinite(alone[n]) and 0.4 in means[n]]
     if map_key == "simple":
         below = [means[n][0.4] / alone[n] for n in navs]
