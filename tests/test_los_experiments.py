@@ -324,6 +324,20 @@ def test_legs_split_r1s_steps_into_leaving_corridor_wrong_rooms_and_entering():
 
 
 # ---------------------------------------------------------------------------- section verdicts
+@pytest.fixture(autouse=True)
+def _no_min_pairs(monkeypatch):
+    """The verdicts' mechanics are tested on hand-made rows of 2-4 tasks: fewer than the claim
+    file's ``min_pairs`` (5, for the judged tasks 11-20), which would make every paired verdict
+    "not judged"; the pairs rule has its own tests, which set it back."""
+    from teamnav.experiments.claims import load_claims
+    from teamnav.papers.los_help.report import _los_verdicts as V
+
+    cf = load_claims("los-help")
+    free = {c.id: c.model_copy(update={"min_pairs": None}) for c in cf.claims}
+    monkeypatch.setattr(V, "_claim", lambda cid: free[cid])
+    return free
+
+
 def _row(nav, steps, finished=1, **params):
     return {"status": "ok", "params": {S.NAV_KEY: nav, S.TARGETS_KEY: [[1.0, 2.0]] * 20, **params},
             "metrics": {"los_steps": 10 * steps, "los_steps_per_target": steps, "los_finished": finished,
@@ -599,9 +613,10 @@ def test_verdict_rules_are_read_from_the_claim_file(monkeypatch):
     by_team = _by_team(True)
     means = S.table_block("simple", by_team)[1]
     assert [c.holds for c in S.table_comparisons("simple", means, by_team)][:3] == [True, True, True]
-    strict = cf["table1-visbug21-falls"].model_copy(update={"rule": [
+    strict = cf["table1-visbug21-falls"].model_copy(update={"min_pairs": None, "rule": [
         cf["table1-visbug21-falls"].rule[0].model_copy(update={"threshold": -1e6})]})
-    monkeypatch.setattr(V, "_claim", lambda cid: strict if cid == "table1-visbug21-falls" else cf[cid])
+    monkeypatch.setattr(V, "_claim", lambda cid: strict if cid == "table1-visbug21-falls"
+                        else cf[cid].model_copy(update={"min_pairs": None}))
     comps = S.table_comparisons("simple", means, by_team)
     assert [c.holds for c in comps][:3] == [True, True, False]
 
@@ -739,8 +754,11 @@ def test_table2_claims_are_judged_on_the_mean_over_route_plans_fixed_before_the_
     t2 = [c for c in cf.claims if c.id.startswith("table2-")]
     assert len(t2) == 5
     for c in t2:
-        last = c.history[-1]
-        assert "route plans" in last.change and last.before_data and "route plans" in c.note
+        plans = [h for h in c.history if "route plans" in h.change]
+        assert plans and plans[-1].before_data and "route plans" in c.note
+    # every claim is judged on tasks no run had touched, written before their first run
+    for c in cf.claims:
+        assert c.task_list == list(range(11, 21)) and c.history[-1].before_data and "11-20" in c.history[-1].change
 
 
 def test_noise_table_pairs_each_algorithms_rows_across_columns_when_one_column_lacks_an_algorithm():
