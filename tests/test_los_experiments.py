@@ -241,7 +241,7 @@ def test_sweeps_grid_what_the_paper_varies():
 
     t1 = load_sweep("los-table1")
     # the paper's nested teams (R1; R1,2; R1..3; R1..4) x 3 algorithms x 5 tasks
-    assert t1.n_trials == 3 * 4 * L.N_TASKS and not t1.set and list(t1.grid) == [S.TARGETS_KEY]
+    assert t1.n_trials == 3 * 4 * len(L.JUDGED_TASKS) and not t1.set and list(t1.grid) == [S.TARGETS_KEY]
     # §6: the potential field with state + goal sharing, Avoid-Past and VisBug with goal sharing only
     ties = {c[S.NAV_KEY]: c[S.STATE_KEY] for c in t1.cases}
     assert ties == {"potential_field": True, "avoid_past": False, "visbug21": False}
@@ -253,13 +253,13 @@ def test_sweeps_grid_what_the_paper_varies():
     # the R1+R2 team's R2 walks both sides of office_simple's corridor, on the complex map no change
     assert "robots.1.params.patrol_xy" in [c for c in t1.cases if c["case"] == "visbug21/R1-2"][0]
     assert not any("robots.1.params.patrol_xy" in c for c in load_sweep("los-table2").cases)
-    assert t1.grid["robots.0.params.targets_xy"][4] == L.task_targets_xy("simple", 5)
+    assert t1.grid["robots.0.params.targets_xy"][4] == L.task_targets_xy("simple", L.JUDGED_TASKS[4])
     from teamnav.experiments.sweep import sweep_names
 
     assert not [n for n in sweep_names() if n.startswith("los-") and n.endswith("-pf")]  # folded into cases
     noise = load_sweep("los-noise-complex")
     assert noise.grid[S.ERR_KEY] == list(L.ERR_MAX) and noise.scenario == "los-help-complex"
-    assert load_sweep("los-ablation").n_trials == 3 * 4 * L.N_TASKS
+    assert load_sweep("los-ablation").n_trials == 3 * 4 * len(L.JUDGED_TASKS)
 
 
 # ---------------------------------------------------------------------------- metrics

@@ -349,3 +349,21 @@ def test_every_claim_quotes_the_paper_word_for_word():
     except FileNotFoundError:
         pytest.skip("the paper's text (shared/papers) is not beside this checkout")
     assert [c.id for c in load_claims("los-help").claims if not G.quote_found(c.statement.quote, text)] == []
+
+
+def test_full_mode_runs_the_claim_files_judged_tasks_and_quick_mode_none_of_them():
+    from teamnav.experiments.claims import load_claims
+    from teamnav.experiments.sweep import load_sweep
+    from teamnav.papers.los_help import tasks as L
+    from teamnav.papers.los_help.report import section as S
+
+    judged = {t for c in load_claims("los-help").claims for t in c.task_list}
+    assert judged == set(L.JUDGED_TASKS) and not judged & set(L.OLD_TASKS) and not judged & set(L.TUNING_TASKS)
+    for m in L.MAPS:
+        want = [L.task_targets_xy(m, t) for t in L.JUDGED_TASKS]
+        assert S._tasks(m, quick=False) == want
+        assert S._tasks(m, quick=True) == [L.task_targets_xy(m, 1, S.QUICK_TARGETS)]
+    for name in ("los-table1", "los-table2", "los-noise-simple", "los-noise-complex", "los-ablation"):
+        grid = load_sweep(name).grid[S.TARGETS_KEY]
+        m = "complex" if "table2" in name or "complex" in name else "simple"
+        assert grid == [L.task_targets_xy(m, t) for t in L.JUDGED_TASKS], name

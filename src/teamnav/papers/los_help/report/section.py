@@ -57,7 +57,10 @@ Budget: R1 abandons its task when a target is not reached within
 complex); the run then ends and counts as failed (not in the means). A trapped run so ends
 at its first trap instead of burning a whole task's budget.
 
-Running it: ``teamnav report los-help --out DIR`` (full) runs, per column, 2 x 60 table trials
+Running it: ``teamnav report los-help --out DIR`` (full) runs the judged tasks 11-20 of the claim
+file (:data:`~teamnav.papers.los_help.tasks.JUDGED_TASKS`): 1410 trials, twice the counts below,
+which are those of the first full run on tasks 1-5 (:data:`FULL_CPU_NOTE` has its cost and the
+estimate for the judged tasks). Per column, on 5 tasks, 2 x 60 table trials
 (3 algorithms x 4 teams x 5 tasks; ``teamnav sweep los-table1 --out DIR`` runs the same 60), 2 x 45
 route-plan trials (plans B and C, teams R1,2..R1..R4) and 2 x 60 noise trials (err_max 0.1-0.4:
 err_max 0 is the tables' R1..R4 run, read from its rows), and 45 ablation trials (teamnav only;
@@ -107,8 +110,14 @@ NOISE_SWEEP = {"simple": "los-noise-simple", "complex": "los-noise-complex"}
 
 
 # ---------------------------------------------------------------------------- sweeps
-#: What the full reproduction costs on this machine (measured, see the note's numbers).
-FULL_CPU_NOTE = ("Cost of the full reproduction here, measured (2026-11-27, session 16, this 2-core machine): "
+#: What the full reproduction costs on this machine: the first full run's measurement (tasks 1-5) and the
+#: estimate for the judged tasks 11-20 (not run when this was written).
+FULL_CPU_NOTE = ("Cost of the full reproduction on the judged tasks 11-20, estimated (2026-11-29, not run): 1410 "
+                 "trials (benchmarks/los_cost_breakdown.py --list: twice the 705 of tasks 1-5), about 8 CPU-hours "
+                 "(6.7 to 9.5: twice the first full run's 3.33, with the paper column's trials now as long as "
+                 "teamnav's, since fewer give up at their first trap, and Avoid-Past's 1000-step memory slower "
+                 "alone than the 125-step one was), about 4 hours of wall time on 2 workers. "
+                 "Cost of the first full reproduction here, measured on tasks 1-5 (2026-11-27, this 2-core machine): "
                  "`teamnav report los-help -j 2` ran the section's 705 trials (two columns, Table 2 over three route "
                  "plans; the noise figures' err_max 0 and three ablation columns are the tables' own runs, read from "
                  "their rows) in 6084 s of wall time, 45.7 M simulated steps and 3.33 CPU-hours summed over the trials, "
@@ -164,7 +173,8 @@ def _n_targets(quick: bool) -> int:
 
 def _tasks(map_key: str, quick: bool) -> list[list[list[float]]]:
     n = _n_targets(quick)
-    return [L.task_targets_xy(map_key, t, n) for t in ([1] if quick else range(1, L.N_TASKS + 1))]
+    # quick mode: old task 1 (CI touches no judged task); full mode: the judged tasks of the claim file
+    return [L.task_targets_xy(map_key, t, n) for t in ([1] if quick else L.JUDGED_TASKS)]
 
 
 def _budget_s(map_key: str, quick: bool) -> float:
@@ -349,8 +359,12 @@ def build(ctx) -> list:
         return [Missing(f"runs of {', '.join(lacking)}", "the brain is not registered yet (teamnav.control.registry)")]
     quick = bool(ctx.quick)
     blocks: list = [Text(
-        f"R1 reaches {_n_targets(quick)} room-centre targets in sequence ({1 if quick else L.N_TASKS} task(s) per cell; "
-        f"the paper: 5 tasks of 200) with a fixed step of {L.STEP_LENGTH_M} m, so steps measure path length. "
+        f"R1 reaches {_n_targets(quick)} room-centre targets in sequence ("
+        + ("1 task per cell: old task 1, never judged" if quick else
+           f"the judged tasks {L.JUDGED_TASKS[0]}-{L.JUDGED_TASKS[-1]} per cell, named in claims/los-help.yaml before "
+           "any run touched them; the tables of tasks 1-5, looked at many times, are the earlier, labelled ones of "
+           "docs/report/los-help.md")
+        + f"; the paper: 5 tasks of 200) with a fixed step of {L.STEP_LENGTH_M} m, so steps measure path length. "
         "Helpers R2..R4 patrol the corridors end to end (on office_simple R2 steps into every south door and R3 "
         "into every north door on its way, so that a robot trapped in a room sees a teammate, §5; R2 alone steps "
         "into the doors on both sides); "
