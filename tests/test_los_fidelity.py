@@ -299,6 +299,7 @@ def test_the_ledger_covers_every_paper_rule_and_artifact_fix_in_the_model_shape(
         for key in ("drop_unreachable_ghost", "trouble_sighting_at_send", "restart_navigator_on_give_up"):
             assert mine[key].source == "artifact-fix" and mine[key].value is True, (col, key)
         assert mine["navigator_params.memory_half_life_steps (avoid_past)"].source == "fill"
+        assert mine["Avoid-Past memory, lifelong (ablation row)"].source == "literal-ablation"
     assert all(r.source in LEDGER_SOURCES for r in rows)
     blocks = ledger_blocks()
     assert [type(b) for b in blocks] == [Ledger, Ledger]
@@ -367,3 +368,17 @@ def test_full_mode_runs_the_claim_files_judged_tasks_and_quick_mode_none_of_them
         grid = load_sweep(name).grid[S.TARGETS_KEY]
         m = "complex" if "table2" in name or "complex" in name else "simple"
         assert grid == [L.task_targets_xy(m, t) for t in L.JUDGED_TASKS], name
+
+
+def test_the_memory_readings_stand_side_by_side_and_the_fill_is_the_longest_that_finished_all():
+    from teamnav.papers.los_help.report._los_ledger import MEMORY_READINGS, memory_readings_block
+    from teamnav.papers.los_help.tasks import choose_half_life
+
+    got = {}
+    for name, fin, _steps, _where in MEMORY_READINGS:
+        if name.startswith("half-life"):
+            k, n = map(int, fin.split("/"))
+            got[float(name.split()[1])] = (k, n)
+    assert choose_half_life(got) == 1000.0  # the printed readings give the printed fill
+    assert {r[0].split(" (")[0] for r in MEMORY_READINGS} >= {"lifelong", "reset per goal"}
+    assert memory_readings_block().columns[0] == "reading"

@@ -155,6 +155,13 @@ def ledger_rows() -> list[LedgerRow]:
         rows.append(LedgerRow(col, "navigator_params.memory_half_life_steps (avoid_past)",
                               NAVIGATORS["avoid_past"].Params.model_fields["memory_half_life_steps"].default, "fill",
                               L.HALF_LIFE_RULE + " Result: " + HALF_LIFE_RESULT))
+        rows.append(LedgerRow(col, "Avoid-Past memory, lifelong (ablation row)", "no decay, never reset",
+                              "literal-ablation",
+                              'the literal reading of Sgorbissa & Arkin §6 ("a potential field algorithm to which the '
+                              'Avoid Past schema [17] has been added"): it contradicts the paper\'s own Table 1 (R1 '
+                              "alone finishes, 554.2 steps): on the tuning tasks R1 alone fails task 1001 (25 targets "
+                              "reached); the reset-per-goal reading fails task 1002 (20 targets). An ablation row "
+                              "(MEMORY_READINGS), never the judged one"))
         for key, why in kept.items():
             if key in ("max_steps_per_target", "patrol_xy"):
                 continue  # the set-up rows below give the scenario's values
@@ -220,3 +227,33 @@ def precondition_blocks() -> list[Precondition]:
     return [Precondition(f"R1 alone finishes its tasks with {label[nav]} in the paper column (§6, Table 1)",
                          seeds, result, holds, PRECONDITION_CLAIMS[nav])
             for nav, (holds, result) in PRECONDITIONS.items()]
+
+
+#: Avoid-Past's memory readings side by side, R1 alone with the paper column's settings on the
+#: tuning tasks (sweep los-avoid-past-half-life, 2026-11-29): (reading, tasks finished / run,
+#: steps per target of the tasks run, targets reached where one was not finished). A reading fails
+#: at its first task not finished (the rule's order), so "0/1" ran one task.
+MEMORY_READINGS: tuple[tuple[str, str, str, str], ...] = (
+    ("lifelong (the literal reading)", "0/1", "1354", "25 of 200 on task 1001"),
+    ("reset per goal (2026-11 sessions 6-13)", "1/2", "221, 483", "20 of 200 on task 1002"),
+    ("half-life 4000 steps", "0/1", "798", "58 of 200 on task 1001"),
+    ("half-life 2000 steps", "0/1", "692", "57 of 200 on task 1001"),
+    ("half-life 1000 steps (the fill)", "5/5", "555, 520, 546, 565, 538", ""),
+    ("half-life 64 steps", "5/5", "342, 320, 351, 342, 350", ""),
+    ("half-life 32 steps", "0/1", "566", "95 of 200 on task 1001"),
+    ("half-life 16 steps", "0/1", "666", "11 of 200 on task 1001"),
+)
+
+
+def memory_readings_block():
+    """The readings of Avoid-Past's memory lifetime as ablation rows (tuning tasks, R1 alone)."""
+    from teamnav.experiments.report.model import Table
+
+    return Table("Avoid-Past's memory lifetime: the readings side by side (R1 alone, paper column, tuning tasks "
+                 "1001-1005, office_simple)",
+                 ["reading", "tasks finished", "steps per target", "where it stopped"],
+                 [list(r) for r in MEMORY_READINGS],
+                 "The paper gives no lifetime; the fill is the longest half-life with which R1 alone finishes every "
+                 "tuning task (the paper's precondition). A very short memory degenerates to the plain potential "
+                 "field (trapped in its first local minimum). 125-500 were not run: the rule needs only the values "
+                 "above its choice. With helpers these readings were not run.")

@@ -148,10 +148,11 @@ GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on t
                   "candidate at the spot R1 saw it (trouble_sighting_at_send; the radio's one-step delay had hidden "
                   "teammates seen through a door for one step): potential field, 40-target prefixes of tasks 1-10, "
                   "office_complex tasks finished R1,2 / R1..3 / R1..4 from 0 / 1 / 4 to 4 / 4 / 5 of 10. "
-                  "Avoid-Past's memory is the robot's, lifelong and undecayed, as the paper and Balch & Arkin "
-                  "describe it (AvoidPastParams.memory_scope='robot', the default since issue 21 §1; sessions 6-13 "
+                  "Avoid-Past's memory is the robot's (AvoidPastParams.memory_scope='robot'; sessions 6-13 "
                   "forgot it at each own goal, after a lifelong memory saturated the push at the old 1500-step "
-                  "budget: R1 alone finished no 40-target task then). "
+                  "budget), and decays with a 1000-step half-life in both columns: the paper gives no lifetime, so "
+                  "it is a fill chosen on tuning tasks by the paper's precondition that R1 alone finishes (see the "
+                  "ledger). "
                   "In trouble, the last seen position of a helper now out of sight is given up after 500 steps "
                   "without getting closer (trouble_drop_stalled_helper; R1 had stood 5800 steps against a wall "
                   "below it): office_simple, potential field, 200-target tasks finished with R1..3 3/5 -> 5/5, "
@@ -428,10 +429,11 @@ def build(ctx) -> list:
                         note="verdicts judged on the paper-as-written column (claims/los-help.yaml); the teamnav column "
                              "is what the gap-fills buy; Table 2's claims read the mean over the route plans"
                              + ("; quick mode: indicative only" if quick else "")))
-    from teamnav.papers.los_help.report._los_ledger import ledger_blocks, precondition_blocks
+    from teamnav.papers.los_help.report._los_ledger import ledger_blocks, memory_readings_block, precondition_blocks
 
     blocks += ledger_blocks()
     blocks += precondition_blocks()
+    blocks.append(memory_readings_block())
     blocks.append(Text("The tables below are the teamnav column's runs (our gap-fills): the ablation, where R1's "
                        "steps and path go, and the traffic."))
     if quick:
