@@ -10,11 +10,13 @@ gap-fills around that rule, each a field of
 :class:`~.explorer_params.LosExplorerParams` documented there with what was measured:
 
 - which teammate qualifies: one whose Tr bit arrived and that R1 saw when it was sent
-  (``trouble_sighting_at_send``), not one walking away from R1's goal
+  (``trouble_sighting_at_send``, an artifact fix of our radio's one-step delay, in both
+  columns), not one walking away from R1's goal
   (``trouble_helper_towards_goal``, :meth:`_TroubleFollowing._watch_mates` keeps the teammates'
   distances to it);
 - what R1 does when it goes out of sight: head on to its last seen position
-  (``keep_trouble_helper``), given up when R1 does not close in on it
+  (``keep_trouble_helper``, teamnav only: the paper column follows a teammate only while it is
+  in V(R_i), §5 rule 3), given up when R1 does not close in on it
   (``trouble_drop_stalled_helper``);
 - what counts as progress while following it (``trouble_progress``, ``trouble_near_helper_m``);
 - where R1 goes when nobody is in sight (``trouble_return``) and when a followed teammate is let
@@ -73,9 +75,9 @@ class _TroubleFollowing:
         p = self.params
         action: Action | None = None
         # §5 rule 3: in trouble, a teammate in sight that is not becomes the temporary goal
-        # "until it realizes it is no longer in trouble or ... perceives its own goal": kept
-        # (at its last seen position) when it goes out of sight (gap filled; the paper
-        # names only these two ends)
+        # "until it realizes it is no longer in trouble or ... perceives its own goal"; with
+        # ``keep_trouble_helper`` (teamnav's gap-fill) kept at its last seen position when it
+        # goes out of sight, without it (the paper column) followed only while in V(R_i)
         near = 2.0 * self.radius_m + self.step_m
         seen = self._seen_now
         if p.trouble_sighting_at_send:
