@@ -18,7 +18,7 @@ BRAINS = (LosExplorerParams, LosHelperParams)
 #: the gap-fills issue 21 §3 names, and the three flags it asks for
 ISSUE_LIST = ("see_past_teammates", "keep_direct_view", "report_margin_steps", "slide_when_blocked",
               "trust_direct_promise", "trouble_helper_towards_goal", "trouble_drop_stalled_helper",
-              "trouble_sighting_at_send", "navigator_params.turn", "relay_hop_limit", "drop_stalled_ghost",
+              "keep_trouble_helper", "navigator_params.turn", "relay_hop_limit", "drop_stalled_ghost",
               "navigator_params.boundary_shortcut")
 
 
@@ -35,10 +35,13 @@ def test_the_issue_list_is_covered_and_the_defaults_are_ours():
     for name in ISSUE_LIST:
         assert name in fills, name
         assert fills[name].teamnav_value != fills[name].paper_value, name
-    assert fills["navigator_params.turn"].paper_value == "left"
+    assert fills["navigator_params.turn"].paper_value == "right"  # a fill of the paper column (TURN_RULE)
     assert fills["report_margin_steps"].paper_value == 0.0
+    # Avoid-Past's memory lifetime is a fill the same in both columns, not a paper rule
     ap = {g.field: g for g in los_gap_fills(LosExplorerParams, "avoid_past")}
-    assert ap["navigator_params.memory_scope"].paper_value == "robot"
+    assert not any(f.startswith("navigator_params.memory") for f in ap)
+    # the same-step sighting is an artifact fix in both columns, not a paper rule
+    assert "trouble_sighting_at_send" not in fills and LosExplorerParams(paper_rules=True).trouble_sighting_at_send
     # a helper has no explorer-only rule
     assert "trust_direct_promise" not in {g.field for g in los_gap_fills(LosHelperParams, "potential_field")}
 
@@ -64,7 +67,7 @@ def test_paper_rules_sets_every_listed_field_and_the_navigator_as_written(cls, n
     {"relay_hop_limit": True},
     {"navigator": "visbug21", "navigator_params": {"turn": "nearer_end"}},
     {"navigator": "visbug21", "navigator_params": {"paper_rules": False}},
-    {"navigator": "avoid_past", "navigator_params": {"memory_scope": "goal"}},
+    {"keep_trouble_helper": True},
 ])
 def test_a_mix_is_an_error_naming_the_field(kwargs):
     name = next(iter(kwargs.get("navigator_params", kwargs)))

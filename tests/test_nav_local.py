@@ -606,16 +606,17 @@ def test_visbug_resumes_with_step1_when_the_excursion_left_the_boundary_far_behi
 
 # ---------------------------------------------------------------------------- paper rules (issue 21 §3)
 def test_visbug_as_written_reaches_the_goal_behind_the_u_cutting_across_the_boundary():
-    """``paper_rules``: turn left, and Step 2's Ti may be the farthest visible boundary point
-    (``boundary_shortcut``): Bug2 still arrives, on the left side, no slower than the follower."""
-    follower = Loop(u_trap(), nav_of("visbug21", {"turn": "left"}), U_START, U_GOAL)
+    """``paper_rules``: one fixed turn (right, the paper column's fill chosen on tuning tasks), and
+    Step 2's Ti may be the farthest visible boundary point (``boundary_shortcut``): Bug2 still
+    arrives, on the right side, no slower than the follower."""
+    follower = Loop(u_trap(), nav_of("visbug21", {"turn": "right"}), U_START, U_GOAL)
     base = follower.run(600)
     nav = nav_of("visbug21", {"paper_rules": True})
-    assert nav.params.turn == "left" and nav.params.boundary_shortcut
+    assert nav.params.turn == "right" and nav.params.boundary_shortcut
     loop = Loop(u_trap(), nav, U_START, U_GOAL)
     steps = loop.run(600)
     assert steps is not None and base is not None and loop.stalls == 0
-    assert min(p[0] for p in loop.path) < 3.3  # round the cup's west side
+    assert max(p[0] for p in loop.path) > 8.7  # round the cup's east side
     assert steps <= base
 
 
@@ -633,8 +634,10 @@ def test_visbug_boundary_target_is_the_farthest_visible_point_ahead():
 
 
 def test_avoid_past_as_written_keeps_one_memory():
+    """The memory's lifetime is a fill the same in both columns (the paper gives none): paper_rules
+    keeps the default and lets an ablation choose another lifetime."""
     nav = nav_of("avoid_past", {"paper_rules": True})
     assert nav.params.memory_scope == "robot"
-    with pytest.raises(ValueError, match="memory_scope"):
-        nav_of("avoid_past", {"paper_rules": True, "memory_scope": "goal"})
+    assert nav.params.memory_half_life_steps == nav_of("avoid_past").params.memory_half_life_steps
+    assert nav_of("avoid_past", {"paper_rules": True, "memory_scope": "goal"}).params.memory_scope == "goal"
     assert nav_of("potential_field", {"paper_rules": True}).params.paper_rules

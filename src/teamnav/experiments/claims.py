@@ -127,8 +127,13 @@ class Claim(BaseModel):
     judged: Literal["paper_rules", "teamnav"]
     history: list[HistoryEntry] = Field(min_length=1)
     note: str = ""
+    #: For sections whose runs vary a task, not a seed (line-of-sight help): the judged task
+    #: numbers, "a-b" or "a,b,c", below TUNING_SEED_MIN like seeds (FIDELITY §3); None: seeds only.
+    tasks: str | None = None
+    #: A paired verdict's fewest pairs (FIDELITY §3, at least 5); fewer read "not judged (n = k)".
+    min_pairs: int | None = Field(None, ge=5)
 
-    @field_validator("seeds", "quick_seeds")
+    @field_validator("seeds", "quick_seeds", "tasks")
     @classmethod
     def _report_seeds(cls, v: str | None) -> str | None:
         if v is None:
@@ -147,6 +152,11 @@ class Claim(BaseModel):
     @property
     def seed_list(self) -> list[int]:
         return _parse_seeds(self.seeds)
+
+    @property
+    def task_list(self) -> list[int]:
+        """The judged tasks (``tasks``; empty when the claim names none)."""
+        return _parse_seeds(self.tasks) if self.tasks else []
 
 
 class ClaimFile(BaseModel):

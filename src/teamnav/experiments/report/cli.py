@@ -39,9 +39,11 @@ QUICK_NOTE = "quick mode: indicative only, small sample; run without --quick for
 def section_line(section, quick: bool) -> str:
     """One section's line: key, status, wall time, claims that hold (and how many were not
     judged: a rule that needs full-length runs, a metric not measured); a quick report says so on it."""
-    holds = sum(c.holds is True for c in section.comparisons)
-    unjudged = sum(c.holds is None for c in section.comparisons)
-    line = f"  {section.key:<22} {section.status:<8} {section.wall_s:7.1f} s  {holds}/{len(section.comparisons)} claims hold"
+    # a section with two columns (FIDELITY §1) is judged on its paper column; teamnav's are beside it
+    judged = [c for c in section.comparisons if c.column != "teamnav"]
+    holds = sum(c.holds is True for c in judged)
+    unjudged = sum(c.holds is None for c in judged)
+    line = f"  {section.key:<22} {section.status:<8} {section.wall_s:7.1f} s  {holds}/{len(judged)} claims hold"
     if unjudged:
         line += f", {unjudged} not judged"
     if quick:

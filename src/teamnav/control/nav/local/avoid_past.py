@@ -16,9 +16,12 @@ Here:
   (a dict keyed by cell index, so it grows with the explored area); every :meth:`direction`
   call adds the step length to the cell under the robot (a visit weighs the path it stands
   for, so the law below does not change with the step length);
-- lifetime (``memory_scope``): ``"robot"`` (the default since issue 21 §1, the paper's rule:
-  neither Sgorbissa & Arkin nor Balch & Arkin reset the memory at a new goal or decay it)
-  keeps one memory for the robot's whole life, with no decay. ``"goal"`` (the default from
+- lifetime (``memory_scope``): ``"robot"`` (the default since 2026-11-27) keeps one memory for
+  the robot's whole life, decayed by ``memory_half_life_steps`` (None: lifelong). Neither
+  Sgorbissa & Arkin nor the abstract of Balch & Arkin (the only part of [17] found, again on
+  2026-11-29: the full text is in no reachable source) says whether the memory is reset at a
+  new goal or decays, so the lifetime is a fill, not the paper's rule (an earlier version of
+  this docstring cited Balch & Arkin for "visits never decay": that citation had no source). ``"goal"`` (the default from
   session 6 to issue 21, a gap-fill measured only at the old 1500 / 2500-step budgets) forgets
   the visits when the robot is given a new goal of its own (not a temporary one: an
   excursion to a teammate or a ghost, Sgorbissa & Arkin §3-§5, keeps the memory, and so does
@@ -32,7 +35,7 @@ Here:
   into rooms N4/N5/S5 for 1500 steps without entering S4's door 1.5 m from where it stood.
   With ``"goal"``: 28 % saturated, 12 m of path in memory over the same task's last 1500
   steps;
-- decay (``memory_half_life_steps``, issue 21 §1; a gap-fill, None under ``paper_rules``): the
+- decay (``memory_half_life_steps``; a fill, the same in both columns since 2026-11-29): the
   full section of session 16 (docs/report/los-help.md) ran the paper's lifelong memory at
   today's budgets (6000 / 12000 steps per target): R1 alone finished 0 of 5 200-target tasks on
   either map (19 and 34 targets reached on average), so the issue's fallback applies. The
@@ -42,8 +45,24 @@ Here:
   of the tables. Measured (steps per target, tasks finished of 5): no decay 0/5 (12-42
   targets reached); 125: 284 5/5; 250: 330 5/5; 500: 409 4/5; 1000: 515 4/5; 2000: 672 3/5;
   4000: 725 1/5. So 125 (the grid's shortest: shorter ones were not tried; the trend says a
-  longer memory only costs steps on these tasks). It is a short memory (12.5 m of path at
-  half weight), closer to the old per-goal reset than to the paper's;
+  longer memory only costs steps on these tasks). It is a short memory (25 m of path at half
+  weight, at 0.2 m a step), closer to the old per-goal reset than to the lifelong one. That
+  grid never bracketed its choice, and ran the teamnav column's R1; the rule of 2026-11-29
+  (:data:`teamnav.papers.los_help.tasks.HALF_LIFE_RULE`, commit f9f094e, before its runs)
+  replaces it: *the longest half-life of 16, 32, 64, 125, 250, 500, 1000, 2000, 4000 steps
+  with which R1 alone, with the paper column's settings, finishes every tuning task
+  1001-1005 on office_simple* (the paper's own precondition, Table 1: R1 alone finishes, in
+  554.2 steps; the reading nearest the literal lifelong memory that meets it; a value fails
+  at its first task not finished). Measured (sweep ``los-avoid-past-half-life``, 200 targets,
+  6000 steps per target at most, steps per target): 4000 and 2000 fail on task 1001 (58 and
+  57 targets reached); 1000 finishes 5/5, 555 / 520 / 546 / 565 / 538 (mean 545); so
+  **1000** (an inner point: 2000 above fails, the grid goes on below), the default since then
+  in both columns (200 m of path at half weight). Below it, for the record: 64 finishes 5/5
+  (342 / 320 / 351 / 342 / 350, mean 341); 32 and 16 fail on task 1001 (95 and 11 targets):
+  a very short memory degenerates to the plain potential field, trapped in the first local
+  minimum it meets (Sgorbissa & Arkin §6's algorithm 1, which "does not guarantee the robot
+  to reach its target"). The lifelong and reset-per-goal readings are the section's
+  ablation rows (``docs/report/los-help.md``);
 - avoid-past vector: ``avoid_gain_per_m · Σ_c n_c · (1 − d_c / memory_radius_m) · (x − c) / d_c``
   over the cells ``c`` whose centre is within ``memory_radius_m`` of the robot (``n_c`` metres
   of path in the cell, ``d_c`` distance from the cell centre to the robot ``x``): a discrete,
@@ -122,36 +141,31 @@ class AvoidPastParams(PotentialFieldParams):
     avoid_max : float, default 2.0
         Largest avoid-past magnitude (saturation; see the module docstring).
     memory_scope : {"robot", "goal"}, default "robot"
-        Lifetime of the memory: kept for the robot's life, no decay (the paper's rule, the
-        default since issue 21 §1: neither Sgorbissa & Arkin nor Balch & Arkin reset the
-        spatial memory at a new goal, nor decay it), or forgotten at each new goal of the
-        robot's own, temporary goals keeping it (a gap-fill, the default of sessions 6-13; see
-        the module docstring).
-    memory_half_life_steps : float or None, default 125.0
-        Decay of the memory (a gap-fill, issue 21 §1; None, the paper's rule and
-        ``paper_rules``' value: no decay): a visit's weight halves every
-        ``memory_half_life_steps`` navigator steps (calls of :meth:`direction`). Stored as
-        visits inflated by ``2^(t / h)`` and a push deflated by the same factor, so a step stays
-        O(cells near the robot). How 125 was chosen: see the module docstring.
+        Lifetime of the memory: kept for the robot's life (with ``memory_half_life_steps``
+        None: lifelong, the literal reading), or forgotten at each new goal of the robot's own,
+        temporary goals keeping it ("reset per goal", the default of 2026-11 sessions 6-13; see
+        the module docstring). A fill, the same in both columns: neither Sgorbissa & Arkin nor
+        the abstract of Balch & Arkin 1993 (all of it that was found) says how long the memory
+        lasts.
+    memory_half_life_steps : float or None, default 1000.0
+        Decay of the memory (a fill, the same in both columns; None: no decay): a visit's weight
+        halves every ``memory_half_life_steps`` navigator steps (calls of :meth:`direction`).
+        Stored as visits inflated by ``2^(t / h)`` and a push deflated by the same factor, so a
+        step stays O(cells near the robot). How its value was chosen: see the module docstring.
     """
 
-    #: Avoid-Past as Sgorbissa & Arkin §6 and its source [17] (Balch & Arkin 1993) describe it.
-    PAPER_RULES: ClassVar[dict[str, Any]] = {
-        # §6 / Balch & Arkin 1993: a spatial memory of visited places, never reset at a new goal nor decayed
-        "memory_scope": "robot",
-        "memory_half_life_steps": None,
-    }
-    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
-        "memory_scope": "Sgorbissa §6, Balch & Arkin 1993: one lifelong memory of visited places, no reset, no decay",
-        "memory_half_life_steps": "Sgorbissa §6, Balch & Arkin 1993: the visits never decay",
-    }
+    #: None: the memory's lifetime is a silence of Sgorbissa & Arkin (§6 names only "the Avoid
+    #: Past schema [17]") and of the part of [17] found (its abstract), so it is a fill, the same
+    #: in both columns (``memory_scope``, ``memory_half_life_steps``; see the module docstring).
+    PAPER_RULES: ClassVar[dict[str, Any]] = {}
+    PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {}
 
     cell_m: float = Field(0.3, gt=0.0, le=10.0)
     memory_radius_m: float = Field(3.0, gt=0.0, le=50.0)
     avoid_gain_per_m: float = Field(1.0, ge=0.0, le=1000.0)
     avoid_max: float = Field(2.0, ge=0.0, le=1000.0)
     memory_scope: Literal["goal", "robot"] = "robot"
-    memory_half_life_steps: float | None = Field(125.0, gt=0.0)
+    memory_half_life_steps: float | None = Field(1000.0, gt=0.0)
 
 
 def avoid_past_vector(xy: np.ndarray, visits: dict[tuple[int, int], float], cell_m: float,
@@ -226,8 +240,8 @@ class AvoidPast(PotentialField):
     with ``memory_scope="robot"`` (the default) it is kept for the robot's life; with
     ``memory_scope="goal"`` a new goal of the robot's own (``temporary=False``, farther than
     ``GOAL_SAME_TOL_M`` from the last one) starts an empty memory. With a half-life
-    (``memory_half_life_steps``, the default 125) the stored metres are inflated by
-    ``2^(t / h)`` (see the Params); without one (None, the paper) they are the metres walked:
+    (``memory_half_life_steps``, the default 1000) the stored metres are inflated by
+    ``2^(t / h)`` (see the Params); without one (None, lifelong) they are the metres walked:
 
     Examples
     --------

@@ -88,13 +88,16 @@ class VisBugParams(BaseModel):
     #: VisBug-21 as Lumelsky & Skewis wrote it (Sgorbissa & Arkin §6 run "the VisBug21 algorithm
     #: [7]"): {field: the paper's value}; ``paper_rules: true`` sets them.
     PAPER_RULES: ClassVar[dict[str, Any]] = {
-        # Lumelsky & Skewis fix the local direction a priori ("left"); nearer_end is TangentBug's heuristic
-        "turn": "left",
+        # Lumelsky & Skewis fix the local direction a priori; which one is a silence of the paper, a
+        # fill chosen by teamnav.papers.los_help.tasks.TURN_RULE on tuning tasks 1001-1005 (2026-11-29):
+        # right (R1 alone 5/5 at 517 steps per target, left 5/5 at 735); nearer_end is TangentBug's heuristic
+        "turn": "right",
         # Lumelsky & Skewis: Ti is also the farthest visible boundary point in the local direction
         "boundary_shortcut": True,
     }
     PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
-        "turn": "VisBug-21 (Lumelsky & Skewis): one local direction fixed a priori, left",
+        "turn": "VisBug-21 (Lumelsky & Skewis): one local direction fixed a priori; right, a fill chosen on "
+                "tuning tasks (which direction is not given)",
         "boundary_shortcut": "VisBug-21 (Lumelsky & Skewis): Step 2's Ti may be the farthest visible boundary point",
     }
 

@@ -129,6 +129,8 @@ class _LosBrain(_Driving, abc.ABC):
         self._rng = rng
         self._nav = None
         self._nav_goal: tuple[float, float] | None = None
+        #: A (the navigator) found the temporary point of this step unreachable (``_Driving._navigate``)
+        self._temp_unreachable = False
         self.sharing = GoalSharing(self.me, self.team_size, delayed=params.delayed_visibility,
                                    point_margin_m=2.5 * self.radius_m,
                                    report_margin_m=params.report_margin_steps * self.step_m,

@@ -54,10 +54,13 @@ class _Driving:
             self._nav_goal = key
         heading = nav.direction(self._pose.copy(), self._nav_scan)
         progressing = bool(nav.progressing)
+        self._temp_unreachable = False
         if heading is None:
             if temporary:
-                # A found the temporary point unreachable: drop the excursion for this step,
-                # keeping A (and the task's suspended memory)
+                # A found the temporary point unreachable: no move this step, keeping A (and
+                # the task's suspended memory); the host drops the point (the explorer's
+                # ``drop_unreachable_ghost``), else A is asked again next step and says the same
+                self._temp_unreachable = True
                 return Action(), progressing
             if self.params.restart_navigator_on_give_up:
                 # gap filled: A gave up on this target (VisBug's "unreachable", which on a grid

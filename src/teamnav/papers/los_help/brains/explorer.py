@@ -65,6 +65,8 @@ class LosExplorer(_TroubleFollowing, _LosBrain):
         self._promised: int | None = None
         self._temp_stall = 0
         self.temp_dropped = 0
+        #: teammate or ghost points dropped because A declared them unreachable (``drop_unreachable_ghost``)
+        self.ghosts_unreachable = 0
         #: times R1 went on from a teammate's reached point to the point its D led through
         self.vias_taken = 0
         self._prev_goal_d = math.inf
@@ -168,14 +170,26 @@ class LosExplorer(_TroubleFollowing, _LosBrain):
                     self._promised = self.target_index
             else:
                 self.mode = "follow_teammate" if live else "ghost"
+                self._temp_unreachable = False
                 action, progressing = self._head_to(point, ("path", path.source, path.step),
                                                     end_margin_m=reach)
+                if self._temp_unreachable and p.drop_unreachable_ghost:
+                    # artifact fixed (both columns): A (VisBug-21's Bug2 test, on our grid with
+                    # a robot radius) declared the point unreachable; §4.2 takes the ghost to be
+                    # reachable ("we assume odometry to be adequate to guarantee R2(t2)
+                    # reachability"), so the case does not arise in the paper. Drop it as a
+                    # reached one (A starts again on R1's own goal) instead of standing still
+                    self.ghosts_unreachable += 1
+                    self._temp_stall = 0
+                    self.sharing.mark_reached(self.me)
+                    self._last_target = None
+                    action, progressing = None, False
                 # a point R1 makes no progress towards for Cr steps (A trapped on the way; a
                 # teammate standing still in a doorway) is given up like a reached one, so
                 # that A, or §5 when in trouble, takes over (gap filled: §4.2 assumes the
                 # straight path to a ghost is free)
-                self._temp_stall = 0 if progressing else self._temp_stall + 1
-                if p.drop_stalled_ghost and self._temp_stall >= p.trouble_cr:
+                self._temp_stall = 0 if progressing or action is None else self._temp_stall + 1
+                if action is not None and p.drop_stalled_ghost and self._temp_stall >= p.trouble_cr:
                     self._temp_stall = 0
                     self.temp_dropped += 1
                     self.sharing.mark_reached(self.me)
@@ -222,7 +236,9 @@ class LosExplorer(_TroubleFollowing, _LosBrain):
         teammate's direct promise, ``trust_direct_promise``), ``slide_steps`` (heading to
         a seen point along a side direction), ``temp_switches`` (changes of the teammate, ghost
         or trouble helper headed for), ``temp_dropped`` (teammate or ghost points given up after
-        ``trouble_cr`` steps without progress towards them), ``trouble_helpers_dropped`` (last seen
+        ``trouble_cr`` steps without progress towards them), ``ghosts_unreachable`` (teammate or ghost
+        points dropped because A declared them unreachable, ``drop_unreachable_ghost``),
+        ``trouble_helpers_dropped`` (last seen
         helper positions given up, ``trouble_drop_stalled_helper``), ``vias_taken`` (times R1 went on from
         a teammate's reached point to the point its D led through, ``share_via``); and ``layers``: ``los_goal`` and ``los_ghosts`` markers in
         the odometry frame (when ``log_layers``).
@@ -231,7 +247,8 @@ class LosExplorer(_TroubleFollowing, _LosBrain):
         out.update(target_index=int(self.target_index), targets_reached=int(self.targets_reached),
                    finished=bool(self.finished), gave_up=bool(self.gave_up),
                    goal_seen_steps=int(self.goal_seen_steps), promised_steps=int(self.promised_steps),
-                   temp_dropped=int(self.temp_dropped), vias_taken=int(self.vias_taken),
+                   temp_dropped=int(self.temp_dropped), ghosts_unreachable=int(self.ghosts_unreachable),
+                   vias_taken=int(self.vias_taken),
                    trouble_helpers_dropped=int(self.trouble_helpers_dropped))
         layers = self._layers()
         if layers:

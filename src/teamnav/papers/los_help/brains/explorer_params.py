@@ -39,8 +39,10 @@ class LosExplorerParams(_CommonParams):
         finished at once (the robot stays and still relays).
     keep_trouble_helper : bool
         In trouble, keep heading to the chosen helper's last seen position when it goes out of
-        sight, until no longer in trouble or the goal is seen (§5 names only these two ends);
-        False follows it only while in sight.
+        sight, until no longer in trouble or the goal is seen (a teamnav gap-fill: §5 names only
+        these two ends). False (the paper column, ``PAPER_RULES``): §5 rule 3's teammate is one
+        "in V(R_i)", so it is followed only while in sight (seen now, or, with
+        ``trouble_sighting_at_send``, seen at the step it sent the Tr bit that arrived now).
     trouble_progress : {"helper", "goal", "moved"}
         While following a teammate in trouble (§5 rule 3), what counts as progress for Pr.
         Default ``"helper"`` (the paper's rule, see below). ``"goal"`` (a gap-fill, the default
@@ -138,8 +140,9 @@ class LosExplorerParams(_CommonParams):
         (279/400) -> 5/10 (271/400); office_simple R1+R2 2/10 (161/400) -> 2/10 (205/400),
         R1..3 9/10 (387/400) -> 9/10 (367/400), 349 -> 330 steps per target on the 8 tasks
         both finished, R1..4 10/10 both, 299 -> 290. R1 alone is unaffected (no teammate).
-        The default since H7pf. False: only teammates in sight at the step the bit arrives
-        (the earlier behaviour).
+        The default since H7pf, and since 2026-11-29 in the paper column too: an artifact fix
+        (``ARTIFACT_FIXES``), not a gap-fill, since the paper's radio has no such delay.
+        False: only teammates in sight at the step the bit arrives (the earlier behaviour).
     trouble_return : bool
         In trouble with no teammate in sight to head to (§5 rule 3 needs one), head back to the
         position where R1 last saw a teammate not in trouble (own frame; with
@@ -211,6 +214,20 @@ class LosExplorerParams(_CommonParams):
     trouble_drop_after_steps : int
         Steps without progress towards a kept helper position out of sight after which
         ``trouble_drop_stalled_helper`` drops it (default 500, ten times ``trouble_cr``).
+    drop_unreachable_ghost : bool
+        A teammate's point or ghost (§3 rule 5, §4.2) that the navigator A declares unreachable
+        (VisBug-21's Bug2 termination test: back at its hit point after a full lap) is dropped
+        like a reached one (``ghosts_unreachable``), so that A starts again on R1's own goal.
+        Artifact fixed, in both columns (not a gap-fill: the paper's rule does not cover the
+        case): §4.2 takes the ghost to be reachable (R1's path to R2(t1) "is by definition a
+        straight one" and "we assume odometry to be adequate to guarantee R2(t2)
+        reachability"), while ours can stand 0.11 m from a wall line, closer than our robot's
+        radius, where VisBug-21 on our grid calls it unreachable. Traced (office_simple,
+        R1..R4, paper rules, task 1, first 12 targets): 3,479 of 5,251 ghost steps were R1
+        standing still at such a ghost (R2's doorway stop, 5.3 m away in R1's own corridor),
+        the explorer picking the same ghost every step; dropping it once, the same prefix
+        finished 12 of 12 targets. False: R1 keeps the ghost and A keeps answering
+        "unreachable" (R1 stands still until a shorter D replaces it).
     drop_stalled_ghost : bool
         A teammate's point or ghost (§3 rule 5, §4.2) that R1 makes no progress towards for
         ``trouble_cr`` steps (A trapped on the way, a teammate standing still in a doorway) is
@@ -228,8 +245,8 @@ class LosExplorerParams(_CommonParams):
         "trouble_helper_towards_goal": False,
         # §5 rule 3: followed "until it is no longer in trouble or ... perceive[s] its own goal"
         "trouble_drop_stalled_helper": False,
-        # §5 rule 3: R_j in V(R_i) when R_i reads its Tr bit
-        "trouble_sighting_at_send": False,
+        # §5 rule 3: R_i heads to a teammate R_j "in V(R_i)"; one out of sight is not followed
+        "keep_trouble_helper": False,
         # §4.2 / §6: VisBug-21's one local direction at a ghost too
         "visbug_reverse_walk_factor": None,
         # §4.2: R1 heads to the ghost that promised the shortest D until it reaches it
@@ -240,7 +257,8 @@ class LosExplorerParams(_CommonParams):
         "trust_direct_promise": "Sgorbissa §3 rule 3: R1 heads to its goal once it perceives it itself",
         "trouble_helper_towards_goal": "Sgorbissa §5 rule 3: any teammate in sight not in trouble",
         "trouble_drop_stalled_helper": "Sgorbissa §5 rule 3: followed until not in trouble or the goal is seen",
-        "trouble_sighting_at_send": "Sgorbissa §5 rule 3: the teammate is in sight when its Tr bit is read",
+        "keep_trouble_helper": "Sgorbissa §5 rule 3: a teammate in V(R_i) not in trouble is headed for, "
+                               "so only while it is in sight",
         "visbug_reverse_walk_factor": "Sgorbissa §6 / Lumelsky & Skewis: one local direction, at a ghost too",
         "drop_stalled_ghost": "Sgorbissa §4.2: the ghost is headed for until reached or replaced by a shorter D",
     }
@@ -248,9 +266,21 @@ class LosExplorerParams(_CommonParams):
         **_CommonParams.GAP_FILLS_KEPT,
         "max_steps_per_target": "a step budget per target ends a hopeless task (§6 says the potential field "
                                 "alone fails, not after how long)",
-        "keep_trouble_helper": "a helper out of sight is still headed for (§5 names only two ends of following)",
         "trouble_progress": "'helper': closing in on the followed teammate is progress (the paper's Fig. 10 reading)",
         "restart_navigator_at_ghost": "§4.2's 'start again with A' at a reached ghost",
+    }
+
+    #: Behaviours of our simulator that the paper's robots do not have, fixed in both columns
+    #: (FIDELITY §1: never "the paper's rule"): {field: what it removes} (the ledger's
+    #: ``artifact-fix`` rows; each field's docstring has the trace).
+    ARTIFACT_FIXES: ClassVar[dict[str, str]] = {
+        **_CommonParams.ARTIFACT_FIXES,
+        "trouble_sighting_at_send": "our radio delivers a Tr bit one step after it is sent, when a teammate seen "
+                                    "through a door for one step is out of sight again; the teammate seen at the "
+                                    "sending step is a candidate (it was in V(R_i) when it shared its state, §5)",
+        "drop_unreachable_ghost": "VisBug-21 on our grid with a robot radius declares a ghost unreachable (one "
+                                  "0.11 m from a wall line) and R1 stood still at it; §4.2 assumes the ghost "
+                                  "reachable, so the point is dropped as a reached one",
     }
 
     targets_xy: list[tuple[float, float]] = Field(default_factory=list, max_length=100_000)
@@ -271,3 +301,4 @@ class LosExplorerParams(_CommonParams):
     trouble_drop_stalled_helper: bool = True
     trouble_drop_after_steps: int = Field(500, ge=1, le=10_000_000)
     drop_stalled_ghost: bool = True
+    drop_unreachable_ghost: bool = True

@@ -163,7 +163,7 @@ class _CommonParams(BaseModel):
         ``"fused"`` only: eq. 2's robot size [m]; None: twice the robot's own radius.
     paper_rules : bool
         Every gap-fill of :attr:`PAPER_RULES` at the paper's value, and ``navigator_params``
-        with ``paper_rules: true`` (the navigator's own, e.g. VisBug-21's ``turn="left"``);
+        with ``paper_rules: true`` (the navigator's own, e.g. VisBug-21's ``boundary_shortcut``);
         setting one of them to another value as well is an error
         (:mod:`teamnav.control.paper_rules`). The report's "paper as written" column.
     """
@@ -202,9 +202,15 @@ class _CommonParams(BaseModel):
         "progress_min_fraction": "progress towards a point in sight (§5 rule 1 names no metric): a quarter step",
         "trouble_cr": "Cr of §5 has no value in the paper: 50 steps",
         "reset_trouble_on_target": "Pr, Tr, Nt restart at each new target (the paper has one goal per §5 example)",
-        "restart_navigator_on_give_up": "VisBug-21 declaring a reachable target unreachable (grid, robot radius) "
-                                        "starts over (the paper's VisBug never does)",
         "via_in_sight": "moot without share_via",
+    }
+
+    #: Behaviours of our simulator the paper does not have, fixed in both columns (FIDELITY §1):
+    #: {field: what it removes}; the brains extend it (the ledger's ``artifact-fix`` rows).
+    ARTIFACT_FIXES: ClassVar[dict[str, str]] = {
+        "restart_navigator_on_give_up": "VisBug-21 on our grid with a robot radius declares a reachable target "
+                                        "unreachable (the paper's VisBug, 'guaranteed to find a path to the goal "
+                                        "(whenever it exists)', §6, never does): A starts over from where the robot is",
     }
 
     @model_validator(mode="before")

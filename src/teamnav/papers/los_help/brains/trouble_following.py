@@ -10,11 +10,13 @@ gap-fills around that rule, each a field of
 :class:`~.explorer_params.LosExplorerParams` documented there with what was measured:
 
 - which teammate qualifies: one whose Tr bit arrived and that R1 saw when it was sent
-  (``trouble_sighting_at_send``), not one walking away from R1's goal
+  (``trouble_sighting_at_send``, an artifact fix of our radio's one-step delay, in both
+  columns), not one walking away from R1's goal
   (``trouble_helper_towards_goal``, :meth:`_TroubleFollowing._watch_mates` keeps the teammates'
   distances to it);
 - what R1 does when it goes out of sight: head on to its last seen position
-  (``keep_trouble_helper``), given up when R1 does not close in on it
+  (``keep_trouble_helper``, teamnav only: the paper column follows a teammate only while it is
+  in V(R_i), §5 rule 3), given up when R1 does not close in on it
   (``trouble_drop_stalled_helper``);
 - what counts as progress while following it (``trouble_progress``, ``trouble_near_helper_m``);
 - where R1 goes when nobody is in sight (``trouble_return``) and when a followed teammate is let
@@ -73,9 +75,9 @@ class _TroubleFollowing:
         p = self.params
         action: Action | None = None
         # §5 rule 3: in trouble, a teammate in sight that is not becomes the temporary goal
-        # "until it realizes it is no longer in trouble or ... perceives its own goal": kept
-        # (at its last seen position) when it goes out of sight (gap filled; the paper
-        # names only these two ends)
+        # "until it realizes it is no longer in trouble or ... perceives its own goal"; with
+        # ``keep_trouble_helper`` (teamnav's gap-fill) kept at its last seen position when it
+        # goes out of sight, without it (the paper column) followed only while in V(R_i)
         near = 2.0 * self.radius_m + self.step_m
         seen = self._seen_now
         if p.trouble_sighting_at_send:
@@ -95,8 +97,12 @@ class _TroubleFollowing:
                     # on to where it was last seen first (see ``trouble_release_to_helper``)
                     self._release_xy, self._release_stall = self._seen_now[tt[0]], 0
                 tt = self._trouble_target = None  # it turned away from the goal: let it go
-        if tt is not None and tt[0] in self._seen_now:
-            tt = self._trouble_target = (tt[0], self._seen_now[tt[0]])
+        # in V(R_i): seen now, or (``trouble_sighting_at_send``) seen at the step it sent the Tr
+        # bit that arrived now; without ``keep_trouble_helper`` (the paper column, §5 rule 3:
+        # R_j in V(R_i)) a helper is followed only while it is in V(R_i) in this sense
+        visible = self._seen_now if p.keep_trouble_helper else seen
+        if tt is not None and tt[0] in visible:
+            tt = self._trouble_target = (tt[0], visible[tt[0]])
         elif tt is None or math.hypot(tt[1][0] - self._pose[0], tt[1][1] - self._pose[1]) <= near:
             helper = choose_helper(True, self._me_xy(), cands)
             tt = self._trouble_target = None if helper is None else (helper, seen[helper])
@@ -105,7 +111,7 @@ class _TroubleFollowing:
                 hist = self._mate_goal_d.get(helper)
                 self._tt_best_d = hist[-1][1] if hist else math.hypot(seen[helper][0] - goal[0],
                                                                       seen[helper][1] - goal[1])
-        if tt is not None and (tt[0] in self._seen_now or p.keep_trouble_helper):
+        if tt is not None and (tt[0] in visible or p.keep_trouble_helper):
             self.mode = "trouble_follow"
             action, towards = self._head_to(tt[1], ("helper", tt[0]), stop_within_m=near, end_margin_m=near)
             if p.trouble_drop_stalled_helper:

@@ -6,8 +6,9 @@ Split from :mod:`.section` (no behaviour change). The rules are read from the cl
 its claim names and calls :func:`~teamnav.experiments.claims.judge`; no threshold lives here.
 
 Two columns (issue 21 §3): the verdicts are computed on each column's rows and merged by
-:func:`column_comparisons`, which keeps the paper-as-written column's verdict (every claim is
-``judged: paper_rules``) and reports the teamnav one beside it. Table 2's verdicts read the mean
+:func:`column_comparisons`, which gives each claim a comparison per column (``column`` of the
+report model): the paper-as-written one is the verdict (every claim is ``judged:
+paper_rules``), the teamnav one stands beside it. Table 2's verdicts read the mean
 over the route plans of :data:`._los_common.ROUTE_PLANS` (issue 21 §4; ``plans`` of
 :func:`table_comparisons`, :func:`_plan_means`).
 """
@@ -134,6 +135,12 @@ def _plan_means(plans: Sequence[dict[int, list[dict]]], nav: str, hs: Sequence[i
     return means, "; ".join(text)
 
 
+def _fewest_pairs(plans: Sequence[dict[int, list[dict]]], nav: str, hs: Sequence[int]) -> int | None:
+    """The fewest tasks paired across the teams ``hs`` in any route plan (None: rows name no tasks)."""
+    ks = [got[1] for p in plans if (got := paired_means(p, nav, hs)) is not None]
+    return min(ks) if ks else None
+
+
 #: the route plans' labels, in the order the section passes them (plan A first: the table's own runs)
 PLAN_LABELS = ("plan A", "plan B", "plan C")
 
@@ -171,12 +178,20 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         elif paired is not None:
             ms, k, n = paired
             note = f" (paired: the {k} of {n} tasks finished with every team that finished one)"
+        pairs = _fewest_pairs(plans, nav, ok_hs) if multi and ok_hs else (paired[1] if paired is not None else None)
         p = [paper[nav][h][0] for h in hs if paper[nav][h] is not None]
         fails_first = not failing or not ok_hs or max(failing) < min(ok_hs)
         cid = f"table{tab}-{nav.replace('_', '-')}-falls"
         plan_gap = multi and bool(ok_hs) and not all(np.isfinite(ms))
         no_common = False
-        if plan_gap:
+        min_pairs = _claim(cid).min_pairs
+        too_few = min_pairs is not None and pairs is not None and 0 < pairs < min_pairs and len(ms) >= 2
+        if too_few:
+            # FIDELITY §3: a paired verdict on fewer pairs than the claim file fixes is no verdict
+            holds = None
+            if record is not None:
+                record[cid] = ({"pairs": float(pairs)}, (None, f"not judged (n = {pairs})"))
+        elif plan_gap:
             # claims/los-help.yaml's plan rule: a plan without a paired mean at a team (it finished no
             # task common to the teams that finished one) makes the trend fail
             holds = _failed(cid, "a route plan has no paired mean at some team", record)
@@ -205,6 +220,7 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
         out.append(Comparison(
             f"Table {tab}: {NAV_LABEL[nav]} steps fall as helpers are added ({', '.join(TEAM_LABEL[h] for h in hs)})",
             " → ".join(f"{v:.1f}" for v in p), ours + ratio + note, holds,
+            f"not judged (n = {pairs}): the claim file fixes at least {min_pairs} pairs" if too_few else
             "" if holds or holds is None else
             "a route plan has no paired mean at some team (no task finished by every team that finished one in "
             "that plan), which fails the trend (claims/los-help.yaml)" if plan_gap else
@@ -293,22 +309,32 @@ def noise_comparisons(map_key: str, means: dict[str, dict[float, float]], alone:
     (:func:`paired_noise`); ``record`` as in :func:`table_comparisons`."""
     out: list[Comparison] = []
     fig = 16 if map_key == "simple" else 17
-    grow, text = [], []
+    grow, text, pairs = [], [], []
     for nav, per in means.items():
         if 0.0 in per and 0.4 in per and np.isfinite(per[0.0]) and np.isfinite(per[0.4]):
             pn = paired_noise(rows, nav, (0.0, 0.4)) if rows else None
             if pn is not None and pn[1] > 0:
                 (a, b), k = pn
+                pairs.append(k)
                 grow.append(b - a)
                 text.append(f"{NAV_LABEL[nav]} {a:.0f} → {b:.0f} (paired, {k} tasks)")
             else:
                 grow.append(per[0.4] - per[0.0])
                 text.append(f"{NAV_LABEL[nav]} {per[0.0]:.0f} → {per[0.4]:.0f}")
-    gholds = _judged(f"fig{fig}-noise-grows", {"min_growth": min(grow) if grow else math.nan}, record) if grow else None
+    min_pairs = _claim(f"fig{fig}-noise-grows").min_pairs
+    few = min(pairs) if pairs and min_pairs is not None and min(pairs) < min_pairs else None
+    if few is not None:
+        # FIDELITY §3: fewer pairs than the claim file fixes is no verdict
+        gholds = None
+        if record is not None:
+            record[f"fig{fig}-noise-grows"] = ({"pairs": float(few)}, (None, f"not judged (n = {few})"))
+    else:
+        gholds = _judged(f"fig{fig}-noise-grows", {"min_growth": min(grow) if grow else math.nan}, record) if grow else None
     out.append(Comparison(f"Fig. {fig}: steps grow with err_max (0 → 0.4), R2..R4 present",
                           "performance decreases for every algorithm as err_max grows",
                           "; ".join(text) or "not run", gholds,
-                          "" if (not grow or gholds) else "some algorithms did not get slower with noise"))
+                          f"not judged (n = {few}): the claim file fixes at least {min_pairs} pairs" if few is not None
+                          else "" if (not grow or gholds) else "some algorithms did not get slower with noise"))
     navs = [n for n in means if n in alone and np.isfinite(alone[n]) and 0.4 in means[n]]
     if map_key == "simple":
         below = [means[n][0.4] / alone[n] for n in navs]
@@ -339,10 +365,11 @@ COLUMNS = (("paper_rules", "paper as written"), ("teamnav", "teamnav"))
 
 
 def column_comparisons(by_col: dict[str, list[Comparison]]) -> list[Comparison]:
-    """One :class:`Comparison` per claim from the same claims judged on each column's runs
-    (``{"paper_rules": [...], "teamnav": [...]}``, in the same order): the verdict is the
-    paper-as-written column's (every claim of claims/los-help.yaml is ``judged: paper_rules``);
-    "ours" reads both columns, and "differs" says what the teamnav column (our gap-fills) gives.
+    """Each claim judged on both columns' runs (``{"paper_rules": [...], "teamnav": [...]}``, in the
+    same order, from the same calls): for every claim its paper-as-written comparison
+    (``column="paper"``, the verdict: every claim of claims/los-help.yaml is ``judged:
+    paper_rules``), then its teamnav comparison (``column="teamnav"``, what our gap-fills give;
+    not a verdict). Report models and ``report.json`` carry the column of each (FIDELITY §2).
 
     Raises
     ------
@@ -352,14 +379,12 @@ def column_comparisons(by_col: dict[str, list[Comparison]]) -> list[Comparison]:
     pr, tn = by_col["paper_rules"], by_col["teamnav"]
     if [c.claim for c in pr] != [c.claim for c in tn]:
         raise ValueError("the two columns' verdicts name different claims")
-    word = {True: "holds", False: "does not hold", None: "not judged"}
     out = []
     for a, b in zip(pr, tn):
-        ours = a.ours if a.ours == b.ours else f"paper as written: {a.ours} | teamnav: {b.ours}"
-        differs = "; ".join(x for x in (
-            a.differs,
-            f"judged on the paper-as-written column (claims/los-help.yaml); teamnav (our gap-fills): {word[b.holds]}"
-            + (f" ({b.differs})" if b.differs and b.holds is False and b.differs != a.differs else ""),
-        ) if x)
-        out.append(Comparison(a.claim, a.paper, ours, a.holds, differs))
+        out.append(Comparison(a.claim, a.paper, a.ours, a.holds,
+                              "; ".join(x for x in (a.differs, "the verdict (claims/los-help.yaml)") if x),
+                              column="paper"))
+        out.append(Comparison(b.claim, b.paper, b.ours, b.holds,
+                              "; ".join(x for x in (b.differs, "our gap-fills beside the verdict, not judged") if x),
+                              column="teamnav"))
     return out
