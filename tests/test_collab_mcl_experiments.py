@@ -217,6 +217,7 @@ def test_claim_file_report_seeds_and_the_rules_changed_with_their_data():
         assert len(c.seed_list) >= 20 and max(c.seed_list) < 1000 and c.history
         assert c.judged == ("teamnav" if c.id in teamnav_only else "paper_rules")
     after = {(c.id, h.commit) for c in cf.claims for h in c.history if not h.before_data}
-    assert after == {("hallway-faster", "79674cc"), ("hexagon-together", "b81d177"), ("single-detection", "b81d177")}
+    assert after == {("hallway-faster", "79674cc"), ("hexagon-together", "b81d177"), ("single-detection", "b81d177"),
+                     ("delayed-integration", "349d51d"), ("delayed-vs-drop", "349d51d")}
     assert [(r.metric, r.op, r.threshold) for r in cf["single-detection"].rule] == [
         ("team_final_error_mean_m", "<", 1.5), ("alone_final_error_mean_m", ">=", 1.5), ("team_localized_frac", ">=", 0.9)]

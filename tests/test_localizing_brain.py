@@ -17,7 +17,19 @@ from teamnav.experiments.spec import load_scenario
 from teamnav.localization.sync import SYNC_KIND, SyncMessage
 from teamnav.world import builtin_map
 
-GRID = builtin_map("lab_and_corridor").grid
+def _bare_corridor():
+    """The brain's unit tests feed synthetic scans: a bare 40 m corridor with a lab behind one
+    opening (the §5.1 map before 2026-11-29), where those scans fit everywhere along the corridor."""
+    from teamnav.world.map_builder import MapBuilder
+
+    b = MapBuilder(42.0, 12.0, 0.1).fill("wall")
+    b.clear_rect(1.0, 8.5, 41.0, 10.7).clear_rect(22.0, 1.0, 30.0, 8.3).clear_rect(23.0, 8.3, 24.6, 8.5)
+    b.rect(26.0, 1.0, 29.6, 2.0).rect(29.4, 3.0, 30.0, 6.6).disc(25.6, 4.4, 0.7).rect(22.0, 1.0, 23.3, 3.0)
+    b.rect(27.2, 6.6, 28.4, 8.3)
+    return b.build("builtin:lab_and_corridor")
+
+
+GRID = _bare_corridor()
 ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 19)
 LASER = SensorInfo("laser", "laser", ANGLES, 8.0)
 

@@ -17,6 +17,7 @@ import numpy as np
 from teamnav.experiments.report.model import Comparison, MapView, Missing, Plot, Table
 from teamnav.papers.collab_mcl.report._collab_common import (
     COLUMNS, HEAD, _col_sweep, _metric, _ms, _param, _rule_text, _seeds, _series, _verdicts,
+    judged_column,
 )
 
 #: Quick-mode override (CI: the whole section in about a minute on 2 cores).
@@ -144,7 +145,7 @@ def _detection(ctx, out: dict | None = None) -> list:
                    "posterior probability that Robin was lost, lost prior 0.3) with headings picked by its "
                    "scan (as in the hallway; chosen on tuning seeds 1000-1039 in session 15), and tempers the "
                    "likelihood (0.03)."
-                   + _rule_text(claim, verdicts, n_text)),
+                   + _rule_text(claim, verdicts, n_text), column=judged_column(claim)),
         Plot("Fig. 11: the corridor robot's error vs time", "time [s]", "mean distance of samples to the true pose [m]",
              [s for col, head in COLUMNS for s in
               _series(f"single-robot MCL (ignores detections), {head}", split[col][0],
