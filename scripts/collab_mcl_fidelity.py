@@ -102,7 +102,7 @@ def calibrate_run(job) -> dict:
             "cpu_s": round(time.process_time() - t0, 1)}
 
 
-def precondition_run(seed: int) -> dict:
+def precondition_run(seed: int, robin_min: int | None = None) -> dict:
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
     from teamnav.papers.collab_mcl.maps import LAB_DOOR_X
@@ -111,9 +111,12 @@ def precondition_run(seed: int) -> dict:
     scen = "collab-mcl-detection"
     params = _paper_params(scen)
     ov = {f"robots.{i}.params": {**p, "collaborate": False} if i == 1 else p for i, p in params.items()}
+    if robin_min is not None:
+        ov["robots.1.params"]["min_particles"] = robin_min
     t0 = time.process_time()
     res = run(load_scenario(scen, overrides=ov, seed=seed, duration_s=110.0), progress=False)
-    out = {"part": "precondition", "seed": seed, "t_s": None, "heaviest_mode": None, "error_m": None}
+    out = {"part": "precondition", "seed": seed, "robin_min": robin_min, "t_s": None, "heaviest_mode": None,
+           "error_m": None}
     for t, truth, pts, v in _records(res.data, 1):
         if truth[0] >= LAB_DOOR_X:
             out.update({"t_s": t, "heaviest_mode": heaviest_mode(pts), "n_particles": v.get("n_particles"),
@@ -123,20 +126,21 @@ def precondition_run(seed: int) -> dict:
     return out
 
 
-def modes_run(seed: int) -> dict:
+def modes_run(seed: int, column: str = "paper") -> dict:
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
     from teamnav.papers.collab_mcl.metrics import belief_modes
 
     scen = "collab-mcl-hexagon"
-    params = _paper_params(scen)
+    params = _paper_params(scen) if column == "paper" else {
+        i: dict(g.params or {}) for i, g in enumerate(load_scenario(scen).robots)}
     ov = {}
     for i, p in params.items():
         ov[f"robots.{i}.params"] = {**p, "collaborate": False}
         ov[f"robots.{i}.count"] = 1
     t0 = time.process_time()
     res = run(load_scenario(scen, overrides=ov, seed=seed, duration_s=200.0), progress=False)
-    out = {"part": "modes", "seed": seed}
+    out = {"part": "modes", "column": column, "seed": seed}
     for robot, kind in ((0, "sonar"), (1, "laser")):
         recs = list(_records(res.data, robot))
         t, truth, pts, v = recs[-1]
@@ -152,13 +156,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", default="1000-1004")
     ap.add_argument("--groups", default=",".join(CALIBRATE))
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--column", choices=["paper", "teamnav"], default="paper", help="modes: which column")
+    ap.add_argument("--robin-min", type=int, default=None, help="precondition: Robin's min_particles (rule 6)")
     ap.add_argument("--out", default=None)
     a = ap.parse_args(argv)
     seeds = parse_seeds(a.seeds)
     if a.part == "calibrate":
         fn, jobs = calibrate_run, [(g, s) for g in a.groups.split(",") for s in seeds]
     else:
-        fn, jobs = (precondition_run if a.part == "precondition" else modes_run), seeds
+        import functools
+
+        fn = (functools.partial(precondition_run, robin_min=a.robin_min) if a.part == "precondition"
+              else functools.partial(modes_run, column=a.column))
+        jobs = seeds
     t0 = time.time()
     rows = []
     with ProcessPoolExecutor(a.workers) if a.workers > 1 else _Serial() as ex:

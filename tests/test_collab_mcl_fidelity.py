@@ -98,3 +98,34 @@ def test_modes_and_heaviest_mode_count_what_they_say():
     assert heaviest_mode(three) == pytest.approx(1 / 3, abs=0.02)
     one = rng.normal(0, 0.2, (64, 2))
     assert belief_modes(one) == 1 and heaviest_mode(one) == 1.0
+
+
+@pytest.mark.parametrize("pose", [(12.0, 9.0, 2.5), (5.0, 10.0, -0.5)])
+def test_hexagon_sonar_robots_cannot_tell_three_locations_apart_laser_robots_two(pose):
+    """Fox §5.2.2: "robots using sonar sensors ... cannot distinguish between three possible robot
+    locations ..., robots equipped with laser range-finders remain uncertain about two". The
+    filter's own likelihood of a noise-free scan at the six turns of the pose about the hexagon's
+    centre: as likely as the truth (within 1 nat) at three turns for a sonar robot, two for a laser
+    robot (the paper column's models: sonar sigma 0.3 m, 16 cones; laser the fill's 10 beams, 0.8 m)."""
+    from teamnav.sim.config import SonarConfig
+    from teamnav.world.generators import builtin_map
+
+    env = builtin_map("hexagon")
+    g = env.grid
+    cx, cy = env.places["centre"]
+    x, y, th = pose
+    turns = np.array([[cx + (x - cx) * math.cos(a) - (y - cy) * math.sin(a),
+                       cy + (x - cx) * math.sin(a) + (y - cy) * math.cos(a), th + a]
+                      for a in np.arange(6) * math.pi / 3])
+    kinds = {
+        "sonar": (SonarConfig(n_transducers=16, fov_deg=360, cone_deg=15, rays_per_cone=5, max_range_m=5.0,
+                              noise_std_m=0.05, p_specular=0.0), BEAM.model_copy(update={"sigma_hit_m": 0.3}), 1, 3),
+        "laser": (LaserConfig(n_beams=180, fov_deg=179, max_range_m=8.0, noise_std_m=0.05),
+                  BEAM.model_copy(update={"sigma_hit_m": 0.8}), 18, 2),
+    }
+    for kind, (cfg, beam, stride, expect) in kinds.items():
+        s = build_range_sensor(cfg, g)
+        f = MCL(MCLParams(beam=beam, beam_stride=stride, parallel=False), g, s.info(), np.random.default_rng(0))
+        z = s.true_ranges(np.array([x]), np.array([y]), np.array([th]))[0]
+        ll = f.pose_log_likelihood(turns, z)
+        assert int((ll >= ll[0] - 1.0).sum()) == expect, (kind, np.round(ll - ll[0], 1))

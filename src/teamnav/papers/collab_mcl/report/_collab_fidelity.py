@@ -167,8 +167,11 @@ def precondition_block() -> Precondition:
     hm = p.get("heaviest_mode", [])
     result = (f"heaviest mode of Robin's belief at the lab door per run: "
               f"{', '.join('n/a' if h is None else f'{h:.2f}' for h in hm)}; <= {p['threshold']} in "
-              f"{p['runs_ok']} of {len(hm)} runs (needed: {p['runs_needed']}); map {p['map']}; "
-              f"measured {p['date']} ({p['cpu_s']:.0f} CPU s)")
+              f"{p['runs_ok']} of {len(hm)} runs (needed: {p['runs_needed']}; n/a: Robin never reached the door "
+              f"in 110 s); map {p['map']}; " + (f"{p['also']}; " if p.get("also") else "")
+              + f"measured {p['date']} ({p['cpu_s']:.0f} CPU s, scripts/collab_mcl_fidelity.py precondition). "
+              "Mechanism: every period of the corridor fits Robin's scans, and resampling at every update "
+              "(§3.1) lets one period win by drift before Robin reaches the lab")
     return Precondition("§5.1 / Fig. 10(a): Robin alone (paper as written, no detections) is still multi-modal "
                         "when it passes the lab ('still highly uncertain about its exact location within the "
                         "corridor and even does not know its global heading direction'): no mode (the samples "
