@@ -26,6 +26,9 @@ def test_unknown_keys_tuning_seeds_and_bad_ops_are_refused():
         Claim.model_validate({**BASE, "threshold": 3})
     with pytest.raises(ValidationError, match="tuning seeds"):
         Claim.model_validate({**BASE, "seeds": "1000-1009"})
+    with pytest.raises(ValidationError, match="tuning seeds"):
+        Claim.model_validate({**BASE, "seeds": "1990-2009"})  # straddles the tuning range's end
+    assert Claim.model_validate({**BASE, "seeds": "2000-2009"}).seed_list[0] == 2000  # fresh judged seeds
     with pytest.raises(ValidationError):
         Claim.model_validate({**BASE, "rule": [{"metric": "r", "op": "=>", "threshold": 1}]})
 
