@@ -11,10 +11,17 @@ every one in two columns beside the paper's number:
   dropped from the scenario (:func:`teamnav.papers.trails.report._trails.paper_rules_spec`);
 - "teamnav": the scenarios as they are (our gap-fills).
 
+First, §5.1's precondition (:func:`~._collab_fidelity.precondition_block`: Robin alone still
+multi-modal when it passes the lab, measured on tuning seeds and shown as measured; the claims that need
+it read "precondition not met" when it does not hold) and the ledger of both columns
+(:func:`~._collab_fidelity.ledger_blocks`, ``shared/FIDELITY.md`` §2). Every comparison names the column
+its verdict is judged on.
+
 Verdict rules are read from ``papers/collab_mcl/claims/collab-mcl.yaml`` (:mod:`teamnav.experiments.claims`),
 never written here, and judged on the column each claim names (the paper as written, except the
-two §7.2 extensions only teamnav has); the seeds are the claim's report seeds (its
-``quick_seeds`` in quick mode; tuning seeds are >= 1000 and never run here).
+two §7.2 extensions only teamnav has); the seeds are the claim's judged seeds (2000-2029, named
+before any run on them; its ``quick_seeds`` in quick mode; tuning seeds are 1000-1999 and never run
+here).
 
 - §5.2.1 / Fig. 12: ``collab-mcl-hallway``, 8 sonar robots, single vs collaborative MCL:
   error vs time with 95 % bands, time to localize (error < 1.5 m) mean ± std over runs, the
