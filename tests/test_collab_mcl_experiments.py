@@ -176,6 +176,13 @@ def test_report_section_quick_build(tmp_path):
     assert time.perf_counter() - t0 < 120
     assert sum(isinstance(b, Comparison) for b in blocks) >= 3
     assert all(len(s.x) > 2 for b in blocks if isinstance(b, Plot) for s in b.series)
+    # FIDELITY §2: the precondition and both columns' ledgers before the verdicts, a column on every comparison
+    from teamnav.experiments.report.model import Ledger, Precondition
+
+    kinds = [type(b) for b in blocks]
+    first_comparison = kinds.index(Comparison)
+    assert Precondition in kinds[:first_comparison] and kinds[:first_comparison].count(Ledger) == 2
+    assert all(b.column in ("paper", "teamnav") for b in blocks if isinstance(b, Comparison))
 
 
 def _hallway_rows(alone_s, team_s):
@@ -200,7 +207,7 @@ def test_hallway_verdict_needs_a_paired_reduction_beyond_two_standard_errors(tea
     rows = _hallway_rows(alone, team)
     res = SimpleNamespace(rows=lambda: rows, total=len(rows))
     comparison = _hallway(SimpleNamespace(quick=False, sweep=lambda *a, **k: res))[0]
-    assert comparison.holds is holds
+    assert comparison.holds is holds and comparison.column == "paper"
     assert "faster together in" in comparison.ours
 
 

@@ -129,3 +129,50 @@ def test_hexagon_sonar_robots_cannot_tell_three_locations_apart_laser_robots_two
         z = s.true_ranges(np.array([x]), np.array([y]), np.array([th]))[0]
         ll = f.pose_log_likelihood(turns, z)
         assert int((ll >= ll[0] - 1.0).sum()) == expect, (kind, np.round(ll - ll[0], 1))
+
+
+# ---------------------------------------------------------------------------- the section's fidelity blocks
+def test_ledger_has_both_columns_with_a_source_and_a_ref_for_the_fills():
+    from teamnav.experiments.report.model import LEDGER_SOURCES
+    from teamnav.papers.collab_mcl.report._collab_fidelity import ledger_blocks
+
+    paper, teamnav = ledger_blocks()
+    assert {r.column for r in paper.rows} == {"paper"} and {r.column for r in teamnav.rows} == {"teamnav"}
+    rows = {r.name: r for r in paper.rows}
+    # the fills the 2026-11-29 rules chose, with their rule and tuning seeds
+    stride = rows["collab-mcl-detection / robin: beam_stride"]
+    assert stride.value == 18 and stride.source == "fill" and "1000-1009" in stride.ref
+    assert rows["collab-mcl-hexagon / laser: beam.sigma_hit_m"].value == 0.8
+    assert rows["collab-mcl-hallway / sonar: adapt_ref_loglik_per_beam"].source == "fill"
+    # the paper's rules, stated, and the hardware the paper gives
+    assert rows["collab-mcl-hallway / sonar: adapt"].value == "likelihood"
+    assert rows["collab-mcl-hallway / sonar: likelihood_exponent"].source == "stated"
+    assert rows["collab-mcl-detection / robin: laser"].source == "stated" and '"n_beams": 180' in \
+        rows["collab-mcl-detection / robin: laser"].value
+    # settings the paper's rules make inert are not listed as the paper's
+    assert not any(": inject_heading" in n for n in rows)
+    # teamnav's in-sample choices say so
+    lost = [r for r in teamnav.rows if r.name.endswith("inject_fraction")]
+    assert lost and all("sensor resetting" in r.ref for r in lost)
+    assert all(r.source in LEDGER_SOURCES and r.ref.strip() for r in paper.rows + teamnav.rows)
+
+
+def test_a_claim_that_needs_an_unmet_precondition_reads_precondition_not_met(monkeypatch):
+    from teamnav.experiments.claims import load_claims
+    from teamnav.papers.collab_mcl.report import _collab_fidelity as fid
+
+    claims = load_claims("collab-mcl")
+    good = {"team_final_error_mean_m": 0.3, "alone_final_error_mean_m": 9.0, "team_localized_frac": 1.0}
+    monkeypatch.setitem(fid.PRECONDITION, "holds", False)
+    h, text = fid.gated_judge(claims["single-detection"], good)
+    assert h is None and text.startswith("precondition not met")
+    monkeypatch.setitem(fid.PRECONDITION, "holds", True)
+    assert fid.gated_judge(claims["single-detection"], good)[0] is True
+    # a claim that does not need it is judged as the claim file says either way
+    monkeypatch.setitem(fid.PRECONDITION, "holds", False)
+    hv = {"together_ttl_mean_s": 100.0, "alone_ttl_mean_s": 200.0, "together_final_localized": 1.0,
+          "alone_final_localized": 1.0, "paired_change_upper_s": -10.0}
+    assert fid.gated_judge(claims["hallway-faster"], hv)[0] is True
+    block = fid.precondition_block()
+    assert block.holds is False and set(block.claims) == {"single-detection", "fp-breaks"}
+    assert block.record()["seeds"] == "1000-1009"
