@@ -144,8 +144,8 @@ def _detection(ctx, out: dict | None = None) -> list:
                    "only reweight the samples Robin has, and on tuning seeds Robin alone had already committed to "
                    "one period of the corridor, mostly a wrong one, when it passed the lab (the precondition "
                    "above). The teamnav column (with sensor resetting) draws part of Robin's samples from the "
-                   "received tree, weighted by the posterior probability that Robin was lost (lost prior 0.3, "
-                   "chosen on report seed 7), with headings picked by its scan (tuning seeds 1000-1039)."
+                   "received tree, weighted by the posterior probability that Robin was lost (lost prior 0.6, "
+                   "chosen on tuning seeds 1000-1019), with headings picked by its scan (tuning seeds 1000-1039)."
                    + _rule_text(claim, verdicts, n_text), column=judged_column(claim)),
         Plot("Fig. 11: the corridor robot's error vs time", "time [s]", "mean distance of samples to the true pose [m]",
              [s for col, head in COLUMNS for s in

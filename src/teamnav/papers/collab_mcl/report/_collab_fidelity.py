@@ -69,8 +69,9 @@ TEAMNAV_REFS: dict[str, str] = {
     "inject_heading_belief_share": "draws' headings not from the own belief; hexagon: chosen on report seeds 0-7 "
                                    "(in-sample); §5.1 and hallway: tuning seeds 1000-1039",
     "inject_heading_scan_share": "draws' headings picked by the scan; tuning seeds 1000-1039 (§5.1)",
-    "inject_lost_prior": "the brain's 0.3, chosen on report seed 7 (in-sample); not beaten by 0.1 or 0.6 on tuning "
-                         "seeds 1000-1019",
+    "inject_lost_prior": "§5.1: 0.6, re-chosen on tuning seeds 1000-1019 (rule 7 of docs/report/collab-mcl.md, "
+                         "2026-11-29: lowest mean final error of Robin, 0.1-0.9); elsewhere the brain's 0.3, chosen "
+                         "on report seed 7 (in-sample)",
     "resample_ess_fraction": "selective resampling (Doucet et al. 2000), not §3.1",
     "provenance": "rule 2 of §2.3 made transitive (beyond the paper)",
     "receive_gate": "rule 2 of §2.3 on the receiving side too (beyond the paper)",
