@@ -248,7 +248,7 @@ def test_cotravel_values_pair_by_seed_and_feed_the_claim():
 
 
 def test_cotravel_sweep_runs_the_claims_seeds_with_valid_params():
-    """The sweep's four cases on the claim's report seeds; every case's params validate (integrate with
+    """The sweep's four cases on the claim's judged seeds; every case's params validate (integrate with
     no threshold, drop and delay with the same one); the robots start together, heading north."""
     from teamnav.experiments.claims import load_claims
     from teamnav.experiments.spec import load_scenario
