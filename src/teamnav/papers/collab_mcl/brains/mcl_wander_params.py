@@ -300,7 +300,8 @@ class MCLWanderParams(BaseModel):
         "random_fraction": "§3.1 'a small number of uniformly distributed, random samples'; no number",
         "min_update_m": "the paper updates on each odometry reading and scan; no rate is given",
         "min_update_deg": "as min_update_m",
-        "beam": "Fig. 1's mixture; its weights and widths are not given (ours: the simulated sensor's)",
+        "beam": "Fig. 1's mixture; its weights and widths are not given (weights 0.7/0.1/0.1/0.1 kept from the "
+                "first version; the laser's sigma_hit chosen with beam_stride by papers/collab_mcl/beam_fill.py)",
         "motion": "Fig. 2's motion model; its noise is not given",
         "tree_min_samples": "§3.2's stopping rule 'see Thrun et al. (1999b)'; no value",
         "inject_lost_prior": "inert with inject_fraction 0 (the paper's), as are inject_weighting and the "
