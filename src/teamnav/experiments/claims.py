@@ -127,6 +127,10 @@ class Claim(BaseModel):
     seeds: str
     quick_seeds: str | None = None
     n: int = Field(ge=1)  # runs judged in full mode (all cases and both teams where a rule reads both)
+    #: a paired verdict: fewer pairs than this (read from the metric ``pairs_metric``) reads "not
+    #: judged (n = k)" (FIDELITY §3: at least 5, fixed in the claim file)
+    min_pairs: int | None = Field(None, ge=5)
+    pairs_metric: str = Field("n_pairs", min_length=1)
     judged: Literal["paper_rules", "teamnav"]
     history: list[HistoryEntry] = Field(min_length=1)
     note: str = ""
@@ -206,11 +210,17 @@ def _fmt(v: float) -> str:
 def judge(claim: Claim, values: Mapping[str, float], duration_s: float | None = None) -> tuple[bool | None, str]:
     """Whether ``claim`` holds on ``values`` (metric name -> number), and how it was read.
 
-    None (not judged) when a metric is missing or not finite, or when ``duration_s`` is below
-    the claim's ``min_duration_s``.
+    None (not judged) when a metric is missing or not finite, when ``duration_s`` is below
+    the claim's ``min_duration_s``, or when a paired claim has fewer than ``min_pairs`` pairs.
     """
     if duration_s is not None and duration_s < claim.min_duration_s:
         return None, f"not judged on {duration_s / 60:g}-min runs (the rule needs >= {claim.min_duration_s / 60:g} min)"
+    if claim.min_pairs is not None:
+        k = values.get(claim.pairs_metric)
+        if not isinstance(k, (int, float)) or not math.isfinite(k):
+            return None, f"{claim.pairs_metric}: not measured"
+        if k < claim.min_pairs:
+            return None, f"not judged (n = {int(k)} pairs; the rule needs >= {claim.min_pairs})"
     parts, holds = [], True
     for c in claim.rule:
         a = values.get(c.metric)
