@@ -118,7 +118,7 @@ def test_hallway_tuning_row_needs_the_paired_reduction():
     from teamnav.papers.collab_mcl.report.section import tuning_claim_values
 
     row = {"part": "hallway", "alone_ttl_s": 150.0, "team_ttl_s": 139.0, "alone_final_localized": 0.78,
-           "team_final_localized": 0.91, "paired_s": -11.0, "paired_se_s": 33.0}
+           "team_final_localized": 0.91, "paired_s": -11.0, "paired_se_s": 33.0, "pairs": 12}
     claim = load_claims("collab-mcl")["hallway-faster"]
     assert judge(claim, tuning_claim_values(row))[0] is False  # -11 + 2 x 33 > 0
     assert judge(claim, tuning_claim_values({**row, "paired_se_s": 5.0}))[0] is True

@@ -171,7 +171,7 @@ def test_a_claim_that_needs_an_unmet_precondition_reads_precondition_not_met(mon
     # a claim that does not need it is judged as the claim file says either way
     monkeypatch.setitem(fid.PRECONDITION, "holds", False)
     hv = {"together_ttl_mean_s": 100.0, "alone_ttl_mean_s": 200.0, "together_final_localized": 1.0,
-          "alone_final_localized": 1.0, "paired_change_upper_s": -10.0}
+          "alone_final_localized": 1.0, "paired_change_upper_s": -10.0, "n_pairs": 8.0}
     assert fid.gated_judge(claims["hallway-faster"], hv)[0] is True
     block = fid.precondition_block()
     assert block.holds is False and set(block.claims) == {"single-detection", "fp-breaks"}

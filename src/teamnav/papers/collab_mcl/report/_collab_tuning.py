@@ -74,7 +74,8 @@ def tuning_claim_values(row: dict) -> dict[str, float]:
     out = {"alone_ttl_mean_s": num(row["alone_ttl_s"]), "together_ttl_mean_s": num(row["team_ttl_s"]),
            "alone_final_localized": num(row["alone_final_localized"]),
            "together_final_localized": num(row["team_final_localized"]),
-           "paired_change_upper_s": num(row["paired_s"]) + 2.0 * num(row["paired_se_s"])}
+           "paired_change_upper_s": num(row["paired_s"]) + 2.0 * num(row["paired_se_s"]),
+           "n_pairs": num(row.get("pairs"))}
     if row["part"] == "hexagon":
         out.update({"together_min_localized": min(num(row["team_localized_sonar"]), num(row["team_localized_laser"])),
                     "alone_best_localized": max(num(row["alone_localized_sonar"]), num(row["alone_localized_laser"])),
