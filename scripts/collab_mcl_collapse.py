@@ -79,6 +79,9 @@ TEAMNAV_CHECKS: dict[str, tuple[str, str, dict[int, dict]]] = {
     "detection": ("collab-mcl-detection", "§5.1 as the scenario is (lost prior 0.3)", {}),
     "detection-prior0.1": ("collab-mcl-detection", "§5.1, inject_lost_prior 0.1", {1: {"inject_lost_prior": 0.1}}),
     "detection-prior0.6": ("collab-mcl-detection", "§5.1, inject_lost_prior 0.6", {1: {"inject_lost_prior": 0.6}}),
+    # 2026-11-29: the grid extended past 0.6, which the rule picked at the edge (FIDELITY §3)
+    "detection-prior0.8": ("collab-mcl-detection", "§5.1, inject_lost_prior 0.8", {1: {"inject_lost_prior": 0.8}}),
+    "detection-prior0.9": ("collab-mcl-detection", "§5.1, inject_lost_prior 0.9", {1: {"inject_lost_prior": 0.9}}),
     "detection-scanheading": ("collab-mcl-detection", "§5.1, draws' headings picked by the scan (the hallway's "
                               "setting) instead of half from the own belief",
                               {1: {"inject_heading_belief_share": 0.0, "inject_heading_scan_share": 1.0}}),

@@ -26,6 +26,9 @@ def test_unknown_keys_tuning_seeds_and_bad_ops_are_refused():
         Claim.model_validate({**BASE, "threshold": 3})
     with pytest.raises(ValidationError, match="tuning seeds"):
         Claim.model_validate({**BASE, "seeds": "1000-1009"})
+    with pytest.raises(ValidationError, match="tuning seeds"):
+        Claim.model_validate({**BASE, "seeds": "1990-2009"})  # straddles the tuning range's end
+    assert Claim.model_validate({**BASE, "seeds": "2000-2009"}).seed_list[0] == 2000  # fresh judged seeds
     with pytest.raises(ValidationError):
         Claim.model_validate({**BASE, "rule": [{"metric": "r", "op": "=>", "threshold": 1}]})
 
@@ -46,3 +49,12 @@ def test_the_two_rules_changed_with_their_data_are_restored():
     drift = load_claims("try-to-see-it-my-way")["drift-collapse"]
     assert {c.metric for c in drift.rule} == {"share_last10_kmax", "blaze_last10_kmax"}
     assert any(not h.before_data and h.commit == "ece0e2d" for h in drift.history)
+
+
+def test_a_paired_rule_with_too_few_pairs_is_not_judged():
+    c = Claim.model_validate({**BASE, "min_pairs": 5, "pairs_metric": "pairs"})
+    assert judge(c, {"r": 5.0, "b": 2.0, "pairs": 4.0}) == (None, "not judged (n = 4 pairs; the rule needs >= 5)")
+    assert judge(c, {"r": 5.0, "b": 2.0, "pairs": 5.0})[0] is True
+    assert judge(c, {"r": 5.0, "b": 2.0})[0] is None  # the count itself not measured
+    with pytest.raises(ValidationError):
+        Claim.model_validate({**BASE, "min_pairs": 2})  # FIDELITY §3: at least 5

@@ -59,15 +59,17 @@ def test_a_factor_that_is_a_paper_rule_writes_the_other_rules_out(factor, field,
 
 
 def test_one_short_run_measures_the_belief_and_a_flatter_likelihood_keeps_it_wider():
-    """At 6 s Robin's paper-rules belief is already within a metre on seed 1000 (the collapse the
-    script measures); the tempered likelihood (teamnav's 0.03) keeps it spread over metres."""
+    """The script's measures on one short run; a flatter likelihood (exponent 0.03) keeps the belief
+    wider. Until 2026-11-29 (90 beams at sigma_hit 0.2 m, the bare corridor) the paper-rules belief was
+    within a metre at 5 s on seed 1000 (the collapse the script was written for); with the beam fill
+    (10 beams, 0.8 m) it is still spread over metres."""
     paper = cc.one_run(("detection", "paper_rules", "paper", 1000, True, 6.0))
     temper = cc.one_run(("detection", "paper_rules", "temper", 1000, True, 6.0))
     for r in (paper, temper):
         assert {"n_5s", "spread_5s_m", "final_error_m", "det_n"} <= set(r)
         assert r["det_n"] is None  # no detection in 6 s
-    assert paper["spread_5s_m"] < 1.0
-    assert temper["spread_5s_m"] > 3.0 * paper["spread_5s_m"]
+    assert paper["spread_5s_m"] > 1.0
+    assert temper["spread_5s_m"] > paper["spread_5s_m"]
 
 
 def test_teamnav_checks_load():
@@ -116,7 +118,7 @@ def test_hallway_tuning_row_needs_the_paired_reduction():
     from teamnav.papers.collab_mcl.report.section import tuning_claim_values
 
     row = {"part": "hallway", "alone_ttl_s": 150.0, "team_ttl_s": 139.0, "alone_final_localized": 0.78,
-           "team_final_localized": 0.91, "paired_s": -11.0, "paired_se_s": 33.0}
+           "team_final_localized": 0.91, "paired_s": -11.0, "paired_se_s": 33.0, "pairs": 12}
     claim = load_claims("collab-mcl")["hallway-faster"]
     assert judge(claim, tuning_claim_values(row))[0] is False  # -11 + 2 x 33 > 0
     assert judge(claim, tuning_claim_values({**row, "paired_se_s": 5.0}))[0] is True

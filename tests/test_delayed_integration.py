@@ -242,13 +242,17 @@ def test_cotravel_values_pair_by_seed_and_feed_the_claim():
     assert v["delay_faster_pairs"] == 2 and v["delay_n_pairs"] == 3
     assert v["integrate_ttl_mean_s"] == pytest.approx(950 / 3)
     assert v["delay_vs_drop_paired_mean_s"] == pytest.approx((-60 - 80 + 20) / 3)
-    # the upper bound -20 + 2 * 33 > 0: not clearly faster, so the claim does not hold
-    ok, _ = judge(load_claims("collab-mcl")["delayed-integration"], v)
+    # three pairs are fewer than the claim's minimum of five: not judged
+    claim = load_claims("collab-mcl")["delayed-integration"]
+    ok, text = judge(claim, v)
+    assert ok is None and "n = 3" in text
+    # with five pairs, the upper bound -20 + 2 * 33 > 0: not clearly faster, so the claim does not hold
+    ok, _ = judge(claim, {**v, "delay_n_pairs": 5.0})
     assert ok is False
 
 
 def test_cotravel_sweep_runs_the_claims_seeds_with_valid_params():
-    """The sweep's four cases on the claim's report seeds; every case's params validate (integrate with
+    """The sweep's four cases on the claim's judged seeds; every case's params validate (integrate with
     no threshold, drop and delay with the same one); the robots start together, heading north."""
     from teamnav.experiments.claims import load_claims
     from teamnav.experiments.spec import load_scenario

@@ -93,7 +93,7 @@ def test_hexagon_has_glass_and_foam_and_8m_edges():
     env = builtin_map("hexagon")
     g = env.grid
     assert (g.cells == GLASS).sum() > 50 and (g.cells == FOAM).sum() > 50
-    assert set(env.regions) == {"glass_1", "glass_2", "foam_1", "foam_2", "foam_3"}
+    assert set(env.regions) == {"glass_1", "glass_2", "glass_3", "foam_1", "foam_2"}
     # a laser does not see glass, a sonar does not see foam
     laser = g.blocking(("wall", "unknown", "foam"))
     sonar = g.blocking(("wall", "unknown", "glass"))
@@ -109,7 +109,9 @@ def test_hexagon_has_glass_and_foam_and_8m_edges():
 
 
 def test_hexagon_symmetries_per_sensor():
-    """Sonar map keeps a 180° symmetry, laser map a 120° one, the union neither (Fox §5.2.2)."""
+    """Sonar map keeps a 120° symmetry (three locations), laser map a 180° one (two), the union
+    neither (Fox §5.2.2: sonar robots "cannot distinguish between three possible robot
+    locations", laser robots "remain uncertain about two")."""
     env = builtin_map("hexagon")
     cx, cy = env.places["centre"]
 
@@ -122,8 +124,8 @@ def test_hexagon_symmetries_per_sensor():
         return all(np.min(np.hypot(*(pts - p).T)) < 1e-6 for p in rot)
 
     glass, foam = centres("glass"), centres("foam")
-    assert invariant(glass, 180) and not invariant(glass, 120) and not invariant(glass, 60)
-    assert invariant(foam, 120) and not invariant(foam, 180) and not invariant(foam, 60)
+    assert invariant(glass, 120) and not invariant(glass, 180) and not invariant(glass, 60)
+    assert invariant(foam, 180) and not invariant(foam, 120) and not invariant(foam, 60)
 
 
 def test_trail_office_home_source_path_length():
@@ -231,23 +233,30 @@ def test_symmetric_hallway_regions_and_mirror_symmetry():
     assert not (np.array_equal(np.rot90(w, 1), b) or np.array_equal(np.rot90(w, -1), b))
 
 
-def test_lab_is_cluttered_and_corridor_featureless():
+def test_corridor_has_alike_offices_and_looks_the_same_both_ways():
+    """Fox §5.1 / Fig. 8: a long corridor lined with alike doors and offices, the lab one of them;
+    the map is symmetric under the 180° turn about the corridor's centre and periodic with the
+    door spacing away from its ends, so a robot in it stays unsure of its place and heading."""
+    from teamnav.papers.collab_mcl.maps import CORRIDOR_DOORS_X, LAB_DOOR_X
+
     env = builtin_map("lab_and_corridor")
     g = env.grid
-    lab = g.cells[g.world_to_cell(np.array([22.0, 1.0]))[0]:g.world_to_cell(np.array([30.0, 8.3]))[0] + 1,
-                  g.world_to_cell(np.array([22.0, 1.0]))[1]:g.world_to_cell(np.array([30.0, 8.3]))[1] + 1]
-    assert (lab != FREE).mean() > 0.1  # clutter
-    assert not np.array_equal(lab, lab[::-1]) and not np.array_equal(lab, lab[:, ::-1])
-    (r0, c0), (r1, c1) = g.world_to_cell(np.array([[2.0, 8.5], [40.0, 10.7]]))
-    assert (g.cells[r0 + 1:r1, c0:c1] == FREE).all()  # the corridor itself is open along its length
-    # bare walls: apart from the lab opening, every column across the corridor (walls included)
-    # is the same, so nothing along it tells a robot where it is
-    band = g.cells[r0 - 2:r1 + 3, c0:c1] == FREE  # corridor and its two 0.2 m walls
-    (_, o0), (_, o1) = g.world_to_cell(np.array([[23.0, 0.0], [24.6, 0.0]]))
-    keep = np.ones(band.shape[1], bool)
-    keep[o0 - c0 - 1:o1 - c0 + 2] = False
-    assert (band[:, keep] == band[:, :1]).all()
-    assert not (band[:, ~keep] == band[:, :1]).all()  # the opening is visible
+    x0, y0, x1, y1 = env.regions["corridor"]
+    (r0, c0), (r1, c1) = g.world_to_cell(np.array([[x0 + 0.05, 4.35], [x1 - 0.05, 14.85]]))
+    block = g.cells[r0:r1 + 1, c0:c1 + 1] == FREE
+    assert np.array_equal(block, block[::-1, ::-1])  # 180° turn about (31.3, 9.6)
+    period = int(round(5.0 / g.resolution_m))
+    inner = block[:, period:-period]
+    assert np.array_equal(inner[:, period:], inner[:, :-period])  # one office pair repeats every 5 m
+    assert LAB_DOOR_X in CORRIDOR_DOORS_X
+    lx0, ly0, lx1, ly1 = env.regions["lab"]
+    (a0, b0), (a1, b1) = g.world_to_cell(np.array([[lx0 + 0.05, ly0 + 0.05], [lx1 - 0.05, ly1 - 0.05]]))
+    lab = g.cells[a0:a1 + 1, b0:b1 + 1]
+    assert 0.05 < (lab != FREE).mean() < 0.5  # furniture
+    assert not np.array_equal(lab, lab[:, ::-1])  # not mirror symmetric across the door's axis
+    # the observer stands in the lab, facing the lab's door
+    ox, oy = env.places["observer"]
+    assert lx0 < ox < lx1 and ly0 < oy < ly1 and ox == LAB_DOOR_X
 
 
 # ---------------------------------------------------------------------------- registry

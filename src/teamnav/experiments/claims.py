@@ -4,7 +4,7 @@
 (:mod:`teamnav.plugins`; e.g. ``teamnav/papers/los_help/claims/los-help.yaml``) holds, for each claim a report section judges: the
 paper's statement (quote and section), the paper's number, the metric, the verdict rule (one or
 more conditions, all of which must hold: a metric, a comparison, a threshold and, for a relative
-rule, the metric it is relative to), the seeds (report seeds only; tuning uses seeds >= 1000,
+rule, the metric it is relative to), the seeds (report seeds only: below 1000, or fresh judged seeds from 2000; tuning uses 1000-1999,
 never a report), the number of runs judged, which column is judged (``paper_rules``: the paper
 as written; ``teamnav``: our gap-fills) and the rule's history.
 
@@ -35,7 +35,7 @@ from typing import Literal, Mapping
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-__all__ = ["CLAIMS_DIR", "Claim", "claims_path", "ClaimFile", "Condition", "TUNING_SEED_MIN", "judge", "load_claims", "rule_text"]
+__all__ = ["CLAIMS_DIR", "Claim", "claims_path", "ClaimFile", "Condition", "TUNING_SEED_MAX", "TUNING_SEED_MIN", "judge", "load_claims", "rule_text"]
 
 #: the folder of the claim files
 CLAIMS_DIR = Path(__file__).with_name("claims")  #: claim files of sections the core adds itself (none today)
@@ -52,8 +52,11 @@ def claims_path(section: str) -> Path:
             if folder is not None:
                 return folder / "claims" / f"{section}.yaml"
     return CLAIMS_DIR / f"{section}.yaml"
-#: seeds at or above this are tuning seeds; a claim's (report) seeds must lie below it
+#: tuning seeds are TUNING_SEED_MIN .. TUNING_SEED_MAX; a claim's seeds lie outside that range: the
+#: report seeds below it, or fresh judged seeds above it (FIDELITY §3: judged on seeds no run has
+#: touched, e.g. 2000-2029)
 TUNING_SEED_MIN = 1000
+TUNING_SEED_MAX = 1999
 
 _OPS = {">=": lambda a, b: a >= b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, "<": lambda a, b: a < b}
 _STRICT = ConfigDict(extra="forbid", frozen=True, strict=False)
@@ -124,6 +127,10 @@ class Claim(BaseModel):
     seeds: str
     quick_seeds: str | None = None
     n: int = Field(ge=1)  # runs judged in full mode (all cases and both teams where a rule reads both)
+    #: a paired verdict: fewer pairs than this (read from the metric ``pairs_metric``) reads "not
+    #: judged (n = k)" (FIDELITY §3: at least 5, fixed in the claim file)
+    min_pairs: int | None = Field(None, ge=5)
+    pairs_metric: str = Field("n_pairs", min_length=1)
     judged: Literal["paper_rules", "teamnav"]
     history: list[HistoryEntry] = Field(min_length=1)
     note: str = ""
@@ -139,8 +146,10 @@ class Claim(BaseModel):
         if v is None:
             return v
         seeds = _parse_seeds(v)
-        if max(seeds) >= TUNING_SEED_MIN:
-            raise ValueError(f"seeds {v!r}: seeds >= {TUNING_SEED_MIN} are tuning seeds, never a report's")
+        tuning = [x for x in seeds if TUNING_SEED_MIN <= x <= TUNING_SEED_MAX]
+        if tuning:
+            raise ValueError(f"seeds {v!r}: seeds {TUNING_SEED_MIN}-{TUNING_SEED_MAX} are tuning seeds, never a "
+                             f"report's (got {tuning[0]})")
         return v
 
     @model_validator(mode="after")
@@ -211,11 +220,17 @@ def _fmt(v: float) -> str:
 def judge(claim: Claim, values: Mapping[str, float], duration_s: float | None = None) -> tuple[bool | None, str]:
     """Whether ``claim`` holds on ``values`` (metric name -> number), and how it was read.
 
-    None (not judged) when a metric is missing or not finite, or when ``duration_s`` is below
-    the claim's ``min_duration_s``.
+    None (not judged) when a metric is missing or not finite, when ``duration_s`` is below
+    the claim's ``min_duration_s``, or when a paired claim has fewer than ``min_pairs`` pairs.
     """
     if duration_s is not None and duration_s < claim.min_duration_s:
         return None, f"not judged on {duration_s / 60:g}-min runs (the rule needs >= {claim.min_duration_s / 60:g} min)"
+    if claim.min_pairs is not None:
+        k = values.get(claim.pairs_metric)
+        if not isinstance(k, (int, float)) or not math.isfinite(k):
+            return None, f"{claim.pairs_metric}: not measured"
+        if k < claim.min_pairs:
+            return None, f"not judged (n = {int(k)} pairs; the rule needs >= {claim.min_pairs})"
     parts, holds = [], True
     for c in claim.rule:
         a = values.get(c.metric)

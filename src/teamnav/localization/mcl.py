@@ -100,7 +100,20 @@ class MCLParams(BaseModel):
     alpha_slow, alpha_fast : float
         Averaging rates of ``w_slow``, ``w_fast`` (``0 < alpha_slow < alpha_fast <= 1``).
     adaptive : bool, default False
-        KLD-sampling of the sample count (Fox 2003).
+        Adapt the sample count at each resampling (``adapt`` says how).
+    adapt : {"kld", "likelihood"}, default "kld"
+        ``"kld"``: KLD-sampling (Fox 2003). ``"likelihood"``: the likelihood-based adaptation of
+        Fox et al. (1999a), the method Fox et al. 2000 §3.1 cites for "MCL determines the sample set
+        size on-the-fly": samples are drawn until the sum of their non-normalised likelihoods
+        exceeds a threshold ``eta``. Here the next set's count is the number expected to reach it,
+        ``n = eta / mean_i P(o | l_i)`` of the last applied scan, with ``eta = min_particles *
+        P_ref`` and ``log P_ref = likelihood_ref_per_beam * (beams used) * likelihood_exponent``,
+        clipped to ``[kld.min_particles, kld.max_particles]`` (:meth:`MCL.likelihood_count`): a
+        robot whose samples fit the scan as well as a tracking robot's keeps about
+        ``min_particles``, one whose samples fit worse (lost) gets more.
+    likelihood_ref_per_beam : float or None
+        ``log P_ref`` per used beam (untempered) for ``adapt="likelihood"``: a tracking filter's
+        per-beam log mean likelihood (a fill; :attr:`MCL.last_log_mean_likelihood_per_beam`).
     init_clearance_m : float, default 0
         Uniform samples are drawn only where the nearest obstacle is at least this far [m].
     min_update_trans_m, min_update_rot_rad : float, default 0
@@ -131,6 +144,8 @@ class MCLParams(BaseModel):
     alpha_slow: float = Field(0.001, gt=0.0, lt=1.0)
     alpha_fast: float = Field(0.1, gt=0.0, le=1.0)
     adaptive: bool = False
+    adapt: Literal["kld", "likelihood"] = "kld"
+    likelihood_ref_per_beam: float | None = Field(None, ge=-1e6, le=1e6)
     kld: KLDParams = KLDParams()
     init_clearance_m: float = Field(0.0, ge=0.0, le=10.0)
     min_update_trans_m: float = Field(0.0, ge=0.0, le=100.0)
@@ -144,6 +159,9 @@ class MCLParams(BaseModel):
         if self.recovery == "augmented" and not self.alpha_slow < self.alpha_fast:
             raise ValueError(f"alpha_slow must be < alpha_fast ({self.alpha_fast}) for recovery='augmented', "
                              f"got {self.alpha_slow}")
+        if self.adapt == "likelihood" and self.likelihood_ref_per_beam is None:
+            raise ValueError("adapt='likelihood' needs likelihood_ref_per_beam (a tracking filter's per-beam log "
+                             "mean likelihood)")
         return self
 
 
@@ -574,6 +592,24 @@ class MCL(SampleSetState):
                 self._log_w_fast = float(np.logaddexp(math.log1p(-ps.alpha_fast) + self._log_w_fast if ps.alpha_fast < 1
                                                       else -math.inf, math.log(ps.alpha_fast) + log_mean))
 
+    @property
+    def last_log_mean_likelihood_per_beam(self) -> float:
+        """:attr:`last_log_mean_likelihood` per used beam, untempered (NaN before the first scan)."""
+        return self.last_log_mean_likelihood / (self._beam_idx.shape[0] * self.params.likelihood_exponent)
+
+    def likelihood_count(self) -> int:
+        """Sample count of the next set under ``adapt="likelihood"`` (see :class:`MCLParams`): the
+        number of samples whose likelihoods are expected to sum to ``eta``; ``max_particles`` before
+        the first scan."""
+        ps = self.params
+        kp = ps.kld
+        ll = self.last_log_mean_likelihood
+        if not math.isfinite(ll) or ps.likelihood_ref_per_beam is None:
+            return kp.max_particles
+        ref = ps.likelihood_ref_per_beam * self._beam_idx.shape[0] * ps.likelihood_exponent
+        n = kp.min_particles * math.exp(min(ref - ll, 50.0))
+        return int(min(kp.max_particles, max(kp.min_particles, math.ceil(n))))
+
     def random_sample_probability(self) -> float:
         """Share of samples the next :meth:`resample` draws uniformly over free space."""
         ps = self.params
@@ -587,13 +623,17 @@ class MCL(SampleSetState):
         """Draw a new, equally weighted sample set from the weighted one (§3.1 step 1).
 
         Low-variance draws; the count is ``n_particles`` or, with ``adaptive``, the
-        KLD-sampling bound (Fox 2003) over the drawn samples; then each sample is replaced with
+        KLD-sampling bound (Fox 2003) over the drawn samples or the likelihood-based count
+        (Fox et al. 1999a, :meth:`likelihood_count`); then each sample is replaced with
         probability :meth:`random_sample_probability` by one uniform over free space.
         """
         self._require_particles("resample")
         ps = self.params
         w = self._weights
-        if ps.adaptive:
+        if ps.adaptive and ps.adapt == "likelihood":
+            n = self.likelihood_count()
+            idx = low_variance_kernel(w, n, float(self.rng.random()), np.empty(n, dtype=np.int64))
+        elif ps.adaptive:
             kp = ps.kld
             m = kp.max_particles
             idx = low_variance_kernel(w, m, float(self.rng.random()), np.empty(m, dtype=np.int64))

@@ -17,7 +17,7 @@ import numpy as np
 
 from teamnav.world.map_builder import EnvironmentMap, MapBuilder, _res
 
-__all__ = ["symmetric_hallway", "hexagon", "lab_and_corridor"]
+__all__ = ["CORRIDOR_DOORS_X", "LAB_DOOR_X", "symmetric_hallway", "hexagon", "lab_and_corridor"]
 
 
 def symmetric_hallway(resolution_m: float = 0.1) -> EnvironmentMap:
@@ -77,11 +77,15 @@ def hexagon(resolution_m: float = 0.1) -> EnvironmentMap:
     A regular hexagon (circumradius 8 m, flat top and bottom) centred at (8.5, 7.5) m.
     Interior obstacles are discs of radius 0.6 m made of materials only one sensor sees:
 
-    - ``glass`` (sonar only), at polar angles 20° and 200°, 4.5 m from the centre: the
-      hexagon's symmetries that keep them are the identity and the 180° turn, so a
-      sonar robot keeps two hypotheses;
-    - ``foam`` (laser only), at 100°, 220° and 340°, 2.5 m from the centre: kept by the
-      120° and 240° turns, so a laser robot keeps three hypotheses.
+    - ``glass`` (sonar only), at polar angles 100°, 220° and 340°, 2.5 m from the centre:
+      kept by the 120° and 240° turns, so a sonar robot keeps three hypotheses;
+    - ``foam`` (laser only), at 20° and 200°, 4.5 m from the centre: the hexagon's symmetries
+      that keep them are the identity and the 180° turn, so a laser robot keeps two.
+
+    §5.2.2: "robots using sonar sensors for localization cannot distinguish between three
+    possible robot locations (see Fig. 13(c)), robots equipped with laser range-finders remain
+    uncertain about two possible locations". Until 2026-11-29 the materials were the other way
+    round (sonar two, laser three).
 
     No mirror of the hexagon keeps either set, and the only rotation keeping both is the
     identity, so only a team mixing sensors (sharing beliefs at detections) can localize
@@ -98,55 +102,91 @@ def hexagon(resolution_m: float = 0.1) -> EnvironmentMap:
     b = MapBuilder(17.0, 15.0, res).fill("wall").clear_polygon(verts)
     regions: dict[str, tuple[float, float, float, float]] = {}
     r_obs = 0.6
-    for k, deg in enumerate((20.0, 200.0), start=1):
-        x, y = cx + 4.5 * math.cos(math.radians(deg)), cy + 4.5 * math.sin(math.radians(deg))
-        b.disc(x, y, r_obs, material="glass")
-        regions[f"glass_{k}"] = (x - r_obs, y - r_obs, x + r_obs, y + r_obs)
     for k, deg in enumerate((100.0, 220.0, 340.0), start=1):
         x, y = cx + 2.5 * math.cos(math.radians(deg)), cy + 2.5 * math.sin(math.radians(deg))
+        b.disc(x, y, r_obs, material="glass")
+        regions[f"glass_{k}"] = (x - r_obs, y - r_obs, x + r_obs, y + r_obs)
+    for k, deg in enumerate((20.0, 200.0), start=1):
+        x, y = cx + 4.5 * math.cos(math.radians(deg)), cy + 4.5 * math.sin(math.radians(deg))
         b.disc(x, y, r_obs, material="foam")
         regions[f"foam_{k}"] = (x - r_obs, y - r_obs, x + r_obs, y + r_obs)
     places = {"centre": (cx, cy)}
     for k, a in enumerate(angles):
         places[f"start_{k}"] = (round(cx + (radius - 2.0) * math.cos(a), 6), round(cy + (radius - 2.0) * math.sin(a), 6))
     notes = (
-        "Fox et al. §5.2.2 Fig. 13: regular hexagon, 8 m edges; glass discs (sonar only) at 20/200 deg "
-        "(2-fold symmetric), foam discs (laser only) at 100/220/340 deg (3-fold); together unique."
+        "Fox et al. §5.2.2 Fig. 13: regular hexagon, 8 m edges; glass discs (sonar only) at 100/220/340 deg "
+        "(3-fold symmetric: sonar robots keep 3 locations), foam discs (laser only) at 20/200 deg (2-fold: "
+        "laser robots keep 2); together unique."
     )
     return EnvironmentMap(b.build("builtin:hexagon"), places, notes, regions)
 
 
-def lab_and_corridor(resolution_m: float = 0.1) -> EnvironmentMap:
-    """Fox, Burgard, Kruppa & Thrun §5.1, Fig. 8: a cluttered lab beside a long corridor.
+#: Door centres along the §5.1 corridor [m]: every 5 m on both sides; the lab's is 23.8 m.
+CORRIDOR_DOORS_X: tuple[float, ...] = tuple(3.8 + 5.0 * k for k in range(12))
+#: The lab's door centre [m] (Marian faces it).
+LAB_DOOR_X: float = 23.8
 
-    A 40 m x 2.2 m corridor with bare, featureless walls (so a robot in it "generally has
-    to travel a long distance" to resolve its position and even its heading, §5.1), and an
-    8 m x 7.3 m lab south of it, joined by a 1.6 m opening near the lab's west end. The lab
-    is cluttered and non-symmetric (desk, cabinet, round table, boxes) so a robot in it
-    knows "fairly well where it is". Marian, in the lab, faces the opening (``observer``,
-    heading +90°); Robin travels the corridor (``corridor_west`` to ``corridor_east``).
+
+def _office(b: MapBuilder, xc: float, south: bool) -> None:
+    """One office of :func:`lab_and_corridor`: a 4.6 m x 4 m room behind a 1.6 m door centred at
+    ``xc``, with a desk along its far wall and a round table beside the door's east jamb. A north
+    office is the south one turned by 180° about the point (xc, 9.6) (the corridor's centre line),
+    so the corridor looks the same driven east or west."""
+    def box(x0, y0, x1, y1, clear=False):
+        if not south:  # 180° turn about (xc, 9.6)
+            x0, y0, x1, y1 = 2 * xc - x1, 19.2 - y1, 2 * xc - x0, 19.2 - y0
+        (b.clear_rect if clear else b.rect)(x0, y0, x1, y1)
+
+    def disc(x, y, r):
+        if not south:
+            x, y = 2 * xc - x, 19.2 - y
+        b.disc(x, y, r)
+
+    box(xc - 2.3, 4.3, xc + 2.3, 8.3, clear=True)  # room
+    box(xc - 0.8, 8.3, xc + 0.8, 8.5, clear=True)  # door
+    box(xc - 1.6, 4.3, xc + 1.2, 5.0)              # desk along the far wall
+    disc(xc + 1.4, 6.4, 0.45)                      # round table
+
+
+def lab_and_corridor(resolution_m: float = 0.1) -> EnvironmentMap:
+    """Fox, Burgard, Kruppa & Thrun §5.1, Fig. 8: a long corridor with many similar offices, one
+    of them the lab.
+
+    A 60.6 m x 2.2 m corridor (x 1.0 .. 61.6 m, y 8.5 .. 10.7 m) with 12 doors on each side,
+    1.6 m wide, every 5 m (:data:`CORRIDOR_DOORS_X`), each into a 4.6 m x 4 m office with a desk and
+    a round table. The offices are alike and the north ones are the south ones turned by 180°
+    about the corridor's centre line, so the whole corridor is symmetric under the 180° turn about
+    its centre (31.3, 9.6) and, away from its ends, periodic with the door spacing. The lab is the
+    south office at x = 23.8 m (:data:`LAB_DOOR_X`). Marian, in the lab, faces its door
+    (``observer``, heading +90°); Robin travels the corridor eastwards.
+
+    From the paper: Fig. 8 shows a long corridor lined with doors and offices; Robin, passing the
+    lab after "several meters" of travel, is "still highly uncertain about its exact location
+    within the corridor and even does not know its global heading direction ... due to the lack of
+    features in the corridor the robots generally have to travel a long distance" (§5.1). Ours:
+    the sizes, the 5 m spacing, the furniture and the exact symmetry, chosen (2026-11-29, on tuning
+    seeds 1000-1009, docs/report/collab-mcl.md) so that the precondition holds: Robin alone is
+    still multi-modal when it passes the lab. Until 2026-11-29 the corridor was bare with a single
+    opening, the lab's, which localized Robin by itself before the detection.
     """
     res = _res(resolution_m)
-    b = MapBuilder(42.0, 12.0, res).fill("wall")
-    b.clear_rect(1.0, 8.5, 41.0, 10.7)  # corridor
-    b.clear_rect(22.0, 1.0, 30.0, 8.3)  # lab
-    b.clear_rect(23.0, 8.3, 24.6, 8.5)  # opening
-    b.rect(26.0, 1.0, 29.6, 2.0)  # desk along the south wall
-    b.rect(29.4, 3.0, 30.0, 6.6)  # cabinet on the east wall
-    b.disc(25.6, 4.4, 0.7)  # round table
-    b.rect(22.0, 1.0, 23.3, 3.0)  # boxes in the south-west corner
-    b.rect(27.2, 6.6, 28.4, 8.3)  # shelf against the north wall
+    b = MapBuilder(62.6, 16.0, res).fill("wall")
+    b.clear_rect(1.0, 8.5, 61.6, 10.7)  # corridor
+    for xc in CORRIDOR_DOORS_X:
+        _office(b, xc, south=True)
+        _office(b, xc, south=False)
+    lab = (LAB_DOOR_X - 2.3, 4.3, LAB_DOOR_X + 2.3, 8.3)
     places = {
-        "observer": (23.8, 6.6),
-        "lab_centre": (27.0, 4.6),
-        "lab_door": (23.8, 9.6),
+        "observer": (LAB_DOOR_X, 6.6),
+        "lab_centre": (LAB_DOOR_X, 6.3),
+        "lab_door": (LAB_DOOR_X, 9.6),
         "corridor_west": (2.5, 9.6),
-        "corridor_east": (39.5, 9.6),
+        "corridor_east": (60.1, 9.6),
     }
-    regions = {"corridor": (1.0, 8.5, 41.0, 10.7), "lab": (22.0, 1.0, 30.0, 8.3)}
+    regions = {"corridor": (1.0, 8.5, 61.6, 10.7), "lab": lab}
     notes = (
-        "Fox et al. §5.1 Fig. 8: 40x2.2 m featureless corridor; 8x7.3 m cluttered, non-symmetric lab "
-        "south of it with a 1.6 m opening at x in [23.0, 24.6] m; the observer (Marian) faces the "
-        "opening (heading +90 deg)."
+        "Fox et al. §5.1 Fig. 8: a 60.6x2.2 m corridor with 12 alike offices (4.6x4 m, desk and round table) on "
+        "each side behind 1.6 m doors every 5 m, north ones the south ones turned by 180 deg; the lab is the "
+        f"south office with its door at x = {LAB_DOOR_X} m; the observer (Marian) faces that door (heading +90 deg)."
     )
     return EnvironmentMap(b.build("builtin:lab_and_corridor"), places, notes, regions)

@@ -38,7 +38,7 @@ import numpy as np
 
 from teamnav.experiments.metrics import RunData, register
 
-__all__ = ["HEADLINE", "LOCALIZED_M", "error_matrix"]
+__all__ = ["HEADLINE", "LOCALIZED_M", "MODE_RADIUS_M", "belief_modes", "error_matrix", "heaviest_mode"]
 
 #: what ``teamnav run`` prints of these metrics (see :mod:`teamnav.experiments.metric_sets`)
 HEADLINE: dict[str, tuple[tuple[str, str], ...]] = {
@@ -56,6 +56,55 @@ HEADLINE: dict[str, tuple[tuple[str, str], ...]] = {
 #: Fox et al. §5.2.1: a robot is localized once its error is below this [m].
 LOCALIZED_M: float = 1.5
 _MAX_SERIES = 300
+
+
+#: §5.1 precondition: a "mode" is the samples within this of one sample [m]
+MODE_RADIUS_M: float = 1.0
+
+
+def heaviest_mode(pts, radius_m: float = MODE_RADIUS_M) -> float:
+    """The heaviest mode of a belief given as points drawn by weight: the largest share of the
+    points within ``radius_m`` of one of them (the §5.1 precondition's measure, rule 3 of
+    docs/report/collab-mcl.md "2026-11-29").
+
+    Examples
+    --------
+    >>> heaviest_mode([[0, 0], [0.5, 0], [10, 0], [20, 0]])
+    0.5
+    """
+    p = np.asarray(pts, dtype=float).reshape(-1, 2)
+    if p.shape[0] == 0:
+        raise ValueError("pts must hold at least one point")
+    d = np.hypot(p[:, None, 0] - p[None, :, 0], p[:, None, 1] - p[None, :, 1])
+    return float((d <= radius_m).sum(axis=1).max() / p.shape[0])
+
+
+def belief_modes(pts, link_m: float = 1.5, min_share: float = 0.1) -> int:
+    """Number of modes of a belief given as points drawn by weight: groups of points joined by
+    single linkage at ``link_m`` that hold at least ``min_share`` of them (the hexagon's counts,
+    rule 4 of docs/report/collab-mcl.md "2026-11-29").
+
+    Examples
+    --------
+    >>> belief_modes([[0, 0], [1, 0], [2, 0], [9, 9], [9, 10], [30, 0]], min_share=0.2)
+    2
+    """
+    p = np.asarray(pts, dtype=float).reshape(-1, 2)
+    n = p.shape[0]
+    parent = list(range(n))
+
+    def find(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    d = np.hypot(p[:, None, 0] - p[None, :, 0], p[:, None, 1] - p[None, :, 1])
+    for i, j in zip(*np.nonzero(np.triu(d <= link_m, 1))):
+        parent[find(i)] = find(j)
+    roots = [find(i) for i in range(n)]
+    sizes = np.unique(roots, return_counts=True)[1]
+    return int((sizes >= min_share * n).sum())
 
 
 def error_matrix(data: RunData) -> tuple[np.ndarray, np.ndarray, list[str], list[str]] | None:

@@ -369,6 +369,8 @@ class MCLWander(AnonymousAssociation):
         self._det_log.append({"t_s": round(float(obs.time_s), 2), "from": int(body.observer),
                               "n_particles": int(est.n_particles),
                               "spread_m": round(float(math.sqrt(max(0.0, est.cov[0, 0] + est.cov[1, 1]))), 3),
+            "loglik_per_beam": (round(float(self.mcl.last_log_mean_likelihood_per_beam), 4)
+                                if math.isfinite(self.mcl.last_log_mean_likelihood) else None),
                               "cluster_weight": round(float(est.cluster_weight), 3),
                               "applied": bool(self.sync.applied["detection"] > before)})
         return out
@@ -428,6 +430,8 @@ class MCLWander(AnonymousAssociation):
             "est_th": round(float(est.cluster_pose[2]), 3),
             "n_particles": int(est.n_particles),
             "spread_m": round(float(math.sqrt(max(0.0, est.cov[0, 0] + est.cov[1, 1]))), 3),
+            "loglik_per_beam": (round(float(self.mcl.last_log_mean_likelihood_per_beam), 4)
+                                if math.isfinite(self.mcl.last_log_mean_likelihood) else None),
             "syncs": int(sum(self.sync.applied.values())) if self.sync is not None else 0,
             "looped": int(self.sync.looped) if self.sync is not None else 0,
             "pts": [round(float(v), 2) for v in sub[:, :2].ravel()],

@@ -46,7 +46,15 @@ class MCLWanderParams(BaseModel):
     max_particles, min_particles : int
         KLD-sampling bounds (global initialisation draws ``max_particles``).
     adaptive : bool
-        KLD-sampling on (else a fixed ``max_particles``).
+        Adaptive sample count on (else a fixed ``max_particles``).
+    adapt : {"kld", "likelihood"}
+        How the count adapts (:class:`~teamnav.localization.MCLParams`): KLD-sampling (Fox 2003,
+        the default) or the likelihood-based adaptation of Fox et al. (1999a) that §3.1 cites (the
+        paper's: "It typically uses many samples during global localization or if the position of
+        the robot is lost"; a lost robot's samples fit its scans badly, so its set grows).
+    adapt_ref_loglik_per_beam : float or None
+        ``"likelihood"``: a tracking filter's per-beam log mean likelihood (a fill per sensor and
+        map, chosen on tuning seeds; the brain logs ``loglik_per_beam``).
     kld_epsilon : float
         KLD error bound.
     random_fraction : float
@@ -263,6 +271,10 @@ class MCLWanderParams(BaseModel):
         "anonymous": "ignore",
         # §2.3 rule 1: "Our approach ignores *negative* sights"; §7.2 lists them as future work
         "negative_detections": False,
+        # §3.1: "MCL determines the sample set size on-the-fly: It typically uses many samples during
+        # global localization or if the position of the robot is lost ... (see Fox et al. (1999a) for
+        # details)": 1999a's likelihood-based adaptation
+        "adapt": "likelihood",
     }
     PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
         "inject_fraction": "Fox §3.2 eq. 14: the tree only reweights the existing samples (no sensor resetting)",
@@ -277,6 +289,8 @@ class MCLWanderParams(BaseModel):
         "false_positive_filter": "Fox §7.2: false positives not filtered",
         "anonymous": "Fox §7.2: sights without identity are not used",
         "negative_detections": "Fox §2.3 rule 1: negative sights are ignored (§7.2: future work)",
+        "adapt": "Fox §3.1 (Fox et al. 1999a): the sample count grows when the samples fit the scan badly "
+                 "(likelihood-based adaptation)",
     }
     #: gap-fills the paper gives no value for: the same value in both columns (field: why)
     GAP_FILLS_KEPT: ClassVar[dict[str, str]] = {
@@ -286,7 +300,8 @@ class MCLWanderParams(BaseModel):
         "random_fraction": "§3.1 'a small number of uniformly distributed, random samples'; no number",
         "min_update_m": "the paper updates on each odometry reading and scan; no rate is given",
         "min_update_deg": "as min_update_m",
-        "beam": "Fig. 1's mixture; its weights and widths are not given (ours: the simulated sensor's)",
+        "beam": "Fig. 1's mixture; its weights and widths are not given (weights 0.7/0.1/0.1/0.1 kept from the "
+                "first version; the laser's sigma_hit chosen with beam_stride by papers/collab_mcl/beam_fill.py)",
         "motion": "Fig. 2's motion model; its noise is not given",
         "tree_min_samples": "§3.2's stopping rule 'see Thrun et al. (1999b)'; no value",
         "inject_lost_prior": "inert with inject_fraction 0 (the paper's), as are inject_weighting and the "
@@ -295,6 +310,10 @@ class MCLWanderParams(BaseModel):
         "send_max_cluster_spread_m": "inert with send_min_cluster_weight 0 (the paper's)",
         "wander": "§5: the robots follow an operator or a random walk; our wanderer's settings",
         "neg_points": "inert with negative_detections false (the paper's), as are the other neg_* settings",
+        "adapt_ref_loglik_per_beam": "Fox et al. 1999a's threshold on the summed likelihoods, in our units: a "
+                                     "tracking filter's per-beam log mean likelihood on tuning seeds (a fill)",
+        "beam_stride": "§4.1 gives 180 beams; how many the filter multiplies is not given (a fill, chosen "
+                       "against a grid filter on tuning seeds: papers/collab_mcl/beam_fill.py)",
     }
 
     sensor: str | None = Field(None, min_length=1)
@@ -302,6 +321,8 @@ class MCLWanderParams(BaseModel):
     max_particles: int = Field(5000, ge=10, le=1_000_000)
     min_particles: int = Field(300, ge=10, le=1_000_000)
     adaptive: bool = True
+    adapt: Literal["kld", "likelihood"] = "kld"
+    adapt_ref_loglik_per_beam: float | None = Field(None, ge=-1e6, le=1e6)
     kld_epsilon: float = Field(0.05, gt=0.0, le=1.0)
     random_fraction: float = Field(0.005, ge=0.0, le=0.5)
     sensor_model: Literal["beam", "likelihood_field"] = "beam"
@@ -384,7 +405,8 @@ class MCLWanderParams(BaseModel):
             n_particles=self.max_particles, sensor_model=self.sensor_model, beam=self.beam,
             likelihood_field=self.likelihood_field, motion=self.motion, beam_stride=self.beam_stride,
             likelihood_exponent=self.likelihood_exponent, recovery="fixed" if self.random_fraction > 0 else "none",
-            random_fraction=self.random_fraction, adaptive=self.adaptive,
+            random_fraction=self.random_fraction, adaptive=self.adaptive, adapt=self.adapt,
+            likelihood_ref_per_beam=self.adapt_ref_loglik_per_beam,
             kld=KLDParams(epsilon=self.kld_epsilon, min_particles=min(self.min_particles, self.max_particles),
                           max_particles=self.max_particles),
             sonar_rays_per_cone=self.sonar_rays_per_cone, init_clearance_m=self.init_clearance_m,

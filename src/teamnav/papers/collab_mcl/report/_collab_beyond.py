@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from teamnav.experiments.report.model import Comparison, Missing, Table
-from teamnav.papers.collab_mcl.report._collab_common import COLUMNS, HEAD, _col_sweep, _metric, _ms
+from teamnav.papers.collab_mcl.report._collab_common import COLUMNS, HEAD, _col_sweep, _metric, _ms, judged_column
+from teamnav.papers.collab_mcl.report._collab_fidelity import gated_judge
 
 
 _FP = {"robots.0.detector.p_false_positive": 0.035}
@@ -24,7 +25,7 @@ def _beyond(ctx, out: dict | None = None) -> list:
     sights ignored); the filter and the association exist only in the teamnav column. Claims
     ``fp-breaks`` (paper as written), ``fp-filter`` and ``anon-assoc`` (teamnav); their metrics per
     column go into ``out[column][claim id]``."""
-    from teamnav.experiments.claims import judge, load_claims, rule_text
+    from teamnav.experiments.claims import load_claims, rule_text
 
     if ctx.quick:
         return [Missing("false positives and withheld identities (§7.2)", "measured in the full report only "
@@ -67,7 +68,7 @@ def _beyond(ctx, out: dict | None = None) -> list:
 
     def verdict(cid: str) -> tuple[bool | None, str]:
         c = claims[cid]
-        v = {col: judge(c, vals[col][cid]) for col, _ in COLUMNS}
+        v = {col: gated_judge(c, vals[col][cid]) for col, _ in COLUMNS}
         other = "teamnav" if c.judged == "paper_rules" else "paper_rules"
         return v[c.judged][0], (f" Rule (claims/collab-mcl.yaml, {cid}, judged on {HEAD[c.judged]}): {rule_text(c)}; "
                                 f"{v[c.judged][1]}. {HEAD[other]}: {v[other][1]}. Seeds {seeds[0]}-{seeds[-1]}.")
@@ -82,13 +83,14 @@ def _beyond(ctx, out: dict | None = None) -> list:
                              "; ".join(f"{head}: Robin localized in {pct(col, 'fp')} of runs with phantoms vs "
                                        f"{pct(col, 'nofp')} without" for col, head in COLUMNS),
                              h, "Marian stands still, so the 2.5 m rule lets it use Robin once: a phantom that comes "
-                                "first spends that use." + why))
+                                "first spends that use." + why, column=judged_column(claims["fp-breaks"])))
     h, why = verdict("fp-filter")
     blocks.append(Comparison("§7.2, beyond the paper: a false-positive filter survives 3.5 % phantoms",
                              "future work (\"first experiments ... very promising\")",
                              f"teamnav: Robin localized in {pct('teamnav', 'fp')} of runs with phantoms vs "
                              f"{pct('teamnav', 'filter')} with the filter ({pct('teamnav', 'nofp')} without phantoms)",
-                             h, "The filter is teamnav's; the paper-as-written column has none." + why))
+                             h, "The filter is teamnav's; the paper-as-written column has none." + why,
+                             column=judged_column(claims["fp-filter"])))
     h, why = verdict("anon-assoc")
     blocks.append(Comparison("§7.2, beyond the paper: detections without identity",
                              "the factorial method cannot use them",
@@ -96,5 +98,5 @@ def _beyond(ctx, out: dict | None = None) -> list:
                              f"{pct('teamnav', 'assoc')} associating by belief; paper as written (ignored): "
                              f"{pct('paper_rules', 'anon_ignore')}",
                              h, "With two robots the association is easy; in a team, ambiguous sights are dropped."
-                             + why))
+                             + why, column=judged_column(claims["anon-assoc"])))
     return blocks

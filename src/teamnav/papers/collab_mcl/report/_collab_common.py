@@ -100,12 +100,17 @@ def _col_sweep(ctx, col: str, sweep_name: str, **kw) -> list[dict]:
 def _verdicts(claim, vals: dict[str, dict], out: dict | None = None) -> dict[str, tuple]:
     """``{column: judge(claim, that column's values)}``; each column of ``out`` (the section's
     ``{column: {claim id: metrics}}``) also gets its values as ``out[column][claim.id]``."""
-    from teamnav.experiments.claims import judge
+    from teamnav.papers.collab_mcl.report._collab_fidelity import gated_judge
 
-    verdicts = {col: judge(claim, vals[col]) for col, _ in COLUMNS}
+    verdicts = {col: gated_judge(claim, vals[col]) for col, _ in COLUMNS}
     for col in (out or {}):
         out[col][claim.id] = vals[col]
     return verdicts
+
+
+def judged_column(claim) -> str:
+    """The report model's column key (``"paper"`` / ``"teamnav"``) of the column a claim is judged on."""
+    return "paper" if claim.judged == "paper_rules" else "teamnav"
 
 
 def _rule_text(claim, verdicts: dict[str, tuple], n_text: str) -> str:

@@ -116,5 +116,6 @@ def _delayed(ctx, out: dict | None = None) -> list:
                                  f"at the end {vals['integrate_final_localized']:.0%} / "
                                  f"{vals['drop_final_localized']:.0%} / {vals['delay_final_localized']:.0%}",
                                  ok, f"Teamnav column only (paper_rules integrates at once). Rule (claims/collab-mcl.yaml, "
-                                     f"{cid}, judged on teamnav): {rule_text(c)}; {how}. Seeds {seeds[0]}-{seeds[-1]}."))
+                                     f"{cid}, judged on teamnav): {rule_text(c)}; {how}. Seeds {seeds[0]}-{seeds[-1]}.",
+                                 column="teamnav"))
     return blocks

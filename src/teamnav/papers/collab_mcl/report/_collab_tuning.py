@@ -74,7 +74,8 @@ def tuning_claim_values(row: dict) -> dict[str, float]:
     out = {"alone_ttl_mean_s": num(row["alone_ttl_s"]), "together_ttl_mean_s": num(row["team_ttl_s"]),
            "alone_final_localized": num(row["alone_final_localized"]),
            "together_final_localized": num(row["team_final_localized"]),
-           "paired_change_upper_s": num(row["paired_s"]) + 2.0 * num(row["paired_se_s"])}
+           "paired_change_upper_s": num(row["paired_s"]) + 2.0 * num(row["paired_se_s"]),
+           "n_pairs": num(row.get("pairs"))}
     if row["part"] == "hexagon":
         out.update({"together_min_localized": min(num(row["team_localized_sonar"]), num(row["team_localized_laser"])),
                     "alone_best_localized": max(num(row["alone_localized_sonar"]), num(row["alone_localized_laser"])),
@@ -150,18 +151,20 @@ def _tuning_blocks() -> list:
     prior_text = "; ".join(f"{f.removeprefix('detection-prior')}: {r['team_final_m']:.2f} m, {r['team_localized']} / "
                            f"{r['team_runs']} localized" for f, r in sorted(prior.items()))
     return [
-        Table("Issue 26 §2: why the paper-rules filter collapses (Robin, §5.1 setting, one setting changed at a "
-              "time; tuning seeds, measured by scripts/collab_mcl_collapse.py, not re-run here)",
+        Table("Measured before 2026-11-29 (the bare corridor, the 90-beam laser at sigma_hit 0.2 m, KLD counts): why "
+              "the paper-rules filter collapsed (Robin, §5.1 setting, one setting changed at a time; tuning seeds, "
+              "measured by scripts/collab_mcl_collapse.py, not re-run here)",
               ["factor", "what changes", "the paper", "seeds", "spread at 5 s, mean / median [m]",
                "spread at 30 s [m]", "when Marian's tree arrives: samples, spread, error (runs within 1.5 m)",
                "final error ignoring detections (runs localized)", "final error using them (runs localized)"],
               collapse_rows(), note=COLLAPSE_READING),
-        Table("Issue 26 §2: the hallway per factor (paper rules, 8 sonar robots, 600 s; tuning seeds)",
+        Table("Measured before 2026-11-29: the hallway per factor (paper rules, 8 sonar robots, 600 s; tuning seeds)",
               ["factor", "what changes", "seeds", "time to localize alone → together [s]",
                "paired change together - alone [s] (± s.e.; seeds faster)", "localized at the end alone / together"],
               hallway_factor_rows(), note=HALLWAY_FACTOR_READING),
-        Table("Issue 26 §3: the teamnav column out of sample (its values were chosen on report seeds; here on tuning "
-              "seeds, by the claim file's rules)", ["claim", "tuning seeds", "teamnav column", "reading"],
+        Table("Measured before 2026-11-29 (the bare corridor, the swapped hexagon, the 90-beam laser): the teamnav "
+              "column out of sample (its values were chosen on report seeds; here on tuning seeds, by the claim "
+              "file's rules)", ["claim", "tuning seeds", "teamnav column", "reading"],
               out_of_sample_rows(),
               note=f"§5.1's lost prior (inject_lost_prior, chosen on report seed 7), Robin's final error and runs "
                    f"localized with the detection on seeds {_seed_text(base['seeds'])}: 0.3 (the scenario's): "

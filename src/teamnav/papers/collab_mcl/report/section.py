@@ -11,10 +11,17 @@ every one in two columns beside the paper's number:
   dropped from the scenario (:func:`teamnav.papers.trails.report._trails.paper_rules_spec`);
 - "teamnav": the scenarios as they are (our gap-fills).
 
+First, §5.1's precondition (:func:`~._collab_fidelity.precondition_block`: Robin alone still
+multi-modal when it passes the lab, measured on tuning seeds and shown as measured; the claims that need
+it read "precondition not met" when it does not hold) and the ledger of both columns
+(:func:`~._collab_fidelity.ledger_blocks`, ``shared/FIDELITY.md`` §2). Every comparison names the column
+its verdict is judged on.
+
 Verdict rules are read from ``papers/collab_mcl/claims/collab-mcl.yaml`` (:mod:`teamnav.experiments.claims`),
 never written here, and judged on the column each claim names (the paper as written, except the
-two §7.2 extensions only teamnav has); the seeds are the claim's report seeds (its
-``quick_seeds`` in quick mode; tuning seeds are >= 1000 and never run here).
+two §7.2 extensions only teamnav has); the seeds are the claim's judged seeds (2000-2029, named
+before any run on them; its ``quick_seeds`` in quick mode; tuning seeds are 1000-1999 and never run
+here).
 
 - §5.2.1 / Fig. 12: ``collab-mcl-hallway``, 8 sonar robots, single vs collaborative MCL:
   error vs time with 95 % bands, time to localize (error < 1.5 m) mean ± std over runs, the
@@ -70,7 +77,9 @@ from teamnav.experiments.report.model import Comparison, Missing, Plot, SectionS
 from teamnav.papers.collab_mcl.report._collab_beyond import _ANON, _FILTER, _FP, _beyond  # noqa: F401
 from teamnav.papers.collab_mcl.report._collab_common import (  # noqa: F401
     COLUMNS, HEAD, _band, _col_sweep, _metric, _ms, _ok, _param, _rule_text, _seeds, _series, _verdicts,
+    judged_column,
 )
+from teamnav.papers.collab_mcl.report._collab_fidelity import gated_judge, ledger_blocks, precondition_block
 from teamnav.papers.collab_mcl.report._collab_delayed import _delayed
 from teamnav.papers.collab_mcl.report._collab_detection import (  # noqa: F401
     PICTURED_SEED, QUICK_DETECTION, _detection, detection_belief_rows, detection_values,
@@ -156,11 +165,13 @@ def _hallway(ctx, out: dict | None = None) -> list:
             verdicts[claim.judged][0],
             "Our times are mean ± std over runs of the per-run mean over robots, censored robots counted at the "
             "run's duration (a lower bound). Our hallway, sonar model and sample counts are not the paper's. "
-            "The teamnav column adds, beyond the paper (each a scenario setting): sensor resetting on received "
+            "The teamnav column (with sensor resetting) adds, beyond the paper (each a scenario setting): sensor "
+            "resetting on received "
             "trees (inject_fraction) whose headings come from the receiver's scan, "
             "a tempered likelihood (0.1), selective resampling, provenance and a "
             "receive-side 2.5 m gate; both columns use the wanderer without side openings (the paper's robots "
             "follow an operator or a random walk)." + _rule_text(claim, verdicts, n_text),
+            column=judged_column(claim),
         ),
         Plot("Fig. 12(b): localization error vs time, 8 sonar robots", "time [s]",
              "mean distance of samples to the true pose [m]",
@@ -241,12 +252,14 @@ def _hexagon(ctx, out: dict | None = None) -> list:
                    "for both types",
                    "; ".join(ours(col) for col, _ in COLUMNS),
                    verdicts[claim.judged][0],
-                   "Our hexagon's glass discs are 2-fold and foam discs 3-fold symmetric, so sonar robots keep 2 "
-                   "modes and laser robots 3 (the paper has them the other way round). The teamnav column guards "
+                   "Our hexagon's glass discs are 3-fold and foam discs 2-fold symmetric, so sonar robots keep 3 "
+                   "locations and laser robots 2, as the paper says. The teamnav column (with sensor resetting) "
+                   "guards "
                    "double counting beyond §2.3's two rules: received trees become draws weighted by the chance "
                    "the receiver is lost, the answer tree carries only the answering robot's own belief, a tree "
                    "holding the receiver's own recent information through a third robot is dropped (provenance), "
-                   "and the likelihoods are tempered (sonar 0.1, laser 0.01)." + _rule_text(claim, verdicts, n_text)),
+                   "and the likelihoods are tempered (sonar 0.1, laser 0.01)." + _rule_text(claim, verdicts, n_text),
+                   column=judged_column(claim)),
         Plot("Fig. 14: error vs time by sensor kind", "time [s]", "mean distance of samples to the true pose [m]",
              series, hlines=[(1.5, "localized (1.5 m)")], caption="Bands: 95 % confidence interval over runs."),
         Table("Hexagon: by sensor kind (mean ± std over runs)",
@@ -258,14 +271,14 @@ def _hexagon(ctx, out: dict | None = None) -> list:
 def _claims_and_gap_fills(ctx, vals: dict) -> list:
     """The claim table (both columns, rules and their history) and the gap-fill table."""
     from teamnav.papers.collab_mcl.brains.localizing import MCLWanderParams
-    from teamnav.experiments.claims import judge, load_claims
+    from teamnav.experiments.claims import load_claims
     from teamnav.papers.trails.report._trails import claim_rows, gap_fill_rows
     from teamnav.experiments.spec import load_scenario
 
     claims = load_claims("collab-mcl")
     ran = [c for c in claims.claims if c.id in vals.get("teamnav", {})]
     sub = claims.model_copy(update={"claims": ran})
-    verdicts = {col: {c.id: judge(c, vals[col][c.id]) for c in ran} for col, _ in COLUMNS}
+    verdicts = {col: {c.id: gated_judge(c, vals[col][c.id]) for c in ran} for col, _ in COLUMNS}
     blocks = [Table("Claims: the paper, the paper as written, teamnav",
                     ["claim", "paper", "rule (claim file)", "paper as written", "teamnav", "rule history"],
                     claim_rows(sub, vals, verdicts),
@@ -295,7 +308,8 @@ def build(ctx) -> list:
                          "resampling at every update, §2.3's two rules only, anonymous sights ignored) and "
                          "\"teamnav\" (the scenarios' gap-fills); verdicts by the rules of "
                          "papers/collab_mcl/claims/collab-mcl.yaml, on report seeds (tuning seeds are >= 1000)."
-                         + (" Quick mode: few robots and samples, 1-2 seeds, short runs." if ctx.quick else ""))]
+                         + (" Quick mode: few robots and samples, 1-2 seeds, short runs." if ctx.quick else "")),
+                    precondition_block(), *ledger_blocks()]
     vals: dict = {col: {} for col, _ in COLUMNS}  # {column: {claim id: {metric: value}}}, filled by the parts
     for part in (_hallway, _hexagon, _detection, _beyond, _delayed):
         blocks += part(ctx, vals)
