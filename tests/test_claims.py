@@ -58,3 +58,14 @@ def test_a_paired_rule_with_too_few_pairs_is_not_judged():
     assert judge(c, {"r": 5.0, "b": 2.0})[0] is None  # the count itself not measured
     with pytest.raises(ValidationError):
         Claim.model_validate({**BASE, "min_pairs": 2})  # FIDELITY §3: at least 5
+
+
+def test_a_section_that_counts_its_own_pairs_still_gets_a_verdict():
+    # line-of-sight help applies min_pairs per route plan and navigator before it asks the
+    # judge; a claim that names min_pairs must not then read "n_pairs: not measured"
+    from teamnav.papers.los_help.report import _los_verdicts as V
+
+    assert V._claim("table1-potential-field-falls").min_pairs == 5
+    assert V._judged("table1-potential-field-falls", {"max_rise": -5.0, "fails_first": 1.0}) is True
+    assert V._judged("table1-potential-field-falls", {"max_rise": 5.0, "fails_first": 1.0}) is False
+    assert V._judged("fig16-noise-grows", {"min_growth": 10.0}) is True

@@ -135,10 +135,8 @@ class Claim(BaseModel):
     history: list[HistoryEntry] = Field(min_length=1)
     note: str = ""
     #: For sections whose runs vary a task, not a seed (line-of-sight help): the judged task
-    #: numbers, "a-b" or "a,b,c", below TUNING_SEED_MIN like seeds (FIDELITY §3); None: seeds only.
+    #: numbers, "a-b" or "a,b,c", outside the tuning range like seeds (FIDELITY §3); None: seeds only.
     tasks: str | None = None
-    #: A paired verdict's fewest pairs (FIDELITY §3, at least 5); fewer read "not judged (n = k)".
-    min_pairs: int | None = Field(None, ge=5)
 
     @field_validator("seeds", "quick_seeds", "tasks")
     @classmethod

@@ -95,8 +95,11 @@ def _claim(claim_id: str):
 
 def _judged(claim_id: str, values: dict[str, float], record: dict | None = None) -> bool | None:
     """The claim's verdict on ``values`` (None: a metric not measured); with ``record``, the
-    values and the judge's reading are kept there under the claim's id (the claim table)."""
-    got = judge(_claim(claim_id), values)
+    values and the judge's reading are kept there under the claim's id (the claim table).
+
+    The callers apply the claim's ``min_pairs`` themselves (they know the pairs of each trend,
+    per route plan and navigator), before calling this: the claim is judged here without it."""
+    got = judge(_claim(claim_id).model_copy(update={"min_pairs": None}), values)
     if record is not None:
         record[claim_id] = (dict(values), got)
     return got[0]
