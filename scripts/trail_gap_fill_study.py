@@ -67,14 +67,30 @@ DRIFT_CASES = ("x0", "x1", "x4", "x1-slip", "x1-scale5")
 DRIFT_CONFIGS = ("paper", "paper+reverse_carried_crumbs", "teamnav@0.25", "teamnav")
 
 
+#: the study's stored runs were made when blazing-trail-v1's ``paper_rules`` also set cruise 0.25 m/s
+#: and crumbs laid while carrying unreversed (Blazing §4.1 read literally). Since 2026-11-29 neither
+#: is among the brain's paper rules (the 2000 paper column reverses them, Try §1, and drives at the
+#: speed the 2000 paper implies); the study keeps its configurations as they were run, so these two
+#: are named here as gap-fills of the study: (field, teamnav value, the study's "paper" value, note)
+STUDY_EXTRA_FILLS = {"blazing": (
+    ("cruise_speed_mps", TEAMNAV_CRUISE, 0.25, "Try §3.6: 0.25 m/s cruise (the study's paper column)"),
+    ("reverse_carried_crumbs", True, False, "Blazing §4.1 read literally (the study's paper column)"),
+)}
+
+
 def gap_fill_table(system: str = "blazing") -> list:
-    """The gap-fills of the system's brain (Navigate's included), ours at cruise 0.4 m/s."""
+    """The gap-fills of the system's brain (Navigate's included), ours at cruise 0.4 m/s, and the
+    study's own (:data:`STUDY_EXTRA_FILLS`)."""
     import importlib
 
-    from teamnav.control.paper_rules import gap_fills
+    from teamnav.control.paper_rules import GapFill, gap_fills
 
     module, _, cls = SYSTEMS[system][1].partition(":")
-    return gap_fills(getattr(importlib.import_module(module), cls), {"cruise_speed_mps": TEAMNAV_CRUISE})
+    fills = gap_fills(getattr(importlib.import_module(module), cls), {"cruise_speed_mps": TEAMNAV_CRUISE})
+    have = {g.field for g in fills}
+    extra = [GapFill(*e) for e in STUDY_EXTRA_FILLS.get(system, ()) if e[0] not in have]
+    # the brain's own order first, then the study's, cruise first (as the stored runs' tables list them)
+    return sorted(extra, key=lambda g: g.field != "cruise_speed_mps") + fills if extra else fills
 
 
 def params_for(config: str, system: str = "blazing") -> dict:

@@ -28,10 +28,13 @@ def _dump(params: dict) -> dict:
     return out
 
 
-def test_paper_config_is_paper_rules_true():
+def test_paper_config_is_paper_rules_true_as_the_study_ran_it():
     """The study's "paper" configuration, written out field by field, validates to the same
-    brain parameters as the report's ``paper_rules: true`` column."""
-    assert _dump(gs.params_for("paper")) == _dump({**gs.BASE_PARAMS, "paper_rules": True})
+    brain parameters as ``paper_rules: true`` with the two settings the study's stored runs had
+    then (0.25 m/s, crumbs laid while carrying not reversed), which are no longer paper rules."""
+    assert _dump(gs.params_for("paper")) == _dump({**gs.BASE_PARAMS, "paper_rules": True, "cruise_speed_mps": 0.25,
+                                                   "reverse_carried_crumbs": False})
+    assert _dump(gs.params_for("paper")) != _dump({**gs.BASE_PARAMS, "paper_rules": True})
 
 
 def test_teamnav_config_is_the_scenario_column():

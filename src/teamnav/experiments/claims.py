@@ -4,8 +4,8 @@
 (:mod:`teamnav.plugins`; e.g. ``teamnav/papers/los_help/claims/los-help.yaml``) holds, for each claim a report section judges: the
 paper's statement (quote and section), the paper's number, the metric, the verdict rule (one or
 more conditions, all of which must hold: a metric, a comparison, a threshold and, for a relative
-rule, the metric it is relative to), the seeds (report seeds only; tuning uses seeds >= 1000,
-never a report), the number of runs judged, which column is judged (``paper_rules``: the paper
+rule, the metric it is relative to), the seeds (report seeds only: below 1000, or fresh judged
+seeds >= 2000; tuning uses seeds 1000-1999, never a report), the number of runs judged, which column is judged (``paper_rules``: the paper
 as written; ``teamnav``: our gap-fills) and the rule's history.
 
 The section computes the named metrics (store columns or derived metrics it names in its
@@ -35,7 +35,8 @@ from typing import Literal, Mapping
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-__all__ = ["CLAIMS_DIR", "Claim", "claims_path", "ClaimFile", "Condition", "TUNING_SEED_MIN", "judge", "load_claims", "rule_text"]
+__all__ = ["CLAIMS_DIR", "Claim", "claims_path", "ClaimFile", "Condition", "JUDGED_SEED_MIN", "TUNING_SEED_MIN", "judge",
+           "load_claims", "rule_text"]
 
 #: the folder of the claim files
 CLAIMS_DIR = Path(__file__).with_name("claims")  #: claim files of sections the core adds itself (none today)
@@ -52,8 +53,12 @@ def claims_path(section: str) -> Path:
             if folder is not None:
                 return folder / "claims" / f"{section}.yaml"
     return CLAIMS_DIR / f"{section}.yaml"
-#: seeds at or above this are tuning seeds; a claim's (report) seeds must lie below it
+#: seeds from this up to :data:`JUDGED_SEED_MIN` are tuning seeds; a claim's (report) seeds lie
+#: below it or at or above :data:`JUDGED_SEED_MIN`
 TUNING_SEED_MIN = 1000
+#: seeds at or above this are kept for judged runs named in a claim file before any run (FIDELITY
+#: §3: seeds no run has touched; seeds 0-29 have been looked at many times), never for tuning
+JUDGED_SEED_MIN = 2000
 
 _OPS = {">=": lambda a, b: a >= b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, "<": lambda a, b: a < b}
 _STRICT = ConfigDict(extra="forbid", frozen=True, strict=False)
@@ -134,8 +139,9 @@ class Claim(BaseModel):
         if v is None:
             return v
         seeds = _parse_seeds(v)
-        if max(seeds) >= TUNING_SEED_MIN:
-            raise ValueError(f"seeds {v!r}: seeds >= {TUNING_SEED_MIN} are tuning seeds, never a report's")
+        if any(TUNING_SEED_MIN <= s < JUDGED_SEED_MIN for s in seeds):
+            raise ValueError(f"seeds {v!r}: seeds {TUNING_SEED_MIN}-{JUDGED_SEED_MIN - 1} are tuning seeds, never a "
+                             f"report's (judged seeds no run has touched: >= {JUDGED_SEED_MIN})")
         return v
 
     @model_validator(mode="after")
