@@ -65,6 +65,20 @@ RATES = (-1.0, 1.0, 2.0, 0.35)
 SCALE5 = (0.05, -0.05, 0.03, -0.03)
 DRIFT_CASES = ("x0", "x1", "x4", "x1-slip", "x1-scale5")
 DRIFT_CONFIGS = ("paper", "paper+reverse_carried_crumbs", "teamnav@0.25", "teamnav")
+#: the 2000 paper column as the report judges it since 2026-11-29: the paper's rules, the single trail
+#: followed backwards (crumbs laid while carrying reversed, Try §1) and the cruise speed the 2000 paper
+#: implies (0.4 m/s; teamnav.papers.trails.report._trails.BLAZING_IMPLIED_CRUISE_MPS)
+PAPER_2000_CRUISE = 0.4
+#: the breakdown study (part ``breakdown``): the 2000 paper column at the papers' drift (k = 1) without
+#: and with a heading random walk of h deg/sqrt(m) ("x1-slip<h>"; "x1-slip" is h = 1), 1 h, >= 20 seeds
+BREAKDOWN_CASES = ("x1", "x1-slip0.5", "x1-slip", "x1-slip2")
+BREAKDOWN_CONFIGS = ("paper-2000",)
+#: a run "never worked" when it delivered fewer than this many units in its first 30 min (one optimal
+#: robot delivers ~10, the paper's team 28): reported apart, not counted as a breakdown
+NEVER_WORKED_UNITS_30MIN = 3
+#: breakdowns are counted within the paper's 30 min: the last delivery before 30 min - 180 s
+#: followed by none until 30 min (the report's 180-s rule applied to the first 30 min)
+BREAKDOWN_WINDOW_S = 1800.0
 
 
 #: the study's stored runs were made when blazing-trail-v1's ``paper_rules`` also set cruise 0.25 m/s
@@ -107,6 +121,8 @@ def params_for(config: str, system: str = "blazing") -> dict:
     ours = {g.field: g.teamnav_value for g in fills}
     if config == "paper":
         chosen = paper
+    elif config == "paper-2000":
+        chosen = {**paper, "cruise_speed_mps": PAPER_2000_CRUISE, "reverse_carried_crumbs": True}
     elif config == "teamnav":
         chosen = ours
     elif config == "teamnav@0.25":
@@ -116,7 +132,7 @@ def params_for(config: str, system: str = "blazing") -> dict:
     elif config.startswith("teamnav-") and config[8:] in names:
         chosen = {**ours, config[8:]: paper[config[8:]]}
     else:
-        raise ValueError(f"unknown configuration {config!r}: expected paper, teamnav, teamnav@0.25, "
+        raise ValueError(f"unknown configuration {config!r}: expected paper, paper-2000, teamnav, teamnav@0.25, "
                          f"paper+G or teamnav-G with G one of {', '.join(names)}")
     out: dict = dict(SYSTEMS[system][2])
     for key, value in chosen.items():
@@ -135,10 +151,15 @@ def drift_overrides(case: str) -> dict:
         raise ValueError(f"unknown drift case {case!r}: expected one of {', '.join(DRIFT_CASES)}")
     k = float(base[1:])
     out = {f"robots.{i}.odometry.heading_drift_deg_per_min": k * r for i, r in enumerate(RATES)}
-    if extra == "slip":
+    if extra.startswith("slip"):
+        try:
+            h = float(extra[4:]) if extra[4:] else 1.0  # "slip" = 1 deg/sqrt(m), as stored
+        except ValueError:
+            raise ValueError(f"unknown drift case {case!r}: expected one of {', '.join(DRIFT_CASES)} "
+                             "or x<k>-slip<deg per sqrt m>") from None
         for i in range(4):
             out[f"robots.{i}.odometry.slip_std_m_per_sqrt_m"] = 0.01
-            out[f"robots.{i}.odometry.heading_slip_deg_per_sqrt_m"] = 1.0
+            out[f"robots.{i}.odometry.heading_slip_deg_per_sqrt_m"] = h
     elif extra == "scale5":
         for i, s in enumerate(SCALE5):
             out[f"robots.{i}.odometry.scale_error"] = s
@@ -162,6 +183,12 @@ def one_run(job: tuple) -> dict:
     t0 = time.process_time()
     res = run(load_scenario(SYSTEMS[system][0], overrides=ov, seed=seed, duration_s=duration), progress=False)
     times = sorted(t for t, _ in deliveries(res.data.event_log))
+    # the 180° rule's turns per robot (Navigate's counter, in each brain's log): the last logged value
+    last_rev: dict[int, int] = {}
+    for rec in res.data.logs:
+        v = (rec.get("values") or {}).get("reversals")
+        if isinstance(v, int):
+            last_rev[int(rec["robot"])] = v
     if times and duration - times[-1] >= BREAKDOWN_GAP_S:
         bd, cens = times[-1], False
     elif not times:
@@ -172,7 +199,10 @@ def one_run(job: tuple) -> dict:
     row = {} if system == "blazing" else {"system": system}  # rows without it are blazing-trail-v1's
     return {**row, "part": part, "config": config, "case": case, "seed": seed, "duration_s": duration,
             "units": len(times), "units_second_half": len(half), "first_delivery_s": times[0] if times else None,
-            "breakdown_s": bd, "breakdown_censored": cens, "cpu_s": round(time.process_time() - t0, 2)}
+            "breakdown_s": bd, "breakdown_censored": cens, "cpu_s": round(time.process_time() - t0, 2),
+            "reversals": sum(last_rev.values()) if last_rev else None,
+            "cruise_mps": float(params.get("cruise_speed_mps", 0.25)),
+            "delivery_times_s": [round(t, 1) for t in times]}
 
 
 def parse_seeds(text: str) -> list[int]:
@@ -186,12 +216,55 @@ def parse_seeds(text: str) -> list[int]:
     return out
 
 
+def breakdown_in_window(times_s: list[float], window_s: float = BREAKDOWN_WINDOW_S) -> bool:
+    """The report's breakdown rule on the first ``window_s`` of a run: deliveries before it, the last
+    one at least 180 s (:data:`~teamnav.papers.trails.metrics.BREAKDOWN_GAP_S`) before its end.
+
+    >>> breakdown_in_window([100.0, 900.0]), breakdown_in_window([100.0, 1700.0]), breakdown_in_window([])
+    (True, False, False)
+    """
+    from teamnav.papers.trails.metrics import BREAKDOWN_GAP_S
+
+    inside = [t for t in times_s if t <= window_s]
+    return bool(inside) and window_s - inside[-1] >= BREAKDOWN_GAP_S
+
+
+def breakdown_rows(rows: list[dict]) -> list[list[str]]:
+    """The breakdown study's table: per configuration and case, the runs that never worked (fewer than
+    :data:`NEVER_WORKED_UNITS_30MIN` units in the first 30 min) apart, and of the runs that worked, how
+    many broke down within 30 min and within the hour, with units and the 180° rule's turns."""
+    import numpy as np
+
+    out = []
+    for key in sorted({(r["config"], r["case"]) for r in rows if r["part"] == "breakdown"}):
+        g = [r for r in rows if r["part"] == "breakdown" and (r["config"], r["case"]) == key]
+        t30 = [[t for t in r.get("delivery_times_s") or [] if t <= BREAKDOWN_WINDOW_S] for r in g]
+        never = [r for r, t in zip(g, t30) if len(t) < NEVER_WORKED_UNITS_30MIN]
+        worked = [(r, t) for r, t in zip(g, t30) if len(t) >= NEVER_WORKED_UNITS_30MIN]
+        b30 = sum(breakdown_in_window(r.get("delivery_times_s") or []) for r, _ in worked)
+        b60 = sum(not r["breakdown_censored"] for r, _ in worked)
+        rev = [r["reversals"] / (r["duration_s"] / 3600.0) for r in g if r.get("reversals") is not None]
+        out.append([key[0], key[1], str(len(g)), f"{len(never)} (seeds {','.join(str(r['seed']) for r in never) or '-'})",
+                    f"{b30}/{len(worked)}", f"{b60}/{len(worked)}",
+                    f"{np.mean([r['units'] for r in g]):.1f}" if g else "-",
+                    f"{np.mean(rev):.0f}" if rev else "-"])
+    return out
+
+
+BREAKDOWN_HEADER = ["configuration", "case", "runs", "never worked (< 3 units in 30 min)",
+                    "of the runs that worked: broke down within 30 min", "within the hour", "units (mean)",
+                    "180° turns per hour (team)"]
+
+
 def summarize(rows: list[dict]) -> list[str]:
     """Markdown tables of the runs, as the report section shows them
     (:mod:`teamnav.papers.trails.report._trails_gap_fills`)."""
     from teamnav.papers.trails.report._trails_gap_fills import HEADER, cases, table_rows
 
     out: list[str] = []
+    if any(r["part"] == "breakdown" for r in rows):
+        out += ["\n## breakdown", "| " + " | ".join(BREAKDOWN_HEADER) + " |", "|" + "---|" * len(BREAKDOWN_HEADER)]
+        out += ["| " + " | ".join(r) + " |" for r in breakdown_rows(rows)]
     for part in ("gapfills", "drift"):
         for case in cases(rows, part):
             out += [f"\n## {part} {case or '(the scenario drift)'}", "| " + " | ".join(HEADER) + " |",
@@ -202,7 +275,7 @@ def summarize(rows: list[dict]) -> list[str]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("part", choices=["gapfills", "drift", "summary"])
+    ap.add_argument("part", choices=["gapfills", "drift", "breakdown", "summary"])
     ap.add_argument("--seeds", default="100-109")
     ap.add_argument("--system", choices=sorted(SYSTEMS), default="blazing",
                     help="blazing: blazing-trail-v1 on blazing-a-trail; try: trail-share-v1 on try-to-see-it-my-way")
@@ -222,6 +295,10 @@ def main(argv: list[str] | None = None) -> int:
         configs = a.configs.split(",") if a.configs else (
             ["paper", "teamnav"] + [f"paper+{n}" for n in names] + [f"teamnav-{n}" for n in names])
         jobs = [("gapfills", c, "", s, a.duration or 1800.0, a.system) for c in configs for s in seeds]
+    elif a.part == "breakdown":
+        configs = a.configs.split(",") if a.configs else list(BREAKDOWN_CONFIGS)
+        cases = a.cases.split(",") if a.cases != ",".join(DRIFT_CASES) else list(BREAKDOWN_CASES)
+        jobs = [("breakdown", c, k, s, a.duration or 3600.0, a.system) for k in cases for c in configs for s in seeds]
     else:
         configs = a.configs.split(",") if a.configs else list(DRIFT_CONFIGS)
         jobs = [("drift", c, k, s, a.duration or 3600.0, a.system)

@@ -141,3 +141,38 @@ def test_try_configs_are_trail_share_columns():
     q = TrailShareParams(**{**gs.SYSTEMS["try"][2], "paper_rules": True}).model_dump(exclude={"paper_rules", "navigate"})
     assert p == q
     assert {g.field for g in gs.gap_fill_table("try")} >= {"descend_only", "recover_radius_m"}
+
+
+def test_paper_2000_config_is_the_report_paper_column():
+    """The breakdown study's "paper-2000" is the 2000 paper column the report judges: paper_rules, the
+    single trail followed backwards (reversed carried crumbs) and the implied 0.4 m/s."""
+    from teamnav.papers.trails.report._trails import BLAZING_IMPLIED_CRUISE_MPS
+
+    assert _dump(gs.params_for("paper-2000")) == _dump({**gs.BASE_PARAMS, "paper_rules": True,
+                                                        "cruise_speed_mps": BLAZING_IMPLIED_CRUISE_MPS})
+
+
+@pytest.mark.parametrize("case, h", [("x1-slip", 1.0), ("x1-slip0.5", 0.5), ("x1-slip2", 2.0)])
+def test_slip_cases_name_their_heading_random_walk(case, h):
+    ov = gs.drift_overrides(case)
+    assert {ov[f"robots.{i}.odometry.heading_slip_deg_per_sqrt_m"] for i in range(4)} == {h}
+    assert ov["robots.2.odometry.heading_drift_deg_per_min"] == 2.0  # k = 1: Fly's 2 deg/min
+    with pytest.raises(ValueError, match="unknown drift case"):
+        gs.drift_overrides("x1-slipper")
+
+
+def test_breakdown_table_reports_runs_that_never_worked_apart_and_counts_within_30_min():
+    def run(seed, times, case="x1-slip"):
+        cens = bool(times) and 3600.0 - times[-1] < 180.0
+        return {"part": "breakdown", "config": "paper-2000", "case": case, "seed": seed, "duration_s": 3600.0,
+                "units": len(times), "breakdown_censored": cens, "reversals": 40, "delivery_times_s": times}
+
+    rows = [run(1000, [100.0, 200.0]),                    # 2 units in 30 min: never worked
+            run(1001, [100.0 * k for k in range(1, 15)]),  # last at 1400 s: broke down within 30 min
+            run(1002, [100.0 * k for k in range(1, 36)]),  # working until 3500 s: no breakdown
+            run(1003, [100.0 * k for k in range(1, 25)])]  # 1700 s < 1800 - 180 is false: breaks down at 2400 s
+    (row,) = gs.breakdown_rows(rows)
+    assert row[:3] == ["paper-2000", "x1-slip", "4"]
+    assert row[3] == "1 (seeds 1000)"
+    assert row[4] == "1/3" and row[5] == "2/3"  # within 30 min: seed 1001 only; within the hour: 1001 and 1003
+    assert row[7] == "40"

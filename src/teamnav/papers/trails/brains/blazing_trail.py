@@ -395,8 +395,8 @@ class BlazingTrail:
 
     def log(self) -> dict[str, Any]:
         """``carrying``, ``trips`` (units delivered), ``place_index``, ``n_crumbs`` (global list),
-        ``following``, ``recovering`` (heading back to a trail it left), ``mode`` (Navigate's),
-        and every ``layer_every_steps`` a ``crumbs`` layer (global crumbs, odometry frame)."""
+        ``following``, ``recovering`` (heading back to a trail it left), ``mode`` (Navigate's), ``reversals``
+        (the 180° rule's turns so far), and every ``layer_every_steps`` a ``crumbs`` layer (global crumbs, odometry frame)."""
         out: dict[str, Any] = {
             "carrying": self.carrying,
             "trips": self.deliveries,
@@ -406,6 +406,7 @@ class BlazingTrail:
             "following": self._following,
             "recovering": self._recovering,
             "mode": str(getattr(self.nav, "mode", "")),
+            "reversals": int(getattr(self.nav, "n_reversals", 0)),
         }
         if self._last_layer_step is None or self._step - self._last_layer_step >= self.params.layer_every_steps:
             self._last_layer_step = self._step
