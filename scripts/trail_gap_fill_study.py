@@ -73,12 +73,6 @@ PAPER_2000_CRUISE = 0.4
 #: and with a heading random walk of h deg/sqrt(m) ("x1-slip<h>"; "x1-slip" is h = 1), 1 h, >= 20 seeds
 BREAKDOWN_CASES = ("x1", "x1-slip0.5", "x1-slip", "x1-slip2")
 BREAKDOWN_CONFIGS = ("paper-2000",)
-#: a run "never worked" when it delivered fewer than this many units in its first 30 min (one optimal
-#: robot delivers ~10, the paper's team 28): reported apart, not counted as a breakdown
-NEVER_WORKED_UNITS_30MIN = 3
-#: breakdowns are counted within the paper's 30 min: the last delivery before 30 min - 180 s
-#: followed by none until 30 min (the report's 180-s rule applied to the first 30 min)
-BREAKDOWN_WINDOW_S = 1800.0
 
 
 #: the study's stored runs were made when blazing-trail-v1's ``paper_rules`` also set cruise 0.25 m/s
@@ -216,50 +210,10 @@ def parse_seeds(text: str) -> list[int]:
     return out
 
 
-def breakdown_in_window(times_s: list[float], window_s: float = BREAKDOWN_WINDOW_S) -> bool:
-    """The report's breakdown rule on the first ``window_s`` of a run: deliveries before it, the last
-    one at least 180 s (:data:`~teamnav.papers.trails.metrics.BREAKDOWN_GAP_S`) before its end.
-
-    >>> breakdown_in_window([100.0, 900.0]), breakdown_in_window([100.0, 1700.0]), breakdown_in_window([])
-    (True, False, False)
-    """
-    from teamnav.papers.trails.metrics import BREAKDOWN_GAP_S
-
-    inside = [t for t in times_s if t <= window_s]
-    return bool(inside) and window_s - inside[-1] >= BREAKDOWN_GAP_S
-
-
-def breakdown_rows(rows: list[dict]) -> list[list[str]]:
-    """The breakdown study's table: per configuration and case, the runs that never worked (fewer than
-    :data:`NEVER_WORKED_UNITS_30MIN` units in the first 30 min) apart, and of the runs that worked, how
-    many broke down within 30 min and within the hour, with units and the 180° rule's turns."""
-    import numpy as np
-
-    out = []
-    for key in sorted({(r["config"], r["case"]) for r in rows if r["part"] == "breakdown"}):
-        g = [r for r in rows if r["part"] == "breakdown" and (r["config"], r["case"]) == key]
-        t30 = [[t for t in r.get("delivery_times_s") or [] if t <= BREAKDOWN_WINDOW_S] for r in g]
-        never = [r for r, t in zip(g, t30) if len(t) < NEVER_WORKED_UNITS_30MIN]
-        worked = [(r, t) for r, t in zip(g, t30) if len(t) >= NEVER_WORKED_UNITS_30MIN]
-        b30 = sum(breakdown_in_window(r.get("delivery_times_s") or []) for r, _ in worked)
-        b60 = sum(not r["breakdown_censored"] for r, _ in worked)
-        rev = [r["reversals"] / (r["duration_s"] / 3600.0) for r in g if r.get("reversals") is not None]
-        out.append([key[0], key[1], str(len(g)), f"{len(never)} (seeds {','.join(str(r['seed']) for r in never) or '-'})",
-                    f"{b30}/{len(worked)}", f"{b60}/{len(worked)}",
-                    f"{np.mean([r['units'] for r in g]):.1f}" if g else "-",
-                    f"{np.mean(rev):.0f}" if rev else "-"])
-    return out
-
-
-BREAKDOWN_HEADER = ["configuration", "case", "runs", "never worked (< 3 units in 30 min)",
-                    "of the runs that worked: broke down within 30 min", "within the hour", "units (mean)",
-                    "180° turns per hour (team)"]
-
-
 def summarize(rows: list[dict]) -> list[str]:
     """Markdown tables of the runs, as the report section shows them
     (:mod:`teamnav.papers.trails.report._trails_gap_fills`)."""
-    from teamnav.papers.trails.report._trails_gap_fills import HEADER, cases, table_rows
+    from teamnav.papers.trails.report._trails_gap_fills import BREAKDOWN_HEADER, HEADER, breakdown_rows, cases, table_rows
 
     out: list[str] = []
     if any(r["part"] == "breakdown" for r in rows):

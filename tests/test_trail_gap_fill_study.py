@@ -12,6 +12,7 @@ import pytest
 from teamnav.papers.trails.brains.blazing_trail import BlazingTrailParams, navigate_params
 from teamnav.experiments.spec import load_scenario
 from teamnav.experiments.sweep import load_sweep
+from teamnav.papers.trails.report import _trails_gap_fills as GF
 
 _PATH = Path(__file__).resolve().parents[1] / "scripts" / "trail_gap_fill_study.py"
 _spec = importlib.util.spec_from_file_location("trail_gap_fill_study", _PATH)
@@ -171,7 +172,7 @@ def test_breakdown_table_reports_runs_that_never_worked_apart_and_counts_within_
             run(1001, [100.0 * k for k in range(1, 15)]),  # last at 1400 s: broke down within 30 min
             run(1002, [100.0 * k for k in range(1, 36)]),  # working until 3500 s: no breakdown
             run(1003, [100.0 * k for k in range(1, 25)])]  # 1700 s < 1800 - 180 is false: breaks down at 2400 s
-    (row,) = gs.breakdown_rows(rows)
+    (row,) = GF.breakdown_rows(rows)
     assert row[:3] == ["paper-2000", "x1-slip", "4"]
     assert row[3] == "1 (seeds 1000)"
     assert row[4] == "1/3" and row[5] == "2/3"  # within 30 min: seed 1001 only; within the hour: 1001 and 1003
