@@ -12,6 +12,7 @@ import pytest
 from teamnav.papers.trails.brains.blazing_trail import BlazingTrailParams, navigate_params
 from teamnav.experiments.spec import load_scenario
 from teamnav.experiments.sweep import load_sweep
+from teamnav.experiments.report.model import Missing
 from teamnav.papers.trails.report import _trails_gap_fills as GF
 
 _PATH = Path(__file__).resolve().parents[1] / "scripts" / "trail_gap_fill_study.py"
@@ -113,7 +114,7 @@ def test_study_tables_pair_by_seed():
 
 
 @pytest.mark.parametrize("system, files", [
-    ("blazing", ("blazing-gap-fill-study.jsonl", "blazing-drift-study.jsonl")),
+    ("blazing", ("blazing-gap-fill-study.jsonl", "blazing-drift-study.jsonl", "blazing-breakdown-study.jsonl")),
     ("try", ("try-gap-fill-study.jsonl",)),
 ])
 def test_stored_study_runs_are_the_docs_jsonl(system, files):
@@ -177,3 +178,48 @@ def test_breakdown_table_reports_runs_that_never_worked_apart_and_counts_within_
     assert row[3] == "1 (seeds 1000)"
     assert row[4] == "1/3" and row[5] == "2/3"  # within 30 min: seed 1001 only; within the hour: 1001 and 1003
     assert row[7] == "40"
+
+
+def _probe(config, case, seed, units, broke, reversals=100, cruise=0.4, probe="precondition-2000"):
+    return {"probe": probe, "part": "drift", "config": config, "case": case, "seed": seed, "duration_s": 1800.0,
+            "units": units, "units_second_half": units // 2, "first_delivery_s": 200.0, "breakdown_s": 900.0,
+            "breakdown_censored": not broke, "cpu_s": 7.0, "reversals": reversals, "cruise_mps": cruise}
+
+
+@pytest.mark.parametrize("units, broke, holds", [
+    ([20, 18, 16, 15, 14], [False] * 4 + [True], True),   # mean 16.6 >= 14, one breakdown
+    ([20, 18, 16, 15, 14], [False] * 3 + [True] * 2, False),  # two breakdowns
+    ([13, 14, 12, 15, 14], [False] * 5, False),            # mean 13.6 < 14 (half the paper's 28)
+])
+def test_the_2000_precondition_reads_the_k0_probe_runs(units, broke, holds):
+    runs = [_probe("paper-2000", "x0", 1000 + i, u, b) for i, (u, b) in enumerate(zip(units, broke))]
+    runs += [_probe("paper-2000", "", 1000, 1, True)]  # the scenario's drift: not part of the check
+    pre = GF.precondition_2000(runs)
+    assert pre.holds is holds and pre.seeds == "1000-1004" and pre.claims == ("drift-breakdown",)
+    assert ("precondition not met" in pre.result) is (not holds)
+    assert GF.precondition_2000([]).holds is None
+
+
+def test_probe_table_has_turns_per_hour_and_per_km():
+    runs = [_probe("teamnav", "x0", 1000, 30, False, reversals=36, probe="speed-0.25"),
+            _probe("teamnav@0.25", "x0", 1000, 15, False, reversals=36, cruise=0.25, probe="speed-0.25")]
+    t = GF.probe_table("speed-0.25", runs)
+    fast, slow = t.rows
+    assert fast[0] == "teamnav" and slow[0] == "teamnav@0.25"
+    assert fast[7] == slow[7] == "72.0"  # 36 turns in 30 min
+    # per km at cruise: 72 / (4 robots x 1.44 km/h) = 12.5 at 0.4 m/s, 72 / (4 x 0.9) = 20 at 0.25 m/s
+    assert fast[8] == "12.5" and slow[8] == "20.0"
+    assert isinstance(GF.probe_table("speed-0.25", []), Missing)
+
+
+def test_stored_probe_runs_are_the_docs_jsonl():
+    """The probes on tuning seeds in package data are the lines of docs/report/trails-probes.jsonl,
+    every one on a tuning seed (1000-1999)."""
+    docs = Path(__file__).resolve().parents[1] / "docs" / "report" / "trails-probes.jsonl"
+    lines = [json.loads(x) for x in docs.read_text().splitlines() if x.strip()] if docs.exists() else []
+
+    def key(r):
+        return (r["probe"], r["case"], r["config"], r["seed"])
+
+    assert sorted(GF.probe_runs(), key=key) == sorted(lines, key=key)
+    assert all(1000 <= r["seed"] < 2000 for r in lines)

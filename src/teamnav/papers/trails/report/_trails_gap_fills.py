@@ -198,3 +198,73 @@ def blocks(runs=None, system: str = "blazing") -> list:
                            "not run yet: nice -n 10 python scripts/trail_gap_fill_study.py breakdown --seeds 1000-1019 "
                            "--out F.jsonl, then store F in papers/trails/report/data/"))
     return out
+
+
+# ------------------------------------------------------------------ probes on tuning seeds
+#: the probes on tuning seeds (``scripts/trail_gap_fill_study.py`` runs, seeds >= 1000), package data:
+#: ``probe`` "precondition-2000" (the 2000 paper column, 30 min, k = 0 and the scenario's drift, with
+#: its literal reading beside it) and "speed-0.25" (trail-share-v1's teamnav column at 0.4 and 0.25 m/s,
+#: 30 min, k = 0 and the scenario's drift); docs/report/trails-probes.jsonl holds the same lines
+PROBES_FILE = "trails-probes.json"
+#: the 2000 precondition (Blazing §5.1: "Until 20 minutes all robots made consistently correct turning
+#: decisions"; 28 units in 30 min): without drift the paper column's team delivers at least half the
+#: paper's 28 units in 30 min on average and at most one run of the probe breaks down (the 180-s rule);
+#: written before the probe's k = 0 runs. Needed by claim drift-breakdown (a breakdown from drift needs
+#: a team that works without it)
+PRE_MIN_UNITS_30MIN, PRE_MAX_BROKE = 14.0, 1
+
+
+def probe_runs() -> tuple[dict, ...]:
+    """The stored probe runs (empty when the file is absent)."""
+    path = _DATA / PROBES_FILE
+    return tuple(json.loads(path.read_text(encoding="utf-8"))) if path.is_file() else ()
+
+
+def precondition_2000(runs=None):
+    """The 2000 paper column's precondition (:data:`PRE_MIN_UNITS_30MIN`, :data:`PRE_MAX_BROKE`), checked on
+    the stored probe runs of ``paper-2000`` at k = 0: a :class:`Precondition` (holds None: not run)."""
+    from teamnav.experiments.report.model import Precondition
+
+    runs = [r for r in (probe_runs() if runs is None else runs)
+            if r.get("probe") == "precondition-2000" and r["config"] == "paper-2000" and r["case"] == "x0"]
+    what = ("Blazing §5.1: the team works before drift does (\"Until 20 minutes all robots made consistently "
+            "correct turning decisions\", 28 units in 30 min). Check: the 2000 paper column without drift, 30 min, "
+            f"delivers >= {PRE_MIN_UNITS_30MIN:g} units on average and at most {PRE_MAX_BROKE} run breaks down")
+    if not runs:
+        return Precondition(what, "-", "not run (scripts/trail_gap_fill_study.py drift --configs paper-2000 "
+                                        "--cases x0 --seeds 1000-1004 --duration 1800)", None, ("drift-breakdown",))
+    units = [r["units"] for r in runs]
+    broke = sum(not r["breakdown_censored"] for r in runs)
+    holds = bool(np.mean(units) >= PRE_MIN_UNITS_30MIN and broke <= PRE_MAX_BROKE)
+    rev = [r["reversals"] / (r["duration_s"] / 3600.0) for r in runs if r.get("reversals") is not None]
+    return Precondition(what, _seeds(runs),
+                        f"units {_ms(units)} (paper 28), {broke}/{len(runs)} broke down, the 180° rule's turns "
+                        f"{_ms(rev)} per hour (team)" + ("" if holds else ": does not hold, so claim drift-breakdown "
+                                                                          "reads 'precondition not met' on this column"),
+                        holds, ("drift-breakdown",))
+
+
+def probe_table(probe: str, runs=None) -> Table | Missing:
+    """One probe's runs per configuration and drift case: units, a work rate (units x 2 x 31.5 m per robot
+    and second, over the cruise speed), first delivery, breakdowns, the 180° rule's turns per hour and
+    per km driven at cruise."""
+    runs = [r for r in (probe_runs() if runs is None else runs) if r.get("probe") == probe]
+    if not runs:
+        return Missing(f"probe {probe}", "not run")
+    rows = []
+    for key in sorted({(r["config"], r["case"]) for r in runs}, key=lambda k: (k[1], k[0])):
+        g = [r for r in runs if (r["config"], r["case"]) == key]
+        cr = g[0].get("cruise_mps", 0.25)
+        hours = g[0]["duration_s"] / 3600.0
+        work = [r["units"] * 2 * 31.5 / (4 * r["duration_s"] * cr) for r in g]
+        rev_h = [r["reversals"] / hours for r in g if r.get("reversals") is not None]
+        rows.append([key[0], key[1] or "scenario drift", f"{cr:g}", _ms([r["units"] for r in g]), _ms(work),
+                     _ms([r["first_delivery_s"] / 60 for r in g if r.get("first_delivery_s") is not None]),
+                     f"{sum(not r['breakdown_censored'] for r in g)}/{len(g)}", _ms(rev_h),
+                     _ms([x / (4 * cr * 3.6) for x in rev_h])])
+    return Table(f"Probe {probe} on tuning seeds {_seeds(runs)} ({runs[0]['duration_s'] / 60:g} min)",
+                 ["configuration", "drift", "cruise [m/s]", "units", "work rate (route m delivered per robot-m "
+                  "at cruise)", "first delivery [min]", "broke down", "180° turns per hour (team)",
+                  "180° turns per km at cruise (team)"], rows,
+                 note="tuning seeds, not the report's; the work rate is units x 2 x 31.5 m / (4 robots x duration x "
+                      "cruise): the share of the team's time spent carrying work at cruise")

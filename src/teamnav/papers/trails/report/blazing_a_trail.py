@@ -306,6 +306,12 @@ def build(ctx) -> list:
                                                          "failed in a column")]
     vals = {col: _values(cols[col], dur, drift_dur) for col, _ in T.COLUMNS}
     verdicts = _judge_all(claims, vals, dur, drift_dur)
+    # FIDELITY §1: a precondition checked on tuning seeds before the judged run; when it does not hold,
+    # the claims that need it read "precondition not met" on the paper column, never "fails"
+    pre = GF.precondition_2000()
+    if pre.holds is False:
+        for cid in pre.claims:
+            verdicts["paper_rules"][cid] = (None, f"precondition not met ({verdicts['paper_rules'][cid][1]})")
 
     def rule(cid: str, col: str) -> str:
         c = claims[cid]
@@ -318,6 +324,7 @@ def build(ctx) -> list:
                         note="verdicts judged on the paper-as-written column; the teamnav column is what the "
                              "gap-fills buy"))
     blocks.append(blazing_ledger())
+    blocks += [pre, GF.probe_table("precondition-2000")]
     blocks.append(Table("Gap-fills: teamnav's value and the paper's (paper_rules: true sets the paper's)",
                         ["parameter (blazing-trail-v1)", "teamnav", "paper as written", "where the paper says so"],
                         T.gap_fill_rows(BlazingTrailParams, load_scenario("blazing-a-trail").robots[0].params),

@@ -305,6 +305,8 @@ def build(ctx) -> list:
                              f"{T.PAPER_CRUISE_MPS:g} m/s); the teamnav column (cruise {cruise:g} m/s) is what the "
                              "gap-fills buy"))
     blocks.append(try_ledger())
+    # Navigate's settings were tuned at 0.4 m/s: how they fare at the paper's 0.25 (tuning seeds, stored)
+    blocks.append(GF.probe_table("speed-0.25"))
     blocks.append(Table("Gap-fills: teamnav's value and the paper's (paper_rules: true sets the paper's)",
                         ["parameter (trail-share-v1)", "teamnav", "paper as written", "where the paper says so"],
                         T.gap_fill_rows(TrailShareParams, load_scenario("try-to-see-it-my-way").robots[0].params),
