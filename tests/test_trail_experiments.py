@@ -373,6 +373,12 @@ def test_blazing_section_verdicts_follow_the_data():
     (ledger,) = [b for b in blocks if isinstance(b, Ledger)]
     assert {r.column for r in ledger.rows} == {"paper", "teamnav"}
     assert any(isinstance(b, Table) and b.title.startswith("Ablation: the 2000 paper read literally") for b in blocks)
+    # the seeds looked at before the judged ones were named: a second, labelled table, never a Comparison
+    judged = load_claims("blazing-a-trail")["first-trail"].seed_list
+    if min(judged) >= 10:
+        (old,) = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Seeds 0-9: looked at many times")]
+        assert "not judged" in old.title and len(old.rows) == 3
+        assert drift_calls[1]["seeds"] == list(range(10))
 
 
 @pytest.mark.skipif("blazing-trail-v1" not in controllers.names(), reason="blazing-trail-v1 not registered yet")
