@@ -258,7 +258,8 @@ def probe_table(probe: str, runs=None) -> Table | Missing:
         hours = g[0]["duration_s"] / 3600.0
         work = [r["units"] * 2 * 31.5 / (4 * r["duration_s"] * cr) for r in g]
         rev_h = [r["reversals"] / hours for r in g if r.get("reversals") is not None]
-        rows.append([key[0], key[1] or "scenario drift", f"{cr:g}", _ms([r["units"] for r in g]), _ms(work),
+        rows.append([key[0], key[1] or "scenario drift", f"{cr:g}", _ms([r["units"] for r in g]),
+                     f"{np.mean(work):.2f} ± {np.std(work, ddof=1) if len(work) > 1 else 0.0:.2f}",
                      _ms([r["first_delivery_s"] / 60 for r in g if r.get("first_delivery_s") is not None]),
                      f"{sum(not r['breakdown_censored'] for r in g)}/{len(g)}", _ms(rev_h),
                      _ms([x / (4 * cr * 3.6) for x in rev_h])])
