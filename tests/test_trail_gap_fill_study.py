@@ -115,7 +115,7 @@ def test_study_tables_pair_by_seed():
 
 @pytest.mark.parametrize("system, files", [
     ("blazing", ("blazing-gap-fill-study.jsonl", "blazing-drift-study.jsonl", "blazing-breakdown-study.jsonl")),
-    ("try", ("try-gap-fill-study.jsonl",)),
+    ("try", ("try-gap-fill-study.jsonl", "try-reversal-study.jsonl")),
 ])
 def test_stored_study_runs_are_the_docs_jsonl(system, files):
     """The sections' package data hold exactly the runs recorded in docs/report/."""

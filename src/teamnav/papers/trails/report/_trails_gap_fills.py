@@ -183,6 +183,14 @@ def blocks(runs=None, system: str = "blazing") -> list:
         rs = [r for r in runs if r["part"] == "drift" and r["case"] == case]
         out.append(Table(f"Drift case {case}: {rs[0]['duration_s'] / 60:g} min, paper / paper with homebound crumbs "
                          "reversed / our gap-fills at 0.25 m/s / ours", HEADER, table_rows(runs, "drift", case)))
+    rv = [r for r in runs if r["part"] == "reversals"]
+    if rv:
+        out.append(Table(f"The 180° rule's turns counted: {brain} on {scenario}, {rv[0]['duration_s'] / 60:g} min, the "
+                         f"scenario's drift, the paper's rules with each reversal-damping gap-fill alone, seeds "
+                         f"{_seeds(rv)}", HEADER, table_rows(runs, "reversals", ""),
+                         note="the same configurations as the table above on more seeds (tuning seeds), with "
+                              "Navigate's count of the 180° rule's turns: whether each gap-fill damps the "
+                              "flip-flopping is read from the runs, not inferred"))
     bd = [r for r in runs if r["part"] == "breakdown"]
     if bd:
         out.append(Table(f"Breakdown study: the 2000 paper column as judged (paper-2000: the trail followed backwards, "
