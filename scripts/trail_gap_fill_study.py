@@ -65,16 +65,40 @@ RATES = (-1.0, 1.0, 2.0, 0.35)
 SCALE5 = (0.05, -0.05, 0.03, -0.03)
 DRIFT_CASES = ("x0", "x1", "x4", "x1-slip", "x1-scale5")
 DRIFT_CONFIGS = ("paper", "paper+reverse_carried_crumbs", "teamnav@0.25", "teamnav")
+#: the 2000 paper column as the report judges it since 2026-11-29: the paper's rules, the single trail
+#: followed backwards (crumbs laid while carrying reversed, Try §1) and the cruise speed the 2000 paper
+#: implies (0.4 m/s; teamnav.papers.trails.report._trails.BLAZING_IMPLIED_CRUISE_MPS)
+PAPER_2000_CRUISE = 0.4
+#: the breakdown study (part ``breakdown``): the 2000 paper column at the papers' drift (k = 1) without
+#: and with a heading random walk of h deg/sqrt(m) ("x1-slip<h>"; "x1-slip" is h = 1), 1 h, >= 20 seeds
+BREAKDOWN_CASES = ("x1", "x1-slip0.5", "x1-slip", "x1-slip2")
+BREAKDOWN_CONFIGS = ("paper-2000",)
+
+
+#: the study's stored runs were made when blazing-trail-v1's ``paper_rules`` also set cruise 0.25 m/s
+#: and crumbs laid while carrying unreversed (Blazing §4.1 read literally). Since 2026-11-29 neither
+#: is among the brain's paper rules (the 2000 paper column reverses them, Try §1, and drives at the
+#: speed the 2000 paper implies); the study keeps its configurations as they were run, so these two
+#: are named here as gap-fills of the study: (field, teamnav value, the study's "paper" value, note)
+STUDY_EXTRA_FILLS = {"blazing": (
+    ("cruise_speed_mps", TEAMNAV_CRUISE, 0.25, "Try §3.6: 0.25 m/s cruise (the study's paper column)"),
+    ("reverse_carried_crumbs", True, False, "Blazing §4.1 read literally (the study's paper column)"),
+)}
 
 
 def gap_fill_table(system: str = "blazing") -> list:
-    """The gap-fills of the system's brain (Navigate's included), ours at cruise 0.4 m/s."""
+    """The gap-fills of the system's brain (Navigate's included), ours at cruise 0.4 m/s, and the
+    study's own (:data:`STUDY_EXTRA_FILLS`)."""
     import importlib
 
-    from teamnav.control.paper_rules import gap_fills
+    from teamnav.control.paper_rules import GapFill, gap_fills
 
     module, _, cls = SYSTEMS[system][1].partition(":")
-    return gap_fills(getattr(importlib.import_module(module), cls), {"cruise_speed_mps": TEAMNAV_CRUISE})
+    fills = gap_fills(getattr(importlib.import_module(module), cls), {"cruise_speed_mps": TEAMNAV_CRUISE})
+    have = {g.field for g in fills}
+    extra = [GapFill(*e) for e in STUDY_EXTRA_FILLS.get(system, ()) if e[0] not in have]
+    # the brain's own order first, then the study's, cruise first (as the stored runs' tables list them)
+    return sorted(extra, key=lambda g: g.field != "cruise_speed_mps") + fills if extra else fills
 
 
 def params_for(config: str, system: str = "blazing") -> dict:
@@ -91,6 +115,8 @@ def params_for(config: str, system: str = "blazing") -> dict:
     ours = {g.field: g.teamnav_value for g in fills}
     if config == "paper":
         chosen = paper
+    elif config == "paper-2000":
+        chosen = {**paper, "cruise_speed_mps": PAPER_2000_CRUISE, "reverse_carried_crumbs": True}
     elif config == "teamnav":
         chosen = ours
     elif config == "teamnav@0.25":
@@ -100,7 +126,7 @@ def params_for(config: str, system: str = "blazing") -> dict:
     elif config.startswith("teamnav-") and config[8:] in names:
         chosen = {**ours, config[8:]: paper[config[8:]]}
     else:
-        raise ValueError(f"unknown configuration {config!r}: expected paper, teamnav, teamnav@0.25, "
+        raise ValueError(f"unknown configuration {config!r}: expected paper, paper-2000, teamnav, teamnav@0.25, "
                          f"paper+G or teamnav-G with G one of {', '.join(names)}")
     out: dict = dict(SYSTEMS[system][2])
     for key, value in chosen.items():
@@ -119,10 +145,15 @@ def drift_overrides(case: str) -> dict:
         raise ValueError(f"unknown drift case {case!r}: expected one of {', '.join(DRIFT_CASES)}")
     k = float(base[1:])
     out = {f"robots.{i}.odometry.heading_drift_deg_per_min": k * r for i, r in enumerate(RATES)}
-    if extra == "slip":
+    if extra.startswith("slip"):
+        try:
+            h = float(extra[4:]) if extra[4:] else 1.0  # "slip" = 1 deg/sqrt(m), as stored
+        except ValueError:
+            raise ValueError(f"unknown drift case {case!r}: expected one of {', '.join(DRIFT_CASES)} "
+                             "or x<k>-slip<deg per sqrt m>") from None
         for i in range(4):
             out[f"robots.{i}.odometry.slip_std_m_per_sqrt_m"] = 0.01
-            out[f"robots.{i}.odometry.heading_slip_deg_per_sqrt_m"] = 1.0
+            out[f"robots.{i}.odometry.heading_slip_deg_per_sqrt_m"] = h
     elif extra == "scale5":
         for i, s in enumerate(SCALE5):
             out[f"robots.{i}.odometry.scale_error"] = s
@@ -146,6 +177,12 @@ def one_run(job: tuple) -> dict:
     t0 = time.process_time()
     res = run(load_scenario(SYSTEMS[system][0], overrides=ov, seed=seed, duration_s=duration), progress=False)
     times = sorted(t for t, _ in deliveries(res.data.event_log))
+    # the 180° rule's turns per robot (Navigate's counter, in each brain's log): the last logged value
+    last_rev: dict[int, int] = {}
+    for rec in res.data.logs:
+        v = (rec.get("values") or {}).get("reversals")
+        if isinstance(v, int):
+            last_rev[int(rec["robot"])] = v
     if times and duration - times[-1] >= BREAKDOWN_GAP_S:
         bd, cens = times[-1], False
     elif not times:
@@ -156,7 +193,10 @@ def one_run(job: tuple) -> dict:
     row = {} if system == "blazing" else {"system": system}  # rows without it are blazing-trail-v1's
     return {**row, "part": part, "config": config, "case": case, "seed": seed, "duration_s": duration,
             "units": len(times), "units_second_half": len(half), "first_delivery_s": times[0] if times else None,
-            "breakdown_s": bd, "breakdown_censored": cens, "cpu_s": round(time.process_time() - t0, 2)}
+            "breakdown_s": bd, "breakdown_censored": cens, "cpu_s": round(time.process_time() - t0, 2),
+            "reversals": sum(last_rev.values()) if last_rev else None,
+            "cruise_mps": float(params.get("cruise_speed_mps", 0.25)),
+            "delivery_times_s": [round(t, 1) for t in times]}
 
 
 def parse_seeds(text: str) -> list[int]:
@@ -173,9 +213,12 @@ def parse_seeds(text: str) -> list[int]:
 def summarize(rows: list[dict]) -> list[str]:
     """Markdown tables of the runs, as the report section shows them
     (:mod:`teamnav.papers.trails.report._trails_gap_fills`)."""
-    from teamnav.papers.trails.report._trails_gap_fills import HEADER, cases, table_rows
+    from teamnav.papers.trails.report._trails_gap_fills import BREAKDOWN_HEADER, HEADER, breakdown_rows, cases, table_rows
 
     out: list[str] = []
+    if any(r["part"] == "breakdown" for r in rows):
+        out += ["\n## breakdown", "| " + " | ".join(BREAKDOWN_HEADER) + " |", "|" + "---|" * len(BREAKDOWN_HEADER)]
+        out += ["| " + " | ".join(r) + " |" for r in breakdown_rows(rows)]
     for part in ("gapfills", "drift"):
         for case in cases(rows, part):
             out += [f"\n## {part} {case or '(the scenario drift)'}", "| " + " | ".join(HEADER) + " |",
@@ -186,7 +229,7 @@ def summarize(rows: list[dict]) -> list[str]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("part", choices=["gapfills", "drift", "summary"])
+    ap.add_argument("part", choices=["gapfills", "drift", "breakdown", "summary"])
     ap.add_argument("--seeds", default="100-109")
     ap.add_argument("--system", choices=sorted(SYSTEMS), default="blazing",
                     help="blazing: blazing-trail-v1 on blazing-a-trail; try: trail-share-v1 on try-to-see-it-my-way")
@@ -206,6 +249,10 @@ def main(argv: list[str] | None = None) -> int:
         configs = a.configs.split(",") if a.configs else (
             ["paper", "teamnav"] + [f"paper+{n}" for n in names] + [f"teamnav-{n}" for n in names])
         jobs = [("gapfills", c, "", s, a.duration or 1800.0, a.system) for c in configs for s in seeds]
+    elif a.part == "breakdown":
+        configs = a.configs.split(",") if a.configs else list(BREAKDOWN_CONFIGS)
+        cases = a.cases.split(",") if a.cases != ",".join(DRIFT_CASES) else list(BREAKDOWN_CASES)
+        jobs = [("breakdown", c, k, s, a.duration or 3600.0, a.system) for k in cases for c in configs for s in seeds]
     else:
         configs = a.configs.split(",") if a.configs else list(DRIFT_CONFIGS)
         jobs = [("drift", c, k, s, a.duration or 3600.0, a.system)

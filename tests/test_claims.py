@@ -18,7 +18,8 @@ def test_the_trail_claim_files_load_and_judge_the_paper_rules_column(section):
     cf = load_claims(section)
     assert cf.section == section and cf.claims
     for c in cf.claims:
-        assert c.judged == "paper_rules" and max(c.seed_list) < 1000 and c.history
+        assert c.judged == "paper_rules" and c.history
+        assert not any(1000 <= s < 2000 for s in c.seed_list)  # never a tuning seed
 
 
 def test_unknown_keys_tuning_seeds_and_bad_ops_are_refused():
@@ -29,6 +30,12 @@ def test_unknown_keys_tuning_seeds_and_bad_ops_are_refused():
     with pytest.raises(ValidationError, match="tuning seeds"):
         Claim.model_validate({**BASE, "seeds": "1990-2009"})  # straddles the tuning range's end
     assert Claim.model_validate({**BASE, "seeds": "2000-2009"}).seed_list[0] == 2000  # fresh judged seeds
+    with pytest.raises(ValidationError, match="seeds 1000-1999 are tuning seeds"):
+        Claim.model_validate({**BASE, "seeds": "990-1000"})  # one tuning seed is enough to refuse
+    with pytest.raises(ValidationError, match="tuning seeds"):
+        Claim.model_validate({**BASE, "seeds": "1999-2000"})
+    # fresh judged seeds (>= 2000, kept from tuning) are a report's
+    assert Claim.model_validate({**BASE, "seeds": "2000-2009"}).seed_list[-1] == 2009
     with pytest.raises(ValidationError):
         Claim.model_validate({**BASE, "rule": [{"metric": "r", "op": "=>", "threshold": 1}]})
 

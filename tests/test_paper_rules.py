@@ -44,14 +44,29 @@ def test_paper_rules_sets_every_listed_field_and_navigates_as_written(cls):
 def test_the_issue_list_is_covered():
     fields = {g.field for g in gap_fills(BlazingTrailParams)} | {g.field for g in gap_fills(TrailShareParams)}
     for name in ("crumb_min_move_m", "prune_loops", "lookahead_m", "recover_radius_m", "descend_only",
-                 "reverse_carried_crumbs", "turn_at_place", "cruise_speed_mps", "navigate.reverse_cooldown_s",
+                 "turn_at_place", "cruise_speed_mps", "navigate.reverse_cooldown_s",
                  "navigate.reverse_cooldown_m", "navigate.reverse_memory_m", "navigate.box_ahead_free",
                  "navigate.panic_on_stall"):
         assert name in fields, name
 
 
+def test_the_2000_paper_rules_keep_the_single_trail_backwards_and_leave_the_speed_to_the_column():
+    """Try §1: the 2000 trail "was followed forwards towards the 'goal' and backwards towards 'home'":
+    crumbs laid while carrying stored reversed is the paper's rule, not a gap-fill; the 2000 paper
+    states no speed (the report's paper column sets the one its numbers imply)."""
+    blazing = {g.field for g in gap_fills(BlazingTrailParams)}
+    assert "reverse_carried_crumbs" not in blazing and "cruise_speed_mps" not in blazing
+    p = BlazingTrailParams(paper_rules=True, cruise_speed_mps=0.4)
+    assert p.reverse_carried_crumbs and p.cruise_speed_mps == 0.4
+    # the literal reading is still a run: the ablation row
+    assert not BlazingTrailParams(paper_rules=True, reverse_carried_crumbs=False).reverse_carried_crumbs
+    # the 2002 paper states its speed: trail-share-v1's paper rules still set it
+    assert TrailShareParams(paper_rules=True).cruise_speed_mps == 0.25
+    with pytest.raises(ValidationError, match="cruise_speed_mps"):
+        TrailShareParams(paper_rules=True, cruise_speed_mps=0.4)
+
+
 @pytest.mark.parametrize("kwargs, name", [
-    ({"cruise_speed_mps": 0.4}, "cruise_speed_mps"),
     ({"lookahead_m": 1.0}, "lookahead_m"),
     ({"navigate": {"reverse_cooldown_s": 5.0}}, "navigate.reverse_cooldown_s"),
     ({"navigate": {"box_ahead_free": True}}, "navigate.box_ahead_free"),

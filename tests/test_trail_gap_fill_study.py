@@ -12,6 +12,8 @@ import pytest
 from teamnav.papers.trails.brains.blazing_trail import BlazingTrailParams, navigate_params
 from teamnav.experiments.spec import load_scenario
 from teamnav.experiments.sweep import load_sweep
+from teamnav.experiments.report.model import Missing
+from teamnav.papers.trails.report import _trails_gap_fills as GF
 
 _PATH = Path(__file__).resolve().parents[1] / "scripts" / "trail_gap_fill_study.py"
 _spec = importlib.util.spec_from_file_location("trail_gap_fill_study", _PATH)
@@ -28,10 +30,13 @@ def _dump(params: dict) -> dict:
     return out
 
 
-def test_paper_config_is_paper_rules_true():
+def test_paper_config_is_paper_rules_true_as_the_study_ran_it():
     """The study's "paper" configuration, written out field by field, validates to the same
-    brain parameters as the report's ``paper_rules: true`` column."""
-    assert _dump(gs.params_for("paper")) == _dump({**gs.BASE_PARAMS, "paper_rules": True})
+    brain parameters as ``paper_rules: true`` with the two settings the study's stored runs had
+    then (0.25 m/s, crumbs laid while carrying not reversed), which are no longer paper rules."""
+    assert _dump(gs.params_for("paper")) == _dump({**gs.BASE_PARAMS, "paper_rules": True, "cruise_speed_mps": 0.25,
+                                                   "reverse_carried_crumbs": False})
+    assert _dump(gs.params_for("paper")) != _dump({**gs.BASE_PARAMS, "paper_rules": True})
 
 
 def test_teamnav_config_is_the_scenario_column():
@@ -109,8 +114,8 @@ def test_study_tables_pair_by_seed():
 
 
 @pytest.mark.parametrize("system, files", [
-    ("blazing", ("blazing-gap-fill-study.jsonl", "blazing-drift-study.jsonl")),
-    ("try", ("try-gap-fill-study.jsonl",)),
+    ("blazing", ("blazing-gap-fill-study.jsonl", "blazing-drift-study.jsonl", "blazing-breakdown-study.jsonl")),
+    ("try", ("try-gap-fill-study.jsonl", "try-reversal-study.jsonl")),
 ])
 def test_stored_study_runs_are_the_docs_jsonl(system, files):
     """The sections' package data hold exactly the runs recorded in docs/report/."""
@@ -138,3 +143,83 @@ def test_try_configs_are_trail_share_columns():
     q = TrailShareParams(**{**gs.SYSTEMS["try"][2], "paper_rules": True}).model_dump(exclude={"paper_rules", "navigate"})
     assert p == q
     assert {g.field for g in gs.gap_fill_table("try")} >= {"descend_only", "recover_radius_m"}
+
+
+def test_paper_2000_config_is_the_report_paper_column():
+    """The breakdown study's "paper-2000" is the 2000 paper column the report judges: paper_rules, the
+    single trail followed backwards (reversed carried crumbs) and the implied 0.4 m/s."""
+    from teamnav.papers.trails.report._trails import BLAZING_IMPLIED_CRUISE_MPS
+
+    assert _dump(gs.params_for("paper-2000")) == _dump({**gs.BASE_PARAMS, "paper_rules": True,
+                                                        "cruise_speed_mps": BLAZING_IMPLIED_CRUISE_MPS})
+
+
+@pytest.mark.parametrize("case, h", [("x1-slip", 1.0), ("x1-slip0.5", 0.5), ("x1-slip2", 2.0)])
+def test_slip_cases_name_their_heading_random_walk(case, h):
+    ov = gs.drift_overrides(case)
+    assert {ov[f"robots.{i}.odometry.heading_slip_deg_per_sqrt_m"] for i in range(4)} == {h}
+    assert ov["robots.2.odometry.heading_drift_deg_per_min"] == 2.0  # k = 1: Fly's 2 deg/min
+    with pytest.raises(ValueError, match="unknown drift case"):
+        gs.drift_overrides("x1-slipper")
+
+
+def test_breakdown_table_reports_runs_that_never_worked_apart_and_counts_within_30_min():
+    def run(seed, times, case="x1-slip"):
+        cens = bool(times) and 3600.0 - times[-1] < 180.0
+        return {"part": "breakdown", "config": "paper-2000", "case": case, "seed": seed, "duration_s": 3600.0,
+                "units": len(times), "breakdown_censored": cens, "reversals": 40, "delivery_times_s": times}
+
+    rows = [run(1000, [100.0, 200.0]),                    # 2 units in 30 min: never worked
+            run(1001, [100.0 * k for k in range(1, 15)]),  # last at 1400 s: broke down within 30 min
+            run(1002, [100.0 * k for k in range(1, 36)]),  # working until 3500 s: no breakdown
+            run(1003, [100.0 * k for k in range(1, 25)])]  # 1700 s < 1800 - 180 is false: breaks down at 2400 s
+    (row,) = GF.breakdown_rows(rows)
+    assert row[:3] == ["paper-2000", "x1-slip", "4"]
+    assert row[3] == "1 (seeds 1000)"
+    assert row[4] == "1/3" and row[5] == "2/3"  # within 30 min: seed 1001 only; within the hour: 1001 and 1003
+    assert row[7] == "40"
+
+
+def _probe(config, case, seed, units, broke, reversals=100, cruise=0.4, probe="precondition-2000"):
+    return {"probe": probe, "part": "drift", "config": config, "case": case, "seed": seed, "duration_s": 1800.0,
+            "units": units, "units_second_half": units // 2, "first_delivery_s": 200.0, "breakdown_s": 900.0,
+            "breakdown_censored": not broke, "cpu_s": 7.0, "reversals": reversals, "cruise_mps": cruise}
+
+
+@pytest.mark.parametrize("units, broke, holds", [
+    ([20, 18, 16, 15, 14], [False] * 4 + [True], True),   # mean 16.6 >= 14, one breakdown
+    ([20, 18, 16, 15, 14], [False] * 3 + [True] * 2, False),  # two breakdowns
+    ([13, 14, 12, 15, 14], [False] * 5, False),            # mean 13.6 < 14 (half the paper's 28)
+])
+def test_the_2000_precondition_reads_the_k0_probe_runs(units, broke, holds):
+    runs = [_probe("paper-2000", "x0", 1000 + i, u, b) for i, (u, b) in enumerate(zip(units, broke))]
+    runs += [_probe("paper-2000", "", 1000, 1, True)]  # the scenario's drift: not part of the check
+    pre = GF.precondition_2000(runs)
+    assert pre.holds is holds and pre.seeds == "1000-1004" and pre.claims == ("drift-breakdown",)
+    assert ("precondition not met" in pre.result) is (not holds)
+    assert GF.precondition_2000([]).holds is None
+
+
+def test_probe_table_has_turns_per_hour_and_per_km():
+    runs = [_probe("teamnav", "x0", 1000, 30, False, reversals=36, probe="speed-0.25"),
+            _probe("teamnav@0.25", "x0", 1000, 15, False, reversals=36, cruise=0.25, probe="speed-0.25")]
+    t = GF.probe_table("speed-0.25", runs)
+    fast, slow = t.rows
+    assert fast[0] == "teamnav" and slow[0] == "teamnav@0.25"
+    assert fast[7] == slow[7] == "72.0"  # 36 turns in 30 min
+    # per km at cruise: 72 / (4 robots x 1.44 km/h) = 12.5 at 0.4 m/s, 72 / (4 x 0.9) = 20 at 0.25 m/s
+    assert fast[8] == "12.5" and slow[8] == "20.0"
+    assert isinstance(GF.probe_table("speed-0.25", []), Missing)
+
+
+def test_stored_probe_runs_are_the_docs_jsonl():
+    """The probes on tuning seeds in package data are the lines of docs/report/trails-probes.jsonl,
+    every one on a tuning seed (1000-1999)."""
+    docs = Path(__file__).resolve().parents[1] / "docs" / "report" / "trails-probes.jsonl"
+    lines = [json.loads(x) for x in docs.read_text().splitlines() if x.strip()] if docs.exists() else []
+
+    def key(r):
+        return (r["probe"], r["case"], r["config"], r["seed"])
+
+    assert sorted(GF.probe_runs(), key=key) == sorted(lines, key=key)
+    assert all(1000 <= r["seed"] < 2000 for r in lines)

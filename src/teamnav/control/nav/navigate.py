@@ -341,6 +341,8 @@ class Navigate:
         self._reverse_after_s = -math.inf
         self._reverse_after_m = -math.inf
         self._reversed_at: list[tuple[float, float]] = []  # odometry spots of this leg's reversals
+        #: 180 deg turns made by the trail rule (step 3) so far; the brains log it (``reversals``)
+        self.n_reversals = 0
         self._turn_dir = 0.0
         self._turn_goal_rad = 0.0
         self._turned_rad = 0.0
@@ -592,6 +594,7 @@ class Navigate:
                 and abs(_wrap(preferred_heading_rad - th)) > self._reverse_rad
                 and (reverse_ignore_memory or (self._odo_m >= self._reverse_after_m and not self._reversed_near(x, y)))):
             self._reversed_at = self._reversed_at[-15:] + [(x, y)]  # bounded: a leg may never end
+            self.n_reversals += 1
             self._reverse_after_s = obs.time_s + self.params.reverse_cooldown_s
             self._reverse_after_m = self._odo_m + self.params.reverse_cooldown_m
             self._start_turn(-self.side_sign, math.pi)

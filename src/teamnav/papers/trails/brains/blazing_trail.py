@@ -58,13 +58,24 @@ with all of them; each one flag away from the paper's rules as written):
   seeds 0-7 25.0 ± 3.2 -> 27.3 ± 0.7 units; fresh seeds 8-11 23.8 ± 4.2 -> 27.8 ± 4.2; all 12
   per seed +2.8 ± 1.0 (s.e.). 0 m: the paper's rule.
 
-``reverse_carried_crumbs`` (on): a crumb dropped while carrying stores the opposite heading
-(:mod:`~teamnav.papers.trails.brains.crumbs`), so outbound and homebound crumbs at one spot agree
-instead of cancelling; False stores the robot's own heading, the paper as written.
+``reverse_carried_crumbs`` (on, in both columns): a crumb dropped while carrying stores the
+opposite heading (:mod:`~teamnav.papers.trails.brains.crumbs`), so every crumb points towards the
+source and one trail is followed forwards to the source and backwards home. This is how the
+authors describe their 2000 method in the 2002 paper (Try §1: "connected by a single crumb trail.
+The trail was followed forwards towards the 'goal' and backwards towards 'home'"), so it is the
+paper's rule, not a gap-fill. False stores the robot's own heading also while carrying: the 2000
+paper's §4.1 read literally ("it will follow the opposite heading back to the home position"),
+which sends a carrying robot that follows the opposite of homebound crumbs away from home and
+contradicts the paper's own results; the reports run it as an ablation ("literal reading"), never
+judged.
 
 ``paper_rules=True`` sets every gap-fill above whose other value is the paper's rule to that
-value (:attr:`BlazingTrailParams.PAPER_RULES`, Navigate's own passed down, cruise 0.25 m/s;
-:mod:`teamnav.control.paper_rules`): the reports' "paper as written" column.
+value (:attr:`BlazingTrailParams.PAPER_RULES`, Navigate's own passed down;
+:mod:`teamnav.control.paper_rules`): the reports' "paper as written" column. The cruise speed is
+not among them: the 2000 paper states none, and the speed its numbers imply (≈ 0.37-0.44 m/s, a
+≈ 33 m route, a round trip of "approximately 3 minutes", the resource reached at 1.25 min) is
+not the 2002 paper's 0.25 m/s; the reports set it per column (``_trails.paper_rules_spec``'s
+``cruise_mps``).
 
 Choices where the paper is silent: crumb interval 1 s and radius 2 m (the paper gives neither;
 1.8 m corridors, a radius about a corridor wide, reaches the crumbs of the corridor the robot is
@@ -189,25 +200,23 @@ class BlazingTrailParams(BaseModel):
         ``NAVIGATE_DEFAULTS`` (``trail_rule="side"``, Blazing §5.1; ``box_reach_m=2.0``, lanes).
     reverse_carried_crumbs : bool
         A crumb dropped while carrying stores the opposite of the robot's heading, so every crumb
-        points towards the source (:mod:`~teamnav.papers.trails.brains.crumbs`; a gap-fill; False: the
-        robot's own heading, the paper as written).
+        points towards the source and the single trail is followed backwards home
+        (:mod:`~teamnav.papers.trails.brains.crumbs`; the authors' method as Try §1 describes it;
+        False: the robot's own heading, the 2000 §4.1 literal reading, an ablation).
     paper_rules : bool
         Every gap-fill of :attr:`PAPER_RULES` (and Navigate's) at the paper's value
-        (:mod:`teamnav.control.paper_rules`); setting one of them as well is an error.
+        (:mod:`teamnav.control.paper_rules`); setting one of them as well is an error. Neither
+        the cruise speed nor ``reverse_carried_crumbs`` is among them (module docstring).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     #: the gap-fills whose other value is the 2000 paper's rule (plus Navigate's, passed down)
     PAPER_RULES: ClassVar[dict[str, Any]] = {
-        # Try §3.6: "a cruise speed of 0.25 m/s" (the 2000 paper gives none; the same robots and lab)
-        "cruise_speed_mps": 0.25,
         # Blazing §4.1: crumbs "at regular time intervals", whether or not the robot moved
         "crumb_min_move_m": 0.0,
         # Blazing §4.1: the private list is broadcast as recorded (no loop pruning)
         "prune_loops": False,
-        # Blazing §4.1: "records its current position and heading estimate" (homebound crumbs too)
-        "reverse_carried_crumbs": False,
         # Blazing §4.1: crumbs "within a threshold radius of its current position estimate"
         "lookahead_m": 0.0,
         # Blazing §4.1: "If there are no such crumbs, the robot performs random exploration"
@@ -218,10 +227,8 @@ class BlazingTrailParams(BaseModel):
         "turn_at_place": False,
     }
     PAPER_RULE_NOTES: ClassVar[dict[str, str]] = {
-        "cruise_speed_mps": "Try §3.6: 0.25 m/s cruise (Blazing gives no speed)",
         "crumb_min_move_m": "Blazing §4.1: a crumb every interval, moved or not",
         "prune_loops": "Blazing §4.1: the private list broadcast as recorded",
-        "reverse_carried_crumbs": "Blazing §4.1: a crumb stores the robot's own heading, also while carrying",
         "lookahead_m": "Blazing §4.1: crumbs around the position estimate",
         "recover_radius_m": "Blazing §4.1: no crumb near: random exploration",
         "reverse_min_crumbs": "Blazing §4.2: the 180° turn on any hint",
@@ -388,8 +395,8 @@ class BlazingTrail:
 
     def log(self) -> dict[str, Any]:
         """``carrying``, ``trips`` (units delivered), ``place_index``, ``n_crumbs`` (global list),
-        ``following``, ``recovering`` (heading back to a trail it left), ``mode`` (Navigate's),
-        and every ``layer_every_steps`` a ``crumbs`` layer (global crumbs, odometry frame)."""
+        ``following``, ``recovering`` (heading back to a trail it left), ``mode`` (Navigate's), ``reversals``
+        (the 180° rule's turns so far), and every ``layer_every_steps`` a ``crumbs`` layer (global crumbs, odometry frame)."""
         out: dict[str, Any] = {
             "carrying": self.carrying,
             "trips": self.deliveries,
@@ -399,6 +406,7 @@ class BlazingTrail:
             "following": self._following,
             "recovering": self._recovering,
             "mode": str(getattr(self.nav, "mode", "")),
+            "reversals": int(getattr(self.nav, "n_reversals", 0)),
         }
         if self._last_layer_step is None or self._step - self._last_layer_step >= self.params.layer_every_steps:
             self._last_layer_step = self._step

@@ -16,13 +16,15 @@ by a robot team" (DARS 2000), §4.1 *Trail laying algorithm* and its Fig. 2:
   (:func:`average_heading`, a circular mean). "If a robot is carrying resource ... it will follow
   the opposite heading back to the home position" (:func:`preferred_heading`).
 
-Gap filled here (the paper is silent): crumbs are dropped on both legs, but the average of the
-headings of an outbound and a homebound crumb at one spot would cancel. So a crumb dropped while
-*carrying* stores the opposite of the robot's heading (``outbound=False`` in
-:meth:`CrumbList.drop`): every crumb in every list points *towards the source*, and a carrying
-robot follows the opposite of the average, as the paper says. The brain's
-``reverse_carried_crumbs`` flag turns this off (``outbound=True`` for every crumb: the paper as
-written, under ``paper_rules``).
+Crumbs are dropped on both legs, and the average of the headings of an outbound and a homebound
+crumb at one spot would cancel. So a crumb dropped while *carrying* stores the opposite of the
+robot's heading (``outbound=False`` in :meth:`CrumbList.drop`): every crumb in every list points
+*towards the source*, and a carrying robot follows the opposite of the average. The 2000 paper
+does not say so, but its authors describe the method so in the 2002 paper (Try §1: "a single
+crumb trail. The trail was followed forwards towards the 'goal' and backwards towards 'home'"),
+and a single trail followed backwards works only if every crumb points goal-ward: it is the
+paper's rule in both report columns. The brain's ``reverse_carried_crumbs`` flag turns it off
+(``outbound=True`` for every crumb: Blazing §4.1 read literally, an ablation row of the reports).
 
 Everything is in the robot's own odometry frame; the lists are numpy arrays (a global list
 holds thousands of crumbs) and every query is vectorised.

@@ -430,7 +430,7 @@ class TrailShare:
     def log(self) -> dict[str, Any]:
         """``carrying`` (seeking ``round[0]``, i.e. home), ``trips`` (places reached in order),
         ``place_index``, ``n_crumbs`` (local Trail size), ``following``, ``recovering`` (heading
-        back to a trail it left), ``mode`` (Navigate's), and every ``layer_every_steps`` a ``crumbs`` layer (the Trail's crumbs) and a ``places``
+        back to a trail it left), ``mode`` (Navigate's), ``reversals`` (the 180° rule's turns so far), and every ``layer_every_steps`` a ``crumbs`` layer (the Trail's crumbs) and a ``places``
         layer, both in the own odometry frame."""
         out: dict[str, Any] = {
             "carrying": self.round.index == 0,
@@ -441,6 +441,7 @@ class TrailShare:
             "recovering": self._recovering,
             "mode": str(getattr(self.nav, "mode", "")),
             "refused": self.refused,
+            "reversals": int(getattr(self.nav, "n_reversals", 0)),
         }
         if self._last_layer_step is None or self._step - self._last_layer_step >= self.params.layer_every_steps:
             self._last_layer_step = self._step

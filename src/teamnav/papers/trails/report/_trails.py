@@ -38,18 +38,36 @@ WORKING_UNITS_PER_10MIN = 1.0
 #: the map every trail scenario runs on (the U shape since issue 25; trail_office_z_corridors is
 #: the Z map of sessions 1-11)
 TRAIL_MAP = "trail_office_corridors"
-#: the papers' cruise speed (Try §3.6), the "paper as written" column's
+#: the 2002 paper's cruise speed (Try §3.6: "The Navigate behavior drives the robots at 0.25m s^-1
+#: when cruising freely"), the try-to-see-it-my-way paper column's
 PAPER_CRUISE_MPS = 0.25
+#: the 2000 paper's route [m], round trip [s] and first arrival at the resource [s] (Blazing §5:
+#: "approximately 33m of corridors"; §5.1: "the time for a round-trip from home to resource is
+#: approximately 3 minutes", "Ant was the first robot to reach the resource, at 1.25 minutes")
+BLAZING_ROUTE_M, BLAZING_ROUND_TRIP_S, BLAZING_FIRST_ARRIVAL_S = 33.0, 180.0, 75.0
+#: the cruise speed the 2000 paper's numbers imply, the blazing-a-trail paper column's [m/s]: a round
+#: trip of 2 x 33 m in ~180 s is 0.367 m/s on average, and at the 2002 paper's 92 % of cruise (the same
+#: robots, Navigate and building) a cruise of 0.367 / 0.92 = 0.40 m/s; Ant's first 33 m in 75 s is
+#: 0.44 m/s on average: 0.37-0.44 m/s, and 0.4 inside it (0.25 m/s cannot give a round trip under
+#: 2 x 33 / 0.25 = 264 s). The 2000 paper states no speed: ``implied`` in the ledger.
+BLAZING_IMPLIED_CRUISE_MPS = 0.4
 #: the two columns of every trail table: (key, heading)
 COLUMNS = (("paper_rules", "paper as written"), ("teamnav", "teamnav"))
 
 
-def paper_rules_spec(name_or_spec: Any, **kwargs: Any):
+def paper_rules_spec(name_or_spec: Any, cruise_mps: float | None = None, **kwargs: Any):
     """Sweep ``name_or_spec`` (with ``resolve_spec``'s ``seeds``, ``duration_s``, ``set``...) as
     the papers wrote it: every robot group whose brain declares ``PAPER_RULES``
     (:mod:`teamnav.control.paper_rules`) gets ``paper_rules: true`` and loses the params those rules
-    set (its cruise speed among them: 0.25 m/s); any other brain with a cruise speed (the
-    route-follow-v1 baseline) drives at :data:`PAPER_CRUISE_MPS`. Named ``<sweep>-paper-rules``.
+    set (for trail-share-v1 its cruise speed among them: 0.25 m/s); any other brain with a cruise
+    speed (the route-follow-v1 baseline) drives at :data:`PAPER_CRUISE_MPS`. Named
+    ``<sweep>-paper-rules``.
+
+    ``cruise_mps``: the column's cruise speed for every group whose paper rules do not set one
+    (blazing-trail-v1: the 2000 paper states none, :data:`BLAZING_IMPLIED_CRUISE_MPS`) and for
+    the other brains with a cruise speed; None: as above (the route-follow baseline at
+    :data:`PAPER_CRUISE_MPS`, rule brains as their rules and scenario leave them). A name other
+    than 0.25 m/s gets its speed in the sweep's name (``<sweep>-paper-rules-0.4``).
     """
     from teamnav.control import registry
     from teamnav.experiments.spec import load_scenario
@@ -75,17 +93,22 @@ def paper_rules_spec(name_or_spec: Any, **kwargs: Any):
                 if isinstance(params.get(head), dict):
                     params[head] = {k: v for k, v in params[head].items() if k not in getattr(model, "PAPER_RULES", {})}
             params["paper_rules"] = True
+            if cruise_mps is not None and "cruise_speed_mps" not in rules and "cruise_speed_mps" in cls.model_fields:
+                params["cruise_speed_mps"] = float(cruise_mps)
         elif "cruise_speed_mps" in params:
-            params["cruise_speed_mps"] = PAPER_CRUISE_MPS
+            params["cruise_speed_mps"] = PAPER_CRUISE_MPS if cruise_mps is None else float(cruise_mps)
         extra[f"robots.{i}.params"] = params
-    return resolve_spec(spec, set=extra, name=f"{spec.sweep_name}-paper-rules")
+    tail = "" if cruise_mps is None or float(cruise_mps) == PAPER_CRUISE_MPS else f"-{float(cruise_mps):g}"
+    return resolve_spec(spec, set=extra, name=f"{spec.sweep_name}-paper-rules{tail}")
 
 
-def column_sweep(ctx: Any, column: str, name_or_spec: Any, **kwargs: Any) -> list[dict]:
-    """The finished rows of a sweep in one of the :data:`COLUMNS` (``"paper_rules"`` or ``"teamnav"``)."""
+def column_sweep(ctx: Any, column: str, name_or_spec: Any, *, cruise_mps: float | None = None,
+                 **kwargs: Any) -> list[dict]:
+    """The finished rows of a sweep in one of the :data:`COLUMNS` (``"paper_rules"`` or ``"teamnav"``);
+    ``cruise_mps``: the paper column's cruise speed (:func:`paper_rules_spec`; ignored for teamnav)."""
     if column == "paper_rules":
         # the spec carries the paper's params; seeds, duration and the rest are applied by ctx.sweep as for teamnav
-        return ok(ctx.sweep(paper_rules_spec(name_or_spec), **kwargs))
+        return ok(ctx.sweep(paper_rules_spec(name_or_spec, cruise_mps), **kwargs))
     return ok(ctx.sweep(name_or_spec, **kwargs))
 
 

@@ -55,7 +55,7 @@ def hours_values(hours: list, blaze_k: list, blaze_0: list) -> dict[str, float]:
 
 
 def hours_blocks(hours: list, blaze_k: list, blaze_0: list, drift_dur: float, quick: bool, *,
-                 column: str = "", judged: bool = True) -> list:
+                 column: str = "", judged: bool = True, model_column: str | None = None) -> list:
     """The long-run claim: the 2002 team for HOURS_S at drift k = HOURS_SCALE, HOURS_SEEDS seeds,
     beside the 2000 team at the same drift (the drift sweep's 1-hour runs).
 
@@ -70,7 +70,8 @@ def hours_blocks(hours: list, blaze_k: list, blaze_0: list, drift_dur: float, qu
 
     The rule is claim ``hours-at-breaking-drift`` of ``papers/trails/claims/try-to-see-it-my-way.yaml``;
     ``column`` labels the blocks ("paper as written", "teamnav"); ``judged=False`` shows the
-    rule's reading without a verdict (the column the claim file does not judge).
+    rule's reading without a verdict (the column the claim file does not judge); ``model_column``:
+    the report model's column of the Comparison (``"paper"`` / ``"teamnav"``).
     """
     from teamnav.experiments.claims import judge, load_claims
 
@@ -101,7 +102,7 @@ def hours_blocks(hours: list, blaze_k: list, blaze_0: list, drift_dur: float, qu
         holds,
         f"k = {HOURS_SCALE:g} is Fly at {2 * HOURS_SCALE:g} deg/min, {HOURS_SCALE:g}x the paper's worst robot; our robots "
         "never fail, so a run ends on the clock; the 180-s rule flags a chance lull at the end of a long run "
-        f"(about one run in five at ~5 units per 10 min). Rule (claim file): {reading}")]
+        f"(about one run in five at ~5 units per 10 min). Rule (claim file): {reading}", column=model_column)]
     rows = [[str(r.get("seed")), *[str(u) for u in per_h[i]], str(r.get("units_total")),
              "none" if r.get("breakdown_censored") else f"{float(r.get('breakdown_s', 0)) / 60:.0f} min"]
             for i, r in enumerate(hours)]
@@ -157,7 +158,7 @@ def _profile_blocks(prof: list, prof_b: list, blaze_k: list, blaze_0: list, drif
                         f"{PROFILE_SAMPLE_S / 60:g} min", ["simulated h", "largest Trail [crumbs]", "process RSS [MiB]",
                                                           "CPU s per simulated h"], rows,
                         note="CPU time of the process (time.process_time) per simulated hour of 4 robots with "
-                             "181-beam lasers at dt = 0.1 s; on a machine shared with other runs the figure is "
+                             "361-beam lasers at dt = 0.1 s; on a machine shared with other runs the figure is "
                              "inflated by cache and frequency contention, not by waiting"))
     cpu = [["trail-share-v1 (2002)", f"k = {PROFILE_SCALE:g}, {PROFILE_HOURS:g} h", f"{row.get('cpu_s_per_h', float('nan')):.0f}",
             f"{row.get('cpu_s_per_h_max', float('nan')):.0f}", f"{max(cr, default=0):.0f}"]]

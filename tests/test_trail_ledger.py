@@ -1,0 +1,71 @@
+"""The trail sections' ledgers (shared/FIDELITY.md §2): both columns, every paper rule of the brains
+as a stated row, the 2000 column's single trail followed backwards (stated, the 2002 paper's words),
+its literal reading as an ablation row, its speed implied with the arithmetic; quotes verbatim."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from teamnav.control.paper_rules import gap_fills
+from teamnav.experiments.report.model import LEDGER_SOURCES, Ledger
+from teamnav.papers.trails.brains.blazing_trail import BlazingTrailParams
+from teamnav.papers.trails.brains.trail_share import TrailShareParams
+from teamnav.papers.trails.report import _trails as T
+from teamnav.papers.trails.report import _trails_ledger as L
+
+PAPERS = Path(__file__).resolve().parents[2] / "shared" / "papers"
+
+
+def _rows(ledger: Ledger, column: str) -> dict[tuple[str, object], object]:
+    return {(r.name, r.value): r for r in ledger.rows if r.column == column}
+
+
+@pytest.mark.parametrize("build, cls", [(L.blazing_ledger, BlazingTrailParams), (L.try_ledger, TrailShareParams)])
+def test_both_columns_and_every_paper_rule_is_a_stated_row(build, cls):
+    ledger = build()
+    assert {r.column for r in ledger.rows} == {"paper", "teamnav"}
+    assert all(r.source in LEDGER_SOURCES and r.ref.strip() for r in ledger.rows)
+    paper = {r.name: r for r in ledger.rows if r.column == "paper"}
+    for g in gap_fills(cls):
+        if g.field == "cruise_speed_mps":
+            continue
+        assert paper[g.field].value == g.paper_value and paper[g.field].source == "stated", g.field
+    # every in-sample choice says so; the laser is the papers' two samples per degree
+    assert all("in-sample" in r.ref for r in ledger.rows if r.name in ("navigate.box_reach_m", "radius_m"))
+    assert paper["laser n_beams"].value == 361 and paper["laser n_beams"].source == "stated"
+
+
+def test_the_2000_column_follows_the_single_trail_backwards_at_the_implied_speed():
+    paper = _rows(L.blazing_ledger(), "paper")
+    stated = paper[("reverse_carried_crumbs", True)]
+    assert stated.source == "stated" and L.TRY_SINGLE_TRAIL_QUOTE in stated.ref
+    literal = paper[("reverse_carried_crumbs", False)]
+    assert literal.source == "literal-ablation" and L.BLAZING_LITERAL_QUOTE in literal.ref
+    speed = paper[("cruise_speed_mps", T.BLAZING_IMPLIED_CRUISE_MPS)]
+    assert speed.source == "implied" and "0.367" in speed.ref and "0.44" in speed.ref
+    # the arithmetic the row states: 2 x 33 m / 180 s, / 0.92, and 33 m / 75 s bracket the value
+    avg = 2 * T.BLAZING_ROUTE_M / T.BLAZING_ROUND_TRIP_S
+    assert avg == pytest.approx(0.367, abs=5e-4) and avg / 0.92 == pytest.approx(0.40, abs=5e-3)
+    assert avg <= T.BLAZING_IMPLIED_CRUISE_MPS <= T.BLAZING_ROUTE_M / T.BLAZING_FIRST_ARRIVAL_S
+    # 0.25 m/s cannot give the paper's round trip
+    assert 2 * T.BLAZING_ROUTE_M / T.PAPER_CRUISE_MPS > T.BLAZING_ROUND_TRIP_S
+
+
+def test_the_2002_column_drives_at_the_stated_speed_and_teamnav_says_its_speed_is_in_sample():
+    ledger = L.try_ledger()
+    paper, ours = _rows(ledger, "paper"), _rows(ledger, "teamnav")
+    assert paper[("cruise_speed_mps", 0.25)].source == "stated"
+    assert "in-sample" in ours[("cruise_speed_mps", T.cruise_mps("try-to-see-it-my-way"))].ref
+
+
+@pytest.mark.skipif(not PAPERS.is_dir(), reason="the papers' texts are not beside this checkout")
+def test_quotes_are_verbatim_in_the_papers():
+    def text(name):
+        return re.sub(r"\s+", " ", (PAPERS / f"vaughan-stoy-sukhatme-mataric-{name}.txt").read_text(encoding="utf-8"))
+
+    assert L.TRY_SINGLE_TRAIL_QUOTE in text("try-to-see-it-my-way")
+    assert L.BLAZING_LITERAL_QUOTE in text("blazing-a-trail")
+    assert L.START_QUOTE in text("blazing-a-trail")
