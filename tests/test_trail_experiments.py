@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from teamnav.control import registry as controllers
@@ -195,6 +195,7 @@ def test_crumbs_in_the_fixed_frame_of_the_places_undo_any_drifted_frame(theta, d
 # ---------------------------------------------------------------------------- route-follow-v1
 @settings(max_examples=50, deadline=None)
 @given(st.floats(0.0, 20.0), st.floats(-1.0, 1.0), st.floats(0.1, 3.0))
+@example(10.0, 1.0, 1.0)  # at the corner: the end of segment 0 reached, the projection is on segment 1
 def test_pursuit_point_lies_on_the_route_ahead(x, y_off, look):
     route = np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]])
     xy = np.array([min(x, 10.0), y_off]) if x <= 10 else np.array([10.0 + y_off, x - 10.0])
@@ -206,6 +207,8 @@ def test_pursuit_point_lies_on_the_route_ahead(x, y_off, look):
     assert seg2 >= seg
     # the target is (up to the route's end) the lookahead further along than the projection
     s_proj = min(x, 10.0) if seg == 0 else 10.0 + min(max(x - 10.0, 0.0), 10.0)
+    if x == 10.0:  # the projection on segment 0 is its end (t = 1): pursuit_point moves on to segment 1
+        s_proj = 10.0 + max(y_off, 0.0)
     s_target = target[0] if on_first and not on_second else 10.0 + target[1]
     assert s_target == pytest.approx(min(s_proj + look, 20.0), abs=1e-6)
 
