@@ -44,17 +44,17 @@ class CaseScenario:
 CASE_SCENARIOS: tuple[CaseScenario, ...] = (
     CaseScenario(
         "beyond-negative-detections-on-hallway", "beyond-negative-detections-hallway", "on",
-        "Issue 22, Fox et al. §7.2 (negative sights, beyond the paper): collab-mcl-hallway's 8 sonar robots "
+        "Beyond the papers: Fox et al. §7.2 (negative sights, beyond the paper): collab-mcl-hallway's 8 sonar robots "
         "with negative sights on (mcl-wander-v1's negative_detections), 300 s. Sweep "
         "beyond-negative-detections-hallway runs it beside the paper's rule (off)."),
     CaseScenario(
         "beyond-negative-detections-on-hexagon", "beyond-negative-detections-hexagon", "on",
-        "Issue 22, Fox et al. §7.2 (negative sights, beyond the paper): collab-mcl-hexagon's 4 sonar + 4 laser "
+        "Beyond the papers: Fox et al. §7.2 (negative sights, beyond the paper): collab-mcl-hexagon's 4 sonar + 4 laser "
         "robots with negative sights on in both groups, 300 s. Sweep beyond-negative-detections-hexagon runs "
         "it beside the paper's rule (off)."),
     CaseScenario(
         "beyond-anonymous-associate-hallway", "beyond-anonymous-hallway", "anon-associate",
-        "Issue 22, Fox et al. §7.2 (identification of robots, beyond the paper): collab-mcl-hallway with the "
+        "Beyond the papers: Fox et al. §7.2 (identification of robots, beyond the paper): collab-mcl-hallway with the "
         "detector's identities withheld and each sight associated by belief overlap (anonymous: associate), "
         "300 s. Sweep beyond-anonymous-hallway runs it beside the paper's method (anon-ignore)."),
 )

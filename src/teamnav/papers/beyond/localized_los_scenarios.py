@@ -93,7 +93,7 @@ def scenario_data(map_key: str, *, n_targets: int = N_TARGETS, frame_source: str
     fig = "Fig. 11" if map_key == "simple" else "Fig. 13"
     return {
         "name": scenario_name(map_key),
-        "description": (f"Issue 22, combination 2 (localized LOS help): Sgorbissa & Arkin §6 ({fig}, {L.MAPS[map_key]}), "
+        "description": (f"Beyond the papers, combination 2 (localized LOS help): Sgorbissa & Arkin §6 ({fig}, {L.MAPS[map_key]}), "
                         f"R1's first {n_targets} targets of task 1 helped by R2..R4, every LOS brain on an MCL pose "
                         f"(localized-v1, Fox et al. §3.1, map given, world frames); frame_source bearings (§3.1), "
                         f"mcl or fused (sweep {sweep_name(map_key)})."),
@@ -123,7 +123,7 @@ def sweep_data(map_key: str) -> dict[str, Any]:
     n = len(L.LAYOUTS[map_key].helpers) + 1
     return {
         "name": sweep_name(map_key),
-        "description": (f"Issue 22 combination 2 on {L.MAPS[map_key]}: frames from bearings (§3.1), MCL poses or "
+        "description": (f"Beyond the papers, combination 2 on {L.MAPS[map_key]}: frames from bearings (§3.1), MCL poses or "
                         f"both fused, err_max 0 / 0.4 (eqs. 1-2), {N_TARGETS} targets of task 1, R1..R4, "
                         f"{N_SEEDS} seeds."),
         "scenario": scenario_name(map_key),
