@@ -221,8 +221,10 @@ def _how_workers_ended(pool: ProcessPoolExecutor, known: dict | None = None) -> 
     deadline = time.monotonic() + 2.0  # the pool may not have reaped the dead one yet
     for p in list(procs.values()):
         with contextlib.suppress(Exception):
-            if p.exitcode is None:
-                p.join(max(0.0, deadline - time.monotonic()))
+            # join() returns at once on a dead process whose status the pool's own thread is
+            # reaping at that moment (our waitpid finds nothing): poll until its status is set
+            while p.exitcode is None and time.monotonic() < deadline:
+                p.join(min(0.05, max(0.0, deadline - time.monotonic())))
     return "; ".join(f"pid {pid}: {_exit_status(p.exitcode)}" for pid, p in sorted(procs.items())) or "none left"
 
 
