@@ -17,6 +17,7 @@ from teamnav.papers.los_help.brains.messages import MESSAGE_KIND, LosHelpMsg, Si
 from teamnav.world import MapBuilder
 from teamnav.world.raycast import RayCaster
 from teamnav.control.nav.local.visbug21 import MODE_UNREACHABLE
+from test_nav_local import disc_free
 
 N_BEAMS = 360
 ANGLES = np.linspace(-np.pi, np.pi, N_BEAMS, endpoint=False)
@@ -28,21 +29,6 @@ RADIUS_M = 0.2
 def _info(team_size: int = 2) -> RobotInfo:
     laser = SensorInfo("laser", "laser", ANGLES, MAX_RANGE)
     return RobotInfo(0, team_size, RADIUS_M, "holonomic_step", 0.5, 1.5, STEP_M, 0.1, sensors={"laser": laser})
-
-
-def _disc_free(grid, xy, r: float) -> bool:
-    res = grid.resolution_m
-    ox, oy = grid.origin_xy_m
-    h, w = grid.shape
-    c0, c1 = int(math.floor((xy[0] - r - ox) / res)), int(math.floor((xy[0] + r - ox) / res))
-    r0, r1 = int(math.floor((xy[1] - r - oy) / res)), int(math.floor((xy[1] + r - oy) / res))
-    if c0 < 0 or r0 < 0 or c1 >= w or r1 >= h:
-        return False
-    rows, cols = np.nonzero(grid.cells[r0:r1 + 1, c0:c1 + 1] != 0)
-    x0, y0 = ox + (cols + c0) * res, oy + (rows + r0) * res
-    dx = np.maximum(np.maximum(x0 - xy[0], 0.0), xy[0] - (x0 + res))
-    dy = np.maximum(np.maximum(y0 - xy[1], 0.0), xy[1] - (y0 + res))
-    return bool(np.all(dx * dx + dy * dy >= r * r))
 
 
 def _polar(a, b):
@@ -73,7 +59,7 @@ class _World:
             return action
         self.stood = 0
         new = self.xy + STEP_M * np.array([math.cos(action.direction_rad), math.sin(action.direction_rad)])
-        if _disc_free(self.grid, new, RADIUS_M):
+        if disc_free(self.grid, new, RADIUS_M):
             self.xy = new
         return action
 
