@@ -227,7 +227,7 @@ def _kernels() -> None:
 
 
 def _leave_pair(pose, scan, pts) -> dict:
-    """Issue 21 §5: VisBug-21's leave test (kernel) against its numpy version, following the
+    """VisBug-21's leave test (kernel) against its numpy version, following the
     corridor's wall with the goal 6 m ahead (every sample closer than d_H tested)."""
     import math
 

@@ -1,7 +1,7 @@
 """Where the line-of-sight section's full-mode CPU goes: trials x steps per trial x CPU per step.
 
-Issue 21 §5 asks for the cost of ``teamnav report los-help`` (full mode), which has never been
-run in full (780 trials of 200-target tasks). This script
+The full mode of ``teamnav report los-help`` has never been run
+(780 trials of 200-target tasks). This script
 
 1. lists every trial the section's own ``build`` asks for in full mode: a report context whose
    ``sweep`` expands each sweep spec (the same specs, names, cases, grids and durations as a

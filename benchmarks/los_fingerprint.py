@@ -19,32 +19,32 @@ Usage::
     python benchmarks/los_fingerprint.py --steps 300 --only simple
 
 Recorded in ``benchmarks/los_fingerprints.json`` (1500 steps) at 4641d4c, the brains of
-session 5 (trouble_helper_towards_goal, via_in_sight, visbug_reverse_walk_factor); the
+2026-11-23 (trouble_helper_towards_goal, via_in_sight, visbug_reverse_walk_factor); the
 speed-ups merged after it (56777c6) reproduce every hash. The speed branch itself was checked
-against its base f9d6cb5 after every commit. Re-recorded in session 9 with NumPy 2.4.6 and numba
-0.68.1 (the file now names them; ``--check`` warns when they differ): the session-8 commit
-f9f4cf8 run with NumPy 2.4.6 already differed in 21 of 24 runs, the complex ones by session 8's
+against its base f9d6cb5 after every commit. Re-recorded in 22f62f5 (2026-11-26) with NumPy 2.4.6 and numba
+0.68.1 (the file now names them; ``--check`` warns when they differ): the commit
+f9f4cf8 (2026-11-24) run with NumPy 2.4.6 already differed in 21 of 24 runs, the complex ones by 513792e's
 map and budget, the simple potential-field and Avoid-Past ones by NumPy (2.4's own hypot and
 arctan2 differ from libm in the last bit; VisBug-21 alone, all in numba kernels, held).
-Re-recorded in session 10 after ``see_past_teammates`` (fc95e88): the 12 runs of R1 alone
-reproduced session 9's hashes (the rule acts only on steps with a teammate in sight), the 12
+Re-recorded in e013e31 after ``see_past_teammates`` (fc95e88): the 12 runs of R1 alone
+reproduced 22f62f5's hashes (the rule acts only on steps with a teammate in sight), the 12
 team runs moved, as they must; a re-check reproduces the new file.
 
 ``los_fingerprints_epyc.json``: the same 24 runs at defbca7 on a 2-core AMD EPYC with AVX-512
 (same NumPy and numba), where 16 of the hashes above (every potential-field and Avoid-Past run)
 come out differently already at the commit that recorded them: check against the file recorded
-on your kind of machine (issue 21 §5 held both: the file above's 8 VisBug-21 runs and all 24 of
+on your kind of machine (the speed-ups of 2026-11-27 held both: the file above's 8 VisBug-21 runs and all 24 of
 this one).
 
 Re-recorded (``los_fingerprints_epyc.json`` only) after two changes of behaviour meant to move
-runs (issue 21): Avoid-Past's lifelong memory as the default (§1, ``memory_scope="robot"``: all
-8 Avoid-Past runs moved, R1 alone included) and perfect sensing at ``err_max = 0`` (§2, the
+runs: Avoid-Past's lifelong memory as the default (bdfa8a8, ``memory_scope="robot"``: all
+8 Avoid-Past runs moved, R1 alone included) and perfect sensing at ``err_max = 0`` (7915eb8, the
 occlusion model returns exact range and bearing there: the 4 potential-field and VisBug-21
 team runs at err_max 0 moved). The other 12 (R1 alone and err_max 0.4 for those two
 algorithms) reproduced their hashes. ``los_fingerprints.json`` still holds the hashes of
 before these changes and needs re-recording on the machine that recorded it (not this one).
 
-``--paper-rules`` (issue 21 §5, session 15): the same 24 runs with both brains at
+``--paper-rules`` (8e3551b, 2026-11-27): the same 24 runs with both brains at
 ``paper_rules: true``, as the report's "paper as written" column runs them (VisBug-21's
 ``boundary_shortcut`` and ``turn="left"``, the lifelong Avoid-Past memory, no gap-fills), whose
 code paths the default runs do not reach; ``los_fingerprints_paper_epyc.json`` holds them as

@@ -1,4 +1,4 @@
-"""What each gap-fill of ``blazing-trail-v1`` buys, and what keeps the 2000 team from breaking down (issue 25 §4).
+"""What each gap-fill of ``blazing-trail-v1`` buys, and what keeps the 2000 team from breaking down.
 
 Vaughan, Støy, Sukhatme & Matarić (2000) §5.1: the four robots carried 28 units in 30 min, then
 "the unbounded odometry error causes the system to break down completely at around 27 minutes".

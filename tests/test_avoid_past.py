@@ -90,15 +90,15 @@ def test_avoid_past_finds_the_door_the_potential_field_misses(room, start, door_
     assert pf.run(1500) is None
 
 
-@pytest.mark.slow  # two runs of up to 18,000 steps: a reproduction of issue 7
+@pytest.mark.slow  # two runs of up to 18,000 steps: a reproduction of 2b5e0ce's trace
 def test_trip_memory_reaches_a_sequence_the_robot_memory_does_not():
-    """Issue 7, R1 alone on office_simple (``los-help-simple``, task 1's first 12 targets, budget
-    1500 steps each, pinned here: the scenario's own budget is 6000 since session 8, and with
+    """2b5e0ce's trace, R1 alone on office_simple (``los-help-simple``, task 1's first 12 targets, budget
+    1500 steps each, pinned here: the scenario's own budget is 6000 since 513792e, and with
     that much time even the saturated memory crawls through). With one memory for the robot's
-    life (the old default, and again the default since issue 21 §1: the paper's rule) the trodden
+    life (the old default, and again the default since bdfa8a8: the paper's rule) the trodden
     corridor's visits saturate the push and R1 gives up on the 11th target (S4 from S5), at this
-    radius of 2 m and budget; with the trip's memory (``memory_scope="goal"``, the default of
-    sessions 6-13) it reaches all 12."""
+    radius of 2 m and budget; with the trip's memory (``memory_scope="goal"``, the default from
+    2026-11-23 to 2026-11-27) it reaches all 12."""
     from teamnav import load_scenario, run
     from teamnav.papers.los_help.tasks import task_targets_xy
 
@@ -117,7 +117,7 @@ def test_trip_memory_reaches_a_sequence_the_robot_memory_does_not():
 
 
 def test_memory_half_life_weighs_each_visit_by_its_age():
-    """The decay gap-fill (issue 21 §1): after the same walk, the push equals the one of an
+    """The decay gap-fill: after the same walk, the push equals the one of an
     undecayed memory whose visits were each scaled by 2^(-age / h), and it is smaller."""
     from teamnav.control.nav.local.avoid_past import avoid_past_vector
 

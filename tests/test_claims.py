@@ -1,4 +1,4 @@
-"""The claim files: strict schema, report seeds only, and the restored rules of issue 25 §3."""
+"""The claim files: strict schema, report seeds only, and the rules restored in defbca7."""
 
 from __future__ import annotations
 

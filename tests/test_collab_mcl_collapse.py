@@ -1,4 +1,4 @@
-"""scripts/collab_mcl_collapse.py (issue 26 §2/§3): one factor at a time on top of the paper's
+"""scripts/collab_mcl_collapse.py: one factor at a time on top of the paper's
 rules, tuning seeds only, and the measures it reports (Fox, Burgard, Kruppa & Thrun §5.1, Fig. 10a)."""
 
 from __future__ import annotations

@@ -82,7 +82,7 @@ def test_section_without_the_long_run_says_why():
 
 @pytest.mark.slow
 def test_ten_simulated_hours_keep_memory_flat_and_cost_under_a_minute_per_hour():
-    # the issue's "memory stays flat over a 10-hour simulated run" and "a simulated hour of 4 robots
+    # the stated targets "memory stays flat over a 10-hour simulated run" and "a simulated hour of 4 robots
     # runs in well under a minute on one core", at the drift that breaks the 2000 algorithm (k = 4)
     sc = load_scenario("try-to-see-it-my-way", overrides={
         "record_every": 18000, **{f"robots.{i}.odometry.heading_drift_deg_per_min": 4 * v

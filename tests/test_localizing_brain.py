@@ -335,7 +335,7 @@ def test_a_disagreement_between_confident_robots_is_split_when_the_sender_may_be
     assert (share > 0.9) == (sender_prior == 0.0)
 
 
-# ---------------------------------------------------------------------------- paper_rules (issue 26 §1)
+# ---------------------------------------------------------------------------- paper_rules
 from teamnav.control.paper_rules import gap_fills  # noqa: E402
 
 #: a value other than the paper's for every PAPER_RULES field
@@ -350,7 +350,7 @@ def test_paper_rules_sets_every_listed_field():
     assert set(MCLWanderParams.PAPER_RULES) == set(MCLWanderParams.PAPER_RULE_NOTES) == set(_NOT_PAPER)
     for key, value in MCLWanderParams.PAPER_RULES.items():
         assert getattr(p, key) == value, key
-    # the issue's list: no sensor resetting, untempered likelihood, resampling every update, the
+    # the list of the paper's rules: no sensor resetting, untempered likelihood, resampling every update, the
     # two rules of §2.3 only (no provenance, no receive gate), anonymous sights ignored
     assert (p.inject_fraction, p.likelihood_exponent, p.resample_ess_fraction) == (0.0, 1.0, 1.0)
     assert not p.provenance and not p.receive_gate and p.anonymous == "ignore"
@@ -400,7 +400,7 @@ def test_paper_rules_brain_has_no_receive_gate():
 
 
 def test_every_received_detection_tree_is_logged_with_the_belief_it_met():
-    """Issue 26 §2: Robin's sample count, spread and heaviest cluster at every detection tree, in
+    """Robin's sample count, spread and heaviest cluster at every detection tree, in
     the next log() record (once), whether the tree was applied or gated."""
     from teamnav.localization.sync import detection_tree
 

@@ -492,7 +492,7 @@ def test_full_build_asks_for_nested_teams_and_every_sweep_and_returns_every_bloc
     spec = [c[2] for c in ctx.calls if c[0] == "los-table1"][0]
     assert len(spec.cases) == 12 and [c for c in ctx.calls if c[0] == "los-table1"][0][1] == {"name": "los-table1"}
     tab = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Table 1")][0]
-    # per algorithm: paper as written, teamnav, the paper's row (issue 21 §3)
+    # per algorithm: paper as written, teamnav, the paper's row
     assert [r[1] for r in tab.rows] == ["paper as written", "teamnav", "paper"] * 3
     assert tab.rows[3][0] == "Av. Past" and tab.rows[4][0] == ""
     assert tab.rows[3][2:] == tab.rows[4][2:] == ["502 (0.7 %) 2/2", "252 (1.4 %) 2/2", "169 (2.1 %) 2/2", "128 (2.8 %) 2/2"]
@@ -603,7 +603,7 @@ def test_legs_table_sets_the_finished_tasks_against_their_shortest_path():
 
 
 def test_verdict_rules_are_read_from_the_claim_file(monkeypatch):
-    """Issue 21 §3: the section's rules live in claims/los-help.yaml (judged on the paper-rules
+    """The section's rules live in claims/los-help.yaml (judged on the paper-rules
     column, report seeds < 1000); a stricter threshold there changes the verdict here."""
     from teamnav.experiments.claims import load_claims
     from teamnav.papers.los_help.report import _los_verdicts as V
@@ -621,7 +621,7 @@ def test_verdict_rules_are_read_from_the_claim_file(monkeypatch):
     assert [c.holds for c in comps][:3] == [True, True, False]
 
 
-# ---------------------------------------------------------------------------- two columns, route plans (issue 21 §3-§4)
+# ---------------------------------------------------------------------------- two columns, route plans
 @needs_brains
 def test_verdicts_are_the_paper_as_written_columns_and_the_teamnav_column_says_what_gap_fills_add():
     # the paper-rules runs rise with helpers, the teamnav runs fall: the verdict follows the paper's column

@@ -1,4 +1,4 @@
-"""Issue 21 §3: ``paper_rules: true`` for the LOS brains and navigators (the paper as written),
+"""``paper_rules: true`` for the LOS brains and navigators (the paper as written),
 the new flags' paper values, and a mix refused."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from teamnav.control.paper_rules import gap_fills
 
 BRAINS = (LosExplorerParams, LosHelperParams)
 
-#: the gap-fills issue 21 §3 names, and the three flags it asks for
+#: the gap-fills that the paper-as-written column turns off, and the three new flags
 ISSUE_LIST = ("see_past_teammates", "keep_direct_view", "report_margin_steps", "slide_when_blocked",
               "trust_direct_promise", "trouble_helper_towards_goal", "trouble_drop_stalled_helper",
               "keep_trouble_helper", "navigator_params.turn", "relay_hop_limit", "drop_stalled_ghost",

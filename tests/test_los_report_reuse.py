@@ -1,4 +1,4 @@
-"""Issue 21 §5: the los-help section runs no simulation twice.
+"""The los-help section runs no simulation twice.
 
 The noise figures' err_max = 0 points and the ablation's columns that equal the tables' settings
 are read from the tables' R1..R4 rows when (and only when) their trials are the same resolved
@@ -68,7 +68,7 @@ class _AnyMetric(dict):
 
 
 def test_full_build_asks_for_no_simulation_twice_and_reads_the_duplicates_from_the_tables(memo_scenario_yaml, tmp_path):
-    """Full mode: 780 trials asked before issue 21 §5, 75 of them the same simulation as another
+    """Full mode: 780 trials asked before 14d5e61, 75 of them the same simulation as another
     (noise err_max = 0: 2 maps x 3 algorithms x 5 tasks x 2 columns; ablation: 3 x 5); then 705,
     every (config_hash, seed) once, and the noise figures still get err_max 0 for every algorithm,
     task and column. On the judged tasks 11-20 (ten, not five) the counts double: 1410."""

@@ -353,7 +353,7 @@ def test_boundary_heading_equals_numpy(seed, k, side):
        st.sampled_from([0.33, 0.45]), st.sampled_from([2.0, 7.75]), st.sampled_from(["followed", "wall", "ties"]))
 @settings(max_examples=80, deadline=None)
 def test_visbug_boundary_target_equals_numpy(seed, x, y, th, side, r_safe, follow_m, reach_m, kind):
-    """Issue 21 §5: Step 2's boundary target (``boundary_shortcut``, the paper-rules VisBug-21)
+    """Step 2's boundary target (``boundary_shortcut``, the paper-rules VisBug-21)
     from ``_boundary_pick`` and from the numpy version it replaced (kept as
     ``_boundary_target_numpy``), bit for bit: on the followed points of random scans, on a
     straight wall, and on points with repeated positions and equal bearings (ties in the

@@ -1,4 +1,4 @@
-"""The line-of-sight help speed-ups of issue 21 §5 give the same answers, bit for bit, as the
+"""The line-of-sight help speed-ups of 2026-11-27 (4234b5f) give the same answers, bit for bit, as the
 Python / numpy code they replace (as ``tests/test_los_speed_equivalence.py`` does for H7a).
 
 Each new kernel or rewritten path is compared with its reference on hypothesis inputs; whole

@@ -604,7 +604,7 @@ def test_visbug_resumes_with_step1_when_the_excursion_left_the_boundary_far_behi
     assert nav.mode == MODE_TO_GOAL and nav.mline is mline and nav.hit_xy is hit and nav.hit_dist_m == d_hit
 
 
-# ---------------------------------------------------------------------------- paper rules (issue 21 §3)
+# ---------------------------------------------------------------------------- paper rules
 def test_visbug_as_written_reaches_the_goal_behind_the_u_cutting_across_the_boundary():
     """``paper_rules``: one fixed turn (right, the paper column's fill chosen on tuning tasks), and
     Step 2's Ti may be the farthest visible boundary point (``boundary_shortcut``): Bug2 still

@@ -105,7 +105,7 @@ def test_distance_per_robot_is_the_true_path():
 
 def test_lifetime_distance_stops_at_each_robots_last_place_event():
     # samples at 0, 1800, 3600 s; robot 0 drives 5 m then 3 m, its last place event at 1800 s;
-    # robot 1 drives 1 m then 1 m, its last at 3600 s (issue 25 §5: one window for both)
+    # robot 1 drives 1 m then 1 m, its last at 3600 s (one window for both)
     xy = np.array([[[0.0, 0.0], [1.0, 1.0]], [[3.0, 4.0], [1.0, 2.0]], [[3.0, 7.0], [1.0, 3.0]]])
     log = [_ev(900, 0, "source"), _ev(1800, 0, "home"), _ev(900, 1, "source"), _ev(3600, 1, "home")]
     m = M.trail_metrics(_data(log, xy=xy))
@@ -394,8 +394,8 @@ def test_blazing_section_verdicts_follow_the_data():
     (255.0, 4, False),   # 2.38x: under the claim file's 2.5x
 ])
 def test_blazing_three_times_is_judged_against_the_route_follow_robot(solo_trip_s, route_follow_units, holds):
-    """§5.1: team units >= 2.5x one route-follow-v1 robot's (claims/blazing-a-trail.yaml, restored by
-    issue 25 §3); the paper's method (one robot at its optimal round-trip rate) is shown, not judged."""
+    """§5.1: team units >= 2.5x one route-follow-v1 robot's (claims/blazing-a-trail.yaml, restored in
+    defbca7); the paper's method (one robot at its optimal round-trip rate) is shown, not judged."""
     from teamnav.papers.trails.report.blazing_a_trail import SECTION
 
     def table(key, kw):
@@ -670,7 +670,7 @@ def test_try_section_needs_the_2000_team_to_collapse_not_just_slow_down(blazing_
 
 @pytest.mark.skipif("trail-share-v1" not in controllers.names(), reason="trail-share-v1 not registered yet")
 def test_try_section_judges_the_drift_claim_at_the_highest_k_both_ran():
-    """claims/try-to-see-it-my-way.yaml (restored by issue 25 §3): at the highest k both ran. At
+    """claims/try-to-see-it-my-way.yaml (restored in defbca7): at the highest k both ran. At
     k = 6 the 2000 team keeps a trickle (4 of 9) and the 2002 team degrades (4 of 9): does not
     hold, although at k = 4 the 2000 team collapses (1 of 9) while the 2002 team keeps 6 of 9
     (the rule ece0e2d had chosen after seeing such data)."""
@@ -697,7 +697,7 @@ def test_try_section_judges_the_drift_claim_at_the_highest_k_both_ran():
 
 
 def test_a_report_trial_reproduces_from_its_stored_scenario(tmp_path):
-    """Issue 25 §5: a sweep trial (as the report runs it, in a worker process) and a rerun of the
+    """A sweep trial (as the report runs it, in a worker process) and a rerun of the
     scenario file it stored give the same metrics, every one (wall times aside)."""
     from teamnav.experiments.sweep import sweep
 

@@ -1,4 +1,4 @@
-"""scripts/trail_gap_fill_study.py (issue 25 §4): its configurations are the report's two columns
+"""scripts/trail_gap_fill_study.py: its configurations are the report's two columns
 and single gap-fills between them (Vaughan et al. 2000 §4), and its drift cases are blazing-drift's."""
 
 from __future__ import annotations

@@ -56,7 +56,7 @@ One step, in priority order:
 Meeting flags (gap-fills, all off by default, i.e. the rules above; for trail robots that meet
 at corners, where Panic or the wall follower tracing round the other robot leaves a robot facing
 a wrong branch; see :mod:`teamnav.papers.trails.brains.trail_share` for their measurements, all made
-before session 11 gave the trail brains ``box_reach_m = 2.0``; with Navigate's 1.2 m a robot in
+before 8a4187d (2026-11-26) gave the trail brains ``box_reach_m = 2.0``; with Navigate's 1.2 m a robot in
 the oncoming lane of a 1.8 m corridor never saw its own wall, which was the larger part of those
 meetings: :data:`teamnav.papers.trails.brains.blazing_trail.NAVIGATE_DEFAULTS`):
 
@@ -94,7 +94,7 @@ meetings: :data:`teamnav.papers.trails.brains.blazing_trail.NAVIGATE_DEFAULTS`):
    ``give_way_bold_s`` and drives on (its wall follower takes it round the other robot); a
    ``bold=False`` robot waits the full ``give_way_s`` while the obstacle stays ahead. A head-on
    meeting on the route (one robot out, one back) is thus resolved without a contest.
-   Measured (session 8) on ``try-to-see-it-my-way`` with its drift, 30 min, seeds 0-11, paired
+   Measured (f9f4cf8, 2026-11-24) on ``try-to-see-it-my-way`` with its drift, 30 min, seeds 0-11, paired
    against trail-share-v1's default (give_way_s = 3, symmetric), eff = ``place_speed_mps`` / 0.4,
    trip = ``trip_time_s_after_10min_mean``: bold 0.5 s (yielder 3 s): eff 54.8 % against 54.5 %
    (paired +0.2 ± 2.8 points, 7/12 seeds better), trip 120.4 s against 129.6 s (-9.1 ± 8.0 s,

@@ -101,7 +101,7 @@ def office_complex(resolution_m: float = 0.1, alleys: bool = True) -> Environmen
 
     Where we fill a gap: the paper gives Fig. 13 as a picture only (no sizes or coordinates).
 
-    ``alleys=False`` (builtin ``office_complex_closed``, session 7, H7trap; the map of
+    ``alleys=False`` (builtin ``office_complex_closed``, b4059b2 of 2026-11-24, H7trap; the map of
     ``los-help-complex`` and of Table 2 / Fig. 17 since then): the 1.6 m alleys between the backs of the U walls of rooms 1, 2 and 8 and the
     room's wall are filled, so the U's back is flush with the wall. Why: Table 2's potential
     field with helpers finishes every task, so no trap of the paper's map was out of every

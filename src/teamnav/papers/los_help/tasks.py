@@ -93,7 +93,7 @@ __all__ = [
 ]
 
 #: Map key -> built-in map name (§6: Fig. 11 the simple office, Fig. 13 the complex one).
-#: The complex map is ``office_complex_closed`` since session 8: on ``office_complex`` the 1.6-m
+#: The complex map is ``office_complex_closed`` since 513792e (2026-11-24): on ``office_complex`` the 1.6-m
 #: alleys behind the backs of rooms 1, 2 and 8's U walls trapped the potential field out of the
 #: sight of every patrol route (tests/test_los_complex_traps.py), a trap the paper's map cannot
 #: have had (its Table 2 potential field with helpers finished every task). On the closed variant
@@ -131,19 +131,19 @@ RECORD_EVERY = 10
 #: 200 x 800 steps made each failing run burn 160 000 steps). §6 gives no budget; ours is about
 #: ten times the paper's slowest team mean on the map (potential field with R2: ~630 steps per
 #: target on the simple map, 1246 on the complex one), so that it ends only runs that are
-#: stuck, not slow ones. Measured (session 8, potential field with helpers, 40-target prefixes
+#: stuck, not slow ones. Measured (2026-11-24, potential field with helpers, 40-target prefixes
 #: of tasks 1-5 with a 20 000-step budget): the slowest target took 2068 steps on office_simple
 #: (R1+R2 means 584-745, in line with the paper's ~630) and 4517 on office_complex_closed, and
-#: the only target over 5000 was a trap no helper sees (never reached). The budgets of sessions
-#: 3-7 (1500 / 2500) cut that tail: 4 % of R1+R2's targets on office_simple took > 1500 steps,
+#: the only target over 5000 was a trap no helper sees (never reached). The budgets before
+#: 513792e (1500 / 2500) cut that tail: 4 % of R1+R2's targets on office_simple took > 1500 steps,
 #: so at 200 targets the potential field with one helper "failed" every task (0/5), and two of
-#: the four VisBug-21 + R2 give-ups of session 7 were one target of 1525-1533 steps.
+#: the four VisBug-21 + R2 give-ups of 038afb6 (2026-11-23) were one target of 1525-1533 steps.
 BUDGET_STEPS_PER_TARGET: dict[str, int] = {"simple": 6000, "complex": 12000}
 #: A helper passes over a waypoint it has not reached within this many steps (``los-helper-v1``
 #: ``waypoint_timeout_steps``; ours). On office_complex R2 and R4 step into the same doorways
 #: from opposite sides and, both driven by a potential field, blocked each other in room 5's
 #: door for 2000 steps; the longest leg of a route there is under 60 steps. On office_simple
-#: (session 9) R1, in trouble, followed R2 into room N3's doorway and stood in its way back for
+#: (2026-11-26) R1, in trouble, followed R2 into room N3's doorway and stood in its way back for
 #: 4400 steps (potential field with R2, task 4, target 50, 200-target tasks): 300 steps there,
 #: twice its longest leg (R4's 28 m corridor, 140 steps).
 HELPER_WAYPOINT_TIMEOUT_STEPS: dict[str, int] = {"simple": 300, "complex": 150}
@@ -153,7 +153,7 @@ HELPER_WAYPOINT_TIMEOUT_STEPS: dict[str, int] = {"simple": 300, "complex": 150}
 #: (PF with R2+R3, task 3); VisBug-21 always walks back out. Measured with R1 on the potential
 #: field, tasks 1-3 of 10 targets: targets reached 7/3/2 (R1+R2), 3/5/6 (R1..R3), 10/9/10 (R1..R4)
 #: with VisBug helpers against 0/1/2, 2/3/2, 7/4/6 with potential-field helpers. The same
-#: deadlock on office_simple, seen once tasks ran their 200 targets (session 9, after the
+#: deadlock on office_simple, seen once tasks ran their 200 targets (2026-11-26, after the
 #: budgets above stopped cutting them short): potential field with R2, task 4, target 50 (room
 #: N5 from S2): R1 followed R2 into room N3's door; R2, its potential field blocked by R1, and R1,
 #: its own trapped against N3's east wall, stood 0.45 m apart for 4400 steps and R1 gave up.

@@ -43,7 +43,7 @@ def trail_office(resolution_m: float = 0.1, *, doors: bool = True, shape: str = 
       north into a room, and C3 also runs east to a dead end (two more wrong turns);
     - ``source`` in C3 at x = 5.4 m, 9.5 m past corner 2; C3 goes on west to the wall (x = 0.2).
 
-    ``shape="z"`` (builtin ``trail_office_z``): the map of sessions 1-11, Z-shaped (left, then
+    ``shape="z"`` (builtin ``trail_office_z``): the map until 9fe1783 (2026-11-27), Z-shaped (left, then
     right): C3 runs east from corner 2 to ``source`` at x = 24.4 m and on to a dead end, and west
     to x = 6.0 m (a wrong turn). Kept for comparison with the earlier measurements.
 

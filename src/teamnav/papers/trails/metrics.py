@@ -223,7 +223,7 @@ def trail_metrics(data: RunData) -> dict[str, Any]:
     out["distance_m_total"] = float(dist.sum())
     out["lifetime_min_total"] = float(life.sum() / 60.0)
     # distance over the same window as the lifetime (each robot up to its last place event):
-    # the mean speed over the lifetime is this over lifetime_min_total (issue 25 §5)
+    # the mean speed over the lifetime is this over lifetime_min_total (3b49c8d, 2026-11-27)
     out["distance_m_lifetime_total"] = float(_distance_m(data, life).sum())
     out["units_per_robot_min"] = int(per_units.min())
     out["units_per_robot_max"] = int(per_units.max())

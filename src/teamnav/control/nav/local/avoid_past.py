@@ -5,7 +5,7 @@ been added" (Balch & Arkin 1993, "Avoiding the past: a simple but effective stra
 reactive navigation", ICRA, pp. 678-685). Balch & Arkin add "a local spatial memory [that]
 allows a robot to avoid areas that have already been visited", implemented "within a
 schema-based motor control model", as a solution to box canyons (their abstract, the only
-part of the paper the reference search found, session 6: no MissionLab or TeamBots source of
+part of the paper the reference search found, 2026-11-23: no MissionLab or TeamBots source of
 an avoid-past schema was found either). The grid of visit counts, the repulsion law, its
 saturation and the memory's lifetime below are therefore our reading of that description,
 with our own choices marked.
@@ -22,11 +22,11 @@ Here:
   2026-11-29: the full text is in no reachable source) says whether the memory is reset at a
   new goal or decays, so the lifetime is a fill, not the paper's rule (an earlier version of
   this docstring cited Balch & Arkin for "visits never decay": that citation had no source). ``"goal"`` (the default from
-  session 6 to issue 21, a gap-fill measured only at the old 1500 / 2500-step budgets) forgets
+  2b5e0ce (2026-11-23) to bdfa8a8 (2026-11-27), a gap-fill measured only at the old 1500 / 2500-step budgets) forgets
   the visits when the robot is given a new goal of its own (not a temporary one: an
   excursion to a teammate or a ghost, Sgorbissa & Arkin §3-§5, keeps the memory, and so does
   the way back to the same goal), so that the robot avoids *this* trip's past. Why it was
-  chosen then (issue 7, traced): with ``"robot"`` the
+  chosen then (2b5e0ce, traced): with ``"robot"`` the
   counts of the corridors grow with every target of a 200-target task and the vector below
   is linear in the counts, so after a few targets any asymmetry of the well-trodden corridor
   saturates the push (office_simple, task 1: the unsaturated magnitude's median 1.4 over the
@@ -36,9 +36,9 @@ Here:
   With ``"goal"``: 28 % saturated, 12 m of path in memory over the same task's last 1500
   steps;
 - decay (``memory_half_life_steps``; a fill, the same in both columns since 2026-11-29): the
-  full section of session 16 (docs/report/los-help.md) ran the paper's lifelong memory at
+  full section of 2026-11-27 (docs/report/los-help.md) ran the paper's lifelong memory at
   today's budgets (6000 / 12000 steps per target): R1 alone finished 0 of 5 200-target tasks on
-  either map (19 and 34 targets reached on average), so the issue's fallback applies. The
+  either map (19 and 34 targets reached on average), so the planned fallback (decay as a declared gap-fill) applies. The
   half-life was chosen by a rule fixed before its runs (sweep ``los-avoid-past-half-life``,
   commit of the sweep file): *the shortest of 125, 250, 500, 1000, 2000, 4000 navigator steps
   with which R1 alone finishes every one of tuning tasks 1001-1005 on office_simple*, no task
@@ -99,7 +99,7 @@ targets, mean steps per target over the finished tasks): office_simple R1 200 (5
 already needs fewer steps than the paper's R1..R4. Forgetting the memory at every goal change
 (excursions included) or at a ghost reached without the goal in sight (§4.2 "start again")
 gave R1+R2 on office_simple 225 and 239 (paired, within the task-to-task spread): not kept.
-Where the R1+R2 steps come from (issue 7, H7ap2, office_simple, 5 tasks x 40 targets, seed 0,
+Where the R1+R2 steps come from (041ed99, H7ap2, office_simple, 5 tasks x 40 targets, seed 0,
 per target paired with R1 alone): the 136 targets without an excursion cost the same (180 vs
 178 steps); the 64 with one (R1 followed a teammate or a ghost) cost 245 alone and 354 with R2,
 but 276 of those 354 are spent *before* the first excursion (the helper reports only once R1
@@ -143,7 +143,7 @@ class AvoidPastParams(PotentialFieldParams):
     memory_scope : {"robot", "goal"}, default "robot"
         Lifetime of the memory: kept for the robot's life (with ``memory_half_life_steps``
         None: lifelong, the literal reading), or forgotten at each new goal of the robot's own,
-        temporary goals keeping it ("reset per goal", the default of 2026-11 sessions 6-13; see
+        temporary goals keeping it ("reset per goal", the default from 2026-11-23 to 2026-11-27; see
         the module docstring). A fill, the same in both columns: neither Sgorbissa & Arkin nor
         the abstract of Balch & Arkin 1993 (all of it that was found) says how long the memory
         lasts.

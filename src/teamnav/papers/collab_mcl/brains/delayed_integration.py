@@ -25,7 +25,7 @@ Gaps filled here (the paper states the idea only; each is a declared choice, not
 
 1. *Concentrated* means the heaviest cluster of the belief holds at least
    ``send_min_cluster_weight`` of the weight (:meth:`MCL.estimate`, cells of 0.5 m) and its
-   position spread is at most ``send_max_cluster_spread_m``. The weight alone (sessions 15-16)
+   position spread is at most ``send_max_cluster_spread_m``. The weight alone (before 349d51d)
    called a lost robot's uniform belief concentrated: once the samples fill the free space it is
    one connected cluster of weight 1.
 2. One stored detection per detected robot, the latest: a newer sight of the same robot carries

@@ -206,7 +206,7 @@ class MCLWander(AnonymousAssociation):
         self.stats = {"seen": 0, "sent": 0, "filtered": 0, "rejected": 0, "assoc": 0, "assoc_dropped": 0}
         # §7.2 delayed integration: odometry history, detections kept while unsure
         self._delay = DelayedIntegration(params.delay_max_age_s, keep_history=params.collaborate)
-        # §7.2 negative sights (issue 22): teammates' broadcast points and the rate rule
+        # §7.2 negative sights (beyond the paper): teammates' broadcast points and the rate rule
         self._neg = (NegativeSights(params, self.robot_id, info.known_map, self.model.p_false_negative, info.dt_s)
                      if params.negative_detections else None)
 
@@ -358,7 +358,7 @@ class MCLWander(AnonymousAssociation):
 
     def _on_message_now(self, msg: Message, obs: Observation) -> list[Message]:
         """Handle one message; a detection tree addressed to this robot is logged with the belief it
-        met (issue 26 §2: the paper's Fig. 10a shows that belief still spread along the corridor)."""
+        met (the paper's Fig. 10a shows that belief still spread along the corridor)."""
         body = msg.body
         if not (msg.kind == SYNC_KIND and isinstance(body, SyncMessage) and body.kind == "detection"
                 and body.target == self.robot_id):

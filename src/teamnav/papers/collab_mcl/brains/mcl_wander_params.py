@@ -94,8 +94,8 @@ class MCLWanderParams(BaseModel):
         behaviour).
     send_max_cluster_spread_m : float or None
         The heaviest cluster's position spread ``sqrt(var x + var y)`` must be at most this [m] for a
-        concentrated belief (gap-fill, session 17). None: the weight alone, the definition of
-        sessions 15-16, which called a lost robot's uniform belief concentrated (one connected
+        concentrated belief (gap-fill, 349d51d). None: the weight alone, the definition
+        before 349d51d, which called a lost robot's uniform belief concentrated (one connected
         cluster of weight 1 once the samples fill the free space: 2000 or more in the hallway), so
         "drop" and "delay" sent a lost robot's detections at once. Inert with
         ``send_min_cluster_weight`` 0. 1 m chosen on tuning seeds 1000-1009 of the co-travel hallway
@@ -175,7 +175,7 @@ class MCLWanderParams(BaseModel):
         confirmed by the teammate it had just dragged along). False (default): the reply is
         built from the belief as it was before the message.
     negative_detections : bool
-        Beyond the paper (§7.2 future work; issue 22): on a camera frame that does not see teammate n,
+        Beyond the paper (§7.2 future work): on a camera frame that does not see teammate n,
         weigh each own sample by the probability of not seeing n from it, given the points of n's
         belief that n broadcast (:mod:`teamnav.papers.collab_mcl.brains.negative_sights`, the likelihood
         :mod:`teamnav.localization.negative_detection`). False (default): §2.3 rule 1, negative

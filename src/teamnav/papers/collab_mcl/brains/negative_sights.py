@@ -2,7 +2,7 @@
 
 Fox, Burgard, Kruppa & Thrun (2000) ignore negative sights (§2.3 rule 1; §7.2 lists them as
 future work); ``negative_detections: false`` is that rule and the brain's default. With
-``negative_detections: true`` (issue 22, "the papers' own future work") the brain does, per robot:
+``negative_detections: true`` ("the papers' own future work") the brain does, per robot:
 
 1. *Broadcast*: on the step before each camera frame (so that the points are one step old when
    the frame is taken), a robot whose belief is concentrated (position spread ``sqrt(var x +

@@ -5,7 +5,7 @@ ignoring detections vs using them: Robin's error with 95 % intervals (Fig. 11; c
 ``single-detection``, metrics by :func:`detection_values`), its belief just before and after the
 detection in one pictured run per column (Fig. 10, :data:`PICTURED_SEED`), and its sample count and
 spread whenever a tree reached it (the brain's ``det_belief`` log, :func:`detection_belief_rows`:
-Fig. 10(a)'s precondition, a belief still spread; issue 26 §2).
+Fig. 10(a)'s precondition, a belief still spread).
 
 Split from :mod:`.section` (no behaviour change).
 """
@@ -51,7 +51,7 @@ def detection_belief_rows(logs: list[dict], robot: int = 1) -> list[dict]:
 
 def _belief_views(ctx) -> list:
     """Robin's samples just before and after the first detection of one run per column (Fig. 10),
-    and Robin's sample count and spread at every detection tree it received (issue 26 §2)."""
+    and Robin's sample count and spread at every detection tree it received."""
     from teamnav.world import builtin_map
 
     grid = builtin_map("lab_and_corridor").grid

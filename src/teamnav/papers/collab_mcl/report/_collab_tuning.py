@@ -1,4 +1,4 @@
-"""The ``collab-mcl`` section's tuning-seed tables (issue 26 §2-§3; Fox, Burgard, Kruppa & Thrun 2000):
+"""The ``collab-mcl`` section's tuning-seed tables (68da7cc, 2026-11-27; Fox, Burgard, Kruppa & Thrun 2000):
 why the paper-rules filter collapses in the §5.1 setting (Fig. 10(a)'s precondition, Robin's belief
 still spread when Marian's tree arrives: one filter setting changed at a time), the §5.2.1 hallway
 per factor, and the teamnav column's tuned values out of sample (§5.1, §5.2.1, §5.2.2, judged by
@@ -98,7 +98,7 @@ def _in_factor_order(part: str) -> list[dict]:
 
 
 def collapse_rows() -> list[list]:
-    """Issue 26 §2's table: Robin's paper-rules belief per factor (one setting changed at a time)."""
+    """Why the paper-rules filter collapses, the table: Robin's paper-rules belief per factor (one setting changed at a time)."""
     rows = []
     for r in _in_factor_order("detection"):
         what, status = COLLAPSE_FACTORS[r["factor"]]
@@ -112,7 +112,7 @@ def collapse_rows() -> list[list]:
 
 
 def hallway_factor_rows() -> list[list]:
-    """Issue 26 §2's hallway check: the report's time to localize per factor (paper rules)."""
+    """Why the paper-rules filter collapses, the hallway check: the report's time to localize per factor (paper rules)."""
     rows = []
     for r in _in_factor_order("hallway"):
         rows.append([r["factor"], COLLAPSE_FACTORS[r["factor"]][0], _seed_text(r["seeds"]),
@@ -127,7 +127,7 @@ _RECHECK = {"hallway-faster": "hallway", "hexagon-together": "hexagon", "single-
 
 
 def out_of_sample_rows() -> list[list]:
-    """Issue 26 §3: each teamnav-judged reading of a paper claim on tuning seeds, by the claim file's rule."""
+    """The teamnav values out of sample: each teamnav-judged reading of a paper claim on tuning seeds, by the claim file's rule."""
     from teamnav.experiments.claims import judge, load_claims
 
     claims = load_claims("collab-mcl")
@@ -142,7 +142,7 @@ def out_of_sample_rows() -> list[list]:
 
 
 def _tuning_blocks() -> list:
-    """Issue 26 §2 (why the paper-rules filter collapses) and §3 (the teamnav values out of sample),
+    """Why the paper-rules filter collapses, and the teamnav values out of sample,
     as measured on tuning seeds by scripts/collab_mcl_collapse.py (:data:`TUNING_RUNS`)."""
     if not TUNING_RUNS:
         return [Missing("tuning-seed diagnostics", "TUNING_RUNS is empty")]
@@ -173,7 +173,7 @@ def _tuning_blocks() -> list:
     ]
 
 
-#: issue 26 §2's answer, from the table above it (tuning seeds 1000-1009; docs/report/collab-mcl.md)
+#: Why the paper-rules filter collapses, from the table above it (tuning seeds 1000-1009; docs/report/collab-mcl.md)
 COLLAPSE_READING = (
     "spread = sqrt(var x + var y) of Robin's weighted samples; error = mean distance of 64 logged samples to "
     "the truth; 'localized' = final error < 1.5 m. Reading: the collapse is the likelihood's sharpness against "
@@ -211,7 +211,7 @@ OUT_OF_SAMPLE_READING = (
     "hallway p_turn_at_opening 0.5 instead of 0: 266 against 153 s (+114 ± 20 s), the choice holds; the "
     "brain's defaults inject_min_draws 0 and inject_sender_lost_prior 0 instead of 500 and 0.3: 110 against "
     "153 s (-43 ± 27 s), the choice does NOT hold out of sample (the defaults are no worse, perhaps better; "
-    "re-checked in session 15 on tuning seeds 1000-1014: -22 ± 12 s, lower on 11 of 15 seeds, so the "
+    "re-checked on 2026-11-27 (0e3d31d) on tuning seeds 1000-1014: -22 ± 12 s, lower on 11 of 15 seeds, so the "
     "scenario went back to the defaults; the hallway's teamnav column needs the full re-run); "
     "hexagon laser exponent 0.03 instead of 0.01, or heading share 0.5 instead of 0: every robot localized in "
     "5 of 6 runs against 6 of 6 (both lose seed 1002 entirely), the choices hold, by one run.")

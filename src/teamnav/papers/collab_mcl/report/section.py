@@ -43,9 +43,9 @@ here).
 
 Then three tables measured on tuning seeds (>= 1000) by ``scripts/collab_mcl_collapse.py`` and
 shown as measured (:data:`TUNING_RUNS`, not re-run here): why the paper-rules filter collapses
-(issue 26 §2: one filter setting changed at a time, Robin's belief at 5 s, 30 s and when Marian's
-tree arrives; the hallway per factor) and the teamnav column's tuned values out of sample (issue 26
-§3, judged by the claim file's rules). Then a claim table (both columns, each rule and its history)
+(one filter setting changed at a time, Robin's belief at 5 s, 30 s and when Marian's
+tree arrives; the hallway per factor) and the teamnav column's tuned values out of sample
+(judged by the claim file's rules). Then a claim table (both columns, each rule and its history)
 and, per scenario, the gap-fills with both values (and those kept in both columns because the paper
 gives no value).
 
@@ -62,7 +62,7 @@ Files: the row helpers (error curves with 95 % bands) and the two columns in :mo
 §5.2.1 (hallway), §5.2.2 (hexagon), the claim and gap-fill tables and :func:`build` here; §5.1
 (detection, with the Fig. 10 belief views) in :mod:`._collab_detection`; the §7.2 variants in
 :mod:`._collab_beyond`; §7.2 delayed integration in :mod:`._collab_delayed`; the tuning-seed tables
-(issue 26 §2-§3, :data:`TUNING_RUNS`) in :mod:`._collab_tuning`.
+(:data:`TUNING_RUNS`) in :mod:`._collab_tuning`.
 """
 
 from __future__ import annotations

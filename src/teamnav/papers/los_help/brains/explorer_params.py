@@ -196,11 +196,11 @@ class LosExplorerParams(_CommonParams):
         (as a ghost is after ``trouble_cr``, ``temp_dropped``), so that A, or another teammate
         in sight, takes over. Gap filled:
         §5 ends the following only when R1 is no longer in trouble or sees its goal, and a
-        point behind a wall pinned R1 for good: traced (session 9), office_simple, potential
+        point behind a wall pinned R1 for good: traced (2026-11-26), office_simple, potential
         field, R1..R3, task 5, target 59 (room N2 from room S5): R1 saw R3 through S5's door,
         kept heading for R3's last seen position in the corridor (28.8, 7.8) and stood against
         S5's north wall below it, Tr set and the same robot never in sight again, for 5800 steps
-        until it gave up. Measured (session 9, 200-target tasks of Tables 1-2, VisBug helpers,
+        until it gave up. Measured (2026-11-26, 200-target tasks of Tables 1-2, VisBug helpers,
         paired against False): after ``trouble_cr`` = 50 steps, office_simple tasks finished
         R1..R3 3/5 -> 5/5 (R1+R2, R1..R4 5/5 both; the 13 tasks both finished 343 -> 342 steps
         per target on average), but on office_complex R1..R4 two tasks that finished gave up

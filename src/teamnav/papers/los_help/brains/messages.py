@@ -18,7 +18,7 @@ Its parts are exactly the terms §4.4 counts, so a message is O(M) for a team of
   sender's D leads through and that point's own distance to the goal: 24 bytes more, still
   O(M).
 - ``trouble``: the one-bit internal state Tr of §5 (None when state sharing is off).
-- ``pose``, ``pose_cov``: beyond the paper (issue 22, combination 2, the brains' ``frame_source``
+- ``pose``, ``pose_cov``: beyond the paper (the beyond section's combination 2, the brains' ``frame_source``
   other than ``"bearings"``): the sender's pose in its own (common, map) frame and its six
   covariance numbers (:mod:`teamnav.papers.beyond.brains.localized_los`); None (0 bytes) under the
   paper's §3.1 rule.

@@ -126,10 +126,10 @@ class _CommonParams(BaseModel):
         beside its body (:func:`~.goal_sharing.see_past_teammates`); navigation and the
         straight-corridor test still see the teammate's body. Gap filled: the paper's V(R) is
         bounded by the environment (§2), and its robots do not hide goals from each other; ours
-        have bodies that the laser sees. Why (session 9, office_simple, Avoid-Past, R1+R2,
+        have bodies that the laser sees. Why (measured 2026-11-26, office_simple, Avoid-Past, R1+R2,
         5 tasks x 200 targets, steps per target): R1 alone 214, R2 patrolling silent 236,
         silent R2 with R1's laser blind to robots 221: R2's body hid goals that R1 would have
-        driven straight to. Measured (session 10, same tasks, R1..R3, paired against False):
+        driven straight to. Measured (2026-11-26, same tasks, R1..R3, paired against False):
         227 -> 210; the full tables with it: docs/report/los-help.md. False: a teammate
         occludes like a wall.
     navigate_past_teammates_beyond_m : float or None
@@ -137,7 +137,7 @@ class _CommonParams(BaseModel):
         A distance d: A's scan reads past the teammates this robot detects farther than d
         (the beams on their bodies read what the beams beside them read, as for
         ``see_past_teammates``); nearer ones stay obstacles, and the engine's contact rule keeps
-        bodies apart whatever A does. Measured (session 10, office_simple, Avoid-Past, R1+R2,
+        bodies apart whatever A does. Measured (2026-11-26, office_simple, Avoid-Past, R1+R2,
         5 tasks x 200 targets): silent R2 236 steps per target against 214 alone; helping R2
         225 with None and 226 with 1.0 on R1: the teammate's cost is not its body seen from afar
         (docs/report/los-help.md). Kept off; kept for the next trace.
@@ -149,7 +149,7 @@ class _CommonParams(BaseModel):
         with an Id at least the stored one, a goal relayed at ``Nr = 1`` reaches only robots that
         already hold it first- or second-hand, so both values give the same runs there.
     frame_source : {"bearings", "mcl", "fused"}
-        Where the frame between sender and receiver comes from (issue 22, combination 2;
+        Where the frame between sender and receiver comes from (the beyond section's combination 2;
         :mod:`teamnav.papers.beyond.brains.localized_los` documents the rules and the frames they need).
         ``"bearings"``: §3.1's mutual bearings, θ21 = 180° + α21 − α12 (the paper's rule; messages
         and behaviour exactly as without this parameter). ``"mcl"``: from the sender's pose, sent in

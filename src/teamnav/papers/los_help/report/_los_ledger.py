@@ -235,7 +235,7 @@ def precondition_blocks() -> list[Precondition]:
 #: at its first task not finished (the rule's order), so "0/1" ran one task.
 MEMORY_READINGS: tuple[tuple[str, str, str, str], ...] = (
     ("lifelong (the literal reading)", "0/1", "1354", "25 of 200 on task 1001"),
-    ("reset per goal (2026-11 sessions 6-13)", "1/2", "221, 483", "20 of 200 on task 1002"),
+    ("reset per goal (the default of 2026-11-23 to 11-27)", "1/2", "221, 483", "20 of 200 on task 1002"),
     ("half-life 4000 steps", "0/1", "798", "58 of 200 on task 1001"),
     ("half-life 2000 steps", "0/1", "692", "57 of 200 on task 1001"),
     ("half-life 1000 steps (the fill)", "5/5", "555, 520, 546, 565, 538", ""),

@@ -1,4 +1,4 @@
-"""The ``los-help`` section's trials that another of its sweeps already runs (issue 21 §5, cost).
+"""The ``los-help`` section's trials that another of its sweeps already runs (cost; 14d5e61, 2026-11-27).
 
 In full mode the section asked for 780 trials, of which 75 are the same simulation twice: the
 noise figures' err_max = 0 points (Figs. 16-17, every algorithm, both columns: 60 trials) are

@@ -233,7 +233,7 @@ def legs_block(tables: dict[str, dict[int, list[dict]]]) -> Table:
                       "finished none shows the legs of the targets it reached.")
 
 
-# ---------------------------------------------------------------------------- two columns (issue 21 §3-§4)
+# ---------------------------------------------------------------------------- two columns and route plans
 #: the section's two columns: (key, heading); the trail and collab-mcl sections use the same
 COLUMNS = (("paper_rules", "paper as written"), ("teamnav", "teamnav"))
 HEAD = dict(COLUMNS)
@@ -293,7 +293,7 @@ def noise_table_cols(map_key: str, rows_by_col: dict[str, list[dict]], alone_by_
 
 
 def route_plans_block(plans_by_col: dict[str, list[dict[int, list[dict]]]], labels: tuple[str, ...]) -> Table:
-    """Table 2's robustness column (issue 21 §4): R1's steps per target per algorithm, column and
+    """Table 2's robustness column: R1's steps per target per algorithm, column and
     route plan for R2..R4, and the mean over the plans that the Table 2 verdicts read
     (claims/los-help.yaml; per plan the tasks finished, unpaired here: the verdicts pair by task)."""
     from teamnav.papers.los_help.report._los_verdicts import _team_mean
@@ -312,7 +312,7 @@ def route_plans_block(plans_by_col: dict[str, list[dict[int, list[dict]]]], labe
                 ms = [[_team_mean(p, nav, h) for p in plans] for h in range(4)]
                 rows.append([NAV_LABEL[nav], head, f"mean over {len(plans)} plans",
                              *("n/a" if not np.isfinite(m).all() else f"{np.mean(m):.0f}" for m in ms)])
-    return Table("Table 2 over route plans for R2..R4 (robustness column, issue 21 §4): R1's motion steps per target, "
+    return Table("Table 2 over route plans for R2..R4 (robustness column): R1's motion steps per target, "
                  "mean (std %) tasks finished / run",
                  ["algorithm", "column", "route plan", *TEAM_LABEL.values()], rows,
                  "Plans chosen before their runs (report/sections/_los_common.ROUTE_PLANS; scenarios los-help-complex, "

@@ -5,11 +5,11 @@ Split from :mod:`.section` (no behaviour change). The rules are read from the cl
 ``claims/los-help.yaml`` (:mod:`teamnav.experiments.claims`): each verdict computes the metrics
 its claim names and calls :func:`~teamnav.experiments.claims.judge`; no threshold lives here.
 
-Two columns (issue 21 §3): the verdicts are computed on each column's rows and merged by
+Two columns: the verdicts are computed on each column's rows and merged by
 :func:`column_comparisons`, which gives each claim a comparison per column (``column`` of the
 report model): the paper-as-written one is the verdict (every claim is ``judged:
 paper_rules``), the teamnav one stands beside it. Table 2's verdicts read the mean
-over the route plans of :data:`._los_common.ROUTE_PLANS` (issue 21 §4; ``plans`` of
+over the route plans of :data:`._los_common.ROUTE_PLANS` (``plans`` of
 :func:`table_comparisons`, :func:`_plan_means`).
 """
 
@@ -122,7 +122,7 @@ def _team_mean(by_team: dict[int, list[dict]], nav: str, h: int) -> float:
 
 
 def _plan_means(plans: Sequence[dict[int, list[dict]]], nav: str, hs: Sequence[int]) -> tuple[list[float], str]:
-    """Claims/los-help.yaml's route-plan rule (issue 21 §4): per plan, the paired-by-task mean per
+    """Claims/los-help.yaml's route-plan rule: per plan, the paired-by-task mean per
     team of ``hs`` (:func:`paired_means`; unpaired when the rows name no tasks); then the mean over
     the plans at each team, NaN where some plan has none. Also one line per plan for the text."""
     per_plan, text = [], []
@@ -153,7 +153,7 @@ def table_comparisons(map_key: str, means: dict[str, list[float]], by_team: dict
                       record: dict | None = None) -> list[Comparison]:
     """Tables 1-2's verdicts on one column's rows (``by_team``, team size -> rows).
 
-    ``plans``: the rows of each route plan (Table 2's robustness column, issue 21 §4; plan A, the
+    ``plans``: the rows of each route plan (Table 2's robustness column; plan A, the
     table's own rows, first, each plan with the same R1-alone rows): the verdicts then read the mean
     over the plans, as claims/los-help.yaml's Table 2 rules say (:func:`_plan_means`); a team counts
     as failing when it finished no task in any plan. ``record``: collects each claim's values and

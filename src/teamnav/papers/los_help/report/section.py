@@ -21,7 +21,7 @@ What it runs (sweeps ``los-table1``, ``los-table2``, ``los-noise-simple``,
   (:func:`~teamnav.papers.los_help.tasks.shortest_steps_for_targets`), so that a reader sees
   which part of the path the helpers shorten for each algorithm.
 
-Two columns (issue 21 §3), drawn through the shared paper-rules mechanism of the trail and
+Two columns, drawn through the shared paper-rules mechanism of the trail and
 collab-mcl sections (:func:`teamnav.papers.trails.report._trails.paper_rules_spec`): "paper as written" runs every robot
 group (both brains) at ``paper_rules: true`` (each gap-fill whose other value is the paper's rule
 at the paper's value: ``PAPER_RULES`` of ``los-explorer-v1`` / ``los-helper-v1`` and of their
@@ -33,7 +33,7 @@ claim table shows both columns' metrics, and two tables list the gap-fills (both
 rules the paper leaves unspecified with how each is filled (``GAP_FILLS_KEPT``, both columns).
 The ablation, the legs and the traffic tables are the teamnav column's.
 
-Table 2's map and routes are ours (issue 21 §4; the paper gives no layout for Fig. 13): the
+Table 2's map and routes are ours (the paper gives no layout for Fig. 13): the
 section says so above Table 2 and runs Table 2 over three route plans for R2..R4
 (:data:`._los_common.ROUTE_PLANS`: A the scenario ``los-help-complex``, B and C the scenarios
 ``los-help-complex-plan-b`` / ``-plan-c``; R1 alone is plan A's run in every plan), a robustness
@@ -67,7 +67,7 @@ err_max 0 is the tables' R1..R4 run, read from its rows), and 45 ablation trials
 the column that is the tables' setting of each algorithm is read from Table 1's rows): 705 trials,
 no simulation twice (:mod:`._los_reuse` checks per trial that the reused row is the same resolved
 scenario and seed, and runs the trial when it is not); :data:`FULL_CPU_NOTE` says
-what the whole section cost in its first full run (session 16: 705 trials, 3.33 CPU-h, 101 min on 2 workers). Set
+what the whole section cost in its first full run (2026-11-27: 705 trials, 3.33 CPU-h, 101 min on 2 workers). Set
 ``NUMBA_NUM_THREADS=1`` for sweeps on a small box: the
 line-of-sight kernel of the detector and radio is ``parallel=True`` and its thread launch
 costs more than the work for four robots.
@@ -121,7 +121,7 @@ FULL_CPU_NOTE = ("Cost of the full reproduction on the judged tasks 11-20, estim
                  "`teamnav report los-help -j 2` ran the section's 705 trials (two columns, Table 2 over three route "
                  "plans; the noise figures' err_max 0 and three ablation columns are the tables' own runs, read from "
                  "their rows) in 6084 s of wall time, 45.7 M simulated steps and 3.33 CPU-hours summed over the trials, "
-                 "beside other work at load 8-19 (session 15's estimate from sampled targets, "
+                 "beside other work at load 8-19 (the estimate from sampled targets, "
                  "benchmarks/los_cost_breakdown.py: 3.1 CPU-h, 47 M steps). A failing trial ends at its first target "
                  "over budget; wall time is about the CPU time over the number of workers (`-j`).")
 #: The brains' gap-fills in the sharing rules that change the tables (each a flag of
@@ -148,7 +148,7 @@ GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on t
                   "candidate at the spot R1 saw it (trouble_sighting_at_send; the radio's one-step delay had hidden "
                   "teammates seen through a door for one step): potential field, 40-target prefixes of tasks 1-10, "
                   "office_complex tasks finished R1,2 / R1..3 / R1..4 from 0 / 1 / 4 to 4 / 4 / 5 of 10. "
-                  "Avoid-Past's memory is the robot's (AvoidPastParams.memory_scope='robot'; sessions 6-13 "
+                  "Avoid-Past's memory is the robot's (AvoidPastParams.memory_scope='robot'; from 2026-11-23 to 11-27 it "
                   "forgot it at each own goal, after a lifelong memory saturated the push at the old 1500-step "
                   "budget), and decays with a 1000-step half-life in both columns: the paper gives no lifetime, so "
                   "it is a fill chosen on tuning tasks by the paper's precondition that R1 alone finishes (see the "
@@ -159,7 +159,7 @@ GAP_FILLS_NOTE = ("Beyond the paper's rules (each one flag away, documented on t
                   "office_complex_closed unchanged. The visibility tests see past a teammate the robot detects "
                   "(see_past_teammates: the beams on its body read what the beams beside it read; navigation still "
                   "sees the body): office_simple, Avoid-Past, R1..3, 5 tasks x 200 targets, 227 -> 210 steps per "
-                  "target; in the session-10 sweeps the potential field with R1,2 went from 653 to 562 on "
+                  "target; in the sweeps of 2026-11-26 the potential field with R1,2 went from 653 to 562 on "
                   "office_simple and from 3/5 to 5/5 tasks finished on office_complex_closed.")
 #: Quick mode (CI): targets per task and step budget per target (full: 200 and the scenario's).
 QUICK_TARGETS = 1
@@ -322,7 +322,7 @@ def run_ablation(ctx, all_helpers: list[dict]) -> list[dict]:
     return rows
 
 
-#: Above Table 2 (issue 21 §4): the complex map and the helpers' routes are ours.
+#: Above Table 2: the complex map and the helpers' routes are ours.
 COMPLEX_MAP_NOTE = ("Table 2's map is ours. The paper gives no layout for Fig. 13: office_complex_closed (teamnav.world."
                     "generators), its rooms, their U-shaped walls (the potential field's trap) and the helpers' routes are "
                     "our interpretation of the figure, not the paper's map. So Table 2 is also run over three route plans "
@@ -374,7 +374,7 @@ def build(ctx) -> list:
         f"{QUICK_BUDGET_STEPS_PER_TARGET if quick else ' / '.join(map(str, L.BUDGET_STEPS_PER_TARGET.values()))} "
         f"steps{'' if quick else ' (simple / complex map)'}: R1 then gives up and the run ends. As in §6, state "
         "sharing is used with the potential field only; the ablation shows what it does to the others. "
-        "Two columns (issue 21 §3), as in the trail and collab-mcl sections: \"paper as written\" runs both brains "
+        "Two columns, as in the trail and collab-mcl sections: \"paper as written\" runs both brains "
         "with paper_rules: true (every gap-fill whose other value is the paper's rule at the paper's value: the "
         "gap-fill table below) and \"teamnav\" our gap-fills; Tables 1-2 and Figs. 16-17 show both beside the "
         "paper's numbers. Every verdict is judged on the paper-as-written column by the rules of "

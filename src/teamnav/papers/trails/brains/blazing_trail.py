@@ -83,7 +83,7 @@ in and the corner it approaches); the global list is unbounded as in the paper u
 ``max_global_crumbs`` caps it (oldest dropped).
 
 ``global_crumb_ttl_s`` (None by default: the paper's rule, crumbs never expire; beyond the paper,
-issue 22's moving resource, Blazing §6 future work): a crumb leaves the global list this long
+the beyond section's moving resource, Blazing §6 future work): a crumb leaves the global list this long
 after the robot *added* it (its own batch at its waggle dance, a teammate's on receipt; the
 batches carry no drop times, so a crumb may be up to one trip older than its receipt). Without
 it a trail to a source that has moved stays for ever, beside the new one. The 2002 algorithm's
@@ -114,14 +114,14 @@ __all__ = ["NAVIGATE_DEFAULTS", "BlazingTrail", "BlazingTrailParams", "navigate_
 #: the crumbs points to the side where the opening is detected" (Navigate's ``trail_rule="side"``;
 #: with "closest" the averaged heading lags at corners and robots overshoot into the next door).
 #:
-#: ``box_reach_m = 2.0`` (Navigate's default 1.2; a gap-fill, session 11): the sliding box's first
+#: ``box_reach_m = 2.0`` (Navigate's default 1.2; a gap-fill, 8a4187d, 2026-11-26): the sliding box's first
 #: position reaches across the trail office's 1.8 m corridors, so a robot always finds its left
 #: wall and keeps to the left lane (Blazing §4.2 / Try §3.3: the robots pass each other in the
 #: corridors). With 1.2 m, a robot more than 1.2 m from its left wall finds the first box free and
 #: drives straight on ("big open space", Blazing §4.2): after its 180 deg turn at home or at the
 #: source (made on the spot, in the lane it arrived in) and after swerving round another robot,
 #: it stayed in the *oncoming* lane until a passing place or a corner pulled it across, and met
-#: the next robots head-on. Traced (session 11, true trajectories, ``try-to-see-it-my-way``,
+#: the next robots head-on. Traced (2026-11-26, true trajectories, ``try-to-see-it-my-way``,
 #: seeds 0-3, 30 min, trips from 10 min on): robots left the source at y 16.35 in C3's north
 #: half heading west, the north half being the eastbound lane; the share of time in the robot's
 #: own lane on the three corridors' straight stretches rose from 80 / 82 / 78 % to 97 / 96 / 91 %

@@ -38,13 +38,13 @@ minimum it explores instead of dithering. The bound is reset when the goal chang
 ``descend_only=False`` is the paper's rule as written.
 
 Lanes: the trail brains' Navigate reaches 2.0 m for its wall (``box_reach_m`` in
-:data:`~teamnav.papers.trails.brains.blazing_trail.NAVIGATE_DEFAULTS`, session 11), so robots keep to the
+:data:`~teamnav.papers.trails.brains.blazing_trail.NAVIGATE_DEFAULTS`, 8a4187d), so robots keep to the
 left lane of the 1.8 m corridors and pass each other; that comment has the trace and the paired
 measurements (the scenario's drift, 30 min: 55.8 -> 67.7 % of cruise). In lanes the crumbs a
 robot follows lie in the other lane, so the crumb neighbourhood is 3 m (``radius_m``, "Choices
 where the paper is silent" below: +7.9 points more) and give-way is off again
 (:data:`TRAIL_SHARE_NAVIGATE`: +3.0). Every measurement between this paragraph and that one was
-made before session 11, with the 1.2 m reach and the 2 m neighbourhood.
+made before 2026-11-26 (8a4187d), with the 1.2 m reach and the 2 m neighbourhood.
 
 Efficiency gap-fills (one flag away from the paper's rules): ``turn_at_place`` (a sharp 180 deg
 turn on reaching the sought place, then ``leave_place_m`` of wall following, as in
@@ -92,7 +92,7 @@ scenario's drift 53.5 ± 1.3 %, 128.6 ± 2.6 s): ``hint_skips_cooldown`` 57.4 ±
 7.1 s) with it: better, but not beyond the standard error; on fresh seeds 8-11 (no drift)
 60.1 ± 1.9 % against 56.7 ± 2.3 % (paired gain 3.5 ± 1.4 points; trips 117.6 ± 1.8 s against
 122.5 ± 3.3 s); seeds 0-11 together 60.3 ± 1.6 % against 57.7 ± 1.0 % (paired +2.6 ± 1.6
-points). Drift check (session 6, at 0.4 m/s, paired against the default on the same seeds):
+points). Drift check (67b49fc, 2026-11-23, at 0.4 m/s, paired against the default on the same seeds):
 the scenario's drift, 30 min, seeds 0-23: 54.1 ± 1.3 % against 52.3 ± 1.4 % (paired +1.9 ± 1.9
 points, better on 13 of 24 seeds; seeds 8-15 +1.5 ± 3.5, fresh seeds 16-23 +1.9 ± 3.8; fewer
 bad runs: worst seed 47 % against 29 %); the scenario's 3 h, seeds 0-1: 58.0 and 60.5 % against
@@ -100,15 +100,15 @@ bad runs: worst seed 47 % against 29 %); the scenario's 3 h, seeds 0-1: 58.0 and
 25 units against 16, 39, 34 (last 10 min 6, 4, 4 against 4, 6, 6). Every comparison leans the
 same way but none is beyond the noise under drift, so it stays off (the rule for defaults);
 the first thing to try with more seeds. The try-paper sweep itself (the scenario's drift, 3 h,
-seeds 0-9, session 6, against the stored default runs of the same seeds): 57.3 % against
+seeds 0-9, 2026-11-23, against the stored default runs of the same seeds): 57.3 % against
 54.6 % (paired +2.7 ± 0.9 points, better on 9 of 10): beyond the noise on the paper's own
-condition. On by default in sessions 7-10 (:data:`TRAIL_SHARE_NAVIGATE`); off again since session 11, when
+condition. On by default from ff866a4 (2026-11-23) (:data:`TRAIL_SHARE_NAVIGATE`); off again since dfcab8a (2026-11-26), when
 the lane fix made it cost (+3.9 points without it over 24 paired seeds; that constant's comment).
 ``recover_reverse`` (off by default): while recovering, Navigate's 180 deg rule ignores its
 reversal memory and distance cool-down (the robot is pushed up a branch by a meeting and the
 way back is where it last reversed).
 ``navigate={"meet_guard_deg": ...}`` (Navigate's meeting guard, off by default; Navigate's
-module docstring item 6): session 6, against the default on the same seeds (paired, mean ±
+module docstring item 6): measured 2026-11-23, against the default on the same seeds (paired, mean ±
 s.e.; ``eff`` from ``place_interval_s``, ``eff_trips`` = 31.5 m / mean trip after the first
 source visit / cruise, the fairer figure in 30-min runs where the first exploration weighs):
 guard 90 deg at 0.4 m/s, no drift, seeds 0-7: eff 56.6 ± 1.7 % against 58.2 ± 1.1 % (paired
@@ -120,7 +120,7 @@ on seed 0.)
 module docstring item 6, after Vaughan et al.'s aggressive competition with local investment,
 SAB 2000 / ICAR 2005, a gap-fill): this brain tells Navigate ``bold`` = loaded (seeking
 ``round[0]``, home), so in a head-on meeting on the route the loaded robot drives on after
-``give_way_bold_s`` while the unloaded one waits ``give_way_s``. Session 8, scenario's drift,
+``give_way_bold_s`` while the unloaded one waits ``give_way_s``. Measured (f9f4cf8, 2026-11-24), scenario's drift,
 30 min, seeds 0-11, paired against give_way_s = 3: bold 0.5 s: eff +0.2 ± 2.8 points, trip
 after 10 min -9.1 ± 8.0 s (7/12 seeds better); bold 0 s with give_way_s = 6: eff -0.05 ± 2.1,
 trip -8.9 ± 6.2 s (6/12). No gain beyond the noise: it stays off.
@@ -128,7 +128,7 @@ trip -8.9 ± 6.2 s (6/12). No gain beyond the noise: it stays off.
 Cruise speed: the ``try-to-see-it-my-way`` scenario drives at 0.4 m/s, not the paper's
 0.25 m/s (§3.6, the default here). No reason was recorded when the trail scenarios were written
 (422d896 gave every trail scenario 0.4, as blazing-a-trail, whose paper gives no speed). Measured
-in session 6 (30-min runs, 4 robots, seeds 0-7 paired, efficiency is relative to each run's
+2026-11-23 (30-min runs, 4 robots, seeds 0-7 paired, efficiency is relative to each run's
 cruise so the two compare): without drift 0.25 m/s is not worse (eff 56.2 ± 3.7 % against
 58.2 ± 1.1 %, paired -2.0 ± 3.8 points; eff_trips 71.3 ± 3.3 % against 66.2 ± 1.0 %, paired
 +5.1 ± 3.4: Panic, sharp turns and turns on the spot take the same time at either speed), but
@@ -151,13 +151,13 @@ value (:attr:`TrailShareParams.PAPER_RULES`, Navigate's own passed down, cruise 
 
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
 ``min_move_m`` since the previous temporary trail; radius 3 m (``radius_m``; 2 m, about a
-corridor's width, until session 11). Why 3: once robots keep their lanes (``box_reach_m`` in
+corridor's width, until 907fd28). Why 3: once robots keep their lanes (``box_reach_m`` in
 :data:`~teamnav.papers.trails.brains.blazing_trail.NAVIGATE_DEFAULTS`), the crumbs a robot follows were
 dropped by robots coming the other way, about 1 m across the corridor from it. Traced
 (``try-to-see-it-my-way``, seed 0): an eastbound robot following its wall into C3's passing place
 put its look-ahead point 2 m from the westbound lane's crumbs, found none within 2 m, recovered
 towards the nearest crumb behind it and the 180 deg rule sent it back 3 m (25 s lost, on many
-outbound trips). Measured (session 11, 30 min, paired against 2 m, the scenario's drift,
+outbound trips). Measured (907fd28, 2026-11-26, 30 min, paired against 2 m, the scenario's drift,
 efficiency = ``place_speed_mps`` / cruise): 2.5 m +4.4 ± 1.3 points, **3 m +7.9 ± 1.4 (seeds
 0-11, 11/12 better; trips after 10 min 102.1 -> 93.5 s, 12/12 faster)**, 4 m +7.6 ± 1.0; fresh seeds
 12-23 at 3 m +6.4 ± 1.1 (12/12). Under 4x the drift (1 h, seeds 0-5) 38.2 -> 51.2 units (+13.0 ±
@@ -186,11 +186,11 @@ from teamnav.control.types import Action, Message, Observation
 __all__ = ["TRAIL_SHARE_NAVIGATE", "TrailShare", "TrailShareParams"]
 
 #: Navigate settings of ``trail-share-v1`` over the trail brains' shared ``NAVIGATE_DEFAULTS``
-#: (its ``navigate`` dict overrides them). Empty since session 11: both trail brains drive with the
-#: same Navigate. Sessions 7-10 set ``give_way_s = 3`` here (Navigate's module docstring item 6, a
+#: (its ``navigate`` dict overrides them). Empty since dfcab8a (2026-11-26): both trail brains drive with the
+#: same Navigate. From ff866a4 (2026-11-23) it set ``give_way_s = 3`` here (Navigate's module docstring item 6, a
 #: gap-fill; measured then with the 1.2 m box reach on the try-paper condition: 57.3 % against
 #: 54.6 %, +2.7 ± 0.9 points). Once the robots keep their lanes (``box_reach_m = 2.0`` in
-#: ``NAVIGATE_DEFAULTS``) the stops cost more than they save. Measured (session 11, the scenario's
+#: ``NAVIGATE_DEFAULTS``) the stops cost more than they save. Measured (dfcab8a, the scenario's
 #: drift, 30 min, paired, efficiency = ``place_speed_mps`` / cruise): give_way_s = 0 against 3,
 #: seeds 0-11 67.4 -> 70.4 % (+3.0 ± 1.3 points, 9/12 better; trips after 10 min -4.4 ± 1.4 s),
 #: fresh seeds 12-23 63.8 -> 68.5 % (+4.7 ± 2.5, 8/12; +2.2 ± 1.1 units in 30 min).
@@ -250,7 +250,7 @@ class TrailShareParams(BaseModel):
         Draw the trail in the replay at most once per this many steps.
     navigate : dict
         Further :class:`~teamnav.control.nav.navigate.NavigateParams` fields, over
-        :data:`TRAIL_SHARE_NAVIGATE` (empty since session 11) over ``NAVIGATE_DEFAULTS``
+        :data:`TRAIL_SHARE_NAVIGATE` (empty since dfcab8a) over ``NAVIGATE_DEFAULTS``
         (``trail_rule="side"``, Blazing §5.1; ``box_reach_m=2.0``, lanes).
     paper_rules : bool
         Every gap-fill of :attr:`PAPER_RULES` (and Navigate's) at the paper's value

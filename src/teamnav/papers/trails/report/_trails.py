@@ -35,8 +35,8 @@ TRAIL_BRAINS = ("blazing-trail-v1", "trail-share-v1")
 #: a team "works" when it delivers at least this many units per 10 minutes (the paper's 4 robots
 #: delivered ~9 per 10 min before the breakdown; one optimal robot delivers ~4)
 WORKING_UNITS_PER_10MIN = 1.0
-#: the map every trail scenario runs on (the U shape since issue 25; trail_office_z_corridors is
-#: the Z map of sessions 1-11)
+#: the map every trail scenario runs on (the U shape since 9fe1783, 2026-11-27; trail_office_z_corridors
+#: is the Z map before it)
 TRAIL_MAP = "trail_office_corridors"
 #: the 2002 paper's cruise speed (Try §3.6: "The Navigate behavior drives the robots at 0.25m s^-1
 #: when cruising freely"), the try-to-see-it-my-way paper column's

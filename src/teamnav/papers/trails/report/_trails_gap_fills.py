@@ -1,5 +1,5 @@
 """What each gap-fill of ``blazing-trail-v1`` (and of ``trail-share-v1``) buys, and what keeps the 2000
-team from breaking down (issue 25 §4): the runs of ``scripts/trail_gap_fill_study.py``, shown as
+team from breaking down: the runs of ``scripts/trail_gap_fill_study.py``, shown as
 measured, not re-run by the report.
 
 Vaughan, Støy, Sukhatme & Matarić (2000) §5.1: 28 units in 30 min, then "the unbounded odometry
@@ -169,7 +169,7 @@ def blocks(runs=None, system: str = "blazing") -> list:
     if not runs:
         return [Missing(f"gap-fill study of {brain}", "no runs of scripts/trail_gap_fill_study.py stored")]
     out: list = [Text(
-        f"Why the two columns of {brain} differ, taken apart (issue 25 §4; scripts/trail_gap_fill_study.py "
+        f"Why the two columns of {brain} differ, taken apart (scripts/trail_gap_fill_study.py "
         f"--system {system}, paired seeds "
         f"{_seeds(runs)}, which are neither the report's nor used to choose anything; measured once and shown "
         "as measured, not re-run here). 'paper+G': the paper's rules with gap-fill G alone at teamnav's value "

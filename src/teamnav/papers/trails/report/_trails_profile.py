@@ -1,5 +1,5 @@
 """Profiled trail runs: a run sampled for memory (process RSS, crumbs held) and CPU per simulated
-hour as it goes (the issue's "memory stays flat over a 10-hour simulated run" and "a simulated hour
+hour as it goes (the stated targets "memory stays flat over a 10-hour simulated run" and "a simulated hour
 of 4 robots runs in well under a minute on one core"); :func:`profile_trial` is the sweep
 ``trial_fn`` of the try-to-see-it-my-way section's profiled runs.
 
@@ -30,7 +30,7 @@ def _rss_mb() -> float:
 def profile_run(sc, every_steps: int) -> tuple[list[dict], dict]:
     """Run the loaded scenario ``sc`` in chunks of ``every_steps`` and sample memory and CPU after each.
 
-    The issue's "memory stays flat over a 10-hour simulated run (crumb expiry works)" and "a simulated
+    The stated targets "memory stays flat over a 10-hour simulated run (crumb expiry works)" and "a simulated
     hour of 4 robots runs in well under a minute on one core". Give ``sc`` a large ``record_every``
     (the recorder keeps every recorded step, so a small one makes the recorder's own memory grow with
     the run; events are recorded whatever ``record_every``).

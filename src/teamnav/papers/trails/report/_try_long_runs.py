@@ -1,6 +1,6 @@
 """The ``try-to-see-it-my-way`` section's long runs: the 2002 team for hours at the drift that
 breaks the 2000 team (:func:`hours_blocks`), and the profiled 10-hour run's memory and CPU
-(:func:`_profile_blocks`) (Vaughan et al. 2002 §3.6; the issue's "memory stays flat over a
+(:func:`_profile_blocks`) (Vaughan et al. 2002 §3.6; the stated target "memory stays flat over a
 10-hour simulated run").
 
 Split from :mod:`.try_to_see_it_my_way` (no behaviour change); what these runs measured is in

@@ -54,7 +54,7 @@ second, labelled table, never judged.
 
 What the section measured (the final drift sweep, the paper's conditions, one robot alone,
 the full mode's cost, with commits): ``docs/report/blazing-a-trail.md``. Why the two columns
-differ, each gap-fill alone and the drift models on paired seeds (issue 25 §4), is shown from the
+differ, each gap-fill alone and the drift models on paired seeds, is shown from the
 stored runs of ``scripts/trail_gap_fill_study.py`` (:mod:`._trails_gap_fills`), not re-run.
 """
 

@@ -17,7 +17,7 @@ EXPERIMENTS.md rows, each a :class:`Comparison`:
    for hours under the paper's per-robot drift with no breakdown; efficiency (§3.6: route length
    / (total lifetime / trips) / cruise speed) near the paper's.
 2. EXPERIMENTS.md "runs for hours of simulated time with drift that breaks the Blazing-a-trail
-   system, with no breakdown" and the issue's "the 2002 one keeps working for hours under the
+   system, with no breakdown" and the stated target "the 2002 one keeps working for hours under the
    same drift" → :func:`hours_blocks`: the 2002 team for 3 h at drift k = 4 (where the 2000
    team collapses within the hour), 8 seeds: breakdowns and units per hour per seed, beside the
    2000 team's 1-hour runs at k = 4.
@@ -30,7 +30,7 @@ EXPERIMENTS.md rows, each a :class:`Comparison`:
    checks it), its k = 0, 2, 6 points 1-hour runs (8 seeds); the 2000 team's k = 0, 1, 2, 3, 4, 6
    1-hour runs (10 seeds, the blazing-a-trail section's).
 5. Memory stays flat (crumbs held, first vs second half of the long runs: 4-minute expiry).
-6. The issue's "memory stays flat over a 10-hour simulated run" and "a simulated hour of 4 robots
+6. The stated targets "memory stays flat over a 10-hour simulated run" and "a simulated hour of 4 robots
    runs in well under a minute on one core": one 10-hour run of trail-share-v1 at k = 4, sampled
    every 30 min in the trial (:func:`_trails.profile_trial`: the largest Trail any robot holds,
    the process's RSS, CPU seconds per simulated hour), and a 2-hour run of blazing-trail-v1 at
