@@ -164,7 +164,7 @@ class TutorialParser:
             os.chdir(here)
 
 
-def run_page(name: str, tmp_path: Path, monkeypatch, slow: bool) -> None:
+def run_page(name: str, tmp_path: Path, monkeypatch, slow: bool) -> int:
     from teamnav.control import registry
 
     monkeypatch.chdir(tmp_path)
@@ -174,14 +174,15 @@ def run_page(name: str, tmp_path: Path, monkeypatch, slow: bool) -> None:
     monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))
     modules_before = set(sys.modules)
     try:
-        _run_examples(name, tmp_path, slow)
+        ran = _run_examples(name, tmp_path, slow)
     finally:
         for module in set(sys.modules) - modules_before:
             if str(getattr(sys.modules[module], "__file__", None) or "").startswith(str(tmp_path)):
                 del sys.modules[module]
+    return ran
 
 
-def _run_examples(name: str, tmp_path: Path, slow: bool) -> None:
+def _run_examples(name: str, tmp_path: Path, slow: bool) -> int:
     document = Sybil(parsers=[TutorialParser(), SkipParser()]).parse(TUTORIALS / name)
     document.namespace.update(SLOW=slow, HAVE_RAY=importlib.util.find_spec("ray") is not None,
                               HAVE_PANDAS=importlib.util.find_spec("pandas") is not None, _cwd=str(tmp_path),
@@ -196,6 +197,7 @@ def _run_examples(name: str, tmp_path: Path, slow: bool) -> None:
             skipped.append(f"line {example.line}: {why}")
     if skipped:
         print(f"{name}: skipped " + "; ".join(skipped))
+    return len(examples) - len(skipped)
 
 
 def test_the_seven_tutorials_are_there():
@@ -205,7 +207,8 @@ def test_the_seven_tutorials_are_there():
 
 @pytest.mark.parametrize("name", PAGES)
 def test_tutorial(name, tmp_path, monkeypatch):
-    run_page(name, tmp_path, monkeypatch, slow=False)
+    # every block runs (raising on a failed assertion or command) unless the page skips it
+    assert run_page(name, tmp_path, monkeypatch, slow=False) >= 1, f"{name}: every code block was skipped"
 
 
 #: Pages with blocks that run only in the slow set (a skip directive that reads ``SLOW``).
@@ -215,4 +218,4 @@ SLOW_PAGES = [p for p in PAGES if "SLOW" in (TUTORIALS / p).read_text(encoding="
 @pytest.mark.slow
 @pytest.mark.parametrize("name", SLOW_PAGES)
 def test_tutorial_slow(name, tmp_path, monkeypatch):
-    run_page(name, tmp_path, monkeypatch, slow=True)
+    assert run_page(name, tmp_path, monkeypatch, slow=True) >= 1, f"{name}: every code block was skipped"
