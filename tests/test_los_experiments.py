@@ -295,6 +295,26 @@ def test_metrics_read_r1s_last_log_and_add_the_unrecorded_tail_of_a_finished_run
     assert m["los_frac_ghost"] == 4 / 11 and m["los_frac_goal_seen"] == 2 / 11 and m["los_temp_switches"] == 3
 
 
+def test_max_target_steps_is_the_longest_gap_between_the_samples_that_first_show_each_target():
+    # R1 reaches target 1 by step 20, targets 2 and 3 by step 70 (one sample), target 4 by step 90;
+    # a helper's samples (no "finished") and R1's repeated counts change nothing
+    logs = [_log(0, 0, targets_reached=0, finished=False, moves=0),
+            _log(10, 0, targets_reached=0, finished=False, moves=10),
+            _log(20, 0, targets_reached=1, finished=False, moves=20),
+            _log(20, 1, targets_reached=9, moves=20),
+            _log(40, 0, targets_reached=1, finished=False, moves=40),
+            _log(70, 0, targets_reached=3, finished=False, moves=70),
+            _log(90, 0, targets_reached=4, finished=True, moves=90)]
+    m = los_help(_data(logs, finished=True, n_steps=91))
+    assert m["los_max_target_steps"] == 50 and m["los_finished"] == 1
+    # finished after its last kept sample: the last target counts as reached at the run's last step
+    tail = logs[:-1]
+    assert los_help(_data(tail, finished=True, n_steps=200))["los_max_target_steps"] == 130
+    # not finished: only reached targets count (the one it gave up on is in los_gave_up)
+    assert los_help(_data(tail, finished=False, n_steps=6000))["los_max_target_steps"] == 50
+    assert los_help(_data(logs[:2], finished=False, n_steps=6000))["los_max_target_steps"] == 0
+
+
 def test_metrics_are_empty_without_an_explorer_log():
     assert los_help(_data([_log(0, 1, targets_reached=3, moves=2)], finished=False, n_steps=5)) == {}
 
