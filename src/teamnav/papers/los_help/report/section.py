@@ -388,6 +388,7 @@ def build(ctx) -> list:
     record: dict[str, dict] = {col: {} for col in COLS}
     alone: dict[str, dict[str, dict[str, float]]] = {col: {} for col in COLS}
     maps = [m for m in L.MAPS if not quick or m in QUICK_MAPS]
+    budget_in: dict[str, dict[str, dict]] = {col: {"tables": {}, "plans": {}, "noise": {}} for col in COLS}
     for m in L.MAPS:
         if m not in maps:
             blocks.append(Missing(f"Table 2 / Fig. 14 ({L.MAPS[m]})", "full mode only (teamnav report los-help)"))
@@ -402,6 +403,8 @@ def build(ctx) -> list:
                                            for p in ROUTE_PLANS if p != "A"] for col in COLS}
         for col in COLS:
             tables[col][m] = by_col[col]
+            budget_in[col]["tables"][m] = by_col[col]
+            budget_in[col]["plans"][m] = plans[col] if plans else None
             alone[col][m] = alone_levels(by_col[col].get(0, []))
         tab, means = table_block_cols(m, by_col)
         blocks += [tab, robots_plot_cols(m, by_col)]
@@ -415,6 +418,8 @@ def build(ctx) -> list:
             blocks.append(Missing(f"Fig. 17 ({L.MAPS[m]}, noise)", "full mode only (teamnav report los-help)"))
             continue
         rows = {col: run_noise(ctx, m, tables[col][m].get(3, []), col) for col in COLS}
+        for col in COLS:
+            budget_in[col]["noise"][m] = rows[col]
         plot, nmeans = noise_plot_cols(m, rows, {col: alone[col][m] for col in COLS})
         blocks += [noise_table_cols(m, rows, {col: tables[col][m].get(0, []) for col in COLS}), plot]
         comps += column_comparisons({col: noise_comparisons(m, nmeans[col], alone[col][m], rows[col], record=record[col])
@@ -431,6 +436,13 @@ def build(ctx) -> list:
                              + ("; quick mode: indicative only" if quick else "")))
     from teamnav.papers.los_help.report._los_ledger import ledger_blocks, memory_readings_block, precondition_blocks
 
+    from teamnav.papers.los_help.report._los_budget import budget_blocks
+    from teamnav.papers.los_help.report._los_tables import HEAD
+
+    blocks += budget_blocks(budget_in, {m: float(QUICK_BUDGET_STEPS_PER_TARGET if quick else L.BUDGET_STEPS_PER_TARGET[m])
+                                        for m in maps},
+                            {m: [1] if quick else list(L.JUDGED_TASKS) for m in maps}, _n_targets(quick), claims,
+                            {"paper_rules": HEAD["paper_rules"], "teamnav": HEAD["teamnav"]}, quick=quick)
     blocks += ledger_blocks()
     blocks += precondition_blocks()
     blocks.append(memory_readings_block())
