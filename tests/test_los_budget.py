@@ -107,3 +107,45 @@ def test_budget_multiples_scale_with_the_budget(frac):
     full = B.budget_multiples({"simple": 6000.0}, {"simple": TASKS}, N)["simple"]
     cut = B.budget_multiples({"simple": 6000.0 * frac}, {"simple": TASKS}, N)["simple"]
     assert cut == pytest.approx((full[0] * frac, full[1] * frac))
+
+
+# ---------------------------------------------------------------------------- Avoid-Past half-lives with helpers
+def test_the_half_lives_read_with_helpers_are_those_that_finished_all_tuning_tasks_and_500():
+    from teamnav.control.nav.local import NAVIGATORS
+    from teamnav.papers.los_help.report import _los_half_life as HL
+
+    res = HL.tuning_results()
+    assert HL.fill() == NAVIGATORS["avoid_past"].Params.model_fields["memory_half_life_steps"].default == 1000.0
+    finished = {h for h, (k, n) in res.items() if k == n == len(L.TUNING_TASKS)}
+    assert set(HL.half_lives()) == finished | {500.0, 1000.0}
+    assert all(res[h][0] < res[h][1] or h in finished for h in HL.half_lives())
+    assert 1000.0 not in HL.to_run() and 500.0 in HL.to_run()  # the fill's rows are the judged table's
+    spec = HL.spec()
+    assert len(spec.cases) == len(HL.to_run()) * len(L.TEAMS)
+    assert {c[NAV_KEY] for c in spec.cases} == {"avoid_past"}
+    assert sorted({c[HL.NAV_PARAMS_KEY]["memory_half_life_steps"] for c in spec.cases}) == list(HL.to_run())
+    assert spec.grid[TARGETS_KEY] == [L.task_targets_xy("simple", t) for t in L.JUDGED_TASKS]
+    assert f"{HL.trials()} trials" in HL.cpu_note() and HL.trials() == spec.n_trials
+
+
+def test_the_half_life_block_reads_table_1s_avoid_past_rule_per_half_life_and_marks_the_fill():
+    from teamnav.papers.los_help.report import _los_half_life as HL
+    from teamnav.papers.los_help.report.section import team_of
+
+    def rows(h, falling):
+        out = []
+        for t in range(4):
+            for k, task in enumerate(TASKS):
+                r = _row(task, t, (500 - 100 * t if falling else 300 + 50 * t) + k, 1000)
+                r["params"][HL.NAV_PARAMS_KEY] = {"memory_half_life_steps": h}
+                out.append(r)
+        return out
+    fill_rows = {t: [r for r in _tables(1000)[t]] for t in range(4)}
+    got = HL.by_half_life(rows(250.0, True) + rows(500.0, False), fill_rows, team_of)
+    assert sorted(got) == [250.0, 500.0, 1000.0] and len(got[250.0][3]) == len(TASKS)
+    tab = HL.half_life_block(got)
+    by = {r[0]: r for r in tab.rows}
+    assert by["250"][-1] == "holds" and by["500"][-1] == "does not hold"
+    assert by["1000 (the fill: the judged verdict)"][-1] == "holds"
+    assert by["500"][1] == "0/1 (precondition not met)" and by["250"][1] == "5/5"
+    assert by["250"][-2].startswith("0.4") and "6 pairs" in by["250"][-2]  # 200/500, paired over 6 tasks

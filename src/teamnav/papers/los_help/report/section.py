@@ -435,7 +435,6 @@ def build(ctx) -> list:
                              "is what the gap-fills buy; Table 2's claims read the mean over the route plans"
                              + ("; quick mode: indicative only" if quick else "")))
     from teamnav.papers.los_help.report._los_ledger import ledger_blocks, memory_readings_block, precondition_blocks
-
     from teamnav.papers.los_help.report._los_budget import budget_blocks
     from teamnav.papers.los_help.report._los_tables import HEAD
 
@@ -446,6 +445,14 @@ def build(ctx) -> list:
     blocks += ledger_blocks()
     blocks += precondition_blocks()
     blocks.append(memory_readings_block())
+    from teamnav.papers.los_help.report import _los_half_life as HL
+
+    if quick:  # the readings are 200-target runs on the judged tasks: not in CI
+        blocks.append(Missing("Avoid-Past's memory half-life with helpers (readings beside the verdict)",
+                              "full mode only (teamnav report los-help): " + HL.cpu_note()))
+    else:
+        blocks.append(HL.half_life_block(HL.by_half_life(_col_rows(ctx, "paper_rules", HL.spec(), HL.SWEEP),
+                                                         tables["paper_rules"].get("simple", {}), team_of)))
     blocks.append(Text("The tables below are the teamnav column's runs (our gap-fills): the ablation, where R1's "
                        "steps and path go, and the traffic."))
     if quick:
