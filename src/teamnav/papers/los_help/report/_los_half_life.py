@@ -69,11 +69,13 @@ def trials() -> int:
 
 
 #: CPU per trial used for the estimate [CPU-s]: R1 alone, Avoid-Past, paper column, 200 targets,
-#: on the tuning tasks (2026-11-29, this 2-core machine at load 4-6, /usr/bin/time): 11-18 CPU-s
-#: for the half-lives 125-1000 that finished; one R1..R4 run on tuning task 1001 with the
-#: 250-step half-life measured MEASURED_TEAM_CPU_S.
+#: on the tuning tasks (2026-11-29, this 2-core machine at load 4-6, the sweep's worker CPU):
+#: 11-13 CPU-s at the half-lives 125 and 250, 18 at 1000 (the trials that finished all 200 targets).
 ALONE_CPU_S: tuple[float, float] = (11.0, 18.0)
-MEASURED_TEAM_CPU_S: float | None = None
+#: One R1..R4 trial, Avoid-Past, paper column, 250-step half-life, tuning task 1001 (2026-11-29, the
+#: same machine): 32.2 CPU-s (finished, 278 steps per target). Four robots cost more per step than
+#: R1 alone saves in steps.
+MEASURED_TEAM_CPU_S: float | None = 32.2
 
 
 def cpu_note() -> str:
@@ -82,10 +84,13 @@ def cpu_note() -> str:
     lo, hi = ALONE_CPU_S
     team = MEASURED_TEAM_CPU_S
     hi2 = max(hi, team or hi)
+    alone = len(to_run()) * len(L.JUDGED_TASKS)
+    likely = (alone * (lo + hi) / 2 + (n - alone) * (team or hi)) / 3600
     return (f"Added cost in full mode: {n} trials ({len(to_run())} half-lives x {len(L.TEAMS)} teams x "
-            f"{len(L.JUDGED_TASKS)} tasks), estimated at {n * lo / 3600:.1f}-{n * hi2 / 3600:.1f} CPU-hours from "
-            f"the tuning runs' CPU per Avoid-Past trial ({lo:g}-{hi:g} CPU-s for R1 alone"
-            + (f", {team:g} CPU-s for one R1..R4 run" if team else "") + "; 2026-11-29, not run on the judged tasks).")
+            f"{len(L.JUDGED_TASKS)} tasks), estimated at {n * lo / 3600:.1f}-{n * hi2 / 3600:.1f} CPU-hours, most "
+            f"likely about {likely:.1f} (the R1-alone trials at {lo:g}-{hi:g} CPU-s, the helped ones at "
+            f"{team or hi:g}), from the tuning runs' CPU per Avoid-Past trial (2026-11-29; not run on the judged "
+            "tasks when this was written).")
 
 
 def _half_life_of(row: dict) -> float | None:
