@@ -90,7 +90,8 @@ def test_the_block_names_the_runs_that_gave_up_and_states_the_budget_in_shortest
     text = blocks[0].text
     assert isinstance(blocks[0], Text) and "paper as written 1 of 24" in text
     lo, hi = B.budget_multiples({"simple": 6000.0}, {"simple": TASKS}, N)["simple"]
-    assert 1 < lo <= hi and f"{lo:.0f}-{hi:.0f} times the task's shortest path per target" in text
+    assert 1 < lo <= hi and f"{B.span(lo, hi)} times the task's shortest path per target" in text
+    assert B.span(12.6, 12.8) == "13" and B.span(12.4, 13.6) == "12-14"
     gave = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Runs that gave up")][0]
     assert gave.rows == [["paper as written", "Table 1", "Av. Past", "R1,2", "1003 (7)"]]
     verdicts = [b for b in blocks if isinstance(b, Table) and b.title.startswith("The verdicts with")][0]

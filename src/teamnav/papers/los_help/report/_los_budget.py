@@ -134,11 +134,17 @@ def verdicts_at(col_in: Mapping[str, Any], frac: float, budgets: Mapping[str, fl
 def verdict_word(got: tuple | None) -> str:
     """"holds" / "does not hold" / the reason it is not judged."""
     if got is None:
-        return "not run"
+        return "not judged"
     holds, text = got
     if holds is None:
         return text if text.startswith(("not judged", "not recomputed")) else "not judged"
     return "holds" if holds else "does not hold"
+
+
+def span(lo: float, hi: float) -> str:
+    """"12-14", or "13" when both round alike."""
+    a, b = f"{lo:.0f}", f"{hi:.0f}"
+    return a if a == b else f"{a}-{b}"
 
 
 def task_lookup(tasks: Mapping[str, Sequence[int]], n_targets: int) -> dict[str, dict[str, int]]:
@@ -212,8 +218,8 @@ def budget_blocks(inputs: Mapping[str, Mapping[str, Any]], budgets: Mapping[str,
                                                                    if near else ""))
         per_cut.append(f"cut to {frac:g}: finished runs over the cut: " + ", ".join(parts))
     budget_text = "; ".join(
-        f"{L.MAPS[m]} {budgets[m]:g} steps per target = {lo:.0f}-{hi:.0f} times the task's shortest path per target "
-        f"(1/2: {lo / 2:.0f}-{hi / 2:.0f}, 1/4: {lo / 4:.0f}-{hi / 4:.0f})" for m, (lo, hi) in mult.items())
+        f"{L.MAPS[m]} {budgets[m]:g} steps per target = {span(lo, hi)} times the task's shortest path per target "
+        f"(1/2: {span(lo / 2, hi / 2)}, 1/4: {span(lo / 4, hi / 4)})" for m, (lo, hi) in mult.items())
     n_runs = {col: sum(1 for c, *_ in runs if c == col) for col in inputs}
     n_gave = {col: sum(1 for c, *_ in gave if c == col) for col in inputs}
     blocks: list = [Text(
