@@ -15,7 +15,7 @@ from teamnav.control import registry as controllers
 from teamnav.papers.los_help import tasks as L
 from teamnav.papers.los_help.metrics import los_help, los_legs
 from teamnav.experiments.metrics import RunData
-from teamnav.experiments.report.model import Comparison, Missing, Plot, Table
+from teamnav.experiments.report.model import Comparison, Missing, Plot, Table, Text
 from teamnav.papers.los_help.report import section as S
 from teamnav.world import builtin_map
 from teamnav.world.distance import distance_field
@@ -538,6 +538,12 @@ def test_full_build_asks_for_nested_teams_and_every_sweep_and_returns_every_bloc
     assert not any(isinstance(b, Missing) for b in blocks)
     verdicts = {b.claim: b.holds for b in blocks if isinstance(b, Comparison)}
     assert verdicts["Table 1: Av. Past steps fall as helpers are added (R1, R1,2, R1,2,3, R1,2,3,4)"] is True
+    # the Avoid-Past half-life readings run in the paper column only; the budget block reads every claim
+    assert "los-avoid-past-half-life-teams-paper-rules" in names and "los-avoid-past-half-life-teams" not in names
+    hl = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Avoid-Past's memory half-life with")][0]
+    assert any(r[0].startswith("1000 (the fill") for r in hl.rows) and "Readings, not the judged verdict" in hl.note
+    cut = [b for b in blocks if isinstance(b, Table) and b.title.startswith("The verdicts with the step budget")][0]
+    assert len(cut.rows) == len(claims.rows) and len(cut.columns) == 1 + 2 * 3
 
 
 @needs_brains
@@ -555,6 +561,13 @@ def test_quick_build_runs_short_tasks_and_says_what_it_left_out():
     assert plan_c[1]["name"] == "los-table2-plan-c-quick-paper-rules"
     assert sorted(c["case"] for c in plan_c[2].cases) == ["avoid-past/R1-4", "pot-field/R1-4", "visbug21/R1-4"]
     assert all("quick mode" in b.differs for b in blocks if isinstance(b, Comparison) and b.holds is not None)
+    from teamnav.papers.los_help.report import _los_half_life as HL
+
+    assert any(isinstance(b, Missing) and b.what.startswith("Avoid-Past's memory half-life")
+               and f"{HL.trials()} trials" in b.why
+               for b in blocks)
+    assert not any("half-life-teams" in c[0] for c in ctx.calls)  # quick mode runs no half-life reading
+    assert any(isinstance(b, Text) and b.text.startswith("Does the step budget move the verdicts?") for b in blocks)
 
 
 # ---------------------------------------------------------------------------- a real run

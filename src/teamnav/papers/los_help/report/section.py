@@ -357,7 +357,7 @@ def units_note() -> str:
             "steps per target for R1 alone with Avoid-Past on the tuning tasks against the paper's 554.2) assumes the "
             "paper's step and map scale were ours, which nothing says; it is shown, never judged. The budget per "
             f"target is {budget}: a task given up is one where R1 walked that many longest paths without reaching "
-            "one target. Whether the verdicts move with the budget: the block after the claim table gives the budget "
+            "one target. Whether the verdicts move with the budget: a block after the ledger gives the budget "
             "in shortest paths of each task, names the runs that gave up, and recomputes every verdict from the same "
             "runs with the budget cut to 1/2 and 1/4.")
 
@@ -451,10 +451,6 @@ def build(ctx) -> list:
     from teamnav.papers.los_help.report._los_budget import budget_blocks
     from teamnav.papers.los_help.report._los_tables import HEAD
 
-    blocks += budget_blocks(budget_in, {m: float(QUICK_BUDGET_STEPS_PER_TARGET if quick else L.BUDGET_STEPS_PER_TARGET[m])
-                                        for m in maps},
-                            {m: [1] if quick else list(L.JUDGED_TASKS) for m in maps}, _n_targets(quick), claims,
-                            {"paper_rules": HEAD["paper_rules"], "teamnav": HEAD["teamnav"]}, quick=quick)
     blocks += ledger_blocks()
     blocks += precondition_blocks()
     blocks.append(memory_readings_block())
@@ -466,6 +462,10 @@ def build(ctx) -> list:
     else:
         blocks.append(HL.half_life_block(HL.by_half_life(_col_rows(ctx, "paper_rules", HL.spec(), HL.SWEEP),
                                                          tables["paper_rules"].get("simple", {}), team_of)))
+    blocks += budget_blocks(budget_in, {m: float(QUICK_BUDGET_STEPS_PER_TARGET if quick else L.BUDGET_STEPS_PER_TARGET[m])
+                                        for m in maps},
+                            {m: [1] if quick else list(L.JUDGED_TASKS) for m in maps}, _n_targets(quick), claims,
+                            {"paper_rules": HEAD["paper_rules"], "teamnav": HEAD["teamnav"]}, quick=quick)
     blocks.append(Text("The tables below are the teamnav column's runs (our gap-fills): the ablation, where R1's "
                        "steps and path go, and the traffic."))
     if quick:
