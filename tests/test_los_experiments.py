@@ -544,6 +544,9 @@ def test_full_build_asks_for_nested_teams_and_every_sweep_and_returns_every_bloc
     assert any(r[0].startswith("1000 (the fill") for r in hl.rows) and "Readings, not the judged verdict" in hl.note
     cut = [b for b in blocks if isinstance(b, Table) and b.title.startswith("The verdicts with the step budget")][0]
     assert len(cut.rows) == len(claims.rows) and len(cut.columns) == 1 + 2 * 3
+    for c_row, k_row in zip(claims.rows, cut.rows):  # budget x 1 is the verdict as judged, in both columns
+        for got, cell in ((k_row[1], c_row[3]), (k_row[4], c_row[4])):
+            assert cell.endswith(f"({'not judged' if got.startswith('not judged') else got})"), (c_row[0], got, cell)
 
 
 @needs_brains
