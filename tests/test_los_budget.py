@@ -127,6 +127,14 @@ def test_the_half_lives_read_with_helpers_are_those_that_finished_all_tuning_tas
     assert sorted({c[HL.NAV_PARAMS_KEY]["memory_half_life_steps"] for c in spec.cases}) == list(HL.to_run())
     assert spec.grid[TARGETS_KEY] == [L.task_targets_xy("simple", t) for t in L.JUDGED_TASKS]
     assert f"{HL.trials()} trials" in HL.cpu_note() and HL.trials() == spec.n_trials
+    # run as the section runs it (paper column): R1 keeps both the paper's rules and the half-life
+    from teamnav.experiments.sweep import expand
+    from teamnav.papers.trails.report._trails import paper_rules_spec
+
+    trial = next(t for t in expand(paper_rules_spec(spec)) if t.params["case"] == "avoid-past-h500/R1-4")
+    scen = trial.load()
+    assert scen.robots[0].params["paper_rules"] is True and [g.count for g in scen.robots] == [1, 1, 1, 1]
+    assert scen.robots[0].params["navigator_params"] == {"memory_half_life_steps": 500.0}
 
 
 def test_the_half_life_block_reads_table_1s_avoid_past_rule_per_half_life_and_marks_the_fill():
