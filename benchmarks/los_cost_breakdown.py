@@ -1,7 +1,8 @@
 """Where the line-of-sight section's full-mode CPU goes: trials x steps per trial x CPU per step.
 
-The full mode of ``teamnav report los-help`` has never been run
-(780 trials of 200-target tasks). This script
+The full mode of ``teamnav report los-help`` on the judged tasks 11-20 has not been run yet
+(1570 trials of 200-target tasks by ``--list`` on 2026-11-29: 1410 for the tables, route plans,
+noise figures and ablation, and 160 for the Avoid-Past half-life readings). This script
 
 1. lists every trial the section's own ``build`` asks for in full mode: a report context whose
    ``sweep`` expands each sweep spec (the same specs, names, cases, grids and durations as a

@@ -15,7 +15,7 @@ from teamnav.control import registry as controllers
 from teamnav.papers.los_help import tasks as L
 from teamnav.papers.los_help.metrics import los_help, los_legs
 from teamnav.experiments.metrics import RunData
-from teamnav.experiments.report.model import Comparison, Missing, Plot, Table
+from teamnav.experiments.report.model import Comparison, Missing, Plot, Table, Text
 from teamnav.papers.los_help.report import section as S
 from teamnav.world import builtin_map
 from teamnav.world.distance import distance_field
@@ -295,6 +295,26 @@ def test_metrics_read_r1s_last_log_and_add_the_unrecorded_tail_of_a_finished_run
     assert m["los_frac_ghost"] == 4 / 11 and m["los_frac_goal_seen"] == 2 / 11 and m["los_temp_switches"] == 3
 
 
+def test_max_target_steps_is_the_longest_gap_between_the_samples_that_first_show_each_target():
+    # R1 reaches target 1 by step 20, targets 2 and 3 by step 70 (one sample), target 4 by step 90;
+    # a helper's samples (no "finished") and R1's repeated counts change nothing
+    logs = [_log(0, 0, targets_reached=0, finished=False, moves=0),
+            _log(10, 0, targets_reached=0, finished=False, moves=10),
+            _log(20, 0, targets_reached=1, finished=False, moves=20),
+            _log(20, 1, targets_reached=9, moves=20),
+            _log(40, 0, targets_reached=1, finished=False, moves=40),
+            _log(70, 0, targets_reached=3, finished=False, moves=70),
+            _log(90, 0, targets_reached=4, finished=True, moves=90)]
+    m = los_help(_data(logs, finished=True, n_steps=91))
+    assert m["los_max_target_steps"] == 50 and m["los_finished"] == 1
+    # finished after its last kept sample: the last target counts as reached at the run's last step
+    tail = logs[:-1]
+    assert los_help(_data(tail, finished=True, n_steps=200))["los_max_target_steps"] == 130
+    # not finished: only reached targets count (the one it gave up on is in los_gave_up)
+    assert los_help(_data(tail, finished=False, n_steps=6000))["los_max_target_steps"] == 50
+    assert los_help(_data(logs[:2], finished=False, n_steps=6000))["los_max_target_steps"] == 0
+
+
 def test_metrics_are_empty_without_an_explorer_log():
     assert los_help(_data([_log(0, 1, targets_reached=3, moves=2)], finished=False, n_steps=5)) == {}
 
@@ -518,6 +538,15 @@ def test_full_build_asks_for_nested_teams_and_every_sweep_and_returns_every_bloc
     assert not any(isinstance(b, Missing) for b in blocks)
     verdicts = {b.claim: b.holds for b in blocks if isinstance(b, Comparison)}
     assert verdicts["Table 1: Av. Past steps fall as helpers are added (R1, R1,2, R1,2,3, R1,2,3,4)"] is True
+    # the Avoid-Past half-life readings run in the paper column only; the budget block reads every claim
+    assert "los-avoid-past-half-life-teams-paper-rules" in names and "los-avoid-past-half-life-teams" not in names
+    hl = [b for b in blocks if isinstance(b, Table) and b.title.startswith("Avoid-Past's memory half-life with")][0]
+    assert any(r[0].startswith("1000 (the fill") for r in hl.rows) and "Readings, not the judged verdict" in hl.note
+    cut = [b for b in blocks if isinstance(b, Table) and b.title.startswith("The verdicts with the step budget")][0]
+    assert len(cut.rows) == len(claims.rows) and len(cut.columns) == 1 + 2 * 3
+    for c_row, k_row in zip(claims.rows, cut.rows):  # budget x 1 is the verdict as judged, in both columns
+        for got, cell in ((k_row[1], c_row[3]), (k_row[4], c_row[4])):
+            assert cell.endswith(f"({'not judged' if got.startswith('not judged') else got})"), (c_row[0], got, cell)
 
 
 @needs_brains
@@ -535,6 +564,13 @@ def test_quick_build_runs_short_tasks_and_says_what_it_left_out():
     assert plan_c[1]["name"] == "los-table2-plan-c-quick-paper-rules"
     assert sorted(c["case"] for c in plan_c[2].cases) == ["avoid-past/R1-4", "pot-field/R1-4", "visbug21/R1-4"]
     assert all("quick mode" in b.differs for b in blocks if isinstance(b, Comparison) and b.holds is not None)
+    from teamnav.papers.los_help.report import _los_half_life as HL
+
+    assert any(isinstance(b, Missing) and b.what.startswith("Avoid-Past's memory half-life")
+               and f"{HL.trials()} trials" in b.why
+               for b in blocks)
+    assert not any("half-life-teams" in c[0] for c in ctx.calls)  # quick mode runs no half-life reading
+    assert any(isinstance(b, Text) and b.text.startswith("Does the step budget move the verdicts?") for b in blocks)
 
 
 # ---------------------------------------------------------------------------- a real run

@@ -324,7 +324,7 @@ def test_the_units_note_states_the_budget_relative_to_each_maps_longest_path():
     for m in L.MAPS:
         k = L.budget_over_longest_leg(m)
         assert 10 < k < 100 and f"({k:.0f} times its longest room-to-room shortest path)" in note
-    assert "never judged" in note and "not measured" in note
+    assert "never judged" in note and "cut to 1/2 and 1/4" in note  # the budget block answers it
 
 
 def test_every_claim_quotes_the_paper_word_for_word():

@@ -71,7 +71,9 @@ def test_full_build_asks_for_no_simulation_twice_and_reads_the_duplicates_from_t
     """Full mode: 780 trials asked before 14d5e61, 75 of them the same simulation as another
     (noise err_max = 0: 2 maps x 3 algorithms x 5 tasks x 2 columns; ablation: 3 x 5); then 705,
     every (config_hash, seed) once, and the noise figures still get err_max 0 for every algorithm,
-    task and column. On the judged tasks 11-20 (ten, not five) the counts double: 1410."""
+    task and column. On the judged tasks 11-20 (ten, not five) the counts double: 1410; the Avoid-Past
+    half-life readings add their own trials (none the same simulation as another: the fill's rows are
+    the table's)."""
     from teamnav.experiments.report import available_sections
     from teamnav.experiments.report.context import SweepContext
     from teamnav.papers.los_help.report import section as S
@@ -112,5 +114,8 @@ def test_full_build_asks_for_no_simulation_twice_and_reads_the_duplicates_from_t
         S.run_noise = orig
     assert not twice
     n_tasks = len(S.L.JUDGED_TASKS)
-    assert len(asked) == 705 * n_tasks // 5
+    from teamnav.papers.los_help.report import _los_half_life as HL
+
+    assert len(asked) == 705 * n_tasks // 5 + HL.trials()
+    assert HL.trials() == len(HL.to_run()) * 4 * n_tasks and HL.fill() not in HL.to_run()
     assert noise_zero == {f"{m}/{c}": 3 * n_tasks for m in ("simple", "complex") for c in ("teamnav", "paper_rules")}

@@ -32,6 +32,16 @@ Keys
     ``los_steps`` over the targets reached (over 1 when none was).
 ``los_targets_reached``
     Targets R1 reached.
+``los_max_target_steps``
+    The most steps (simulation steps, what the step budget ``max_steps_per_target`` counts: the
+    budget runs from the step the target became current) any one *reached* target took; 0 when
+    none was reached. Read from the kept samples of ``targets_reached`` (every ``record_every``
+    steps): a target counts as reached at the first kept sample that shows it, so each duration
+    is off by less than ``record_every`` steps; a finished run's targets reached after its last
+    kept sample count as reached at the run's last step (an upper bound, as for ``los_steps``).
+    Ours (§6 gives no budget): with it a smaller budget is judged after the fact, since the budget
+    changes nothing before R1 gives up: a run would have given up under a budget ``B`` exactly
+    when one of its targets took more than ``B`` steps (:mod:`.report._los_budget`).
 ``los_msgs_r1``, ``los_bytes_r1``
     Messages and bytes R1 sent (its own counters, §4.4).
 ``los_msgs_per_robot``, ``los_bytes_per_robot``
@@ -95,6 +105,25 @@ def _explorer(last: dict[int, dict[str, Any]]) -> int | None:
     return ids[0] if ids else None
 
 
+def max_target_steps(data: RunData, robot: int, finished: bool) -> int:
+    """``los_max_target_steps`` of ``robot`` (see the module docstring): the longest gap between the
+    steps at which its kept samples first show each next count of ``targets_reached`` (the first
+    target's budget starts at step 0); a ``finished`` run's targets missing from the last kept
+    sample are reached at ``data.n_steps``."""
+    entries = sorted((int(e.get("step", 0)), int((e.get("values") or {}).get("targets_reached", 0)),
+                      bool((e.get("values") or {}).get("finished", False)))
+                     for e in data.logs if int(e.get("robot", -1)) == robot)
+    longest, since, count = 0, 0, 0
+    for step, reached, _fin in entries:
+        if reached > count:  # targets first seen reached at this sample (after the first, ~0 steps each)
+            longest = max(longest, step - since)
+            since, count = step, reached
+    if finished and entries and not entries[-1][2]:
+        # the last target was reached after the last kept sample, by the run's last step
+        longest = max(longest, int(data.n_steps) - since)
+    return int(longest)
+
+
 def los_help(data: RunData) -> dict[str, float | int]:
     """R1's motion steps, targets and messages (see the module docstring); {} without an explorer log."""
     last = _last_by_robot(data)
@@ -123,6 +152,7 @@ def los_help(data: RunData) -> dict[str, float | int]:
         "los_steps": int(steps),
         "los_steps_per_target": float(steps) / max(reached, 1),
         "los_targets_reached": reached,
+        "los_max_target_steps": max_target_steps(data, r1, finished),
         "los_msgs_r1": int(v.get("msgs_sent", 0)),
         "los_bytes_r1": int(v.get("bytes_sent", 0)),
         "los_msgs_per_robot": float(np.mean(msgs)) if msgs else 0.0,

@@ -55,11 +55,20 @@ sharing does to the others.
 Budget: R1 abandons its task when a target is not reached within
 :data:`~teamnav.papers.los_help.tasks.BUDGET_STEPS_PER_TARGET` steps (6000 simple, 12000
 complex); the run then ends and counts as failed (not in the means). A trapped run so ends
-at its first trap instead of burning a whole task's budget.
+at its first trap instead of burning a whole task's budget. Whether the verdicts move with the budget
+(:mod:`._los_budget`): the budget in multiples of each task's shortest path per target, the runs that
+gave up (a larger budget can change only those), and every verdict recomputed after the fact with the
+budget cut to 1/2 and 1/4 from the metric ``los_max_target_steps`` (no run of its own; quick mode too).
+
+Avoid-Past's memory half-life (a fill, :mod:`._los_half_life`): in full mode the section also reads
+Table 1's Avoid-Past rule, paper column, teams R1..R4, on the judged tasks, at every half-life with
+which R1 alone finished all tuning tasks and at 500 steps (readings beside the verdict; the fill's
+row is the judged table's own runs). Quick mode leaves it out and says so.
 
 Running it: ``teamnav report los-help --out DIR`` (full) runs the judged tasks 11-20 of the claim
 file (:data:`~teamnav.papers.los_help.tasks.JUDGED_TASKS`): 1410 trials, twice the counts below,
-which are those of the first full run on tasks 1-5 (:data:`FULL_CPU_NOTE` has its cost and the
+plus the Avoid-Past half-life readings (:func:`._los_half_life.trials`: 160, 1570 in all; see
+``benchmarks/los_cost_breakdown.py --list``). The counts below are those of the first full run on tasks 1-5 (:data:`FULL_CPU_NOTE` has its cost and the
 estimate for the judged tasks). Per column, on 5 tasks, 2 x 60 table trials
 (3 algorithms x 4 teams x 5 tasks; ``teamnav sweep los-table1 --out DIR`` runs the same 60), 2 x 45
 route-plan trials (plans B and C, teams R1,2..R1..R4) and 2 x 60 noise trials (err_max 0.1-0.4:
@@ -116,7 +125,9 @@ FULL_CPU_NOTE = ("Cost of the full reproduction on the judged tasks 11-20, estim
                  "trials (benchmarks/los_cost_breakdown.py --list: twice the 705 of tasks 1-5), about 8 CPU-hours "
                  "(6.7 to 9.5: twice the first full run's 3.33, with the paper column's trials now as long as "
                  "teamnav's, since fewer give up at their first trap, and Avoid-Past's 1000-step memory slower "
-                 "alone than the 125-step one was), about 4 hours of wall time on 2 workers. "
+                 "alone than the 125-step one was), about 4 hours of wall time on 2 workers; the Avoid-Past half-life "
+                 "readings add 160 trials, about 1.2 CPU-hours (0.5 to 1.4; their block states it): 1570 trials, "
+                 "about 9 CPU-hours in all. "
                  "Cost of the first full reproduction here, measured on tasks 1-5 (2026-11-27, this 2-core machine): "
                  "`teamnav report los-help -j 2` ran the section's 705 trials (two columns, Table 2 over three route "
                  "plans; the noise figures' err_max 0 and three ablation columns are the tables' own runs, read from "
@@ -346,7 +357,9 @@ def units_note() -> str:
             "steps per target for R1 alone with Avoid-Past on the tuning tasks against the paper's 554.2) assumes the "
             "paper's step and map scale were ours, which nothing says; it is shown, never judged. The budget per "
             f"target is {budget}: a task given up is one where R1 walked that many longest paths without reaching "
-            "one target; whether the verdicts move with the budget was not measured.")
+            "one target. Whether the verdicts move with the budget: a block after the ledger gives the budget "
+            "in shortest paths of each task, names the runs that gave up, and recomputes every verdict from the same "
+            "runs with the budget cut to 1/2 and 1/4.")
 
 
 def build(ctx) -> list:
@@ -388,6 +401,7 @@ def build(ctx) -> list:
     record: dict[str, dict] = {col: {} for col in COLS}
     alone: dict[str, dict[str, dict[str, float]]] = {col: {} for col in COLS}
     maps = [m for m in L.MAPS if not quick or m in QUICK_MAPS]
+    budget_in: dict[str, dict[str, dict]] = {col: {"tables": {}, "plans": {}, "noise": {}} for col in COLS}
     for m in L.MAPS:
         if m not in maps:
             blocks.append(Missing(f"Table 2 / Fig. 14 ({L.MAPS[m]})", "full mode only (teamnav report los-help)"))
@@ -402,6 +416,8 @@ def build(ctx) -> list:
                                            for p in ROUTE_PLANS if p != "A"] for col in COLS}
         for col in COLS:
             tables[col][m] = by_col[col]
+            budget_in[col]["tables"][m] = by_col[col]
+            budget_in[col]["plans"][m] = plans[col] if plans else None
             alone[col][m] = alone_levels(by_col[col].get(0, []))
         tab, means = table_block_cols(m, by_col)
         blocks += [tab, robots_plot_cols(m, by_col)]
@@ -415,6 +431,8 @@ def build(ctx) -> list:
             blocks.append(Missing(f"Fig. 17 ({L.MAPS[m]}, noise)", "full mode only (teamnav report los-help)"))
             continue
         rows = {col: run_noise(ctx, m, tables[col][m].get(3, []), col) for col in COLS}
+        for col in COLS:
+            budget_in[col]["noise"][m] = rows[col]
         plot, nmeans = noise_plot_cols(m, rows, {col: alone[col][m] for col in COLS})
         blocks += [noise_table_cols(m, rows, {col: tables[col][m].get(0, []) for col in COLS}), plot]
         comps += column_comparisons({col: noise_comparisons(m, nmeans[col], alone[col][m], rows[col], record=record[col])
@@ -430,10 +448,24 @@ def build(ctx) -> list:
                              "is what the gap-fills buy; Table 2's claims read the mean over the route plans"
                              + ("; quick mode: indicative only" if quick else "")))
     from teamnav.papers.los_help.report._los_ledger import ledger_blocks, memory_readings_block, precondition_blocks
+    from teamnav.papers.los_help.report._los_budget import budget_blocks
+    from teamnav.papers.los_help.report._los_tables import HEAD
 
     blocks += ledger_blocks()
     blocks += precondition_blocks()
     blocks.append(memory_readings_block())
+    from teamnav.papers.los_help.report import _los_half_life as HL
+
+    if quick:  # the readings are 200-target runs on the judged tasks: not in CI
+        blocks.append(Missing("Avoid-Past's memory half-life with helpers (readings beside the verdict)",
+                              "full mode only (teamnav report los-help): " + HL.cpu_note()))
+    else:
+        blocks.append(HL.half_life_block(HL.by_half_life(_col_rows(ctx, "paper_rules", HL.spec(), HL.SWEEP),
+                                                         tables["paper_rules"].get("simple", {}), team_of)))
+    blocks += budget_blocks(budget_in, {m: float(QUICK_BUDGET_STEPS_PER_TARGET if quick else L.BUDGET_STEPS_PER_TARGET[m])
+                                        for m in maps},
+                            {m: [1] if quick else list(L.JUDGED_TASKS) for m in maps}, _n_targets(quick), claims,
+                            {"paper_rules": HEAD["paper_rules"], "teamnav": HEAD["teamnav"]}, quick=quick)
     blocks.append(Text("The tables below are the teamnav column's runs (our gap-fills): the ablation, where R1's "
                        "steps and path go, and the traffic."))
     if quick:
