@@ -25,8 +25,9 @@ Usage::
 ``--team-step``: CPU seconds per 1000 team steps of R1..R4 on office_simple (R1 on tuning task
 1001, Table 1's helpers' routes), for each column (teamnav, paper as written) and navigator
 of R1 (potential field, Avoid-Past, VisBug-21), base and this tree alternating ``--repeats``
-rounds (medians; first one untimed run per tree, which fills numba's cache); each run's outputs (true and odometry poses, every brain's log, events,
-radio totals) are hashed, and a configuration whose hashes differ between the trees says so.
+rounds (medians; first one untimed run per tree, which fills numba's cache); each run's
+outputs (true and odometry poses, every brain's log, events, radio totals) are hashed, and a
+configuration whose hashes differ between the trees says so.
 It prints, last, one line per configuration and one for their median, in the form
 ``LOS team step, 4 robots (teamnav, potential_field): base / this tree = 1.05x``.
 
