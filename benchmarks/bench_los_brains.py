@@ -20,6 +20,16 @@ Usage::
     python benchmarks/bench_los_brains.py --targets 10 --repeats 1   # CPU of a 10-target task
     python benchmarks/bench_los_brains.py --kernels                  # each fast path vs its numpy version
     python benchmarks/bench_los_brains.py --paper-rules --only visbug21   # the paper-as-written column
+    python benchmarks/bench_los_brains.py --team-step --base-commit 37d70e6   # 4-robot team steps, both columns
+
+``--team-step``: CPU seconds per 1000 team steps of R1..R4 on office_simple (R1 on tuning task
+1001, Table 1's helpers' routes), for each column (teamnav, paper as written) and navigator
+of R1 (potential field, Avoid-Past, VisBug-21), base and this tree alternating ``--repeats``
+rounds (medians; first one untimed run per tree, which fills numba's cache); each run's
+outputs (true and odometry poses, every brain's log, events, radio totals) are hashed, and a
+configuration whose hashes differ between the trees says so.
+It prints, last, one line per configuration and one for their median, in the form
+``LOS team step, 4 robots (teamnav, potential_field): base / this tree = 1.05x``.
 
 ``--targets N``: instead of a fixed number of steps, each run is the first N targets of task 1
 (the scenario's own step budget per target and ``stop_when_finished``), and the table gives
@@ -110,6 +120,9 @@ def _base_src(commit: str) -> Path:
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--worker", nargs=5, metavar=("MAP", "CASE", "TEAM", "STEPS", "TARGETS"), help=argparse.SUPPRESS)
+    ap.add_argument("--team-worker", nargs=3, metavar=("CASE", "PAPER", "STEPS"), help=argparse.SUPPRESS)
+    ap.add_argument("--team-step", action="store_true",
+                    help="CPU per 1000 team steps at 4 robots, both columns x 3 navigators, base vs this tree")
     ap.add_argument("--targets", type=int, default=0, help="time whole tasks of the first N targets of task 1")
     ap.add_argument("--kernels", action="store_true", help="time each fast path against its numpy version")
     ap.add_argument("--steps", type=int, default=2000, help="simulated steps per timed run (default 2000)")
@@ -128,6 +141,10 @@ def main(argv: list[str] | None = None) -> None:
         m, c, t, n, k = args.worker
         print(json.dumps(_worker(m, c, t, int(n), int(k))))
         return
+    if args.team_worker:
+        c, paper, n = args.team_worker
+        print(json.dumps(_team_worker(c, paper == "1", int(n))))
+        return
     if args.kernels:
         _kernels()
         return
@@ -135,6 +152,9 @@ def main(argv: list[str] | None = None) -> None:
     repeats = 1 if args.quick else max(1, args.repeats)
     base = Path(args.base_src) if args.base_src else _base_src(args.base_commit)
     new = Path(args.new_src) if args.new_src else REPO / "src"
+    if args.team_step:
+        return _team_steps(base, new, 1000 if args.quick else args.steps, 1 if args.quick else max(1, args.repeats),
+                           args.base_src or args.base_commit, args.only)
     what = f"tasks of {args.targets} targets" if args.targets else f"{steps} steps per run"
     print(f"base {base}\nnew  {new}\n{what}, {repeats} repeat(s), load {os.getloadavg()[0]:.1f}")
     if args.targets:
@@ -300,6 +320,83 @@ def _tasks(base: Path, new: Path, args, repeats: int) -> None:
         bt = statistics.median(r["cpu_s"] for r in b)
         nt = statistics.median(r["cpu_s"] for r in n)
         print(f"{key:26s} {n[0]['steps']:6d} {n[0]['reached']:7d} {bt:10.2f} {nt:10.2f} {bt / nt:6.2f}", flush=True)
+
+
+#: navigator of R1 per case of ``los-table1.yaml`` (the keys of :data:`CASES`)
+TEAM_NAVIGATORS = {"pot-field": "potential_field", "avoid-past": "avoid_past", "visbug21": "visbug21"}
+#: tuning task (FIDELITY: line-of-sight tuning tasks are >= 1001; the judged ones are never timed here)
+TEAM_TASK = 1001
+
+
+def _team_worker(case: str, paper: bool, steps: int) -> dict:
+    """(in the measuring process) CPU of ``steps`` warm team steps of R1..R4 on office_simple and a
+    digest of everything the run put out."""
+    import hashlib
+
+    import numpy as np
+
+    from los_fingerprint import _default, _paper_rules_set
+    from teamnav import load_scenario
+    from teamnav.papers.los_help.tasks import task_targets_xy
+
+    ov = {**(_paper_rules_set("simple") if paper else {}), **CASES[case]}
+    for k in (1, 2, 3):
+        ov[f"robots.{k}.count"] = 1
+    ov["robots.0.params.targets_xy"] = task_targets_xy("simple", TEAM_TASK)
+    ov["robots.0.params.max_steps_per_target"] = 100_000_000
+    from teamnav.experiments.runner import run
+
+    run(load_scenario(MAPS["simple"], overrides=ov, duration_s=20.0, seed=0), progress=False)  # warm-up
+    total, brain_s, res = timed_run(load_scenario(MAPS["simple"], overrides=ov, duration_s=steps * 0.1, seed=0))
+    d = res.data
+    h = hashlib.sha256()
+    for a in (d.true_pose, d.odom_pose):
+        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    h.update(np.ascontiguousarray(d.stalled).astype(np.uint8).tobytes())
+    h.update(json.dumps([d.logs, d.event_log, d.messages_sent, d.bytes_sent, d.messages_delivered],
+                        sort_keys=True, default=_default).encode())
+    return {"cpu_s": total, "brain_s": brain_s, "steps": int(res.sim.step_index), "digest": h.hexdigest()}
+
+
+def _team_measure(src: Path, case: str, paper: bool, steps: int) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(src), NUMBA_NUM_THREADS="1")
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--team-worker", case, "1" if paper else "0",
+                          str(steps)], env=env, check=True, capture_output=True, text=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _team_steps(base: Path, new: Path, steps: int, repeats: int, base_name: str, only) -> None:
+    """CPU s per 1000 team steps at 4 robots, base and this tree alternating (see ``--team-step``)."""
+    print(f"R1..R4 on office_simple, R1 on tuning task {TEAM_TASK}, {steps} steps per run, {repeats} round(s), "
+          f"medians of CPU (time.process_time, one numba thread)")
+    print(f"{'column':8s} {'navigator':16s} {'base s/1000':>11s} {'(brains)':>9s} {'new s/1000':>11s} {'(brains)':>9s} "
+          f"{'ratio':>6s}  outputs")
+    lines, ratios = [], []
+    for paper, case in itertools.product((False, True), CASES):
+        col, nav = ("paper" if paper else "teamnav"), TEAM_NAVIGATORS[case]
+        if only and not any(o in f"{col}/{case}/{nav}" for o in only):
+            continue
+        b, n = [], []
+        for src in (base, new):  # not timed: fills numba's cache for the kernels this configuration reaches
+            _team_measure(src, case, paper, min(steps, 1000))
+        for _ in range(repeats):  # alternate: both trees see the same load
+            b.append(_team_measure(base, case, paper, steps))
+            n.append(_team_measure(new, case, paper, steps))
+        same = {r["digest"] for r in b} == {r["digest"] for r in n} and len({r["digest"] for r in b + n}) == 1
+        bt = statistics.median(1000 * r["cpu_s"] / r["steps"] for r in b)
+        bb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in b)
+        nt = statistics.median(1000 * r["cpu_s"] / r["steps"] for r in n)
+        nb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in n)
+        ratios.append(bt / nt)
+        print(f"{col:8s} {nav:16s} {bt:11.3f} {bb:9.3f} {nt:11.3f} {nb:9.3f} {bt / nt:6.2f}  "
+              f"{'identical' if same else 'DIFFER'}", flush=True)
+        lines.append(f"LOS team step, 4 robots ({col}, {nav}): base / this tree = {bt / nt:.2f}x")
+    if ratios:
+        print(f"(base: {base_name}; brains: CPU inside the brains' step and log)")
+        for line in lines:
+            print(line)
+        print(f"LOS team step, 4 robots: base / this tree = {statistics.median(ratios):.2f}x "
+              f"(median of {len(ratios)} configurations)")
 
 
 if __name__ == "__main__":

@@ -51,6 +51,14 @@ code paths the default runs do not reach; ``los_fingerprints_paper_epyc.json`` h
 recorded at 2abec5c on the EPYC machine::
 
     python benchmarks/los_fingerprint.py --paper-rules --check benchmarks/los_fingerprints_paper_epyc.json
+
+2026-11-29, at 37d70e6, on a 2-core Intel Xeon (NumPy 2.4.6, numba 0.68.1): ``los_fingerprints.json``
+(default) and ``los_fingerprints_paper.json`` (``--paper-rules``) re-recorded, 24 runs each; on
+this machine every one of the 48 hashes differs from the EPYC files' (recorded at earlier commits
+on another CPU), and a second run reproduced all 48. Check on this kind of machine with::
+
+    python benchmarks/los_fingerprint.py --check benchmarks/los_fingerprints.json
+    python benchmarks/los_fingerprint.py --paper-rules --check benchmarks/los_fingerprints_paper.json
 """
 
 from __future__ import annotations
@@ -152,7 +160,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--check", help="compare with the fingerprints in this JSON file")
     ap.add_argument("--paper-rules", action="store_true",
                     help="the same 24 runs with both brains at paper_rules: true (the report's paper-as-written "
-                         "column; its own reference file, los_fingerprints_paper_epyc.json)")
+                         "column; its own reference files, los_fingerprints_paper.json and los_fingerprints_paper_epyc.json)")
     args = ap.parse_args(argv)
     import teamnav
 

@@ -19,7 +19,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from teamnav.papers.trails.brains.crumbs import CrumbBatch
-from teamnav.papers.los_help.brains.messages import GoalShare, LosHelpMsg, Sighting, VisReport, message_size_bytes
+from teamnav.papers.los_help.brains.messages import (
+    GoalShare,
+    LosHelpMsg,
+    Sighting,
+    VisReport,
+    _payload_size_bytes,
+    message_size_bytes,
+)
 from teamnav.papers.trails.brains.trails import TrailMessage
 from teamnav.control.types import Message, _payload_size_bytes_generic, payload_size_bytes
 from teamnav.localization.density_tree import DensityTree
@@ -123,6 +130,19 @@ def test_per_type_sizers_equal_the_generic_walk(value):
 def test_los_help_messages_match_the_formula_and_the_walk(body):
     size = Message(1, 2.0, body, kind="los_help").size_bytes()
     assert size == message_size_bytes(body) == 24 + _payload_size_bytes_generic(body)
+
+
+@given(st.builds(LosHelpMsg, st.integers(0, 10**6), st.lists(sightings, max_size=4).map(tuple),
+                 st.lists(goals, max_size=5).map(tuple), st.lists(reports, max_size=5).map(tuple),
+                 st.none() | st.booleans() | st.builds(np.bool_, st.booleans()),
+                 st.none() | st.tuples(flt, flt, flt), st.none() | st.tuples(*[flt] * 6)))
+@FAST
+def test_los_help_formula_sizer_is_the_walk(body):
+    """The radio sizes a los-help message by formula (registered for its type): the walk's count
+    for any mix of via fields present, Tr bits and the beyond section's pose and covariance."""
+    assert _payload_size_bytes(body) == _payload_size_bytes_generic(body)
+    assert payload_size_bytes(body) == _payload_size_bytes_generic(body)  # the registered sizer is the formula
+    assert payload_size_bytes((body, [body])) == 2 * _payload_size_bytes_generic(body)  # nested, as any field
 
 
 def test_sizes_by_hand():

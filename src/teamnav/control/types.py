@@ -130,6 +130,17 @@ def _sizer_for(kind: type):
     return sizer
 
 
+def register_payload_sizer(kind: type, sizer) -> None:
+    """Size values of exactly type ``kind`` with ``sizer(value) -> bytes`` from now on.
+
+    For a message type sent every step whose size has a closed form (the line-of-sight help
+    message: a formula over its tuples' lengths instead of a walk over every field). The
+    sizer must return :func:`_payload_size_bytes_generic`'s count for every value its
+    producers build; its module's tests pin that (``tests/test_payload_size.py``).
+    """
+    _SIZER[kind] = sizer
+
+
 def _payload_size_bytes_generic(value: Any) -> int:
     """:func:`payload_size_bytes` as a generic recursive walk (the rules written out once per
     value; kept as the reference the per-type sizers are tested against and benchmarked with)."""

@@ -249,7 +249,8 @@ class PotentialField:
         scan = check_scan(scan)
         if self.goal_xy is None:
             return None
-        self._monitor.update(math.hypot(*(self.goal_xy - pose[:2])))
+        g = self.goal_xy  # on scalars: the same subtractions as the arrays' (speed)
+        self._monitor.update(math.hypot(g[0] - pose[0], g[1] - pose[1]))
         points = scan_points(pose, scan)
         v = self._vector(pose, points, len(scan.ranges_m))
         v0, v1 = float(v[0]), float(v[1])

@@ -325,11 +325,12 @@ class VisBug21(VisBugReference):
         if self.mline is None:
             self.mline = (xy.copy(), goal.copy())
         if self._last_xy is not None and self.mode == MODE_FOLLOW:
-            step_m = math.hypot(*(xy - self._last_xy))
+            lx = self._last_xy  # on scalars: the same subtractions as the arrays' (speed)
+            step_m = math.hypot(xy[0] - lx[0], xy[1] - lx[1])
             self._walked_m += step_m
             self._dir_walked_m += step_m
         self._last_xy = xy.copy()
-        self._monitor.update(math.hypot(*(goal - xy)))
+        self._monitor.update(math.hypot(goal[0] - xy[0], goal[1] - xy[1]))
         p = self.params
         points = scan_points(pose, scan)
         self._slack = math.pi / max(len(scan.ranges_m), 1)  # half the beam spacing [rad]
@@ -345,7 +346,7 @@ class VisBug21(VisBugReference):
                 self._leave_target = ti
                 self._leave_steps = 2 * int(math.ceil(math.hypot(*(ti - xy)) / self.step_length_m)) + 5
             else:
-                d_hit = math.hypot(*(xy - self.hit_xy))
+                d_hit = math.hypot(xy[0] - self.hit_xy[0], xy[1] - self.hit_xy[1])
                 if d_hit >= 2.0 * p.return_tol_m:
                     self._left_hit = True
                 elif self._left_hit and d_hit <= p.return_tol_m:
@@ -372,7 +373,8 @@ class VisBug21(VisBugReference):
                     self.mode = MODE_TO_GOAL
         if self.mode == MODE_TO_GOAL and self._leave_target is not None:
             # on the way from the boundary to the leave point: go there (Bug2 hits only on the M-line)
-            if math.hypot(*(self._leave_target - xy)) < self.step_length_m or self._leave_steps <= 0:
+            lt = self._leave_target
+            if math.hypot(lt[0] - xy[0], lt[1] - xy[1]) < self.step_length_m or self._leave_steps <= 0:
                 self._leave_target = None
             else:
                 self._leave_steps -= 1

@@ -254,18 +254,22 @@ class _LosBrain(_Driving, abc.ABC):
             ) from None
         self._set_scan(scan)
         self._set_pose(np.asarray(obs.odom_pose, dtype=np.float64).copy())
-        self._step = int(obs.step)
+        self._step = step = int(obs.step)
         sightings = {}
+        my_id = self.me
         for det in obs.detections:
-            if det.robot_id is None or det.robot_id == self.me:
+            rid = det.robot_id
+            if rid is None or rid == my_id:
                 continue  # without an identity a teammate cannot be paired with its messages
-            sightings[int(det.robot_id)] = (float(det.range_m), float(det.bearing_rad))
-        self._history[int(obs.step)] = ((self._px, self._py, self._th), sightings)
-        for old in [k for k in self._history if k <= obs.step - _HISTORY_STEPS]:
-            del self._history[old]
+            sightings[int(rid)] = (float(det.range_m), float(det.bearing_rad))
+        history = self._history
+        history[step] = ((self._px, self._py, self._th), sightings)
+        limit = step - _HISTORY_STEPS
+        for old in [k for k in history if k <= limit]:
+            del history[old]
         if self.params.frame_source == "fused":
-            self._cov_history[int(obs.step)] = self._pose_cov
-            for old in [k for k in self._cov_history if k <= obs.step - _HISTORY_STEPS]:
+            self._cov_history[step] = self._pose_cov
+            for old in [k for k in self._cov_history if k <= step - _HISTORY_STEPS]:
                 del self._cov_history[old]
         px, py, c, sn = self._px, self._py, self._c, self._s
         seen_now = {}

@@ -87,7 +87,7 @@ class LosExplorer(_TroubleFollowing, _LosBrain):
         A target not reached within ``max_steps_per_target`` steps ends the task (gave up)."""
         while not self.finished:
             gx, gy = self.targets[self.target_index]
-            if math.hypot(gx - self._pose[0], gy - self._pose[1]) >= self.params.goal_tolerance_m:
+            if math.hypot(gx - self._px, gy - self._py) >= self.params.goal_tolerance_m:  # _px: float(_pose[0])
                 budget = self.params.max_steps_per_target
                 if budget is not None and self._step - self._target_since >= budget:
                     self.gave_up = True

@@ -76,7 +76,7 @@ class LosHelper(_LosBrain):
         if not self.patrol:
             return
         wx, wy = self.patrol[self.waypoint_index]
-        reached = math.hypot(wx - self._pose[0], wy - self._pose[1]) < self.params.goal_tolerance_m
+        reached = math.hypot(wx - self._px, wy - self._py) < self.params.goal_tolerance_m  # _px: float(_pose[0])
         self._steps_on_waypoint += 1
         timeout = self.params.waypoint_timeout_steps
         timed_out = not reached and timeout > 0 and self._steps_on_waypoint > timeout

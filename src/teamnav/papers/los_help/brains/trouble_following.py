@@ -103,7 +103,7 @@ class _TroubleFollowing:
         visible = self._seen_now if p.keep_trouble_helper else seen
         if tt is not None and tt[0] in visible:
             tt = self._trouble_target = (tt[0], visible[tt[0]])
-        elif tt is None or math.hypot(tt[1][0] - self._pose[0], tt[1][1] - self._pose[1]) <= near:
+        elif tt is None or math.hypot(tt[1][0] - self._px, tt[1][1] - self._py) <= near:
             helper = choose_helper(True, self._me_xy(), cands)
             tt = self._trouble_target = None if helper is None else (helper, seen[helper])
             self._tt_stall = 0
