@@ -137,7 +137,11 @@ def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator,
 
     # ---- random poses
     h, w = blocking.shape
-    rows, cols = np.mgrid[0:h, 0:w]
+    # the cells' row and column indices, broadcast (h, 1) and (1, w) rather than two full (h, w)
+    # grids: the tests below are per axis, and a 10 000-robot arena has 25 M cells (the full
+    # grids and their float copies took 1 GB while a simulation was built)
+    rows = np.arange(h)[:, None]
+    cols = np.arange(w)[None, :]
     for gi, g in enumerate(groups):
         if g.start.poses is not None:
             continue
@@ -155,7 +159,7 @@ def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator,
             lx0 = cols * res
             ly0 = rows * res
             ok &= (lx0 - r >= 0) & (lx0 + res + r <= w * res) & (ly0 - r >= 0) & (ly0 + res + r <= h * res)
-            centre = grid.cell_centers(rows, cols)
+            centre = grid.cell_centers(*np.broadcast_arrays(rows, cols))
             half = res / math.sqrt(2.0)
             ok &= (centre[..., 0] + half > xmin) & (centre[..., 0] - half < xmax)
             ok &= (centre[..., 1] + half > ymin) & (centre[..., 1] - half < ymax)
