@@ -128,7 +128,15 @@ def test_without_launch_the_config_serialises_as_before_and_bad_launches_are_ref
     assert "launch" not in SimConfig().model_dump()
     with pytest.raises(ValueError, match=r"launch.spot \[0.1, 1.0, 0.0\]"):
         Simulation(_corridor(), _config(spot=(0.1, 1.0, 0.0)))
-    batched = SimConfig(robots=(RobotGroupConfig(name="b", count=2, controller="wander-batched-v1"),),
-                        launch=LaunchConfig(spot=(2.0, 1.0, 0.0), clear_m=0.9))
-    with pytest.raises(ValueError, match="per-robot controllers"):
-        Simulation(_corridor(), batched)
+
+
+def test_a_batched_groups_waiting_robots_ignore_its_commands_until_they_start():
+    batched = SimConfig(robots=(RobotGroupConfig(name="b", count=3, radius_m=0.2, controller="wander-batched-v1"),),
+                        launch=LaunchConfig(spot=(2.0, 1.0, 0.0), clear_m=0.6))
+    sim = Simulation(_corridor(), batched)
+    xy, waiting = _run(sim, 600)
+    assert (sim.launched_at[1:] > 0).all() or waiting[-1].any()
+    for i in (1, 2):
+        stop = sim.launched_at[i] - 1 if sim.launched_at[i] > 0 else len(xy)
+        assert np.allclose(xy[:stop, i], [2.0, 1.0])
+    assert np.hypot(*(xy[-1, 0] - [2.0, 1.0])) > 0.0  # robot 0 did move

@@ -198,8 +198,10 @@ class LaunchConfig(Model):
     never steps its brain, commands it nothing, delivers it no message, and no other robot's
     sensors, detector or body meet it; its odometry starts from the spot when it starts. The
     truth keeps it at the spot (recorded there, so its path starts there) and place events are
-    withheld from it while it waits. Per-robot controllers only (a batched brain steps all its
-    robots at once).
+    withheld from it while it waits. A batched brain (one brain for a whole group) is still
+    handed its waiting robots' rows, sensed from outside the map (every range 0), and their
+    commands are ignored until they start. :mod:`teamnav.env` drops the section (its agents act
+    for every robot from step 0) and uses the groups' ``start``.
     """
 
     spot: tuple[float, float, float]

@@ -20,7 +20,8 @@ from typing import Any
 
 from teamnav.experiments.report.model import Ledger, LedgerRow
 
-__all__ = ["TRY_SINGLE_TRAIL_QUOTE", "BLAZING_LITERAL_QUOTE", "blazing_ledger", "model_column", "try_ledger"]
+__all__ = ["TRY_SINGLE_TRAIL_QUOTE", "BLAZING_LITERAL_QUOTE", "blazing_ledger", "launch_clear_rule_m", "model_column",
+           "try_ledger"]
 
 #: the 2002 paper's description of the 2000 method (Try §1, verbatim)
 TRY_SINGLE_TRAIL_QUOTE = ("Our previous work assumed that there were two places of interest in the environment "
@@ -35,6 +36,15 @@ LASER_QUOTE = ("a SICK LMS scanning laser rangefinder ... over 180°. The SICK g
 #: the 2000 paper's start (Blazing §5, verbatim)
 START_QUOTE = ("The robots are started one at a time from the same spot at the home position, with the same "
                "orientation.")
+#: the 2002 paper's start (Try §3.5, verbatim: the same sentence, the home position named A)
+TRY_START_QUOTE = ("The robots are started one at a time from the same spot at the home position *A*, with the "
+                   "same orientation.")
+#: the gap at which robots begin to interfere (Blazing §4.2 and Try §3.3, verbatim): the launch rule's input
+BLAZING_GAP_QUOTE = "passing within as little as 40cm of each other before interference occurs"
+TRY_GAP_QUOTE = "passing within as little as 20cm of each other before interference occurs"
+#: (gap [m], where, quote) per section, for the rule of ``launch.clear_m``
+LAUNCH_GAP = {"blazing-a-trail": (0.40, "Blazing §4.2", BLAZING_GAP_QUOTE),
+              "try-to-see-it-my-way": (0.20, "Try §3.3", TRY_GAP_QUOTE)}
 
 #: report-column key of the trail sections (``_trails.COLUMNS``) -> the report model's column
 _MODEL_COLUMN = {"paper_rules": "paper", "teamnav": "teamnav"}
@@ -66,11 +76,40 @@ def _rule_rows(params_cls: type, ours: dict[str, Any]) -> tuple[list[LedgerRow],
     return paper, teamnav
 
 
-#: the start, the same in both sections and columns (not the papers' set-up)
-_START_ROW = ("start", "together, four spots 0.7 m apart along the home corridor", "fill",
-              "NOT the papers' set-up: \"" + START_QUOTE + "\" (Blazing §5; Try §3.5 the same) is stated but not yet "
-              "implemented (the brains have no start delay); the frames are aligned with the map, so the spots "
-              "differ by < 2.6 m of position, not by frame. Both columns")
+def launch_clear_rule_m(section: str) -> float:
+    """``launch.clear_m`` by its rule: two robot radii plus the gap at which the section's paper says
+    robots begin to interfere (the papers give no interval between starts).
+
+    >>> round(launch_clear_rule_m("blazing-a-trail"), 6), round(launch_clear_rule_m("try-to-see-it-my-way"), 6)
+    (0.9, 0.7)
+    """
+    from teamnav.experiments.spec import load_scenario
+
+    return 2.0 * load_scenario(section).robots[0].radius_m + LAUNCH_GAP[section][0]
+
+
+def _start_rows(section: str) -> tuple[tuple[str, object, str, str], ...]:
+    """The start's rows (the same in both columns: the set-up is the experiment's, not a gap-fill),
+    from the scenario's ``launch`` section."""
+    from teamnav.experiments.spec import load_scenario
+
+    sc = load_scenario(section)
+    la, r = sc.launch, sc.robots[0].radius_m
+    gap, where, quote = LAUNCH_GAP[section]
+    start = (f"Blazing §5: \"{START_QUOTE}\"" if section == "blazing-a-trail"
+             else f"Try §3.5: \"{TRY_START_QUOTE}\"")
+    names = ", ".join(g.name for g in sc.robots)
+    return (
+        ("start", f"one at a time from home ({la.spot[0]:g}, {la.spot[1]:g}), heading {la.spot[2]:g}°", "stated",
+         f"{start} Every robot is put at the spot in turn; one not yet started is out of the arena (the simulator "
+         "holds it: no brain, sensor or radio meets it) and its odometry starts at the spot. Both columns (since "
+         "2026-11-29; before, all four started together from four spots along the home corridor)"),
+        ("launch.clear_m", la.clear_m, "fill",
+         f"the papers give no interval between starts. Rule, written with the set-up before any run of it: the "
+         f"next robot is started once every robot already started is clear of the spot by two radii plus the gap "
+         f"at which the paper says robots begin to interfere ({where}: \"{quote}\"): 2 x {r:g} + {gap:g} = "
+         f"{2 * r + gap:g} m, not tuned. The order is not given either: robot order ({names}). Both columns"),
+    )
 
 #: rows that are the same in both columns: (name, value, source, ref)
 _SHARED_BLAZING = (
@@ -88,7 +127,7 @@ _SHARED_BLAZING = (
      "Blazing §5.1 gives no rates: \"the odometry of Ant and Bee is worse than the odometry of Tanis and Punky "
      "whose odometry only rotates slightly\"; the rates and signs are our choice, made before the section's "
      "first runs, not tuned. The drift sweep uses the 2002 paper's rates scaled by k instead. Both columns"),
-    _START_ROW,
+
 )
 
 
@@ -125,7 +164,8 @@ def blazing_ledger() -> Ledger:
         *teamnav,
     ]
     for col in ("paper", "teamnav"):
-        rows += [LedgerRow(col, name, value, source, ref) for name, value, source, ref in _SHARED_BLAZING]
+        rows += [LedgerRow(col, name, value, source, ref)
+                 for name, value, source, ref in _SHARED_BLAZING + _start_rows("blazing-a-trail")]
     return Ledger(rows, note="paper: the paper as its authors ran it (judged); teamnav: our gap-fills beside it. "
                              "'in-sample' marks a value chosen on the report's own seeds (not on tuning seeds "
                              ">= 1000 by a rule written first): not re-chosen yet")
@@ -153,7 +193,7 @@ def try_ledger() -> Ledger:
         ("navigate.box_reach_m", 2.0, "fill",
          "in-sample choice: chosen on report seeds 0-7 (the old Z map, blazing_trail.NAVIGATE_DEFAULTS); not yet "
          "re-chosen on tuning seeds. Both columns"),
-        _START_ROW,
+        *_start_rows("try-to-see-it-my-way"),
         ("heading drift per robot", T.DRIFT_TEXT, "fill",
          "Try §3.6 states Tanis 0.35 and Fly 2 deg/min and the directions (\"Bug's coordinate system rotated "
          "clockwise; the other robots' systems drifted anti-clockwise\"); Bug's and Ant's rates are not given: "
