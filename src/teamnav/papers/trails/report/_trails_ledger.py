@@ -156,9 +156,12 @@ def blazing_ledger() -> Ledger:
                   "home and their opposite sends a carrying robot away from home, contradicting §5.1's results. "
                   "An ablation row (full mode), never judged"),
         *paper,
-        LedgerRow("teamnav", "cruise_speed_mps", cruise, "fill",
-                  "in-sample choice: 0.4 m/s chosen on report seeds 0-7 (the old Z map) against 0.25; it coincides "
-                  "with the speed the 2000 paper implies (0.37-0.44 m/s, see the paper column's row)"),
+        LedgerRow("teamnav", "cruise_speed_mps", cruise, "implied" if cruise == T.BLAZING_IMPLIED_CRUISE_MPS else "fill",
+                  "the speed the 2000 paper implies, as the paper column (0.37-0.44 m/s: the arithmetic in that "
+                  "column's row); taken from the paper since 2026-11-29. It had first been chosen on report seeds "
+                  "0-7 (the old Z map) against 0.25 m/s, an in-sample choice that the paper's numbers now replace"
+                  if cruise == T.BLAZING_IMPLIED_CRUISE_MPS else
+                  "in-sample choice: chosen on report seeds 0-7 (the old Z map) against 0.25 m/s"),
         LedgerRow("teamnav", "reverse_carried_crumbs", True, "stated",
                   "as the paper column (Try §1's single trail followed backwards)"),
         *teamnav,
