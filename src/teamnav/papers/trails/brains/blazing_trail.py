@@ -135,6 +135,14 @@ __all__ = ["NAVIGATE_DEFAULTS", "BlazingTrail", "BlazingTrailParams", "navigate_
 #: 0-7: 27.3 -> 32.8 units in 30 min (+5.5 ± 0.6, 8/8). At 4x the drift (blazing-trail-v1, 1 h,
 #: seeds 0-3) the 2000 team still breaks down (3 of 4; 1.75 units in the last 10 min against
 #: 0.5). Both trail brains share it, so the 2000 and 2002 systems drive alike.
+#:
+#: Those measurements were on the report's own seeds, judged by efficiency. Re-chosen 2026-11-29 by a
+#: rule written before its runs (``scripts/trail_fill_tuning.py``, 6552f12 and 68bf150): on tuning
+#: seeds 1000-1003 (30 min, both sections' paper columns, the robots started one at a time), the
+#: smallest reach whose lane share (time on the route's straight corridor stretches spent left of the
+#: centre line in the direction of travel) is within one paired s.e. of the best: 1.2 m 0.842,
+#: 1.6 m 0.959, 2.0 m 0.966, 2.4 m 0.946, 3.0 m 0.958; 1.6 m is 0.007 ± 0.002 below, so 2.0 m stays
+#: (``docs/report/trails-fill-tuning.jsonl``, 40 runs, 317 CPU s).
 NAVIGATE_DEFAULTS: dict[str, Any] = {"trail_rule": "side", "box_reach_m": 2.0}
 
 
