@@ -42,8 +42,19 @@ pass that way earlier") leads a robot astray. The rule picks the **radius with t
 off-route share over the seeds; values within one standard error (paired, per seed) of it are
 ties, and the smallest of the tied radii is taken**. Edge picks extend the grid (1.0, 8.0).
 
-Left for later (not run here): ``recover_radius_m`` (a teamnav-only gap-fill of both brains,
-chosen on report seeds 0-7) and the teamnav column's 0.4 m/s in the 2002 section. The 2000
+``recover_radius_m`` (a teamnav-only gap-fill of both brains: with no crumb near, head for the
+nearest crumb within this radius instead of exploring; the paper's rule, 0, explores; chosen on
+report seeds 0-7: 6 m in blazing-trail-v1, 4 m in trail-share-v1). Rule added 2026-11-29 after the
+box part's 40 runs and 4 of the radius part's 20 had been seen (seed 1000, off-route shares 0.549,
+0.471, 0.365, 0.359 at radius 1.5, 2, 3, 4 m; no run with another ``recover_radius_m``), before any
+run of it: each section's **teamnav column** (the scenario's own
+params, ``box_reach_m`` and ``radius_m`` at the picks above), seeds 1000-1003, 30 min; grids
+blazing-trail-v1 0, 3, 6, 9, 12 m and trail-share-v1 0, 2, 4, 6, 8 m; criterion the off-route
+share, as for ``radius_m`` (what the gap-fill is for: dead-end branches driven to their end);
+the same pick rule (lowest mean, ties within one paired s.e. to the smallest; an edge pick other
+than 0 extends the grid by one step; 0 is the paper's rule and may be picked).
+
+Left for later (not run here): the teamnav column's 0.4 m/s in the 2002 section. The 2000
 section's teamnav 0.4 m/s is the speed the 2000 paper implies (the paper column's arithmetic),
 so that column takes it from the paper and needs no run.
 
@@ -82,6 +93,7 @@ BOX_GRID = (1.2, 1.6, 2.0, 2.4, 3.0)
 BOX_EXTEND = (0.8, 4.0)
 RADIUS_GRID = (1.5, 2.0, 3.0, 4.0, 6.0)
 RADIUS_EXTEND = (1.0, 8.0)
+RECOVER_GRID = {"blazing-a-trail": (0.0, 3.0, 6.0, 9.0, 12.0), "try-to-see-it-my-way": (0.0, 2.0, 4.0, 6.0, 8.0)}
 SECTIONS = ("blazing-a-trail", "try-to-see-it-my-way")
 
 #: straight route stretches: (name, axis, centre of the other coordinate, lo, hi, excluded (lo, hi))
@@ -142,11 +154,25 @@ def paper_overrides(section: str, extra: dict) -> dict:
     return out
 
 
-def one_run(section: str, seed: int, extra: dict) -> dict:
+def teamnav_overrides(section: str, extra: dict) -> dict:
+    """Scenario overrides of a section's teamnav column (the scenario's params) with ``extra`` merged in."""
+    from teamnav.experiments.spec import load_scenario
+
+    out = {}
+    for i, g in enumerate(load_scenario(section).robots):
+        p = dict(g.params)
+        for k, v in extra.items():
+            p[k] = {**dict(p.get(k) or {}), **v} if isinstance(v, dict) else v
+        out[f"robots.{i}.params"] = p
+    return out
+
+
+def one_run(section: str, seed: int, extra: dict, column: str = "paper") -> dict:
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
 
-    sc = load_scenario(section, duration_s=DURATION_S, seed=seed, overrides=paper_overrides(section, extra))
+    over = paper_overrides(section, extra) if column == "paper" else teamnav_overrides(section, extra)
+    sc = load_scenario(section, duration_s=DURATION_S, seed=seed, overrides=over)
     t0 = time.process_time()
     res = run(sc, progress=False)
     cpu = time.process_time() - t0
@@ -154,27 +180,29 @@ def one_run(section: str, seed: int, extra: dict) -> dict:
     share, n = lane_share(pose)
     brain0 = res.sim.brains[0][0]
     nav = getattr(getattr(brain0, "nav", None), "params", None)
-    return {"section": section, "seed": seed, "extra": extra, "lane_share": share, "lane_samples": n,
+    return {"section": section, "seed": seed, "extra": extra, "column": column, "lane_share": share, "lane_samples": n,
             "off_route_share": off_route_share(pose), "cpu_s": round(cpu, 2),
             "box_reach_m": getattr(nav, "box_reach_m", None),
-            "radius_m": getattr(getattr(brain0, "params", None), "radius_m", None)}
+            "radius_m": getattr(getattr(brain0, "params", None), "radius_m", None),
+            "recover_radius_m": getattr(getattr(brain0, "params", None), "recover_radius_m", None),
+            "cruise_mps": getattr(getattr(brain0, "params", None), "cruise_speed_mps", None)}
 
 
 def _done(out: Path) -> set:
     if not out.exists():
         return set()
-    return {(r["section"], r["seed"], json.dumps(r["extra"], sort_keys=True))
+    return {(r["section"], r["seed"], json.dumps(r["extra"], sort_keys=True), r.get("column", "paper"))
             for r in map(json.loads, out.read_text().splitlines()) if r}
 
 
-def _sweep(out: Path, section_extras: list[tuple[str, dict]]) -> None:
+def _sweep(out: Path, section_extras: list[tuple[str, dict]], column: str = "paper") -> None:
     done = _done(out)
     for seed in SEEDS:
         for section, extra in section_extras:
-            key = (section, seed, json.dumps(extra, sort_keys=True))
+            key = (section, seed, json.dumps(extra, sort_keys=True), column)
             if key in done:
                 continue
-            row = one_run(section, seed, extra)
+            row = one_run(section, seed, extra, column)
             with out.open("a") as f:
                 f.write(json.dumps(row) + "\n")
             print(json.dumps(row), flush=True)
@@ -204,7 +232,8 @@ def _pick(rows: list[dict], key: str, values, best: str) -> tuple[list, float]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("part", choices=["box", "radius", "summary"])
+    ap.add_argument("part", choices=["box", "radius", "recover", "summary"])
+    ap.add_argument("--radius", type=float, default=None, help="radius_m for the recover part (the radius rule's pick)")
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--box", type=float, default=None, help="box_reach_m for the radius part (the box rule's pick)")
     ap.add_argument("--values", type=str, default=None, help="comma-separated values instead of the grid (extension)")
@@ -217,7 +246,25 @@ def main() -> None:
             raise SystemExit("--box: the box rule's pick")
         grid = [float(v) for v in a.values.split(",")] if a.values else RADIUS_GRID
         _sweep(a.out, [("try-to-see-it-my-way", {"navigate": {"box_reach_m": a.box}, "radius_m": v}) for v in grid])
+    elif a.part == "recover":
+        if a.box is None or a.radius is None:
+            raise SystemExit("--box and --radius: the box and radius rules' picks")
+        for section, grid in RECOVER_GRID.items():
+            base = {"navigate": {"box_reach_m": a.box}}
+            if section == "try-to-see-it-my-way":
+                base["radius_m"] = a.radius
+            _sweep(a.out, [(section, {**base, "recover_radius_m": v}) for v in grid], column="teamnav")
     rows = [json.loads(line) for line in a.out.read_text().splitlines() if line] if a.out.exists() else []
+    for section in RECOVER_GRID:
+        rec = [dict(r, value=r["extra"]["recover_radius_m"]) for r in rows
+               if "recover_radius_m" in r["extra"] and r["section"] == section]
+        if rec:
+            table, pick = _pick(rec, "off_route_share", sorted({r["value"] for r in rec}), "min")
+            print(f"recover_radius_m, {section} teamnav column: value, mean off-route share, diff vs best, s.e., n")
+            for v, m, d, se, n in table:
+                print(f"  {v:4.1f}  {m:.4f}  {d:+.4f} ± {se:.4f}  n={n}")
+            print(f"  rule's pick: {pick}  (cpu {sum(r['cpu_s'] for r in rec):.0f} s over {len(rec)} runs)")
+    rows = [r for r in rows if "recover_radius_m" not in r["extra"]]
     box_rows = [dict(r, value=r["extra"]["navigate"]["box_reach_m"]) for r in rows if "radius_m" not in r["extra"]]
     if box_rows:
         vals = sorted({r["value"] for r in box_rows})
