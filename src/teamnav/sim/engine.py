@@ -342,10 +342,6 @@ class Simulation:
         #: step at which each robot started (-1 while it waits; None without ``launch``)
         self.launched_at: np.ndarray | None = None
         if launch is not None:
-            if any(grp.batched or grp.whole for grp in self._groups):
-                raise ValueError("launch: robots started one at a time need per-robot controllers; group "
-                                 f"{next(g.cfg.name for g in self._groups if g.batched or g.whole)!r} steps all its "
-                                 "robots at once")
             self.waiting = np.ones(n, dtype=np.bool_)
             self.waiting[0] = False
             self.launched_at = np.full(n, -1, dtype=np.int64)
