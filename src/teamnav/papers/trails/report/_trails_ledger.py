@@ -198,10 +198,14 @@ def try_ledger() -> Ledger:
         ("broadcast_interval_s", 2.0, "stated", "Try §2.2 step 2: \"it creates a temporary Trail every S seconds (we used S = 2)\""),
         ("crumb_max_age_s", 240.0, "stated", "Try §2.3 step 2: \"Any Crumbs with timestamp older than some threshold (we used 4 minutes) are destroyed\""),
         ("policy", "optimistic", "stated", "Try §3.5: \"The robots' local coordinate systems are therefore initially aligned, so we adopt the optimistic strategy\""),
-        ("radius_m", 3.0, "fill",
-         "in-sample choice: the crumb neighbourhood 3 m chosen against 2, 2.5 and 4 m on report seeds 0-11 "
-         "(trail_share's docstring; fresh seeds 12-23 agreed); not yet re-chosen by a rule on tuning seeds. "
-         "Both columns"),
+        ("radius_m", TrailShareParams().radius_m, "fill",
+         "Try §2.3 gives none (\"within a fixed radius of the current position\"). Rule, written before its runs "
+         "(6552f12, seeds cut to 4 in 68bf150): of 1.5, 2, 3, 4, 6 m, the radius with the lowest share of robot "
+         "time off the route (in dead-end branches: how often following the crumbs leads a robot astray), ties "
+         "within one paired s.e. to the smallest; tuning seeds 1000-1003, 30 min, the paper column at 0.25 m/s, "
+         "box_reach_m 2.0, the one-at-a-time start. Off-route share 0.478, 0.414, 0.287, 0.218, 0.255 (6 m "
+         "+0.037 ± 0.037, a tie; 3 m +0.069 ± 0.026): 4 m, an inner point (20 runs, 162 CPU s). 3 m until "
+         "2026-11-29, chosen on report seeds 0-11 by efficiency. Both columns"),
         ("navigate.box_reach_m", 2.0, "fill", BOX_REACH_REF),
         *_start_rows("try-to-see-it-my-way"),
         ("heading drift per robot", T.DRIFT_TEXT, "fill",
