@@ -140,3 +140,17 @@ def test_a_batched_groups_waiting_robots_ignore_its_commands_until_they_start():
         stop = sim.launched_at[i] - 1 if sim.launched_at[i] > 0 else len(xy)
         assert np.allclose(xy[:stop, i], [2.0, 1.0])
     assert np.hypot(*(xy[-1, 0] - [2.0, 1.0])) > 0.0  # robot 0 did move
+
+
+def test_a_trail_run_logs_every_start_and_counts_no_collision_for_robots_waiting_at_the_spot():
+    from teamnav.experiments.runner import run
+    from teamnav.experiments.spec import load_scenario
+
+    res = run(load_scenario("blazing-a-trail", duration_s=20.0, seed=1000), progress=False)
+    starts = [(e["robot"], e["t_s"]) for e in res.data.event_log if e.get("launched")]
+    assert [r for r, _ in starts] == [0, 1, 2, 3] and starts[0][1] == 0.0
+    assert all(a < b for (_, a), (_, b) in zip(starts, starts[1:]))
+    # the waiting robots are recorded at the spot, on top of each other, yet nothing collided
+    first = res.data.true_pose[0, :, :2]
+    assert np.allclose(first[1:], first[1])
+    assert res.metrics["collisions_robot"] == 0 and res.metrics["collisions_wall"] == 0

@@ -374,6 +374,8 @@ class Simulation:
         self.step_index = 0
         self.recorder = Recorder(n, config.record_every)
         self.recorder.events = self.places.log
+        if launch is not None:  # robot 0 starts at step 0 (the others in _launch_next)
+            self.places.log.append({"step": 0, "t_s": 0.0, "robot": 0, "place": None, "event": None, "launched": True})
         #: the run's faults (None without a ``faults`` section, or with an empty one)
         self.faults = None
         if config.faults is not None and not config.faults.empty:
