@@ -54,7 +54,11 @@ it: junction decisions no longer lag the corner). Measured on ``try-to-see-it-my
 (4 seeds x 30 min): 61 % of cruise speed between places after the first trail.
 
 ``recover_radius_m`` (a gap-fill, as in :mod:`~teamnav.papers.trails.brains.blazing_trail`; 4 m by
-default, 0 gives the paper's exploring): with no goal crumb below the descend-only bound around
+default, 0 gives the paper's exploring; re-chosen 2026-11-29 on tuning seeds 1000-1003 by a rule
+written first, ``scripts/trail_fill_tuning.py`` 105cbe8: the teamnav column, the smallest radius
+within one paired s.e. of the lowest off-route share: 0 m 0.151, 2 m 0.151, **4 m 0.136**, 6 m
+0.167, 8 m 0.133 (4 m +0.004 ± 0.005, a tie; 0 and 2 m +0.019 ± 0.013, not): 4 m stays, 20 runs,
+187 CPU s): with no goal crumb below the descend-only bound around
 the point ahead, the hint points at the nearest such goal crumb within that distance of the
 position estimate (the trail the robot has just left; in a dead end it lies behind and
 Navigate's 180 deg rule turns the robot back). Why: with 4 robots the slow trips start where

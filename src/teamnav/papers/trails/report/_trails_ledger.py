@@ -70,15 +70,37 @@ def model_column(col: str) -> str:
     return _MODEL_COLUMN[col]
 
 
+#: gap-fills re-chosen on tuning seeds by a rule written first (scripts/trail_fill_tuning.py): brain -> field -> ref
+RECHOSEN = {
+    "BlazingTrailParams": {"recover_radius_m": (
+        "a gap-fill (the paper's rule is 0: no crumb near, explore). Rule, written before its runs (105cbe8): of "
+        "0, 3, 6, 9, 12 m, the radius with the lowest share of robot time off the route (dead-end branches), ties "
+        "within one paired s.e. to the smallest; tuning seeds 1000-1003, 30 min, the teamnav column, the "
+        "one-at-a-time start. Off-route share 0.318, 0.211, 0.152, 0.139, 0.139 (6 m +0.013 ± 0.007, not a tie): "
+        "9 m (20 runs, 180 CPU s). 6 m until 2026-11-29, chosen on report seeds 0-7 by units")},
+    "TrailShareParams": {"recover_radius_m": (
+        "a gap-fill (the paper's rule is 0: no crumb near, explore). Rule, written before its runs (105cbe8): of "
+        "0, 2, 4, 6, 8 m, the radius with the lowest share of robot time off the route (dead-end branches), ties "
+        "within one paired s.e. to the smallest; tuning seeds 1000-1003, 30 min, the teamnav column (radius_m 4, "
+        "box_reach_m 2.0), the one-at-a-time start. Off-route share 0.151, 0.151, 0.136, 0.167, 0.133 (4 m "
+        "+0.004 ± 0.005, a tie; 0 and 2 m +0.019 ± 0.013, not): 4 m, as chosen before on report seeds 0-7 (20 "
+        "runs, 187 CPU s)")},
+}
+
+
 def _rule_rows(params_cls: type, ours: dict[str, Any]) -> tuple[list[LedgerRow], list[LedgerRow]]:
     """(paper rows, teamnav rows) of every gap-fill a brain declares (its ``PAPER_RULES``)."""
     from teamnav.control.paper_rules import gap_fills
 
     paper, teamnav = [], []
+    rechosen = RECHOSEN.get(params_cls.__name__, {})
     for g in gap_fills(params_cls, ours):
         if g.field == "cruise_speed_mps":
             continue  # its own rows, with the arithmetic or the quote
         paper.append(LedgerRow("paper", g.field, g.paper_value, "stated", g.note))
+        if g.field in rechosen:
+            teamnav.append(LedgerRow("teamnav", g.field, g.teamnav_value, "fill", rechosen[g.field]))
+            continue
         teamnav.append(LedgerRow("teamnav", g.field, g.teamnav_value, "fill",
                                  f"a gap-fill (the paper's rule is {g.paper_value!r}: {g.note}); chosen by "
                                  f"measuring it on the report's trail scenarios (the brain's docstring has the "
