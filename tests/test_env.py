@@ -156,7 +156,9 @@ def _drive_with_scenario_brains(env: ParallelEnv) -> None:
 def test_scenario_brains_driven_from_outside_reproduce_teamnav_run_bit_for_bit(tmp_path):
     """An agent's action is executed on a built-in brain's timing (no step of latency), its
     messages and logs land where a brain's would: the wrapped built-in rules give the very run."""
-    ref = run(load_scenario("blazing-a-trail", duration_s=30.0, seed=4), progress=False)
+    # an environment drops the scenario's one-at-a-time start (its agents act from step 0)
+    ref = run(load_scenario("blazing-a-trail", duration_s=30.0, seed=4).model_copy(update={"launch": None}),
+              progress=False)
     env = ParallelEnv("blazing-a-trail", duration_s=30.0)
     env.reset(seed=4)
     _drive_with_scenario_brains(env)

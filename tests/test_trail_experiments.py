@@ -68,6 +68,16 @@ def test_units_trips_and_trip_times_from_a_known_event_log():
     assert m["units_per_10min_peak"] == 3 and m["units_per_10min_last"] == 0
 
 
+def test_a_robot_started_later_begins_its_first_trip_when_it_starts():
+    log = [{"step": 0, "t_s": 0.0, "robot": 0, "place": None, "event": None, "launched": True},
+           {"step": 250, "t_s": 25.0, "robot": 1, "place": None, "event": None, "launched": True},
+           _ev(100, 0, "source"), _ev(180, 0, "home"), _ev(125, 1, "source"), _ev(205, 1, "home")]
+    m = M.trail_metrics(_data(log))
+    # robot 0: 0 -> 100, robot 1: 25 -> 125 (not 0 -> 125): both first trips take 100 s
+    assert m["trip_time_s_before_n"] == 2 and m["trip_time_s_before_mean"] == 100.0
+    assert m["units_total"] == 2
+
+
 def test_breakdown_is_censored_when_units_arrive_until_the_end():
     log = []
     for k in range(21):  # a unit every 170 s until 3570 s of a 3600 s run

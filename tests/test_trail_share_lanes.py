@@ -32,11 +32,18 @@ def _swerved(monkeypatch, **params):
 
 def test_the_default_neighbourhood_reaches_the_other_lane_and_points_on_along_it(monkeypatch):
     b = _swerved(monkeypatch)
-    assert b.params.radius_m == 3.0
+    assert b.params.radius_m == 4.0
     hint = b.nav.headings[-1]
     assert b.log()["following"] is True
+    # towards (6, 0), the lowest time-to-place within 4 m of the look-ahead point (3.34, 2.34)
+    assert hint == pytest.approx(math.atan2(-1.4, 3.0))
+
+
+def test_a_three_metre_neighbourhood_reaches_the_other_lane_too(monkeypatch):
+    b = _swerved(monkeypatch, radius_m=3.0)
+    assert b.log()["following"] is True
     # towards (5, 0), the lowest time-to-place within 3 m of the look-ahead point (3.34, 2.34)
-    assert hint == pytest.approx(math.atan2(-1.4, 2.0))
+    assert b.nav.headings[-1] == pytest.approx(math.atan2(-1.4, 2.0))
 
 
 def test_a_two_metre_neighbourhood_loses_the_trail_there(monkeypatch):

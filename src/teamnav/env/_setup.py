@@ -97,6 +97,10 @@ class EnvSetup:
 
     def __init__(self, scenario: Scenario, spec: EnvSpec, file: str, *, robots: list[int] | None = None,
                  dtype: Any = np.float64) -> None:
+        if scenario.launch is not None:
+            # agents act for every robot from step 0: a scenario's one-at-a-time start (its
+            # ``launch`` section) is dropped here and the robots start from their groups' ``start``
+            scenario = scenario.model_copy(update={"launch": None})
         self.scenario = scenario
         self.spec = spec
         self.file = file

@@ -184,6 +184,18 @@ def stall_fraction(data: RunData) -> dict[str, float]:
 _ALL_PAIRS_MAX = 48
 
 
+def _present(data: RunData) -> np.ndarray | None:
+    """(T, N) True where a robot has started (a scenario's ``launch``: robots started one at a
+    time, each ``launched`` in the event log; one not started waits at the spot, out of the
+    arena); None when every robot is there from the start."""
+    launched = {int(e["robot"]): float(e["t_s"]) for e in getattr(data, "event_log", ())
+                if isinstance(e, dict) and e.get("launched")}
+    if not launched:
+        return None
+    t0 = np.array([launched.get(i, np.inf) for i in range(data.n_robots)])
+    return np.asarray(data.t_s)[:, None] >= t0[None, :] - 1e-9
+
+
 def collisions(data: RunData) -> dict[str, int]:
     """Recorded robot-samples overlapping a wall, and robot pairs overlapping each other.
 
@@ -191,9 +203,12 @@ def collisions(data: RunData) -> dict[str, int]:
     wall when the distance from its cell centre to the nearest obstacle cell centre is below
     ``radius - resolution`` (the distance field is exact between cell centres only, so one
     cell of tolerance); two robots overlap when their centres are closer than the sum of
-    their radii minus 1 mm.
+    their radii minus 1 mm. Robots not started yet (a scenario's ``launch``) are not counted:
+    they wait at the spot, outside the arena.
     """
     from teamnav.world.distance import distance_field
+
+    present = _present(data)
 
     grid = data.grid
     dist = distance_field(grid)
@@ -203,7 +218,8 @@ def collisions(data: RunData) -> dict[str, int]:
     inside = (rc[..., 0] >= 0) & (rc[..., 0] < h) & (rc[..., 1] >= 0) & (rc[..., 1] < w)
     clear = np.zeros(inside.shape)
     clear[inside] = dist[rc[..., 0][inside], rc[..., 1][inside]]
-    wall_hits = int(np.count_nonzero(~inside | (clear < data.radius_m[None, :] - grid.resolution_m)))
+    hit = ~inside | (clear < data.radius_m[None, :] - grid.resolution_m)
+    wall_hits = int(np.count_nonzero(hit if present is None else hit & present))
 
     robot_hits = 0
     if 1 < data.n_robots <= _ALL_PAIRS_MAX:
@@ -214,17 +230,23 @@ def collisions(data: RunData) -> dict[str, int]:
         for k in range(0, xy.shape[0], 512):
             f = xy[k:k + 512]
             gap = np.hypot(f[:, i, 0] - f[:, j, 0], f[:, i, 1] - f[:, j, 1]) - rsum
-            robot_hits += int(np.count_nonzero(gap < -1e-3))
+            over = gap < -1e-3
+            if present is not None:
+                over &= present[k:k + 512][:, i] & present[k:k + 512][:, j]
+            robot_hits += int(np.count_nonzero(over))
     elif data.n_robots > 1:
         from scipy.spatial import cKDTree
 
         reach = 2.0 * float(data.radius_m.max())
-        for frame in xy:
+        for k, frame in enumerate(xy):
             pairs = cKDTree(frame).query_pairs(reach, output_type="ndarray")
             if len(pairs):
                 i, j = pairs[:, 0], pairs[:, 1]
                 gap = np.hypot(*(frame[i] - frame[j]).T) - (data.radius_m[i] + data.radius_m[j])
-                robot_hits += int(np.count_nonzero(gap < -1e-3))
+                over = gap < -1e-3
+                if present is not None:
+                    over &= present[k, i] & present[k, j]
+                robot_hits += int(np.count_nonzero(over))
     return {"collisions_wall": wall_hits, "collisions_robot": robot_hits}
 
 

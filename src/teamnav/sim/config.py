@@ -186,6 +186,28 @@ class StartConfig(Model):
         return self
 
 
+class LaunchConfig(Model):
+    """Robots started one at a time from one spot, as an experimenter starts real robots
+    (Vaughan et al. 2000 §5 and 2002 §3.5: "The robots are started one at a time from the same
+    spot at the home position, with the same orientation").
+
+    Every robot starts at ``spot`` [x_m, y_m, theta_deg] (each group's ``start`` is not used),
+    in robot id order. Robot 0 starts at step 0; each later robot starts at the first step at
+    which every robot already started is at least ``clear_m`` from the spot (centre to centre).
+    Until then the robot is not in the arena: the engine (:class:`~teamnav.sim.engine.Simulation`)
+    never steps its brain, commands it nothing, delivers it no message, and no other robot's
+    sensors, detector or body meet it; its odometry starts from the spot when it starts. The
+    truth keeps it at the spot (recorded there, so its path starts there) and place events are
+    withheld from it while it waits. A batched brain (one brain for a whole group) is still
+    handed its waiting robots' rows, sensed from outside the map (every range 0), and their
+    commands are ignored until they start. :mod:`teamnav.env` drops the section (its agents act
+    for every robot from step 0) and uses the groups' ``start``.
+    """
+
+    spot: tuple[float, float, float]
+    clear_m: float = Field(gt=0.0, le=100.0)
+
+
 # ---------------------------------------------------------------------------- robots
 class RobotGroupConfig(Model):
     """``count`` identical robots running the same controller.
@@ -573,6 +595,10 @@ class SimConfig(Model):
     #: faults (None or an empty section) is the same, bit for bit, as before faults existed,
     #: and the section is left out of the resolved scenario then.
     faults: FaultsConfig | None = None
+    #: robots started one at a time from one spot (:class:`LaunchConfig`); None: all at step 0
+    #: from their groups' ``start``. Left out of the resolved scenario when None (config
+    #: hashes unchanged).
+    launch: LaunchConfig | None = None
     #: fields a subclass adds that serialisation leaves out when None (config hashes unchanged)
     _OMIT_WHEN_NONE: ClassVar[tuple[str, ...]] = ()
 
@@ -613,6 +639,8 @@ class SimConfig(Model):
         data = handler(self)
         if isinstance(data, dict) and (self.faults is None or self.faults.empty):
             data.pop("faults", None)
+        if isinstance(data, dict) and self.launch is None:
+            data.pop("launch", None)
         if isinstance(data, dict):  # sections of subclasses that are left out when absent (Scenario.env)
             for key in self._OMIT_WHEN_NONE:
                 if data.get(key, 0) is None:

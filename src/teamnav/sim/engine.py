@@ -73,7 +73,8 @@ from teamnav.control.guard import (
 )
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Action, BatchAction, BatchObservation, Message, Observation, RangeScan
-from teamnav.sim.collisions import move_discs
+from teamnav.geometry.angles import wrap_angle
+from teamnav.sim.collisions import discs_hit_walls, move_discs
 from teamnav.sim.config import SimConfig, resolve_robot, resolve_sensor
 from teamnav.sim.events import Places
 from teamnav.sim.kinematics import motion_primitives
@@ -215,7 +216,14 @@ class Simulation:
         self._blocking = grid.blocking(None)
         self._clear_m = distance_field(self._blocking, grid.resolution_m)
         self._geo = grid.geo  # origin, resolution, cos and sin of the map's yaw
-        poses = start_poses(grid, groups, np.random.default_rng(start_ss), self._clear_m)
+        launch = config.launch
+        if launch is None:
+            poses = start_poses(grid, groups, np.random.default_rng(start_ss), self._clear_m)
+        else:  # everyone at the spot; those not yet started are kept out of the arena (_hide)
+            poses = np.tile([launch.spot[0], launch.spot[1], wrap_angle(math.radians(launch.spot[2]))], (n, 1))
+            radii = np.repeat([g.radius_m for g in groups], [g.count for g in groups]).astype(np.float64)
+            if discs_hit_walls(self._blocking, self._clear_m, grid.geo, poses[:, 0], poses[:, 1], radii).any():
+                raise ValueError(f"launch.spot {list(launch.spot)}: a robot there would overlap a wall or leave the map")
         counts = [g.count for g in groups]
         group_idx = np.repeat(np.arange(len(groups)), counts)
         self.state = RobotState.from_poses(poses, np.repeat([g.radius_m for g in groups], counts), group_idx)
@@ -329,6 +337,21 @@ class Simulation:
         self._y0 = np.empty(n)
         self._th0 = np.empty(n)
         self._decided = False
+        #: robots not started yet (``launch``; None without one): True where a robot waits
+        self.waiting: np.ndarray | None = None
+        #: step at which each robot started (-1 while it waits; None without ``launch``)
+        self.launched_at: np.ndarray | None = None
+        if launch is not None:
+            self.waiting = np.ones(n, dtype=np.bool_)
+            self.waiting[0] = False
+            self.launched_at = np.full(n, -1, dtype=np.int64)
+            self.launched_at[0] = 0
+            self._odom0 = self.odometry.pose.copy()
+            self._spot = poses[0].copy()
+            # off-stage parking while hidden: far outside the map, 10 m apart (no sensor reaches)
+            ox, oy = grid.origin_xy_m
+            self._park_x = ox - 1.0e4 - 10.0 * np.arange(n, dtype=np.float64)
+            self._park_y = np.full(n, oy - 1.0e4)
         #: what the latest observations were built from, for readers of whole groups at once
         #: (:mod:`teamnav.env`): ``(step, odometry poses (n, 3), odometry deltas (n, 3) or None,
         #: {group index: [(sensor name, ranges (count, B), beam angles, max range)]}, inboxes,
@@ -351,6 +374,8 @@ class Simulation:
         self.step_index = 0
         self.recorder = Recorder(n, config.record_every)
         self.recorder.events = self.places.log
+        if launch is not None:  # robot 0 starts at step 0 (the others in _launch_next)
+            self.places.log.append({"step": 0, "t_s": 0.0, "robot": 0, "place": None, "event": None, "launched": True})
         #: the run's faults (None without a ``faults`` section, or with an empty one)
         self.faults = None
         if config.faults is not None and not config.faults.empty:
@@ -496,33 +521,93 @@ class Simulation:
         fx = self.faults
         if fx is not None:
             fx.begin_step(self.step_index)
+        waiting = self.waiting
+        if waiting is not None:
+            self._launch_next()
+            waiting = self.waiting if self.waiting.any() else None
+            if waiting is not None:  # a robot that waits is commanded nothing (set_commands included)
+                self._v_cmd[waiting] = 0.0
+                self._w_cmd[waiting] = 0.0
+                self._dir_cmd[waiting] = math.nan
         np.copyto(self._x0, s.x_m)
         np.copyto(self._y0, s.y_m)
         np.copyto(self._th0, s.theta_rad)
         motion_primitives(self._holonomic, self._v_cmd, self._w_cmd, self._dir_cmd, self._max_v, self._max_w,
                           self._step_m, self.dt_s, s.v_mps, s.omega_radps, self._pre, self._arc, self._turn)
+        if waiting is not None:
+            self._hide(waiting)
         move_discs(s.x_m, s.y_m, s.theta_rad, s.radius_m, self._pre, self._arc, self._turn, self._blocking,
                    self._clear_m, self._geo, self.config.robot_collisions, s.stalled)
+        if waiting is not None:
+            self._unhide(waiting)
         self.odometry.step(self._x0, self._y0, self._th0, s.x_m, s.y_m, s.theta_rad)
         if fx is not None and fx.kidnap_due:
             fx.kidnap(s)  # after the odometry step: odometry never feels the jump
-        events = self.places.update(self.step_index, self.time_s, s.x_m, s.y_m) if self.places.active else None
+        events = self.places.update(self.step_index, self.time_s, s.x_m, s.y_m, muted=waiting) \
+            if self.places.active else None
         if len(self.places.track) != self._n_track:
             self._record_moving_places()
         if fx is None:
-            inboxes = self.radio.collect() if self.radio is not None and self.radio.has_pending else None
+            inboxes = self.radio.collect(muted=waiting) if self.radio is not None and self.radio.has_pending else None
         else:
-            inboxes = self.radio.collect(muted=fx.radio_off if fx.any_radio_off else None, blocked=fx.blackout) \
+            muted = fx.radio_off if fx.any_radio_off else None
+            if waiting is not None:
+                muted = waiting if muted is None else (muted | waiting)
+            inboxes = self.radio.collect(muted=muted, blocked=fx.blackout) \
                 if self.radio is not None and self.radio.has_pending else None
         if inboxes is not None and self._rec_sensing and self.recorder.wants(self.step_index):
             self._record_messages(inboxes)
-        self._observe_and_decide(events, inboxes)
+        if waiting is not None:
+            self._hide(waiting)  # unseen by every sensor and out of radio reach while it waits
+            try:
+                self._observe_and_decide(events, inboxes)
+            finally:
+                self._unhide(waiting)
+        else:
+            self._observe_and_decide(events, inboxes)
         if self.recorder.wants(self.step_index):
             self._record()
         for h in self._post_hooks:
             h(self)
 
     # ------------------------------------------------------------------ internals
+    def _launch_next(self) -> None:
+        """Start the next waiting robot (lowest id) when every started robot is at least
+        ``launch.clear_m`` from the spot (:class:`~teamnav.sim.config.LaunchConfig`); its
+        odometry starts from the spot."""
+        waiting = self.waiting
+        if not waiting.any():
+            return
+        s = self.state
+        on = ~waiting
+        d2 = (s.x_m[on] - self._spot[0]) ** 2 + (s.y_m[on] - self._spot[1]) ** 2
+        clear = float(self.config.launch.clear_m)
+        if d2.size and float(d2.min()) < clear * clear:
+            return
+        i = int(np.flatnonzero(waiting)[0])
+        waiting[i] = False
+        self.launched_at[i] = self.step_index
+        s.x_m[i], s.y_m[i], s.theta_rad[i] = self._spot
+        s.v_mps[i] = 0.0
+        s.omega_radps[i] = 0.0
+        s.stalled[i] = False
+        self.odometry.pose[i] = self._odom0[i]
+        self.odometry.delta[i] = 0.0
+        self.places.log.append({"step": int(self.step_index), "t_s": float(self.time_s), "robot": i, "place": None,
+                                "event": None, "launched": True})
+
+    def _hide(self, waiting: np.ndarray) -> None:
+        """Park the waiting robots far outside the map (``_unhide`` puts them back at the spot)."""
+        s = self.state
+        s.x_m[waiting] = self._park_x[waiting]
+        s.y_m[waiting] = self._park_y[waiting]
+
+    def _unhide(self, waiting: np.ndarray) -> None:
+        s = self.state
+        s.x_m[waiting] = self._spot[0]
+        s.y_m[waiting] = self._spot[1]
+        s.theta_rad[waiting] = self._spot[2]
+
     def _check_faults(self) -> None:
         """Faults on robots of batched groups that their brain could never feel are refused:
         a batched group senses only its controller's range sensor and has no detector."""
@@ -721,7 +806,10 @@ class Simulation:
             delta_rows = list(delta[sl])
             g_inbox = inboxes[sl] if inboxes is not None else None
             g_events = events[sl] if events is not None else None
-            dead = fx.dead[sl].tolist() if fx is not None else None
+            off = fx.dead[sl] if fx is not None else None
+            if self.waiting is not None:
+                off = self.waiting[sl] if off is None else (off | self.waiting[sl])
+            dead = off.tolist() if off is not None else None
             vs = self._v_cmd[sl].tolist()
             ws = self._w_cmd[sl].tolist()
             ds = self._dir_cmd[sl].tolist()

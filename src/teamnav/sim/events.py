@@ -139,8 +139,11 @@ class Places:
     def _inside(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
         return (xs[:, None] - self.px[None, :]) ** 2 + (ys[:, None] - self.py[None, :]) ** 2 <= self.r2[None, :]
 
-    def update(self, step: int, time_s: float, xs: np.ndarray, ys: np.ndarray) -> list[tuple[str, ...]]:
-        """Events fired this step, one tuple per robot (in place order); recorded in :attr:`log`."""
+    def update(self, step: int, time_s: float, xs: np.ndarray, ys: np.ndarray,
+               muted: np.ndarray | None = None) -> list[tuple[str, ...]]:
+        """Events fired this step, one tuple per robot (in place order); recorded in :attr:`log`.
+        Robots where ``muted`` is True (not started yet: :class:`~teamnav.sim.config.LaunchConfig`)
+        fire nothing, though who is inside is still tracked."""
         n = xs.shape[0]
         if not self.places:
             return [()] * n
@@ -148,6 +151,8 @@ class Places:
             self._move(step, time_s)
         now = self._inside(xs, ys)
         fire = np.where(self.on_enter[None, :], now & ~self.inside, now)
+        if muted is not None:
+            fire &= ~muted[:, None]
         self.inside = now
         out: list[tuple[str, ...]] = [()] * n
         if fire.any():

@@ -460,7 +460,9 @@ def build_replay(
             continue
         if fr < F:
             # a fault (teamnav.sim.faults) is recorded with event None and its kind under "fault"
-            label = e.get("event") if e.get("event") is not None else (f"fault: {e['fault']}" if e.get("fault") else "")
+            # a robot's start (a scenario's launch: robots started one at a time) under "launched"
+            label = e.get("event") if e.get("event") is not None else (
+                f"fault: {e['fault']}" if e.get("fault") else "started" if e.get("launched") else "")
             events.append({"f": fr, "t": float(e.get("t_s", 0.0)), "robot": int(e.get("robot", -1)),
                            "event": str(label), "place": str(e.get("place") or "")})
 

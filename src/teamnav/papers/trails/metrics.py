@@ -134,11 +134,15 @@ def trips(event_log: list[dict], n_robots: int, start_place: str = "home") -> li
     """Every trip (robot, start [s], end [s], from place, to place), in time order.
 
     Consecutive events of a robot at the same place (it left the disc and came back) are not
-    trips. Each robot is taken to start at ``start_place`` at t = 0.
+    trips. Each robot is taken to start at ``start_place`` at t = 0, or when it was started (a
+    ``launched`` entry: robots started one at a time, Blazing §5, Try §3.5).
     """
     last: dict[int, tuple[float, str]] = {r: (0.0, start_place) for r in range(n_robots)}
     out = []
     for e in sorted(event_log, key=lambda e: (e["t_s"], e["robot"])):
+        if e.get("launched"):
+            last[int(e["robot"])] = (float(e["t_s"]), start_place)
+            continue
         if e.get("event") is None:
             continue
         r = int(e["robot"])

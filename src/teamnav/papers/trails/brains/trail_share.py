@@ -54,7 +54,11 @@ it: junction decisions no longer lag the corner). Measured on ``try-to-see-it-my
 (4 seeds x 30 min): 61 % of cruise speed between places after the first trail.
 
 ``recover_radius_m`` (a gap-fill, as in :mod:`~teamnav.papers.trails.brains.blazing_trail`; 4 m by
-default, 0 gives the paper's exploring): with no goal crumb below the descend-only bound around
+default, 0 gives the paper's exploring; re-chosen 2026-11-29 on tuning seeds 1000-1003 by a rule
+written first, ``scripts/trail_fill_tuning.py`` 105cbe8: the teamnav column, the smallest radius
+within one paired s.e. of the lowest off-route share: 0 m 0.151, 2 m 0.151, **4 m 0.136**, 6 m
+0.167, 8 m 0.133 (4 m +0.004 ± 0.005, a tie; 0 and 2 m +0.019 ± 0.013, not): 4 m stays, 20 runs,
+187 CPU s): with no goal crumb below the descend-only bound around
 the point ahead, the hint points at the nearest such goal crumb within that distance of the
 position estimate (the trail the robot has just left; in a dead end it lies behind and
 Navigate's 180 deg rule turns the robot back). Why: with 4 robots the slow trips start where
@@ -150,8 +154,8 @@ value (:attr:`TrailShareParams.PAPER_RULES`, Navigate's own passed down, cruise 
 :mod:`teamnav.control.paper_rules`): the reports' "paper as written" column.
 
 Choices where the paper is silent: "if a robot is moving" means its odometry moved at least
-``min_move_m`` since the previous temporary trail; radius 3 m (``radius_m``; 2 m, about a
-corridor's width, until 907fd28). Why 3: once robots keep their lanes (``box_reach_m`` in
+``min_move_m`` since the previous temporary trail; radius 4 m (``radius_m``; 2 m, about a
+corridor's width, until 907fd28; 3 m until 2026-11-29, see below). Why more than 2 m: once robots keep their lanes (``box_reach_m`` in
 :data:`~teamnav.papers.trails.brains.blazing_trail.NAVIGATE_DEFAULTS`), the crumbs a robot follows were
 dropped by robots coming the other way, about 1 m across the corridor from it. Traced
 (``try-to-see-it-my-way``, seed 0): an eastbound robot following its wall into C3's passing place
@@ -162,6 +166,12 @@ efficiency = ``place_speed_mps`` / cruise): 2.5 m +4.4 ± 1.3 points, **3 m +7.9
 0-11, 11/12 better; trips after 10 min 102.1 -> 93.5 s, 12/12 faster)**, 4 m +7.6 ± 1.0; fresh seeds
 12-23 at 3 m +6.4 ± 1.1 (12/12). Under 4x the drift (1 h, seeds 0-5) 38.2 -> 51.2 units (+13.0 ±
 2.4), under 6x 28.0 -> 39.5 (none of 6 broke down, 1 of 6 before).
+Those were report seeds, judged by efficiency. Re-chosen 2026-11-29 by a rule written before its
+runs (``scripts/trail_fill_tuning.py``, 6552f12 and 68bf150): tuning seeds 1000-1003, 30 min, the
+paper column (0.25 m/s, ``box_reach_m`` 2.0, the robots started one at a time), the radius with
+the lowest share of robot time off the route (dead-end branches), ties within one paired s.e. to
+the smallest: 1.5 m 0.478, 2 m 0.414, 3 m 0.287, **4 m 0.218**, 6 m 0.255 (6 m +0.037 ± 0.037, a
+tie; 3 m +0.069 ± 0.026): 4 m (``docs/report/trails-fill-tuning.jsonl``, 20 runs, 162 CPU s).
 ``crumbs_for="every_place"`` is the §2.2 alternative the paper names for future work (one Crumb
 per Place the robot has visited, each with the time since that visit), useful for rounds of
 N > 2 places where the next place is never the previous one.
@@ -286,7 +296,7 @@ class TrailShareParams(BaseModel):
                              max_length=100)
     communicate: bool = True
     broadcast_interval_s: float = Field(2.0, gt=0.0, le=600.0)
-    radius_m: float = Field(3.0, gt=0.0, le=100.0)
+    radius_m: float = Field(4.0, gt=0.0, le=100.0)
     cruise_speed_mps: float = Field(0.25, gt=0.0, le=10.0)
     policy: Literal["pessimistic", "optimistic"] = "pessimistic"
     crumb_max_age_s: float = Field(240.0, gt=0.0, le=1e7)

@@ -20,7 +20,8 @@ from typing import Any
 
 from teamnav.experiments.report.model import Ledger, LedgerRow
 
-__all__ = ["TRY_SINGLE_TRAIL_QUOTE", "BLAZING_LITERAL_QUOTE", "blazing_ledger", "model_column", "try_ledger"]
+__all__ = ["TRY_SINGLE_TRAIL_QUOTE", "BLAZING_LITERAL_QUOTE", "blazing_ledger", "launch_clear_rule_m", "model_column",
+           "try_ledger"]
 
 #: the 2002 paper's description of the 2000 method (Try §1, verbatim)
 TRY_SINGLE_TRAIL_QUOTE = ("Our previous work assumed that there were two places of interest in the environment "
@@ -35,6 +36,26 @@ LASER_QUOTE = ("a SICK LMS scanning laser rangefinder ... over 180°. The SICK g
 #: the 2000 paper's start (Blazing §5, verbatim)
 START_QUOTE = ("The robots are started one at a time from the same spot at the home position, with the same "
                "orientation.")
+#: the 2002 paper's start (Try §3.5, verbatim: the same sentence, the home position named A)
+TRY_START_QUOTE = ("The robots are started one at a time from the same spot at the home position *A*, with the "
+                   "same orientation.")
+#: the gap at which robots begin to interfere (Blazing §4.2 and Try §3.3, verbatim): the launch rule's input
+BLAZING_GAP_QUOTE = "passing within as little as 40cm of each other before interference occurs"
+TRY_GAP_QUOTE = "passing within as little as 20cm of each other before interference occurs"
+#: Navigate's sliding-box reach: the rule, its tuning seeds and its result (scripts/trail_fill_tuning.py,
+#: docs/report/trails-fill-tuning.jsonl)
+BOX_REACH_REF = ("the papers give no size (Blazing §4.2: \"A virtual box a little bigger than the robot ... the size "
+                 "of the box can be tuned\"). Rule, written before its runs (6552f12; seeds cut to 4 in 68bf150 "
+                 "after 3 runs): of reaches 1.2, 1.6, 2.0, 2.4, 3.0 m, the smallest whose lane share (true-pose "
+                 "time on the route's straight corridor stretches spent left of the centre line in the direction "
+                 "of travel: the robots follow their left wall and pass each other) is within one paired s.e. of "
+                 "the best; tuning seeds 1000-1003, 30 min, both sections' paper columns, the one-at-a-time start. "
+                 "Lane share 0.842, 0.959, 0.966, 0.946, 0.958: 1.6 m is 0.007 ± 0.002 below 2.0 m, so 2.0 m "
+                 "(an inner point of the grid; 40 runs, 317 CPU s). It had first been chosen on report seeds 0-7 "
+                 "by efficiency; the rule keeps it. Both columns")
+#: (gap [m], where, quote) per section, for the rule of ``launch.clear_m``
+LAUNCH_GAP = {"blazing-a-trail": (0.40, "Blazing §4.2", BLAZING_GAP_QUOTE),
+              "try-to-see-it-my-way": (0.20, "Try §3.3", TRY_GAP_QUOTE)}
 
 #: report-column key of the trail sections (``_trails.COLUMNS``) -> the report model's column
 _MODEL_COLUMN = {"paper_rules": "paper", "teamnav": "teamnav"}
@@ -49,15 +70,37 @@ def model_column(col: str) -> str:
     return _MODEL_COLUMN[col]
 
 
+#: gap-fills re-chosen on tuning seeds by a rule written first (scripts/trail_fill_tuning.py): brain -> field -> ref
+RECHOSEN = {
+    "BlazingTrailParams": {"recover_radius_m": (
+        "a gap-fill (the paper's rule is 0: no crumb near, explore). Rule, written before its runs (105cbe8): of "
+        "0, 3, 6, 9, 12 m, the radius with the lowest share of robot time off the route (dead-end branches), ties "
+        "within one paired s.e. to the smallest; tuning seeds 1000-1003, 30 min, the teamnav column, the "
+        "one-at-a-time start. Off-route share 0.318, 0.211, 0.152, 0.139, 0.139 (6 m +0.013 ± 0.007, not a tie): "
+        "9 m (20 runs, 180 CPU s). 6 m until 2026-11-29, chosen on report seeds 0-7 by units")},
+    "TrailShareParams": {"recover_radius_m": (
+        "a gap-fill (the paper's rule is 0: no crumb near, explore). Rule, written before its runs (105cbe8): of "
+        "0, 2, 4, 6, 8 m, the radius with the lowest share of robot time off the route (dead-end branches), ties "
+        "within one paired s.e. to the smallest; tuning seeds 1000-1003, 30 min, the teamnav column (radius_m 4, "
+        "box_reach_m 2.0), the one-at-a-time start. Off-route share 0.151, 0.151, 0.136, 0.167, 0.133 (4 m "
+        "+0.004 ± 0.005, a tie; 0 and 2 m +0.019 ± 0.013, not): 4 m, as chosen before on report seeds 0-7 (20 "
+        "runs, 187 CPU s)")},
+}
+
+
 def _rule_rows(params_cls: type, ours: dict[str, Any]) -> tuple[list[LedgerRow], list[LedgerRow]]:
     """(paper rows, teamnav rows) of every gap-fill a brain declares (its ``PAPER_RULES``)."""
     from teamnav.control.paper_rules import gap_fills
 
     paper, teamnav = [], []
+    rechosen = RECHOSEN.get(params_cls.__name__, {})
     for g in gap_fills(params_cls, ours):
         if g.field == "cruise_speed_mps":
             continue  # its own rows, with the arithmetic or the quote
         paper.append(LedgerRow("paper", g.field, g.paper_value, "stated", g.note))
+        if g.field in rechosen:
+            teamnav.append(LedgerRow("teamnav", g.field, g.teamnav_value, "fill", rechosen[g.field]))
+            continue
         teamnav.append(LedgerRow("teamnav", g.field, g.teamnav_value, "fill",
                                  f"a gap-fill (the paper's rule is {g.paper_value!r}: {g.note}); chosen by "
                                  f"measuring it on the report's trail scenarios (the brain's docstring has the "
@@ -66,11 +109,40 @@ def _rule_rows(params_cls: type, ours: dict[str, Any]) -> tuple[list[LedgerRow],
     return paper, teamnav
 
 
-#: the start, the same in both sections and columns (not the papers' set-up)
-_START_ROW = ("start", "together, four spots 0.7 m apart along the home corridor", "fill",
-              "NOT the papers' set-up: \"" + START_QUOTE + "\" (Blazing §5; Try §3.5 the same) is stated but not yet "
-              "implemented (the brains have no start delay); the frames are aligned with the map, so the spots "
-              "differ by < 2.6 m of position, not by frame. Both columns")
+def launch_clear_rule_m(section: str) -> float:
+    """``launch.clear_m`` by its rule: two robot radii plus the gap at which the section's paper says
+    robots begin to interfere (the papers give no interval between starts).
+
+    >>> round(launch_clear_rule_m("blazing-a-trail"), 6), round(launch_clear_rule_m("try-to-see-it-my-way"), 6)
+    (0.9, 0.7)
+    """
+    from teamnav.experiments.spec import load_scenario
+
+    return 2.0 * load_scenario(section).robots[0].radius_m + LAUNCH_GAP[section][0]
+
+
+def _start_rows(section: str) -> tuple[tuple[str, object, str, str], ...]:
+    """The start's rows (the same in both columns: the set-up is the experiment's, not a gap-fill),
+    from the scenario's ``launch`` section."""
+    from teamnav.experiments.spec import load_scenario
+
+    sc = load_scenario(section)
+    la, r = sc.launch, sc.robots[0].radius_m
+    gap, where, quote = LAUNCH_GAP[section]
+    start = (f"Blazing §5: \"{START_QUOTE}\"" if section == "blazing-a-trail"
+             else f"Try §3.5: \"{TRY_START_QUOTE}\"")
+    names = ", ".join(g.name for g in sc.robots)
+    return (
+        ("start", f"one at a time from home ({la.spot[0]:g}, {la.spot[1]:g}), heading {la.spot[2]:g}°", "stated",
+         f"{start} Every robot is put at the spot in turn; one not yet started is out of the arena (the simulator "
+         "holds it: no brain, sensor or radio meets it) and its odometry starts at the spot. Both columns (since "
+         "2026-11-29; before, all four started together from four spots along the home corridor)"),
+        ("launch.clear_m", la.clear_m, "fill",
+         f"the papers give no interval between starts. Rule, written with the set-up before any run of it: the "
+         f"next robot is started once every robot already started is clear of the spot by two radii plus the gap "
+         f"at which the paper says robots begin to interfere ({where}: \"{quote}\"): 2 x {r:g} + {gap:g} = "
+         f"{2 * r + gap:g} m, not tuned. The order is not given either: robot order ({names}). Both columns"),
+    )
 
 #: rows that are the same in both columns: (name, value, source, ref)
 _SHARED_BLAZING = (
@@ -78,9 +150,7 @@ _SHARED_BLAZING = (
     ("navigate.trail_rule", "side", "stated",
      "Blazing §5.1: \"When the robot detects an opening it turns into the opening if the average heading of the "
      "crumbs points to the side where the opening is detected.\""),
-    ("navigate.box_reach_m", 2.0, "fill",
-     "in-sample choice: Navigate's default 1.2 m; 2.0 m chosen on report seeds 0-7 (the old Z map, lanes kept "
-     "and efficiency, blazing_trail.NAVIGATE_DEFAULTS); not yet re-chosen by a rule on tuning seeds. Both columns"),
+    ("navigate.box_reach_m", 2.0, "fill", BOX_REACH_REF),
     ("crumb_interval_s, radius_m", "1 s, 2 m", "fill",
      "the 2000 paper gives neither (\"at regular time intervals\", \"a threshold radius\"); the library defaults: "
      "2 m is about a corridor's width (1.8 m), chosen by that arithmetic, not on runs. Both columns"),
@@ -88,7 +158,7 @@ _SHARED_BLAZING = (
      "Blazing §5.1 gives no rates: \"the odometry of Ant and Bee is worse than the odometry of Tanis and Punky "
      "whose odometry only rotates slightly\"; the rates and signs are our choice, made before the section's "
      "first runs, not tuned. The drift sweep uses the 2002 paper's rates scaled by k instead. Both columns"),
-    _START_ROW,
+
 )
 
 
@@ -117,15 +187,19 @@ def blazing_ledger() -> Ledger:
                   "home and their opposite sends a carrying robot away from home, contradicting §5.1's results. "
                   "An ablation row (full mode), never judged"),
         *paper,
-        LedgerRow("teamnav", "cruise_speed_mps", cruise, "fill",
-                  "in-sample choice: 0.4 m/s chosen on report seeds 0-7 (the old Z map) against 0.25; it coincides "
-                  "with the speed the 2000 paper implies (0.37-0.44 m/s, see the paper column's row)"),
+        LedgerRow("teamnav", "cruise_speed_mps", cruise, "implied" if cruise == T.BLAZING_IMPLIED_CRUISE_MPS else "fill",
+                  "the speed the 2000 paper implies, as the paper column (0.37-0.44 m/s: the arithmetic in that "
+                  "column's row); taken from the paper since 2026-11-29. It had first been chosen on report seeds "
+                  "0-7 (the old Z map) against 0.25 m/s, an in-sample choice that the paper's numbers now replace"
+                  if cruise == T.BLAZING_IMPLIED_CRUISE_MPS else
+                  "in-sample choice: chosen on report seeds 0-7 (the old Z map) against 0.25 m/s"),
         LedgerRow("teamnav", "reverse_carried_crumbs", True, "stated",
                   "as the paper column (Try §1's single trail followed backwards)"),
         *teamnav,
     ]
     for col in ("paper", "teamnav"):
-        rows += [LedgerRow(col, name, value, source, ref) for name, value, source, ref in _SHARED_BLAZING]
+        rows += [LedgerRow(col, name, value, source, ref)
+                 for name, value, source, ref in _SHARED_BLAZING + _start_rows("blazing-a-trail")]
     return Ledger(rows, note="paper: the paper as its authors ran it (judged); teamnav: our gap-fills beside it. "
                              "'in-sample' marks a value chosen on the report's own seeds (not on tuning seeds "
                              ">= 1000 by a rule written first): not re-chosen yet")
@@ -146,14 +220,16 @@ def try_ledger() -> Ledger:
         ("broadcast_interval_s", 2.0, "stated", "Try §2.2 step 2: \"it creates a temporary Trail every S seconds (we used S = 2)\""),
         ("crumb_max_age_s", 240.0, "stated", "Try §2.3 step 2: \"Any Crumbs with timestamp older than some threshold (we used 4 minutes) are destroyed\""),
         ("policy", "optimistic", "stated", "Try §3.5: \"The robots' local coordinate systems are therefore initially aligned, so we adopt the optimistic strategy\""),
-        ("radius_m", 3.0, "fill",
-         "in-sample choice: the crumb neighbourhood 3 m chosen against 2, 2.5 and 4 m on report seeds 0-11 "
-         "(trail_share's docstring; fresh seeds 12-23 agreed); not yet re-chosen by a rule on tuning seeds. "
-         "Both columns"),
-        ("navigate.box_reach_m", 2.0, "fill",
-         "in-sample choice: chosen on report seeds 0-7 (the old Z map, blazing_trail.NAVIGATE_DEFAULTS); not yet "
-         "re-chosen on tuning seeds. Both columns"),
-        _START_ROW,
+        ("radius_m", TrailShareParams().radius_m, "fill",
+         "Try §2.3 gives none (\"within a fixed radius of the current position\"). Rule, written before its runs "
+         "(6552f12, seeds cut to 4 in 68bf150): of 1.5, 2, 3, 4, 6 m, the radius with the lowest share of robot "
+         "time off the route (in dead-end branches: how often following the crumbs leads a robot astray), ties "
+         "within one paired s.e. to the smallest; tuning seeds 1000-1003, 30 min, the paper column at 0.25 m/s, "
+         "box_reach_m 2.0, the one-at-a-time start. Off-route share 0.478, 0.414, 0.287, 0.218, 0.255 (6 m "
+         "+0.037 ± 0.037, a tie; 3 m +0.069 ± 0.026): 4 m, an inner point (20 runs, 162 CPU s). 3 m until "
+         "2026-11-29, chosen on report seeds 0-11 by efficiency. Both columns"),
+        ("navigate.box_reach_m", 2.0, "fill", BOX_REACH_REF),
+        *_start_rows("try-to-see-it-my-way"),
         ("heading drift per robot", T.DRIFT_TEXT, "fill",
          "Try §3.6 states Tanis 0.35 and Fly 2 deg/min and the directions (\"Bug's coordinate system rotated "
          "clockwise; the other robots' systems drifted anti-clockwise\"); Bug's and Ant's rates are not given: "
