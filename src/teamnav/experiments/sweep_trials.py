@@ -47,11 +47,40 @@ def trial_id(scenario_name: str, params: Mapping[str, Any], seed: int) -> str:
 
 
 def config_hash(scenario) -> str:
-    """Hash of a resolved scenario without its seed, name and description."""
+    """Hash of a resolved scenario without its seed, name and description, with every robot
+    group's brain parameters as its brain resolves them (defaults included).
+
+    A scenario usually names only the parameters it changes; the rest are the brain's defaults,
+    which belong to teamnav's code. Hashing the resolved parameters means that a trial stored
+    before a default changed (e.g. a trail brain's crumb radius chosen anew) is not taken for the
+    same configuration: a resumed sweep refuses the folder, and no run reuses the stale row.
+    """
     data = scenario.model_dump(mode="json")
     for key in ("seed", "name", "description"):
         data.pop(key, None)
+    groups = data.get("robots")
+    if isinstance(groups, list):
+        for dumped, resolved in zip(groups, _resolved_brain_params(scenario)):
+            if resolved is not None and isinstance(dumped, dict):
+                dumped["params"] = resolved  # a default spelled out is the same configuration
     return _hash(data)
+
+
+def _resolved_brain_params(scenario) -> list:
+    """Per robot group, its controller's ``Params`` with the group's ``params`` applied
+    (``model_dump``); None where the controller or its parameters cannot be resolved here
+    (the group's own ``params`` are hashed then; the run reports the problem itself)."""
+    from teamnav.control import registry
+
+    out = []
+    for group in getattr(scenario, "robots", ()) or ():
+        try:
+            model = getattr(registry.lookup(group.controller), "Params", None)
+            out.append(model.model_validate(dict(group.params or {})).model_dump(mode="json")
+                       if model is not None else None)
+        except Exception:  # noqa: BLE001 - unknown controller or bad params: the run names the problem
+            out.append(None)
+    return out
 
 
 def _blame(exc, grid_keys: Sequence[str]) -> str | None:
