@@ -256,32 +256,26 @@ def main() -> None:
             _sweep(a.out, [(section, {**base, "recover_radius_m": v}) for v in grid], column="teamnav")
     rows = [json.loads(line) for line in a.out.read_text().splitlines() if line] if a.out.exists() else []
     for section in RECOVER_GRID:
-        rec = [dict(r, value=r["extra"]["recover_radius_m"]) for r in rows
-               if "recover_radius_m" in r["extra"] and r["section"] == section]
-        if rec:
-            table, pick = _pick(rec, "off_route_share", sorted({r["value"] for r in rec}), "min")
-            print(f"recover_radius_m, {section} teamnav column: value, mean off-route share, diff vs best, s.e., n")
-            for v, m, d, se, n in table:
-                print(f"  {v:4.1f}  {m:.4f}  {d:+.4f} ± {se:.4f}  n={n}")
-            print(f"  rule's pick: {pick}  (cpu {sum(r['cpu_s'] for r in rec):.0f} s over {len(rec)} runs)")
+        _print_rule(f"recover_radius_m, {section} teamnav column", "mean off-route share", "off_route_share", "min",
+                    [dict(r, value=r["extra"]["recover_radius_m"]) for r in rows
+                     if "recover_radius_m" in r["extra"] and r["section"] == section], ".4f")
     rows = [r for r in rows if "recover_radius_m" not in r["extra"]]
-    box_rows = [dict(r, value=r["extra"]["navigate"]["box_reach_m"]) for r in rows if "radius_m" not in r["extra"]]
-    if box_rows:
-        vals = sorted({r["value"] for r in box_rows})
-        table, pick = _pick(box_rows, "lane_share", vals, "max")
-        print("box_reach_m: value, mean lane share (per seed: mean of both sections), diff vs best, s.e., n")
-        for v, m, d, se, n in table:
-            print(f"  {v:4.1f}  {m:.3f}  {d:+.3f} ± {se:.3f}  n={n}")
-        print(f"  rule's pick: {pick}  (cpu {sum(r['cpu_s'] for r in box_rows):.0f} s over {len(box_rows)} runs)")
-    rad_rows = [dict(r, value=r["extra"]["radius_m"]) for r in rows if "radius_m" in r["extra"]]
-    if rad_rows:
-        vals = sorted({r["value"] for r in rad_rows})
-        table, pick = _pick(rad_rows, "off_route_share", vals, "min")
-        print("radius_m: value, mean off-route share, diff vs best, s.e., n")
-        for v, m, d, se, n in table:
-            print(f"  {v:4.1f}  {m:.4f}  {d:+.4f} ± {se:.4f}  n={n}")
-        print(f"  rule's pick: {pick}  (cpu {sum(r['cpu_s'] for r in rad_rows):.0f} s over {len(rad_rows)} runs)")
+    _print_rule("box_reach_m", "mean lane share (per seed: mean of both sections)", "lane_share", "max",
+                [dict(r, value=r["extra"]["navigate"]["box_reach_m"]) for r in rows if "radius_m" not in r["extra"]],
+                ".3f")
+    _print_rule("radius_m", "mean off-route share", "off_route_share", "min",
+                [dict(r, value=r["extra"]["radius_m"]) for r in rows if "radius_m" in r["extra"]], ".4f")
 
+
+def _print_rule(name: str, what: str, metric: str, best: str, rows: list, fmt: str) -> None:
+    """One rule's table (value, mean, difference from the best, s.e., n) and its pick."""
+    if not rows:
+        return
+    table, pick = _pick(rows, metric, sorted({r["value"] for r in rows}), best)
+    print(f"{name}: value, {what}, diff vs best, s.e., n")
+    for v, m, d, se, n in table:
+        print(f"  {v:4.1f}  {m:{fmt}}  {d:+{fmt}} ± {se:{fmt}}  n={n}")
+    print(f"  rule's pick: {pick}  (cpu {sum(r['cpu_s'] for r in rows):.0f} s over {len(rows)} runs)")
 
 if __name__ == "__main__":
     main()

@@ -66,14 +66,18 @@ def test_the_2002_column_drives_at_the_stated_speed_and_teamnav_says_its_speed_i
     assert "in-sample" in ours[("cruise_speed_mps", T.cruise_mps("try-to-see-it-my-way"))].ref
 
 
-@pytest.mark.skipif(not PAPERS.is_dir(), reason="the papers' texts are not beside this checkout")
-def test_quotes_are_verbatim_in_the_papers():
-    def text(name):
-        return re.sub(r"\s+", " ", (PAPERS / f"vaughan-stoy-sukhatme-mataric-{name}.txt").read_text(encoding="utf-8"))
+def _paper_text(name: str) -> str:
+    return re.sub(r"\s+", " ", (PAPERS / f"vaughan-stoy-sukhatme-mataric-{name}.txt").read_text(encoding="utf-8"))
 
-    assert L.TRY_SINGLE_TRAIL_QUOTE in text("try-to-see-it-my-way")
-    assert L.BLAZING_LITERAL_QUOTE in text("blazing-a-trail")
-    assert L.START_QUOTE in text("blazing-a-trail")
+
+@pytest.mark.skipif(not PAPERS.is_dir(), reason="the papers' texts are not beside this checkout")
+@pytest.mark.parametrize("quote, paper", [
+    ("TRY_SINGLE_TRAIL_QUOTE", "try-to-see-it-my-way"), ("BLAZING_LITERAL_QUOTE", "blazing-a-trail"),
+    ("START_QUOTE", "blazing-a-trail"), ("TRY_START_QUOTE", "try-to-see-it-my-way"),
+    ("BLAZING_GAP_QUOTE", "blazing-a-trail"), ("TRY_GAP_QUOTE", "try-to-see-it-my-way"),
+])
+def test_quotes_are_verbatim_in_the_papers(quote, paper):
+    assert getattr(L, quote) in _paper_text(paper)
 
 
 @pytest.mark.parametrize("build, section", [(L.blazing_ledger, "blazing-a-trail"), (L.try_ledger, "try-to-see-it-my-way")])
@@ -96,11 +100,3 @@ def test_the_start_is_the_papers_one_at_a_time_in_both_columns_with_its_interval
     assert math.hypot(sc.launch.spot[0] - home.x_m, sc.launch.spot[1] - home.y_m) < 1e-9
 
 
-@pytest.mark.skipif(not PAPERS.is_dir(), reason="the papers' texts are not beside this checkout")
-def test_start_and_gap_quotes_are_verbatim_in_the_papers():
-    def text(name):
-        return re.sub(r"\s+", " ", (PAPERS / f"vaughan-stoy-sukhatme-mataric-{name}.txt").read_text(encoding="utf-8"))
-
-    assert L.TRY_START_QUOTE in text("try-to-see-it-my-way")
-    assert L.BLAZING_GAP_QUOTE in text("blazing-a-trail")
-    assert L.TRY_GAP_QUOTE in text("try-to-see-it-my-way")

@@ -114,22 +114,10 @@ class LosHelpMsg:
 
 
 def message_size_bytes(body: LosHelpMsg) -> int:
-    """``Message.size_bytes()`` of a message carrying ``body``, by formula (no recursive walk).
-
-    Header 24 + step 8 + 24 per sighting + 32 per goal + 24 per report (48 with its via point)
-    + 1 for a Tr bit (+ 24 for a pose, + 48 for its covariance); equal to :meth:`teamnav.control.types.Message.size_bytes` (the tests check it).
-    """
-    n = 32 + 24 * len(body.sightings) + 32 * len(body.goals) + 24 * len(body.reports)
-    for r in body.reports:  # a loop, not sum() over a generator: called once per message sent
-        if r.via_d_m is not None:
-            n += 24
-    if body.trouble is not None:
-        n += 1
-    if body.pose is not None:
-        n += 24
-    if body.pose_cov is not None:
-        n += 48
-    return n
+    """``Message.size_bytes()`` of a message carrying ``body``: the 24-byte header and the body
+    by :func:`_payload_size_bytes`'s formula (no recursive walk; the tests check both against
+    the walk)."""
+    return 24 + _payload_size_bytes(body)
 
 
 def _payload_size_bytes(body: LosHelpMsg) -> int:
