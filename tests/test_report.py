@@ -84,9 +84,12 @@ def test_fake_section_renders_every_block_and_second_build_reuses_the_sweep(tmp_
     first = _store_rows(out)
     assert [(seed, attempts) for _, seed, attempts, _ in first] == [(0, 1), (1, 1)]
     summary = json.loads((out / "report.json").read_text())
-    assert summary["sections"][0]["sweeps"][0] | {"elapsed_s": 0} == {
+    first_sweep = summary["sections"][0]["sweeps"][0]
+    assert first_sweep | {"elapsed_s": 0, "trials_cpu_s": 0} == {
         "name": "fake-demo", "folder": str(out / "sweeps" / "fake-demo"), "total": 2, "run": 2, "failed": 0, "reused": 0, "elapsed_s": 0,
+        "trials_cpu_s": 0, "trials_cpu_measured": 2,
     }
+    assert first_sweep["trials_cpu_s"] > 0  # both trials' CPU time, from the store
 
     # again into the same folder: nothing runs, the store is untouched
     res2 = report.run_report("fake-demo", out, quick=True, workers=1, progress=False)

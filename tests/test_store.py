@@ -112,3 +112,26 @@ def test_pandas_reads_the_table(tmp_path):
     df = load_dataframe(tmp_path, sweep="sw")
     assert isinstance(df, pd.DataFrame) and len(df) == 3
     assert sorted(df["v"]) == [0.0, 1.0, 2.0] and sorted(df["robots.0.count"]) == [1, 2, 3]
+
+
+def test_a_trial_keeps_its_cpu_time_and_an_older_store_gains_the_column(tmp_path):
+    from teamnav.experiments.executors import TrialTask, execute
+    from teamnav.experiments.sweep import expand, load_sweep
+
+    # an older store: one row, then the table as it was before cpu_time_s
+    path = tmp_path / STORE_NAME
+    with ResultsStore(path) as store:
+        store.record(_trial("t0"), _result("t0"))
+    con = sqlite3.connect(path)
+    con.execute("ALTER TABLE trials DROP COLUMN cpu_time_s")
+    con.commit()
+    con.close()
+    trial = expand(load_sweep("demo-robots"))[0]
+    res = execute(TrialTask(trial))
+    assert res.status == "ok", res.error
+    assert 0.0 < res.cpu_time_s < 60.0 * res.wall_time_s + 1.0  # a real CPU time of this trial
+    with ResultsStore(path) as store:
+        store.record(trial, res)
+    rows = {r["trial_id"]: r for r in load_rows(path)}
+    assert rows["t0"]["cpu_time_s"] is None  # written before the column: not measured
+    assert rows[trial.trial_id]["cpu_time_s"] == pytest.approx(res.cpu_time_s)

@@ -109,6 +109,7 @@ def execute(task: TrialTask) -> TrialResult:
     """
     started = _now()
     t0 = time.perf_counter()
+    c0 = time.process_time()  # the worker runs one trial at a time: its CPU time is the trial's
     metrics = error = trace = None
     try:
         scenario = task.trial.load()
@@ -127,6 +128,7 @@ def execute(task: TrialTask) -> TrialResult:
         error=error,
         traceback=trace,
         wall_time_s=time.perf_counter() - t0,
+        cpu_time_s=time.process_time() - c0,
         started_at=started,
         finished_at=_now(),
         host=socket.gethostname(),

@@ -19,6 +19,7 @@ Table ``trials`` (a tidy table: one row per trial, one column per variable)::
     error            TEXT               "Type: message" (NULL when ok)
     traceback        TEXT
     wall_time_s      REAL               trial wall time in the worker [s]
+    cpu_time_s       REAL               the worker's CPU time over the trial [s] (NULL: not measured)
     teamnav_version  TEXT
     started_at       TEXT               ISO 8601 UTC
     finished_at      TEXT
@@ -82,9 +83,10 @@ BASE_COLUMNS: dict[str, str] = {
     "attempts": "INTEGER NOT NULL DEFAULT 1",
     "retries": "INTEGER NOT NULL DEFAULT 0",
     "retry_errors": "TEXT",
+    "cpu_time_s": "REAL",
 }
 #: columns added after stores were first written: an older store gets them when opened
-_ADDED_COLUMNS = ("retries", "retry_errors")
+_ADDED_COLUMNS = ("retries", "retry_errors", "cpu_time_s")
 
 _SCHEMA = f"""
 CREATE TABLE IF NOT EXISTS trials ({", ".join(f"{k} {v}" for k, v in BASE_COLUMNS.items())});
@@ -350,6 +352,7 @@ class ResultsStore:
                 "host": result.host,
                 "retries": int(getattr(result, "retries", 0)),
                 "retry_errors": _json(list(result.retry_errors)) if getattr(result, "retry_errors", ()) else None,
+                "cpu_time_s": _cell(float(result.cpu_time_s)) if getattr(result, "cpu_time_s", None) is not None else None,
             }
             for key, value in trial.params.items():
                 row[self._column("param", key, value, taken, names)] = _cell(value)

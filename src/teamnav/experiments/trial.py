@@ -100,6 +100,10 @@ class TrialResult:
         The formatted traceback when failed.
     wall_time_s : float
         Wall time of the trial in the worker (scenario loading included) [s].
+    cpu_time_s : float or None
+        CPU time of the worker process over the trial (``time.process_time``, every thread of
+        the process) [s]: the trial's cost on a shared machine, where wall time also counts the
+        waits for a core; None where not measured (a lost worker's trial).
     started_at, finished_at : str
         ISO 8601 UTC timestamps.
     host : str
@@ -125,3 +129,4 @@ class TrialResult:
     pid: int
     retries: int = 0
     retry_errors: tuple[str, ...] = ()
+    cpu_time_s: float | None = None

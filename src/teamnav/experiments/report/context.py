@@ -71,7 +71,10 @@ class SweepContext:
     ----------
     sweeps : list of dict
         One entry per :meth:`sweep` call: ``name``, ``folder``, ``total``, ``run`` (trials run
-        now), ``failed``, ``reused`` (trials found in the store), ``elapsed_s``.
+        now), ``failed``, ``reused`` (trials found in the store), ``elapsed_s``,
+        ``trials_cpu_s`` (the CPU time of its finished trials as the store recorded them, run
+        now or found there: the sweep's cost on a shared machine) and ``trials_cpu_measured``
+        (how many of them recorded one).
     """
 
     def __init__(
@@ -147,6 +150,7 @@ class SweepContext:
             **kwargs,
         )
         ids = frozenset(t.trial_id for t in expand(spec))
+        cpu, measured = _trials_cpu_s(res.store_path, ids)
         self.sweeps.append(
             {
                 "name": res.name,
@@ -156,6 +160,8 @@ class SweepContext:
                 "failed": res.failed,
                 "reused": res.skipped,
                 "elapsed_s": round(res.elapsed_s, 3),
+                "trials_cpu_s": round(cpu, 3),
+                "trials_cpu_measured": measured,
             }
         )
         return ReportSweepResult(
@@ -169,3 +175,21 @@ class SweepContext:
             failures=res.failures,
             trial_ids=ids,
         )
+
+
+def _trials_cpu_s(store_path, ids: frozenset) -> tuple[float, int]:
+    """The summed CPU time of the trials ``ids`` as the store recorded them (run now or found
+    there), and how many of them have one (a store written before trials kept their CPU time
+    has none)."""
+    import sqlite3
+
+    try:
+        con = sqlite3.connect(f"file:{store_path}?mode=ro", uri=True)
+        try:
+            rows = con.execute("SELECT trial_id, cpu_time_s FROM trials WHERE status = 'ok'").fetchall()
+        finally:
+            con.close()
+    except sqlite3.Error:
+        return 0.0, 0
+    got = [float(c) for tid, c in rows if tid in ids and c is not None]
+    return float(sum(got)), len(got)
