@@ -152,7 +152,9 @@ def modes(part: str, seed: int, duration: float, times: list[float]) -> list[dic
         pts = np.asarray(r["values"]["pts"], dtype=float).reshape(-1, 2)
         xy = _truth(data, int(r["robot"]), tt)[:2]
         near = float(np.mean(np.hypot(pts[:, 0] - xy[0], pts[:, 1] - xy[1]) < NEAR_M))
+        x0, y0 = (float(v) for v in data.true_pose[0, int(r["robot"])][:2])
         out.append({"type": "modes", "part": part, "seed": seed, "robot": int(r["robot"]), "t": tt,
+                    "start_xy": [round(x0, 2), round(y0, 2)],
                     "modes": belief_modes(pts), "near": round(near, 3), "n": r["values"]["n_particles"],
                     "cpu_s": round(time.process_time() - t0, 1)})
     return out
