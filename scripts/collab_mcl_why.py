@@ -20,6 +20,9 @@ Tuning seeds only (>= 1000). One process, at nice 10. Usage::
     PYTHONPATH=src nice -n 10 python scripts/collab_mcl_why.py hexagon --seeds 1000-1002 --out /tmp/why-hex.jsonl
     PYTHONPATH=src nice -n 10 python scripts/collab_mcl_why.py hallway --seeds 1000 --duration 300 --out /tmp/why-hall.jsonl
     python scripts/collab_mcl_why.py summary --out /tmp/why-hex.jsonl
+    PYTHONPATH=src nice -n 10 python scripts/collab_mcl_why.py modes-hexagon --seeds 1000-1002 --out /tmp/why-modes.jsonl
+    PYTHONPATH=src nice -n 10 python scripts/collab_mcl_why.py modes-hallway --seeds 1000-1009 --times 1,5,10,30,60 \
+        --factor sigma+beams --out /tmp/why-modes.jsonl
 
 What was measured with it: docs/report/collab-mcl.md ("2026-11-29: why the paper column fails on the
 judged seeds").
@@ -129,17 +132,18 @@ def one(part: str, seed: int, collaborate: bool, duration: float | None) -> tupl
     return run_row, dets
 
 
-def modes(part: str, seed: int, duration: float, times: list[float]) -> list[dict]:
+def modes(part: str, seed: int, duration: float, times: list[float], factor: str = "paper") -> list[dict]:
     """Alone, paper column, first ``duration`` s: per robot and time, the modes of its 64 logged
     samples (:func:`teamnav.papers.collab_mcl.metrics.belief_modes`: single linkage 1.5 m, >= 10 %)
-    and the share of them within 1.5 m of the truth."""
+    and the share of them within 1.5 m of the truth. ``factor``: one of
+    ``collab_mcl_collapse.FACTORS`` on top of the paper column (a diagnosis, not a fill choice)."""
     from collab_mcl_collapse import PART_SCENARIO, overrides
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
     from teamnav.papers.collab_mcl.metrics import belief_modes
 
     t0 = time.process_time()
-    res = run(load_scenario(PART_SCENARIO[part], overrides=overrides(part, "paper", False), seed=seed,
+    res = run(load_scenario(PART_SCENARIO[part], overrides=overrides(part, factor, False), seed=seed,
                             duration_s=duration), progress=False)
     data = res.data
     out = []
@@ -153,7 +157,7 @@ def modes(part: str, seed: int, duration: float, times: list[float]) -> list[dic
         xy = _truth(data, int(r["robot"]), tt)[:2]
         near = float(np.mean(np.hypot(pts[:, 0] - xy[0], pts[:, 1] - xy[1]) < NEAR_M))
         x0, y0 = (float(v) for v in data.true_pose[0, int(r["robot"])][:2])
-        out.append({"type": "modes", "part": part, "seed": seed, "robot": int(r["robot"]), "t": tt,
+        out.append({"type": "modes", "part": part, "factor": factor, "seed": seed, "robot": int(r["robot"]), "t": tt,
                     "start_xy": [round(x0, 2), round(y0, 2)],
                     "modes": belief_modes(pts), "near": round(near, 3), "n": r["values"]["n_particles"],
                     "cpu_s": round(time.process_time() - t0, 1)})
@@ -228,6 +232,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("part", choices=["hallway", "hexagon", "summary", "modes-hallway", "modes-hexagon"])
     ap.add_argument("--times", default="1,2,5,10,30", help="modes-*: record times [s]")
+    ap.add_argument("--factor", default="paper", help="modes-*: a factor of collab_mcl_collapse.FACTORS")
     ap.add_argument("--seeds", default="1000")
     ap.add_argument("--duration", type=float, default=None)
     ap.add_argument("--conditions", default="alone,team")
@@ -239,13 +244,13 @@ def main(argv: list[str] | None = None) -> int:
     if a.part.startswith("modes-"):
         times = [float(x) for x in a.times.split(",")]
         for seed in parse_seeds(a.seeds):
-            rows = modes(a.part[6:], seed, a.duration or max(times) + 1, times)
+            rows = modes(a.part[6:], seed, a.duration or max(times) + 1, times, a.factor)
             with open(a.out, "a") as f:
                 for r in rows:
                     f.write(json.dumps(r) + "\n")
             for tt in times:
                 g = [r for r in rows if abs(r["t"] - tt) < 0.05]
-                print(f"{a.part} seed {seed} t {tt:.0f} s: modes {[r['modes'] for r in g]} "
+                print(f"{a.part} {a.factor} seed {seed} t {tt:.0f} s: modes {[r['modes'] for r in g]} "
                       f"share near truth {[r['near'] for r in g]} samples {[r['n'] for r in g]}", flush=True)
         return 0
     patch()
