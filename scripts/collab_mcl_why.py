@@ -97,6 +97,7 @@ def first_loc(t: np.ndarray, err: np.ndarray) -> list[float | None]:
 
 def one(part: str, seed: int, collaborate: bool, duration: float | None) -> tuple[dict, list[dict]]:
     from collab_mcl_collapse import PART_DURATION, PART_SCENARIO, overrides
+
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
     from teamnav.papers.collab_mcl.metrics import error_matrix
@@ -138,6 +139,7 @@ def modes(part: str, seed: int, duration: float, times: list[float], factor: str
     and the share of them within 1.5 m of the truth. ``factor``: one of
     ``collab_mcl_collapse.FACTORS`` on top of the paper column (a diagnosis, not a fill choice)."""
     from collab_mcl_collapse import PART_SCENARIO, overrides
+
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
     from teamnav.papers.collab_mcl.metrics import belief_modes
@@ -246,8 +248,7 @@ def main(argv: list[str] | None = None) -> int:
         for seed in parse_seeds(a.seeds):
             rows = modes(a.part[6:], seed, a.duration or max(times) + 1, times, a.factor)
             with open(a.out, "a") as f:
-                for r in rows:
-                    f.write(json.dumps(r) + "\n")
+                f.writelines(json.dumps(r) + "\n" for r in rows)
             for tt in times:
                 g = [r for r in rows if abs(r["t"] - tt) < 0.05]
                 print(f"{a.part} {a.factor} seed {seed} t {tt:.0f} s: modes {[r['modes'] for r in g]} "
@@ -259,8 +260,7 @@ def main(argv: list[str] | None = None) -> int:
             run_row, dets = one(a.part, seed, cond == "team", a.duration)
             with open(a.out, "a") as f:
                 f.write(json.dumps({"type": "run", **run_row}) + "\n")
-                for d in dets:
-                    f.write(json.dumps({"type": "det", "part": a.part, **d}) + "\n")
+                f.writelines(json.dumps({"type": "det", "part": a.part, **d}) + "\n" for d in dets)
             print(f"{a.part} seed {seed} {cond}: cpu {run_row['cpu_s']} s, trees {len(dets)}", flush=True)
     return 0
 
