@@ -41,7 +41,6 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-TUNING_SEED_MIN = 1000
 NEAR_M = 1.5
 CAPT: list[dict] = []
 
@@ -221,13 +220,11 @@ def summary(rows: list[dict]) -> None:
 
 
 def parse_seeds(text: str) -> list[int]:
-    out: list[int] = []
-    for part in text.split(","):
-        a, _, b = part.partition("-")
-        out += list(range(int(a), int(b or a) + 1))
-    if min(out) < TUNING_SEED_MIN:
-        raise SystemExit(f"tuning seeds only (>= {TUNING_SEED_MIN})")
-    return out
+    """Seeds "1000-1009,1012" (tuning seeds only): the fidelity script's parser, beside this one."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from collab_mcl_fidelity import parse_seeds as parse
+
+    return parse(text)
 
 
 def main(argv: list[str] | None = None) -> int:
