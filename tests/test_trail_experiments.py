@@ -76,6 +76,10 @@ def test_a_robot_started_later_begins_its_first_trip_when_it_starts():
     # robot 0: 0 -> 100, robot 1: 25 -> 125 (not 0 -> 125): both first trips take 100 s
     assert m["trip_time_s_before_n"] == 2 and m["trip_time_s_before_mean"] == 100.0
     assert m["units_total"] == 2
+    # and its lifetime counts from its start: 205 - 25 s, not 205 s
+    assert m["lifetime_min.robot0"] == pytest.approx(180 / 60)
+    assert m["lifetime_min.robot1"] == pytest.approx(180 / 60)
+    assert m["place_interval_s"] == pytest.approx((180 + 180) / 4)
 
 
 def test_breakdown_is_censored_when_units_arrive_until_the_end():

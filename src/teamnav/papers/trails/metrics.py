@@ -27,8 +27,9 @@ Definitions (each with the paper passage it stands for):
   its length and ``breakdown_s`` is the run's duration with ``breakdown_censored = 1``. A run
   with no delivery at all breaks down at 0.
 - **Table 1** (Try §3.6) per robot: trips, distance [m] (true path length), lifetime [min] =
-  time of the robot's last place event (the paper's robots stopped when they failed; ours stop
-  being useful when they stop reaching places).
+  from the robot's start (t = 0, or its ``launched`` entry when robots are started one at a
+  time, Try §3.5) to its last place event (the paper's robots stopped when they failed; ours
+  stop being useful when they stop reaching places).
 - **efficiency** (Try §3.6: "average time between Places was (9h43m40s / 262) = 2m13s. This
   gives an average speed of 0.23 m/s ... approximately 92 % of maximum efficiency"): total
   lifetime / trips = ``place_interval_s``; ``place_speed_mps`` = route length / interval, with
@@ -215,9 +216,15 @@ def trail_metrics(data: RunData) -> dict[str, Any]:
     per_units = np.bincount([r for _, r in dl], minlength=n) if dl else np.zeros(n, dtype=int)
     per_trips = np.bincount([x[0] for x in tr], minlength=n) if tr else np.zeros(n, dtype=int)
     dist = _distance_m(data)
-    life = np.zeros(n)
+    last_place_s = np.zeros(n)  # each robot's last place event [s from the run's start]
     for r, _, t1, _, _ in tr:
-        life[r] = max(life[r], t1)
+        last_place_s[r] = max(last_place_s[r], t1)
+    started_s = np.zeros(n)  # when each robot was started (robots started one at a time)
+    for e in data.event_log:
+        if e.get("launched") and 0 <= int(e["robot"]) < n:
+            started_s[int(e["robot"])] = float(e["t_s"])
+    # the lifetime counts from the robot's own start: a robot started later has not lived before
+    life = np.where(last_place_s > 0.0, last_place_s - started_s, 0.0)
     for i in range(n):
         out[f"units.robot{i}"] = int(per_units[i])
         out[f"trips.robot{i}"] = int(per_trips[i])
@@ -228,7 +235,7 @@ def trail_metrics(data: RunData) -> dict[str, Any]:
     out["lifetime_min_total"] = float(life.sum() / 60.0)
     # distance over the same window as the lifetime (each robot up to its last place event):
     # the mean speed over the lifetime is this over lifetime_min_total (3b49c8d, 2026-11-27)
-    out["distance_m_lifetime_total"] = float(_distance_m(data, life).sum())
+    out["distance_m_lifetime_total"] = float(_distance_m(data, last_place_s).sum())
     out["units_per_robot_min"] = int(per_units.min())
     out["units_per_robot_max"] = int(per_units.max())
     if dl:  # keys left out when there is nothing to time (NaN would not compare equal to itself)
