@@ -36,7 +36,8 @@ PAPER_REFS: dict[str, tuple[str, str]] = {
     "beam_stride": ("fill", f"rule 1 of {_RULES}: the highest mean posterior mass within 1 m / 30° of the true pose "
                             "among settings whose sample posterior matches a 0.2 m / 5° grid filter's (mean gap <= 0.1); "
                             "single scans, tuning seeds 1000-1009, corridor and hexagon (scripts/collab_mcl_beam_fill.py)"),
-    "beam.sigma_hit_m": ("fill", "rule 1 (as beam_stride); the sonar's 0.3 m is the first version's, not chosen by a rule"),
+    "beam.sigma_hit_m": ("fill", "rule 1 (as beam_stride); the sonar's 0.3 m is the first version's, not chosen by a rule: the "
+                         "judged run's two paper-column failures (2026-11-29) trace to it; rule 8 chooses it next"),
     "beam.z_hit": ("fill", "Fig. 1 gives the mixture's parts, not their weights; 0.7/0.1/0.1/0.1 kept from the first "
                            "version, not chosen by a rule"),
     "beam.z_short": ("fill", "as beam.z_hit"), "beam.z_max": ("fill", "as beam.z_hit"),
