@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from teamnav.localization import BeamModelParams, KLDParams, MCL, MCLParams
 from teamnav.papers.collab_mcl.beam_fill import Criterion, FillCase, choose
@@ -46,6 +48,36 @@ def test_fill_criterion_sees_a_sample_set_too_small_for_a_sharp_model():
     # the rule picks a setting whose samples match the grid
     r = choose([c2], [0.1, 1.6], [1, 9], 180)
     assert r["mean_gap"] <= 0.1
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.floats(0.5, 5.5), st.floats(0.5, 3.5), st.floats(-math.pi, math.pi), st.sampled_from([1, 2, 4]),
+       st.sampled_from([0.1, 0.5, 2.0]))
+def test_the_sonar_criterion_scores_a_pose_as_the_filter_does(x, y, th, stride, sigma):
+    """Rule 8's criterion must weigh a pose by the filter's own sonar likelihood: each cone's
+    expected range is the minimum over the rays the filter casts across it, and every
+    ``stride``-th transducer is multiplied (Fox §5.2, ``localization.mcl``)."""
+    from teamnav.localization.beam_model import BeamTable
+    from teamnav.papers.collab_mcl.beam_fill import _ranges, _stride_sums
+    from teamnav.sim.config import SonarConfig
+
+    g = _room()
+    sensor = build_range_sensor(SonarConfig(n_transducers=16, cone_deg=15, rays_per_cone=5, max_range_m=5.0,
+                                            noise_std_m=0.05), g)
+    crit = Criterion(g, sensor, BEAM, [sigma], [stride], n_samples=10, cone_deg=15.0, rays_per_cone=3)
+    scan = np.minimum(sensor.sense(np.array([3.0]), np.array([1.0]), np.array([0.4]), np.random.default_rng(5))[0],
+                      sensor.max_range_m)
+    pose = np.array([[x, y, th]])
+    beam = BEAM.model_copy(update={"sigma_hit_m": sigma})
+    bt = BeamTable(beam.model_copy(update={"table_step_m": None}), sensor.max_range_m)
+    ours = _stride_sums(_ranges(crit.caster, pose, crit.angles, offsets=crit.offsets), bt(scan), 1.0 / bt.step_m,
+                        np.array([stride]), np.empty((1, 1)))[0, 0]
+    p = MCLParams(n_particles=10, beam=beam, beam_stride=stride, sonar_cone_deg=15.0, sonar_rays_per_cone=3,
+                  adaptive=False, recovery="none", parallel=False)
+    mcl = MCL(p, g, sensor.info(), np.random.default_rng(0))
+    mcl.init_global()
+    theirs = mcl.pose_log_likelihood(pose, scan)[0]
+    assert ours == pytest.approx(theirs, rel=1e-3, abs=1e-3)  # ranges kept as float32 by the criterion
 
 
 def test_choose_prefers_fewer_beams_on_a_tie_and_rejects_a_grid_without_admissible_settings():

@@ -17,6 +17,12 @@ run:
 - the choice (:func:`choose`): the highest mean ``m_s`` among the settings whose mean
   ``|m_s - m_g|`` is at most 0.1; a tie within 0.01 goes to fewer beams.
 
+The sonar's model (rule 8, written after the judged run's paper-column failures were traced to the
+sonar's never-chosen ``sigma_hit_m`` 0.3 m and its 16 cones) is chosen by the same criterion over
+``sigma_hit_m`` x cones used (``beam_stride`` over the 16 transducers), the cases on the symmetric
+hallway and the hexagon with a sonar robot, each cone's expected range the minimum over the rays
+the filter casts across it (:func:`cone_offsets`).
+
 The criterion looks at the ground truth and at the grid, never at a claim. Deviation, said here:
 the grid is 0.2 m and 5° (a pose's nearest grid cell is up to 0.14 m and 2.5° off, 0.35 m at 8 m of
 range), so for the sharpest models the grid posterior is itself coarse; ``m_g`` is read as the
@@ -115,13 +121,27 @@ def _near_mass(ll: np.ndarray, poses: np.ndarray, truth: np.ndarray) -> np.ndarr
     return w[near].sum(axis=0)
 
 
-def _ranges(caster: RayCaster, poses: np.ndarray, angles: np.ndarray, chunk: int = 50_000) -> np.ndarray:
+def cone_offsets(cone_deg: float, rays_per_cone: int) -> np.ndarray:
+    """The filter's rays across one sonar cone [rad] (``localization.mcl``: ``linspace`` over the
+    opening; one ray at 0 for a laser)."""
+    if rays_per_cone > 1 and cone_deg > 0:
+        half = math.radians(cone_deg) / 2
+        return np.linspace(-half, half, rays_per_cone)
+    return np.zeros(1)
+
+
+def _ranges(caster: RayCaster, poses: np.ndarray, angles: np.ndarray, chunk: int = 50_000,
+            offsets: np.ndarray | None = None) -> np.ndarray:
+    """Expected ranges (P, B): one ray per beam, or for a sonar the minimum over the rays cast
+    across each cone at ``angles[b] + offsets`` (the filter's own expected distance, Fox §5.2)."""
+    k = 1 if offsets is None else int(offsets.shape[0])
+    rays = angles if k == 1 else np.ascontiguousarray((angles[:, None] + offsets[None, :]).ravel())
     out = np.empty((poses.shape[0], angles.shape[0]), dtype=np.float32)
-    buf = np.empty((min(chunk, poses.shape[0]), angles.shape[0]))
+    buf = np.empty((min(chunk, poses.shape[0]), rays.shape[0]))
     for a in range(0, poses.shape[0], chunk):
         p = poses[a:a + chunk]
-        r = caster.cast_xyt(p[:, 0], p[:, 1], p[:, 2], angles, out=buf[:p.shape[0]], parallel=False)
-        out[a:a + p.shape[0]] = r
+        r = caster.cast_xyt(p[:, 0], p[:, 1], p[:, 2], rays, out=buf[:p.shape[0]], parallel=False)
+        out[a:a + p.shape[0]] = r if k == 1 else r.reshape(p.shape[0], angles.shape[0], k).min(axis=2)
     return out
 
 
@@ -145,10 +165,14 @@ class Criterion:
         The grid filter's resolution.
     clearance_m : float
         The filter's uniform prior's clearance (``init_clearance_m``).
+    cone_deg, rays_per_cone : float, int
+        A sonar's cone as the filter models it (``sonar_cone_deg``, ``sonar_rays_per_cone``): the
+        expected range of a cone is the minimum over its rays. ``rays_per_cone`` 1 for a laser.
     """
 
     def __init__(self, grid, sensor, beam: BeamModelParams, sigmas, strides, n_samples: int,
-                 grid_step_m: float = 0.2, grid_step_deg: float = 5.0, clearance_m: float = 0.2):
+                 grid_step_m: float = 0.2, grid_step_deg: float = 5.0, clearance_m: float = 0.2,
+                 cone_deg: float = 0.0, rays_per_cone: int = 1):
         self.grid = grid
         self.sensor = sensor
         self.beam = beam
@@ -158,8 +182,9 @@ class Criterion:
         self.clearance_m = clearance_m
         self.caster = RayCaster(grid, sensor.sees, sensor.max_range_m)
         self.angles = np.ascontiguousarray(sensor.angles_rad, dtype=np.float64)
+        self.offsets = None if rays_per_cone <= 1 else cone_offsets(cone_deg, rays_per_cone)
         self.poses = grid_poses(grid, grid_step_m, grid_step_deg, clearance_m)
-        self.ranges = _ranges(self.caster, self.poses, self.angles)
+        self.ranges = _ranges(self.caster, self.poses, self.angles, offsets=self.offsets)
         self._free = np.argwhere((grid.cells == FREE) & (distance_field(grid) >= clearance_m))
 
     def _uniform(self, rng: np.random.Generator, n: int) -> np.ndarray:
@@ -177,7 +202,7 @@ class Criterion:
         scan = self.sensor.sense(truth[:1], truth[1:2], truth[2:3], rng)[0]
         scan = np.minimum(scan, self.sensor.max_range_m)
         samples = self._uniform(rng, self.n_samples)
-        s_ranges = _ranges(self.caster, samples, self.angles)
+        s_ranges = _ranges(self.caster, samples, self.angles, offsets=self.offsets)
         m_s = np.empty((len(self.sigmas), self.strides.shape[0]))
         m_g = np.empty_like(m_s)
         for i, sigma in enumerate(self.sigmas):
