@@ -138,7 +138,8 @@ def test_hexagon_sonar_robots_cannot_tell_three_locations_apart_laser_robots_two
     locations ..., robots equipped with laser range-finders remain uncertain about two". The
     filter's own likelihood of a noise-free scan at the six turns of the pose about the hexagon's
     centre: as likely as the truth (within 1 nat) at three turns for a sonar robot, two for a laser
-    robot (the paper column's models: sonar sigma 0.3 m, 16 cones; laser the fill's 10 beams, 0.8 m)."""
+    robot (the paper column's models, the fills of rules 1 and 8: sonar 16 cones, sigma 0.8 m; laser 10
+    beams, 0.8 m)."""
     from teamnav.sim.config import SonarConfig
     from teamnav.world.generators import builtin_map
 
@@ -151,7 +152,7 @@ def test_hexagon_sonar_robots_cannot_tell_three_locations_apart_laser_robots_two
                       for a in np.arange(6) * math.pi / 3])
     kinds = {
         "sonar": (SonarConfig(n_transducers=16, fov_deg=360, cone_deg=15, rays_per_cone=5, max_range_m=5.0,
-                              noise_std_m=0.05, p_specular=0.0), BEAM.model_copy(update={"sigma_hit_m": 0.3}), 1, 3),
+                              noise_std_m=0.05, p_specular=0.0), BEAM.model_copy(update={"sigma_hit_m": 0.8}), 1, 3),
         "laser": (LaserConfig(n_beams=180, fov_deg=179, max_range_m=8.0, noise_std_m=0.05),
                   BEAM.model_copy(update={"sigma_hit_m": 0.8}), 18, 2),
     }

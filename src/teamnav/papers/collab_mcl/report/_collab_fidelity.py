@@ -36,8 +36,11 @@ PAPER_REFS: dict[str, tuple[str, str]] = {
     "beam_stride": ("fill", f"rule 1 of {_RULES}: the highest mean posterior mass within 1 m / 30° of the true pose "
                             "among settings whose sample posterior matches a 0.2 m / 5° grid filter's (mean gap <= 0.1); "
                             "single scans, tuning seeds 1000-1009, corridor and hexagon (scripts/collab_mcl_beam_fill.py)"),
-    "beam.sigma_hit_m": ("fill", "rule 1 (as beam_stride); the sonar's 0.3 m is the first version's, not chosen by a rule: the "
-                         "judged run's two paper-column failures (2026-11-29) trace to it; rule 8 chooses it next"),
+    "beam.sigma_hit_m": ("fill", "the laser's: rule 1 (as beam_stride); the sonar's 0.8 m with all 16 cones: rule 8 of "
+                         f"{_RULES}, the same criterion over sigma_hit {{0.1 .. 2.0}} x cones {{16, 8, 4, 2}}, tuning seeds "
+                         "1000-1009, symmetric hallway and hexagon (scripts/collab_mcl_beam_fill.py --sensor sonar); it "
+                         "replaced the first version's 0.3 m, to which the judged run of 2026-11-29 traced both "
+                         "paper-column failures"),
     "beam.z_hit": ("fill", "Fig. 1 gives the mixture's parts, not their weights; 0.7/0.1/0.1/0.1 kept from the first "
                            "version, not chosen by a rule"),
     "beam.z_short": ("fill", "as beam.z_hit"), "beam.z_max": ("fill", "as beam.z_hit"),
@@ -62,9 +65,9 @@ PAPER_REFS: dict[str, tuple[str, str]] = {
 
 #: teamnav column: field -> ref (source "fill": teamnav's gap-fills beyond the paper)
 TEAMNAV_REFS: dict[str, str] = {
-    "likelihood_exponent": "tempering against correlated beams (not eq. 12); hallway 0.1, hexagon sonar 0.1 / laser "
-                           "0.01 and §5.1 0.03 chosen on report seeds 0-7 (in-sample; hexagon re-checked on 6 tuning "
-                           "seeds), for the 90-beam laser before the 2026-11-29 fill",
+    "likelihood_exponent": "1 in every group since 2026-11-29, as eq. 12 has it (rules 5 and 8 of docs/report/"
+                           "collab-mcl.md): the tempering chosen on report seeds 0-7 (hallway 0.1, hexagon sonar 0.1 / "
+                           "laser 0.01, §5.1 0.03) was for the beam models the fills replaced",
     "inject_fraction": "sensor resetting on a received tree (Lenser & Veloso 2000): what moves the §5.1 and §5.2 rows "
                        "of this column ('with sensor resetting')",
     "inject_heading_belief_share": "draws' headings not from the own belief; hexagon: chosen on report seeds 0-7 "
