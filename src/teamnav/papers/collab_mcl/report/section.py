@@ -19,8 +19,8 @@ its verdict is judged on.
 
 Verdict rules are read from ``papers/collab_mcl/claims/collab-mcl.yaml`` (:mod:`teamnav.experiments.claims`),
 never written here, and judged on the column each claim names (the paper as written, except the
-two §7.2 extensions only teamnav has); the seeds are the claim's judged seeds (2000-2029, named
-before any run on them; its ``quick_seeds`` in quick mode; tuning seeds are 1000-1999 and never run
+two §7.2 extensions only teamnav has); the seeds are the claim's judged seeds (3000-3029 since rule 8's sonar
+model, named before any run on them; its ``quick_seeds`` in quick mode; tuning seeds are 1000-1999 and never run
 here).
 
 - §5.2.1 / Fig. 12: ``collab-mcl-hallway``, 8 sonar robots, single vs collaborative MCL:
