@@ -431,6 +431,34 @@ def _anchored_squares(free, out):
                 out[r, c] = min(np.int64(m) + 1, _MAX_CLEAR)
 
 
+@njit(cache=True)
+def _clearance_into(blocking, out):
+    """Fill ``out`` (H + 2, W + 2, 4) with :func:`clearance_map` of ``blocking`` (H, W) in place.
+
+    For quadrant ``q`` it is :func:`_anchored_squares` of the padded free mask flipped towards
+    the quadrant, run in the original axes: the same recurrence over the same cells, so the
+    same codes, without the flipped copies, the four planes and their transposed copy (5 bytes
+    a cell beside the 4 of the result: 125 MB for a 10 000-robot arena at 2 cm).
+    """
+    h = blocking.shape[0] + 2
+    w = blocking.shape[1] + 2
+    for q in range(4):
+        dr = -1 if q & 2 else 1  # the neighbour towards the quadrant
+        dc = -1 if q & 1 else 1
+        for i in range(h):
+            r = h - 1 - i if dr == 1 else i
+            last_r = r == (h - 1 if dr == 1 else 0)
+            for j in range(w):
+                c = w - 1 - j if dc == 1 else j
+                if r == 0 or r == h - 1 or c == 0 or c == w - 1 or blocking[r - 1, c - 1] != 0:
+                    out[r, c, q] = 0
+                elif last_r or c == (w - 1 if dc == 1 else 0):
+                    out[r, c, q] = 1
+                else:
+                    m = min(out[r + dr, c, q], out[r, c + dc, q], out[r + dr, c + dc, q])
+                    out[r, c, q] = min(np.int64(m) + 1, _MAX_CLEAR)
+
+
 def clearance_map(blocking: np.ndarray) -> np.ndarray:
     """Padded per-quadrant clearance maps used by the ray caster.
 
@@ -457,15 +485,9 @@ def clearance_map(blocking: np.ndarray) -> np.ndarray:
     (2, 2, 0)
     """
     blocking = _check_blocking(blocking)
-    free = np.zeros((blocking.shape[0] + 2, blocking.shape[1] + 2), dtype=np.bool_)
-    free[1:-1, 1:-1] = blocking == 0
-    out = np.empty((4,) + free.shape, dtype=np.uint8)
-    for q in range(4):
-        flip = (slice(None, None, -1 if q & 2 else 1), slice(None, None, -1 if q & 1 else 1))
-        sq = np.empty(free.shape, np.uint8)
-        _anchored_squares(np.ascontiguousarray(free[flip]), sq)
-        out[q] = sq[flip]
-    return np.ascontiguousarray(out.transpose(1, 2, 0))
+    out = np.empty((blocking.shape[0] + 2, blocking.shape[1] + 2, 4), dtype=np.uint8)
+    _clearance_into(blocking, out)
+    return out
 
 
 _CLEAR_CACHE: dict[int, tuple[weakref.ref, np.ndarray]] = {}

@@ -1,0 +1,59 @@
+"""Memory savings on a map's per-cell arrays that change no value.
+
+- The ray caster's clearance maps are filled in place (``raycast._clearance_into``): the codes
+  are those of the former construction (four flipped copies of the padded free mask, one
+  anchored-squares pass each, then a transposed copy), kept here as the reference.
+- A map whose cells are only free and wall (every generated arena) hands out its own cell
+  array as the blocking mask of every sensor that sees walls: the same bytes, not a copy.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings, strategies as st
+from hypothesis.extra.numpy import arrays
+
+from teamnav.world import raycast
+from teamnav.world.grid import DEFAULT_SEES, FREE, GLASS, WALL, OccupancyGrid
+
+
+def _reference_clearance(blocking: np.ndarray) -> np.ndarray:
+    free = np.zeros((blocking.shape[0] + 2, blocking.shape[1] + 2), dtype=np.bool_)
+    free[1:-1, 1:-1] = blocking == 0
+    out = np.empty((4,) + free.shape, dtype=np.uint8)
+    for q in range(4):
+        flip = (slice(None, None, -1 if q & 2 else 1), slice(None, None, -1 if q & 1 else 1))
+        sq = np.empty(free.shape, np.uint8)
+        raycast._anchored_squares(np.ascontiguousarray(free[flip]), sq)
+        out[q] = sq[flip]
+    return np.ascontiguousarray(out.transpose(1, 2, 0))
+
+
+@settings(max_examples=60, deadline=None)
+@given(blocking=arrays(np.uint8, st.tuples(st.integers(1, 40), st.integers(1, 40)),
+                       elements=st.sampled_from([0, 0, 0, 1])))
+def test_clearance_maps_in_place_are_the_former_ones(blocking):
+    got = raycast.clearance_map(blocking)
+    want = _reference_clearance(blocking)
+    assert got.shape == want.shape and got.dtype == want.dtype and got.flags.c_contiguous
+    assert np.array_equal(got, want)
+
+
+def test_clearance_codes_reach_the_cap_in_open_space():
+    b = np.zeros((600, 560), np.uint8)
+    b[300, 140] = 1
+    got = raycast.clearance_map(b)
+    assert got.max() == 255 and np.array_equal(got, _reference_clearance(b))
+
+
+@settings(max_examples=40, deadline=None)
+@given(cells=arrays(np.uint8, st.tuples(st.integers(1, 30), st.integers(1, 30)),
+                    elements=st.sampled_from([FREE, FREE, WALL, GLASS])))
+def test_blocking_masks_are_shared_only_when_equal(cells):
+    g = OccupancyGrid(cells, 0.1)
+    for sees in [None, *DEFAULT_SEES.values(), ("glass",), ("foam",)]:
+        mask = g.blocking(sees)
+        want = (cells != FREE) if sees is None else g.visible_ids(sees)[cells]
+        assert mask.dtype == np.uint8 and not mask.flags.writeable
+        assert np.array_equal(mask, want.astype(np.uint8))
+        assert (mask is g.cells) == (np.array_equal(mask, g.cells))  # shared exactly when the bytes agree
