@@ -17,7 +17,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from teamnav.sim import collisions
-from teamnav.sim.config import ProximityConfig, RobotGroupConfig, SimConfig, StartConfig
+from teamnav.sim.config import LaserConfig, ProximityConfig, RobotGroupConfig, SimConfig, StartConfig
 from teamnav.sim.engine import Simulation
 from teamnav.sim.start import _Candidates, start_poses
 from teamnav.world import distance
@@ -93,14 +93,20 @@ def test_start_poses_are_the_dense_fields(yaw, block, seed):
 
 def _run(cells, monkeypatch, coarse: bool, steps: int = 60):
     import teamnav.sim.engine as engine
+    from teamnav.world import raycast
 
     monkeypatch.setattr(engine, "COARSE_FIELD_CELLS", 1 if coarse else 10**12)
+    monkeypatch.setattr(raycast, "TILED_CLEARANCE_CELLS", 1 if coarse else 10**12)  # and tiled clearance maps
     g = OccupancyGrid(cells, 0.02, (-0.02, -0.02))
     cfg = SimConfig(robots=(RobotGroupConfig(count=150, radius_m=0.08, max_v_mps=0.2, controller="wander-batched-v1",
-                                             params={"cruise_speed_mps": 0.15}, sensors=(ProximityConfig(),)),),
+                                             params={"cruise_speed_mps": 0.15}, sensors=(ProximityConfig(),)),
+                            RobotGroupConfig(count=10, radius_m=0.15, controller="wander-batched-v1",
+                                             sensors=(LaserConfig(n_beams=90, fov_deg=270.0, max_range_m=3.0),))),
                     seed=3, record_every=1_000_000)
     sim = Simulation(g, cfg)
     assert (sim._clear_m.shape != cells.shape) == coarse
+    assert all(isinstance(s.caster.clearance, tuple) == coarse for grp in sim._groups for s in grp.sensors
+               if hasattr(s, "caster"))
     out = []
     for _ in range(steps):
         sim.step()

@@ -57,3 +57,48 @@ def test_blocking_masks_are_shared_only_when_equal(cells):
         assert mask.dtype == np.uint8 and not mask.flags.writeable
         assert np.array_equal(mask, want.astype(np.uint8))
         assert (mask is g.cells) == (np.array_equal(mask, g.cells))  # shared exactly when the bytes agree
+
+
+# ---------------------------------------------------------------------------- tiled clearance
+def _tiles_to_dense(tiles) -> np.ndarray:
+    pool, index, dims = tiles
+    s = raycast.TILE_CELLS
+    r, c = np.meshgrid(np.arange(dims[0]), np.arange(dims[1]), indexing="ij")
+    return np.stack([pool[index[q][r // s, c // s], r % s, c % s] for q in range(4)], axis=-1)
+
+
+@settings(max_examples=40, deadline=None)
+@given(blocking=arrays(np.uint8, st.tuples(st.integers(1, 120), st.integers(1, 120)),
+                       elements=st.sampled_from([0] * 30 + [1])))
+def test_clearance_tiles_hold_the_same_codes(blocking):
+    assert np.array_equal(_tiles_to_dense(raycast.clearance_tiles(blocking)), raycast.clearance_map(blocking))
+
+
+def test_an_open_arena_shares_its_tiles():
+    b = np.zeros((1000, 1000), np.uint8)
+    b[0, :] = b[-1, :] = b[:, 0] = b[:, -1] = 1
+    pool, index, _ = raycast.clearance_tiles(b)
+    assert pool.nbytes * 20 < raycast.clearance_map(b).nbytes
+    assert np.array_equal(_tiles_to_dense((pool, index, _)), raycast.clearance_map(b))
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 1000), h=st.integers(5, 150), w=st.integers(5, 150), n=st.integers(0, 15))
+def test_rays_through_tiles_are_the_dense_rays_bit_for_bit(seed, h, w, n):
+    rng = np.random.default_rng(seed)
+    cells = np.zeros((h, w), np.uint8)
+    for _ in range(n):
+        r, c = int(rng.integers(0, h)), int(rng.integers(0, w))
+        cells[r:r + int(rng.integers(1, 20)), c:c + int(rng.integers(1, 20))] = WALL
+    g = OccupancyGrid(cells, 0.05, (0.3, -0.2))
+    dense = raycast.RayCaster(g, max_range_m=4.0)
+    tiled = raycast.RayCaster(g, max_range_m=4.0)
+    tiled.clearance = raycast.clearance_tiles(tiled.blocking)
+    p = np.column_stack([rng.uniform(0.2, 0.4 + w * 0.05, 64), rng.uniform(-0.3, w * 0.05, 64),
+                         rng.uniform(-np.pi, np.pi, 64)])
+    p[:8, :2] = np.round(p[:8, :2] / 0.05) * 0.05  # on grid lines and vertices
+    beams = np.linspace(-np.pi, np.pi, 37)
+    for parallel in (False, True):
+        want = dense.cast(p, beams, parallel=parallel)
+        got = tiled.cast(p, beams, parallel=parallel)
+        assert np.array_equal(got.view(np.uint64), want.view(np.uint64))
