@@ -102,3 +102,30 @@ def test_rays_through_tiles_are_the_dense_rays_bit_for_bit(seed, h, w, n):
         want = dense.cast(p, beams, parallel=parallel)
         got = tiled.cast(p, beams, parallel=parallel)
         assert np.array_equal(got.view(np.uint64), want.view(np.uint64))
+
+
+def test_sensor_kernels_read_tiles_as_the_dense_maps_serial_and_parallel():
+    """The engine's fused sensing kernels (robot bodies, capped map cast, keyed noise), on
+    enough rays to take the parallel path (``PARALLEL_MIN_RAYS``) and on few."""
+
+    from teamnav.sim.config import LaserConfig
+    from teamnav.sim.sensors.range_sensors import build_range_sensor
+
+    rng = np.random.default_rng(4)
+    cells = np.zeros((260, 240), np.uint8)
+    cells[0, :] = cells[-1, :] = cells[:, 0] = cells[:, -1] = WALL
+    for _ in range(30):
+        r, c = int(rng.integers(0, 250)), int(rng.integers(0, 230))
+        cells[r:r + int(rng.integers(1, 9)), c:c + int(rng.integers(1, 9))] = WALL
+    g = OccupancyGrid(cells, 0.05, (0.0, 0.0))
+    cfg = LaserConfig(n_beams=90, fov_deg=270.0, max_range_m=5.0)
+    dense, tiled = build_range_sensor(cfg, g), build_range_sensor(cfg, g)
+    tiled.caster.clearance = raycast.clearance_tiles(tiled.caster.blocking)
+    for n in (400, 7):  # 36 000 rays (parallel with 2 threads) and 630
+        xs, ys = rng.uniform(0.3, 11.7, n), rng.uniform(0.3, 12.7, n)
+        th = rng.uniform(-np.pi, np.pi, n)
+        bodies = (xs, ys, np.full(n, 0.15), np.arange(n))
+        for b in (None, bodies):
+            want = dense.sense(xs, ys, th, np.random.default_rng(1), b)
+            got = tiled.sense(xs, ys, th, np.random.default_rng(1), b)
+            assert np.array_equal(got.view(np.uint64), want.view(np.uint64))
