@@ -2,7 +2,7 @@
 
 A 10 000-robot arena at 2 cm has 25 M cells: its dense float64 distance field took 200 MB (and
 scipy's transform 400 MB more while it ran). The simulator keeps, for maps of at least
-``COARSE_FIELD_CELLS`` cells, one lower bound per 16 x 16 block instead
+``COARSE_FIELD_CELLS`` cells (2 M), one lower bound per 16 x 16 block instead
 (:func:`teamnav.world.distance.clearance_bound`). These tests check on small maps (the block
 side and the size limit lowered) that the bound is a bound, that start poses are the dense
 field's bit for bit, rotated maps and regions included, and that a run moves the same.
@@ -126,4 +126,10 @@ def test_a_run_on_the_bound_moves_as_on_the_field(monkeypatch):
 
 
 def test_the_simulator_takes_the_bound_only_for_huge_maps():
-    assert distance.COARSE_FIELD_CELLS > 4_000_000  # every paper map is smaller: their runs are untouched
+    """The largest built-in map (the MIT basement, demo and papers) stays on the dense forms."""
+    from teamnav.experiments.spec import build_grid, load_scenario
+    from teamnav.world import raycast
+
+    g = build_grid(load_scenario("demo"))
+    assert g.cells.size == 1200 * 1200
+    assert distance.COARSE_FIELD_CELLS > g.cells.size and raycast.TILED_CLEARANCE_CELLS > g.cells.size

@@ -18,9 +18,10 @@ from teamnav.world.raycast import _check_blocking, _check_positive
 __all__ = ["COARSE_BLOCK_CELLS", "COARSE_FIELD_CELLS", "clearance_bound", "distance_field", "likelihood_field"]
 
 #: Maps of at least this many cells get :func:`clearance_bound` in the simulator instead of a
-#: dense :func:`distance_field` (a 10 000-robot arena at 2 cm has 25 M cells; every paper map
-#: has fewer than 4 M, so their runs never take this path).
-COARSE_FIELD_CELLS: int = 16_000_000
+#: dense :func:`distance_field` (the swarm arena at 2 cm has 2.5 M cells for 1000 robots, 25 M
+#: for 10 000). The largest built-in map (the MIT basement, 1200 x 1200, of the demo and the
+#: papers' runs) has 1.44 M, so no built-in run takes this path.
+COARSE_FIELD_CELLS: int = 2_000_000
 #: Side [cells] of the blocks of :func:`clearance_bound` (a power of 2).
 COARSE_BLOCK_CELLS: int = 16
 

@@ -70,9 +70,10 @@ REFERENCE_STEP_CELLS: float = 1e-3
 #: Largest code stored (uint8): larger free squares are simply crossed in several jumps.
 _MAX_CLEAR: int = 255
 #: Maps of at least this many cells keep their clearance maps as shared tiles
-#: (:func:`clearance_tiles`): a 10 000-robot arena at 2 cm has 25 M cells; every paper map
-#: has fewer than 4 M, so their ray casts never read tiles.
-TILED_CLEARANCE_CELLS: int = 16_000_000
+#: (:func:`clearance_tiles`): the swarm arena at 2 cm has 2.5 M cells for 1000 robots, 25 M
+#: for 10 000. The largest built-in map (the MIT basement, 1200 x 1200) has 1.44 M, so no
+#: built-in run reads tiles.
+TILED_CLEARANCE_CELLS: int = 2_000_000
 _TILE_SHIFT = 5
 #: Side [cells] of a clearance tile.
 TILE_CELLS: int = 1 << _TILE_SHIFT
