@@ -106,8 +106,8 @@ def test_rays_through_tiles_are_the_dense_rays_bit_for_bit(seed, h, w, n):
 
 def test_sensor_kernels_read_tiles_as_the_dense_maps_serial_and_parallel():
     """The engine's fused sensing kernels (robot bodies, capped map cast, keyed noise), on
-    enough rays to take the parallel path (``PARALLEL_MIN_RAYS``) and on few."""
-
+    enough rays to take the parallel path (``PARALLEL_MIN_RAYS``, with numba's threads > 1) and
+    on few."""
     from teamnav.sim.config import LaserConfig
     from teamnav.sim.sensors.range_sensors import build_range_sensor
 
