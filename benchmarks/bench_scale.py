@@ -14,8 +14,10 @@ thread count is set before numba starts):
   once with its ``build`` command; ``--argos-build`` or ``$TEAMNAV_BENCH_ARGOS_BUILD``, default
   ``/tmp/argos3-build``). ARGoS runs with the same number of threads (its ``<system threads>``;
   1 thread = its main thread only, ``threads="0"``).
-- ``laser``: the laser case of ``bench_engine.py`` (180 beams, 10 m, the MIT basement map), no
-  peer (IR-SIM does not reach 10 000 robots in minutes; ``bench_engine.py`` has it at 10-1000).
+- ``laser``: the robots of ``bench_engine.py``'s laser case (radius 0.2 m, a 180-beam, 10-m
+  laser, the batched wanderer) in the swarm's walled arena (side 1 m x sqrt(N), 2 cm cells), no
+  peer (IR-SIM does not reach 10 000 robots in minutes; ``bench_engine.py`` has it at 10-1000 on
+  the MIT basement map, which cannot hold 10 000 such robots: its start gives up near 2 000).
 
 Printed per cell: robot-steps per second (wall clock) and per CPU-second, the real-time factor
 (simulated seconds per wall second at the scenario's 0.1-s step), and the peak resident memory
@@ -51,6 +53,18 @@ def _steps(mode: str, n: int) -> int:
     return table.get(n, max(2, int(table[1000] * 1000 / n)))
 
 
+def laser_arena_sim(n: int, seed: int = 0):
+    """``n`` laser robots (``bench_engine.py``'s laser group) in the swarm arena of ``n`` robots."""
+    sys.path.insert(0, str(HERE))
+    from bench_engine import swarm_arena
+    from teamnav.sim.config import LaserConfig, RobotGroupConfig, SimConfig
+    from teamnav.sim.engine import Simulation
+
+    group = RobotGroupConfig(count=n, radius_m=0.2, controller="wander-batched-v1",
+                             sensors=(LaserConfig(n_beams=180, fov_deg=180.0, max_range_m=10.0),))
+    return Simulation(swarm_arena(n), SimConfig(robots=(group,), seed=seed, record_every=1_000_000))
+
+
 def child(case: str, n: int, steps: int) -> dict:
     """Build and time one cell in this process (numba threads come from the environment)."""
     sys.path.insert(0, str(HERE))
@@ -58,7 +72,7 @@ def child(case: str, n: int, steps: int) -> dict:
 
     from bench_engine import build_sim
 
-    sim = build_sim(case, "batched", n)
+    sim = build_sim(case, "batched", n) if case == "swarm" else laser_arena_sim(n)
     for _ in range(3):
         sim.step()
     t0, c0 = time.perf_counter(), time.process_time()

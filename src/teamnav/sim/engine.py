@@ -83,7 +83,7 @@ from teamnav.sim.radio import Radio
 from teamnav.sim.recorder import Recorder
 from teamnav.sim.start import start_poses
 from teamnav.sim.state import RobotState
-from teamnav.world.distance import distance_field
+from teamnav.world.distance import COARSE_FIELD_CELLS, clearance_bound, distance_field
 from teamnav.world.grid import OccupancyGrid
 
 __all__ = ["Simulation"]
@@ -214,7 +214,10 @@ class Simulation:
 
         # ---- truth
         self._blocking = grid.blocking(None)
-        self._clear_m = distance_field(self._blocking, grid.resolution_m)
+        if self._blocking.size >= COARSE_FIELD_CELLS:  # a huge open arena: a block bound, the same moves
+            self._clear_m = clearance_bound(self._blocking, grid.resolution_m)
+        else:
+            self._clear_m = distance_field(self._blocking, grid.resolution_m)
         self._geo = grid.geo  # origin, resolution, cos and sin of the map's yaw
         launch = config.launch
         if launch is None:

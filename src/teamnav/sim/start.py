@@ -59,6 +59,120 @@ class _Placed:
         self.buckets.setdefault(self.key(x, y), []).append((x, y, r, idx))
 
 
+#: Cells of the candidate mask built at once (a strip of rows; the strip's temporaries are
+#: a few bytes a cell, so about 10 MB).
+_STRIP_CELLS = 1 << 20
+
+
+class _AmbiguousField(Exception):
+    """A block field's window met a cell whose distance is within rounding of the threshold."""
+
+
+class _Candidates:
+    """The candidate cells (flat indices, ascending) of a mask given strip by strip, kept as runs.
+
+    ``take(i)`` is ``np.flatnonzero(mask)[i]``, bit for bit, without the index array (8 bytes
+    per candidate: 200 MB for a 10 000-robot arena at 2 cm): a run of consecutive candidates
+    costs 16 bytes, and an open arena has about one per row.
+    """
+
+    def __init__(self, strips) -> None:
+        starts, counts = [], []
+        for first, ok in strips:
+            h, w = ok.shape
+            pad = np.zeros((h, w + 2), np.int8)
+            pad[:, 1:-1] = ok
+            edge = np.diff(pad, axis=1)
+            r_on, c_on = np.nonzero(edge == 1)  # row-major: the runs in flat order
+            _, c_off = np.nonzero(edge == -1)
+            starts.append((first + r_on) * w + c_on)
+            counts.append(c_off - c_on)
+        start = np.concatenate(starts) if starts else np.zeros(0, np.int64)
+        count = np.concatenate(counts) if counts else np.zeros(0, np.int64)
+        self._start = start.astype(np.int64)
+        self._before = np.concatenate([[0], np.cumsum(count, dtype=np.int64)])  # candidates before run k
+        self.size = int(self._before[-1])
+
+    def take(self, i: np.ndarray) -> np.ndarray:
+        k = np.searchsorted(self._before, i, side="right") - 1
+        return self._start[k] + (i - self._before[k])
+
+
+def _candidate_strips(grid: OccupancyGrid, blocking: np.ndarray, clear_m: np.ndarray, r: float, region):
+    """Yield ``(first row, bool mask of a strip of rows)``: the free cells whose every point has
+    clearance >= ``r`` (distance field >= ``r + sqrt(2) * res``), inside the map by ``r`` and
+    meeting ``region`` (as ``xmin, xmax, ymin, ymax``).
+
+    ``clear_m`` is the distance field or its block lower bound
+    (:func:`teamnav.world.distance.clearance_bound`). With the bound, a block whose bound
+    reaches the threshold is far from every wall; in the others the field is computed exactly
+    in a window around the block reaching ``ceil(thr / res) + 1`` cells further (a wall outside
+    it is further than the threshold), so the mask is the dense field's. A window cell within
+    1e-9 (relative) of the threshold, where two nearest walls could round differently, raises
+    :class:`_AmbiguousField` (the caller then uses the dense field).
+    """
+    from teamnav.world.distance import block_shift
+
+    h, w = blocking.shape
+    res = grid.resolution_m
+    ox, oy = grid.origin_xy_m
+    xmin, xmax, ymin, ymax = region
+    thr = r + math.sqrt(2.0) * res
+    cols = np.arange(w)[None, :]
+    sh = block_shift(clear_m.shape, blocking.shape)
+    step = (1 << sh) if sh else max(1, _STRIP_CELLS // w)
+    for r0 in range(0, h, step):
+        r1 = min(h, r0 + step)
+        rows = np.arange(r0, r1)[:, None]
+        far = _far_strip(blocking, clear_m, sh, thr, res, r0, r1) if sh else clear_m[r0:r1] >= thr
+        ok = far & (blocking[r0:r1] == 0)
+        if not grid.rotated:
+            cx0 = ox + cols * res
+            cy0 = oy + rows * res
+            ok &= (cx0 - r >= ox) & (cx0 + res + r <= ox + w * res) & (cy0 - r >= oy) & (cy0 + res + r <= oy + h * res)
+            ok &= (cx0 + res > xmin) & (cx0 < xmax) & (cy0 + res > ymin) & (cy0 < ymax)
+        else:
+            # the map edge in the grid's own axes; the (world-frame) region against the cell's
+            # centre, widened by half the cell's diagonal (each drawn point is checked exactly below)
+            lx0 = cols * res
+            ly0 = rows * res
+            ok &= (lx0 - r >= 0) & (lx0 + res + r <= w * res) & (ly0 - r >= 0) & (ly0 + res + r <= h * res)
+            centre = grid.cell_centers(*np.broadcast_arrays(rows, cols))
+            half = res / math.sqrt(2.0)
+            ok &= (centre[..., 0] + half > xmin) & (centre[..., 0] - half < xmax)
+            ok &= (centre[..., 1] + half > ymin) & (centre[..., 1] - half < ymax)
+        yield r0, ok
+
+
+def _far_strip(blocking, bound, sh, thr, res, r0, r1) -> np.ndarray:
+    """``distance_field(blocking)[r0:r1] >= thr`` (one block row) from the block bound ``bound``."""
+    from teamnav.world.distance import _edt
+
+    h, w = blocking.shape
+    b = 1 << sh
+    lb = bound[r0 >> sh]
+    far = np.repeat(lb >= thr, b)[:w][None, :].repeat(r1 - r0, axis=0)
+    near = np.flatnonzero(lb < thr)
+    if near.size == 0:
+        return far
+    halo = int(math.ceil(thr / res)) + 1
+    # runs of consecutive near blocks, each with its window
+    cuts = np.flatnonzero(np.diff(near) != 1)
+    for j0, j1 in zip(np.concatenate([[near[0]], near[cuts + 1]]), np.concatenate([near[cuts], [near[-1]]])):
+        c0, c1 = int(j0) * b, min(w, (int(j1) + 1) * b)
+        wr0, wr1 = max(0, r0 - halo), min(h, r1 + halo)
+        wc0, wc1 = max(0, c0 - halo), min(w, c1 + halo)
+        free = blocking[wr0:wr1, wc0:wc1] == 0
+        if free.all():
+            far[:, c0:c1] = True
+            continue
+        d = _edt(free, res)[r0 - wr0:r1 - wr0, c0 - wc0:c1 - wc0]
+        if (np.abs(d - thr) <= 1e-9 * thr).any():
+            raise _AmbiguousField
+        far[:, c0:c1] = d >= thr
+    return far
+
+
 def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator, clear_m: np.ndarray | None = None) -> np.ndarray:
     """Start poses for every robot of ``groups`` (robot ids in group order).
 
@@ -69,8 +183,9 @@ def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator,
     groups : sequence of RobotGroupConfig
     rng : numpy.random.Generator
         The run's start stream.
-    clear_m : ndarray of shape (H, W), optional
-        ``distance_field(grid)`` when the caller already has it.
+    clear_m : ndarray, optional
+        ``distance_field(grid)`` when the caller already has it, or its block lower bound
+        (:func:`~teamnav.world.distance.clearance_bound`, for a huge map): the same poses.
 
     Returns
     -------
@@ -137,33 +252,16 @@ def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator,
 
     # ---- random poses
     h, w = blocking.shape
-    # the cells' row and column indices, broadcast (h, 1) and (1, w) rather than two full (h, w)
-    # grids: the tests below are per axis, and a 10 000-robot arena has 25 M cells (the full
-    # grids and their float copies took 1 GB while a simulation was built)
-    rows = np.arange(h)[:, None]
-    cols = np.arange(w)[None, :]
     for gi, g in enumerate(groups):
         if g.start.poses is not None:
             continue
         r = g.radius_m
         xmin, xmax, ymin, ymax = g.start.region if g.start.region is not None else grid.bounds_m
-        ok = (clear_m >= r + math.sqrt(2.0) * res) & (blocking == 0)
-        if not grid.rotated:
-            cx0 = ox + cols * res
-            cy0 = oy + rows * res
-            ok &= (cx0 - r >= ox) & (cx0 + res + r <= ox + w * res) & (cy0 - r >= oy) & (cy0 + res + r <= oy + h * res)
-            ok &= (cx0 + res > xmin) & (cx0 < xmax) & (cy0 + res > ymin) & (cy0 < ymax)
-        else:
-            # the map edge in the grid's own axes; the (world-frame) region against the cell's
-            # centre, widened by half the cell's diagonal (each drawn point is checked exactly below)
-            lx0 = cols * res
-            ly0 = rows * res
-            ok &= (lx0 - r >= 0) & (lx0 + res + r <= w * res) & (ly0 - r >= 0) & (ly0 + res + r <= h * res)
-            centre = grid.cell_centers(*np.broadcast_arrays(rows, cols))
-            half = res / math.sqrt(2.0)
-            ok &= (centre[..., 0] + half > xmin) & (centre[..., 0] - half < xmax)
-            ok &= (centre[..., 1] + half > ymin) & (centre[..., 1] - half < ymax)
-        cand = np.flatnonzero(ok)
+        try:
+            cand = _Candidates(_candidate_strips(grid, blocking, clear_m, r, (xmin, xmax, ymin, ymax)))
+        except _AmbiguousField:  # never met so far; the dense field decides, as it always did
+            cand = _Candidates(_candidate_strips(grid, blocking, distance_field(blocking, res), r,
+                                                 (xmin, xmax, ymin, ymax)))
         if cand.size == 0:
             where = f"region {list(g.start.region)}" if g.start.region is not None else "the map"
             raise ValueError(
@@ -179,7 +277,7 @@ def start_poses(grid: OccupancyGrid, groups: Sequence, rng: np.random.Generator,
                         f"{label(gi)}.start could not place robot {k} of {g.count} (radius {r} m) without overlap "
                         f"after {tries} tries; give a larger region or fewer robots"
                     )
-                cells = cand[rng.integers(0, cand.size, size=_BATCH)]
+                cells = cand.take(rng.integers(0, cand.size, size=_BATCH))
                 u = rng.random((_BATCH, 2))
                 if not grid.rotated:
                     xs = ox + (cells % w + u[:, 0]) * res

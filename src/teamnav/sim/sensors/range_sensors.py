@@ -332,14 +332,14 @@ def _hash_or_none(use_hits, all_x, all_y, all_r, max_range_m):
 
 
 @njit(cache=True)
-def _sense_rows(i0, i1, cast, hits, beams, even, hsh, noise, out):
+def _sense_rows(i0, i1, clear, cast, hits, beams, even, hsh, noise, out):
     """Rows ``[i0, i1)`` of :func:`_sense_serial`, robot by robot: other robots' discs first
     (:func:`~teamnav.sim.sensors.robot_hits._robot_hits_row`, into the rays' caps), then
     the map cast of the pose, each ray traversed only up to its cap
     (:func:`~teamnav.world.raycast._cast_pose_capped`: ``min(map range, disc hit)`` bit for
     bit), the nearest ray of each beam, then the beam's keyed noise (row ``i``'s streams of
     :func:`_counter_noise_rows`)."""
-    clear, ox, oy, res, kxs, kys, kct, kst, cb, sb, tmax, rpb = cast
+    ox, oy, res, kxs, kys, kct, kst, cb, sb, tmax, rpb = cast
     use_hits, xs, ys, ct, st, self_idx, reach = hits
     use_noise, key, sigma, p_max, p_short, max_range = noise
     nr = cb.shape[0]
@@ -414,18 +414,18 @@ def _sense_rows(i0, i1, cast, hits, beams, even, hsh, noise, out):
 
 
 @njit(cache=True)
-def _sense_serial(cast, hits, beams, even, bodies, noise, out):
+def _sense_serial(clear, cast, hits, beams, even, bodies, noise, out):
     """Every robot's ranges (:func:`_sense_rows`) in this thread; ``bodies = (all_x, all_y,
     all_r)`` are hashed once per call."""
     all_x, all_y, all_r = bodies
     hsh = _hash_or_none(hits[0], all_x, all_y, all_r, hits[6])
     # np.int64(0), not 0: a literal 0 would make numba compile _sense_rows a second time, for
     # Literal[int](0), beside the int64 one _sense_parallel uses (~13 s on 2 cores)
-    _sense_rows(np.int64(0), out.shape[0], cast, hits, beams, even, hsh, noise, out)
+    _sense_rows(np.int64(0), out.shape[0], clear, cast, hits, beams, even, hsh, noise, out)
 
 
 @njit(cache=True, parallel=True)
-def _sense_parallel(cast, hits, beams, even, bodies, noise, out, chunk):
+def _sense_parallel(clear, cast, hits, beams, even, bodies, noise, out, chunk):
     """:func:`_sense_serial` with chunks of ``chunk`` robots spread over numba's threads (each
     robot's result depends on nothing but its own pose: the same on any thread count)."""
     all_x, all_y, all_r = bodies
@@ -433,7 +433,7 @@ def _sense_parallel(cast, hits, beams, even, bodies, noise, out, chunk):
     n = out.shape[0]
     nchunks = (n + chunk - 1) // chunk
     for c in prange(nchunks):
-        _sense_rows(c * chunk, min(n, (c + 1) * chunk), cast, hits, beams, even, hsh, noise, out)
+        _sense_rows(c * chunk, min(n, (c + 1) * chunk), clear, cast, hits, beams, even, hsh, noise, out)
 
 
 def _check_noise_args(true_m, noise_std_m, p_max, p_short, max_range_m, out):
@@ -709,8 +709,11 @@ class RangeSensor:
         st = np.sin(thetas)
         kct, kst = (ct, st) if kth is thetas else (np.cos(kth), np.sin(kth))
         res = self.caster._res
-        cast = (self.caster.clearance, float(ox), float(oy), res, kxs, kys, kct, kst, self._cos_rays, self._sin_rays,
-                self.max_range_m / res, self.rays_per_beam)
+        # the clearance maps apart from the rest: a huge map's tiles are a tuple, which numba's
+        # parallel loops take as an argument of their own but not inside another tuple
+        clear = self.caster.clearance
+        cast = (float(ox), float(oy), res, kxs, kys, kct, kst, self._cos_rays, self._sin_rays, self.max_range_m / res,
+                self.rays_per_beam)
         if use_hits:
             all_x, all_y, all_r, self_idx = bodies
         else:
@@ -721,9 +724,9 @@ class RangeSensor:
                  self.max_range_m)
         if n * nr >= PARALLEL_MIN_RAYS and numba.get_num_threads() > 1:
             chunk = min(256, max(1, n // (4 * numba.get_num_threads())))
-            _sense_parallel(cast, hits, self._plan.beams, self._plan.even, (all_x, all_y, all_r), noise, out, chunk)
+            _sense_parallel(clear, cast, hits, self._plan.beams, self._plan.even, (all_x, all_y, all_r), noise, out, chunk)
         else:
-            _sense_serial(cast, hits, self._plan.beams, self._plan.even, (all_x, all_y, all_r), noise, out)
+            _sense_serial(clear, cast, hits, self._plan.beams, self._plan.even, (all_x, all_y, all_r), noise, out)
         return out
 
     # ------------------------------------------------------------------ observation
