@@ -209,6 +209,7 @@ class Wander:
         self._angles: Any = None  # the beam directions the classes below were computed from
         self._angles_fixed = False  # they are an array nobody can change (its own, read-only)
         self._cls = np.zeros((K.N_CLASSES, 0), dtype=np.bool_)
+        self._action = Action(0.0, 0.0)  # the command in self._row (K.R_V, K.R_W) before the first step
 
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
         """Command for this step from the robot's own scan and stall flag; sends nothing."""
@@ -227,8 +228,10 @@ class Wander:
         if ranges.shape[0] != self._cls.shape[1]:
             raise ValueError(f"scan {self.sensor!r} of robot {obs.robot_id}: {ranges.shape[0]} ranges for "
                              f"{self._cls.shape[1]} beam angles")
-        v, w = K.wander_row(ranges, self._cls, self._row, float(scan.max_range_m), bool(obs.stalled), obs.step)
-        return Action(v, w), []
+        v, w, same = K.wander_row(ranges, self._cls, self._row, float(scan.max_range_m), bool(obs.stalled), obs.step)
+        if not same:  # an Action is immutable: the same command bit for bit is handed out again
+            self._action = Action(v, w)
+        return self._action, []
 
     def _classify(self, angles) -> None:
         """The beam classes of ``angles`` (kept while the scans carry this same unchangeable array)."""

@@ -347,7 +347,7 @@ R_PERP_L = R_STATE + N_STATE  # index of the beam nearest +90° (-1: none), as a
 R_PERP_R = R_PERP_L + 1
 R_KEY = R_PERP_L + 2  # the RNG key's 64 bits (read through a uint64 view)
 R_STALLED = R_KEY + 1  # this step's stall flag (1.0 / 0.0)
-R_V = R_STALLED + 1  # the command decided
+R_V = R_STALLED + 1  # the command decided (0.0, 0.0 before the first call)
 R_W = R_V + 1
 N_ROW = R_W + 1
 
@@ -355,15 +355,19 @@ N_ROW = R_W + 1
 @njit(cache=True)
 def wander_row(ranges: np.ndarray, cls: np.ndarray, row: np.ndarray, max_range_m: float, stalled: bool,
                step: np.int64) -> tuple:
-    """One robot's ``(v, omega)``: :func:`_wander_rows` on one row, with the beam classes
+    """One robot's ``(v, omega, same)``: :func:`_wander_rows` on one row, with the beam classes
     ``cls`` computed once (:func:`beam_classes`) and ``row`` (shape (N_ROW,), ``R_*``) holding
-    the parameters, the state (updated in place) and the key."""
+    the parameters, the state (updated in place), the key and the command (``same``: bit for
+    bit the command of the previous call, so the caller may hand out its previous Action)."""
+    bits = row.view(np.uint64)
+    last_v = bits[R_V]
+    last_w = bits[R_W]
     row[R_STALLED] = 1.0 if stalled else 0.0
     _wander_rows(ranges[np.newaxis, :], cls[C_FRONT], cls[C_SIDE_L], cls[C_SIDE_R], cls[C_HALF_L], cls[C_HALF_R],
                  np.int64(row[R_PERP_L]), np.int64(row[R_PERP_R]), max_range_m,
                  row[R_STALLED:R_STALLED + 1], row.view(np.uint64)[R_KEY:R_KEY + 1], np.int64(step), row,
                  row[np.newaxis, R_STATE:R_STATE + N_STATE], row[R_V:R_V + 1], row[R_W:R_W + 1])
-    return row[R_V], row[R_W]
+    return row[R_V], row[R_W], bits[R_V] == last_v and bits[R_W] == last_w
 
 
 @njit(cache=True)
