@@ -240,6 +240,19 @@ def test_bad_construction_and_observations():
             Observation(0, 0, 0.0, np.zeros(3), np.zeros(3), scans={"laser": scan}))
 
 
+def test_the_per_robot_form_reads_scans_of_any_layout_and_byte_order():
+    """Strided rows, big-endian and float32 ranges drive as the same values in a plain array."""
+    rng = np.random.default_rng(3)
+    plain = [Wander(WanderParams(), np.random.default_rng(9), info()) for _ in range(4)]
+    for step in range(25):
+        r = np.minimum(rng.uniform(0.0, 1.0, 180) ** 2 * 12.0, 10.0).astype(np.float32).astype(np.float64)
+        wide = np.repeat(r, 2)[::2]  # a strided view
+        forms = [r, wide, r.astype(">f8"), r.astype(np.float32)]
+        assert not wide.flags.c_contiguous
+        acts = [b.step(obs(x, step=step, stalled=step % 7 == 3)) for b, x in zip(plain, forms)]
+        assert len({(a.v_mps, a.omega_radps) for a, _ in acts}) == 1
+
+
 def test_the_per_robot_form_follows_beam_angles_changed_in_place():
     """The per-robot wanderer keeps its beam classes while the scans carry one array nobody can
     change; an array changed in place between steps is classified again."""

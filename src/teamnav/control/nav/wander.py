@@ -107,6 +107,29 @@ def pick_sensor(params: WanderParams, info: RobotInfo) -> SensorInfo:
 
 
 _F64 = np.dtype(np.float64)
+_ROW_CALL: Any = None
+
+
+def _row_call() -> Any:
+    """:func:`~teamnav.control.nav.wander_kernel.wander_row`'s compiled code for a 1-D float64
+    scan of any layout, called without numba's type dispatch (which costs about as much as the
+    kernel itself: every other argument's type is fixed by :class:`Wander`, and
+    :meth:`Wander.step` converts a scan of another kind first). The dispatcher itself where
+    this numba keeps its compiled code elsewhere."""
+    global _ROW_CALL
+    if _ROW_CALL is None:
+        call = K.wander_row
+        try:
+            from numba import types as nt
+
+            sig = (nt.Array(nt.float64, 1, "A"), nt.Array(nt.bool_, 2, "C"), nt.Array(nt.float64, 1, "C"), nt.float64,
+                   nt.boolean, nt.int64)
+            K.wander_row.compile(sig)
+            call = K.wander_row.overloads[sig].entry_point
+        except (AttributeError, KeyError, TypeError):
+            pass
+        _ROW_CALL = call
+    return _ROW_CALL
 
 
 def _steps(duration_s: float, dt_s: float) -> float:
@@ -209,6 +232,7 @@ class Wander:
         self._angles: Any = None  # the beam directions the classes below were computed from
         self._angles_fixed = False  # they are an array nobody can change (its own, read-only)
         self._cls = np.zeros((K.N_CLASSES, 0), dtype=np.bool_)
+        self._n_beams = 0
         self._action = Action(0.0, 0.0)  # the command in self._row (K.R_V, K.R_W) before the first step
 
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
@@ -225,10 +249,11 @@ class Wander:
         angles = scan.angles_rad
         if angles is not self._angles or not self._angles_fixed:
             self._classify(angles)
-        if ranges.shape[0] != self._cls.shape[1]:
-            raise ValueError(f"scan {self.sensor!r} of robot {obs.robot_id}: {ranges.shape[0]} ranges for "
-                             f"{self._cls.shape[1]} beam angles")
-        v, w, same = K.wander_row(ranges, self._cls, self._row, float(scan.max_range_m), bool(obs.stalled), obs.step)
+        if len(ranges) != self._n_beams:
+            raise ValueError(f"scan {self.sensor!r} of robot {obs.robot_id}: {len(ranges)} ranges for "
+                             f"{self._n_beams} beam angles")
+        call = _ROW_CALL or _row_call()
+        v, w, same = call(ranges, self._cls, self._row, float(scan.max_range_m), bool(obs.stalled), obs.step)
         if not same:  # an Action is immutable: the same command bit for bit is handed out again
             self._action = Action(v, w)
         return self._action, []
@@ -239,6 +264,7 @@ class Wander:
         if self._cls.shape[1] != a.shape[0] or self._angles is None or not np.array_equal(a, self._angles_copy):
             cls, perp_l, perp_r = K.beam_classes(a, self._row)
             self._cls = cls
+            self._n_beams = a.shape[0]
             self._row[K.R_PERP_L] = perp_l
             self._row[K.R_PERP_R] = perp_r
             self._angles_copy = a.copy()
