@@ -28,7 +28,10 @@ Truth and belief
 ``Simulation.state`` is the truth (for metrics and hooks). Brains are built only from their
 validated parameters, their own ``Generator`` and a :class:`RobotInfo`; each observation
 carries only sensor readings, the robot's own odometry, inbox, events and stall flag, in
-arrays freshly allocated for that step (never views of the engine's arrays).
+arrays freshly allocated for that step (never views of the engine's arrays). The objects
+around them (the Observation, its scans dict, its RangeScan) are last step's, refilled,
+when the brain kept none of them (one sensor, no faults): building them was most of what the
+per-robot path added to a step, and a brain that kept nothing cannot tell.
 
 Determinism
 -----------
