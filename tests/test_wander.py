@@ -234,6 +234,42 @@ def test_bad_construction_and_observations():
         Wander(WanderParams(), np.random.default_rng(0), info()).step(obs(np.full(7, 0.14), PROX))
     with pytest.raises(ValueError, match="dt_s must be a positive"):
         kernel_params(WanderParams(), 10.0, 0.0)
+    scan = RangeScan(np.full(179, 10.0), LASER.angles_rad, 10.0)
+    with pytest.raises(ValueError, match="179 ranges for 180 beam angles"):
+        Wander(WanderParams(), np.random.default_rng(0), info()).step(
+            Observation(0, 0, 0.0, np.zeros(3), np.zeros(3), scans={"laser": scan}))
+
+
+def test_the_per_robot_form_reads_scans_of_any_layout_and_byte_order():
+    """Strided rows, big-endian and float32 ranges drive as the same values in a plain array."""
+    rng = np.random.default_rng(3)
+    plain = [Wander(WanderParams(), np.random.default_rng(9), info()) for _ in range(4)]
+    for step in range(25):
+        r = np.minimum(rng.uniform(0.0, 1.0, 180) ** 2 * 12.0, 10.0).astype(np.float32).astype(np.float64)
+        wide = np.repeat(r, 2)[::2]  # a strided view
+        forms = [r, wide, r.astype(">f8"), r.astype(np.float32)]
+        assert not wide.flags.c_contiguous
+        acts = [b.step(obs(x, step=step, stalled=step % 7 == 3)) for b, x in zip(plain, forms)]
+        assert len({(a.v_mps, a.omega_radps) for a, _ in acts}) == 1
+
+
+def test_the_per_robot_form_follows_beam_angles_changed_in_place():
+    """The per-robot wanderer keeps its beam classes while the scans carry one array nobody can
+    change; an array changed in place between steps is classified again."""
+    params = WanderParams(sensor="proximity")
+    infos = [info(0, 1, sensors=(PROX,))]
+    single = Wander(params, np.random.default_rng(5), infos[0])
+    batch = WanderBatched(params, [np.random.default_rng(5)], infos)
+    angles = PROX.angles_rad.copy()  # writeable: the brain may not trust it to stay the same
+    r = np.array([0.14, 0.14, 0.14, 0.14, 0.14, 0.03, 0.14])  # only the beam at 160° sees something
+    for step, turn in enumerate([0.0, np.pi, np.pi, 0.0]):
+        angles[:] = PROX.angles_rad + turn  # rotated half a turn: the beam at 160° now looks ahead
+        action, _ = single.step(Observation(0, step, 0.1 * step, np.zeros(3), np.zeros(3),
+                                            scans={"proximity": RangeScan(r, angles, 0.14)}))
+        out = batch.step_batch(BatchObservation(np.arange(1), step, 0.1 * step, np.zeros((1, 3)), r[None, :],
+                                                angles, 0.14, np.zeros(1, bool)))
+        assert (action.v_mps, action.omega_radps) == (out.v_mps[0], out.omega_radps[0])
+    assert single.log()["mode"] == batch.log()["mode"][0]
 
 
 def test_thresholds_are_capped_to_a_short_sensor():

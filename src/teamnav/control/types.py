@@ -275,7 +275,11 @@ class RangeScan:
 @_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class Observation:
-    """Everything a robot knows at one step, built fresh by the simulator each step.
+    """Everything a robot knows at one step, with this step's values and arrays.
+
+    The simulator hands a brain that kept nothing of its last observation (not the
+    observation, its ``scans`` dict or a scan) the same objects again, refilled; a brain that
+    keeps any of them gets new ones, and what it kept never changes.
 
     Attributes
     ----------

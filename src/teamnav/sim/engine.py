@@ -28,7 +28,10 @@ Truth and belief
 ``Simulation.state`` is the truth (for metrics and hooks). Brains are built only from their
 validated parameters, their own ``Generator`` and a :class:`RobotInfo`; each observation
 carries only sensor readings, the robot's own odometry, inbox, events and stall flag, in
-arrays freshly allocated for that step (never views of the engine's arrays).
+arrays freshly allocated for that step (never views of the engine's arrays). The objects
+around them (the Observation, its scans dict, its RangeScan) are last step's, refilled,
+when the brain kept none of them (one sensor, no faults): building them was most of what the
+per-robot path added to a step, and a brain that kept nothing cannot tell.
 
 Determinism
 -----------
@@ -60,6 +63,7 @@ from __future__ import annotations
 import contextlib
 import math
 import numbers
+import sys
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterator
@@ -90,6 +94,19 @@ __all__ = ["Simulation"]
 
 
 _now = time.perf_counter
+_refs = sys.getrefcount
+
+# The slots of an Observation and a RangeScan, written directly when the engine refills the
+# objects it handed over last step (both classes are frozen to brains; see _observe_and_decide).
+_set_step = Observation.__dict__["step"].__set__
+_set_time = Observation.__dict__["time_s"].__set__
+_set_odom = Observation.__dict__["odom_pose"].__set__
+_set_delta = Observation.__dict__["odom_delta"].__set__
+_set_stalled = Observation.__dict__["stalled"].__set__
+_set_detections = Observation.__dict__["detections"].__set__
+_set_inbox = Observation.__dict__["inbox"].__set__
+_set_events = Observation.__dict__["events"].__set__
+_set_ranges = RangeScan.__dict__["ranges_m"].__set__
 
 
 def _real_number(x) -> bool:
@@ -140,6 +157,10 @@ class _Group:
     detector_rng: Any = None
     has_log: bool = False
     whole: bool = False  # its controller reads Simulation.observed instead of per-robot observations
+    # Per robot, the (Observation, its scans dict, its RangeScan) handed over last step, to be
+    # refilled when nobody kept any of them (see Simulation._observe_and_decide); None: none yet.
+    handed: list = field(default_factory=list)
+    extras_last: bool = False  # last step's observations carried an inbox, events or detections
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -818,24 +839,69 @@ class Simulation:
             ds = self._dir_cmd[sl].tolist()
             gi = grp.index
             i0 = sl.start
+            # Refilling last step's objects: only with one sensor and no faults, and for a robot
+            # whose brain kept none of them (counted references: the list `handed`, the local
+            # name and getrefcount's argument; the dict and the scan also have their holder).
+            # Such a brain cannot tell the objects apart from new ones, and the arrays in them
+            # are fresh as always; a brain that kept any of them gets new ones.
+            refill = len(rows) == 1 and omit is None
+            handed = grp.handed
+            if refill:
+                if len(handed) != len(grp.brain):
+                    handed[:] = [None] * len(grp.brain)
+                name, r, a, m = rows[0]
+                extras = dets is not None or g_inbox is not None or g_events is not None
+                set_extras = extras or grp.extras_last
+                grp.extras_last = extras
             for k, brain in enumerate(grp.brain):
                 if dead is not None and dead[k]:
                     continue  # a dead robot's brain is off (its commands are zeroed below)
-                if len(rows) == 1:
-                    name, r, a, m = rows[0]
-                    scans = {name: RangeScan(r[k], a, m)}
+                if refill:
+                    h = handed[k]
+                    if h is not None:
+                        obs, scans, scan = h
+                        if not (_refs(obs) == 3 and _refs(scans) == 4 and _refs(scan) == 4 and len(scans) == 1
+                                and scans.get(name) is scan):
+                            h = None
+                    if h is not None:
+                        _set_ranges(scan, r[k])
+                        _set_step(obs, step)
+                        _set_time(obs, t)
+                        _set_odom(obs, odom_rows[k])
+                        _set_delta(obs, delta_rows[k])
+                        _set_stalled(obs, stalled[k])
+                        if set_extras:
+                            _set_detections(obs, tuple(dets[k]) if dets is not None else ())
+                            _set_inbox(obs, g_inbox[k] if g_inbox is not None else ())
+                            _set_events(obs, g_events[k] if g_events is not None else ())
+                    else:
+                        scan = RangeScan(r[k], a, m)
+                        scans = {name: scan}
+                        obs = Observation(
+                            i0 + k, step, t, odom_rows[k], delta_rows[k], scans,
+                            tuple(dets[k]) if dets is not None else (),
+                            stalled[k],
+                            g_inbox[k] if g_inbox is not None else (),
+                            g_events[k] if g_events is not None else (),
+                        )
+                        handed[k] = (obs, scans, scan)
+                    h = None
                 else:
-                    scans = {name: RangeScan(r[k], a, m) for name, r, a, m in rows}
-                if omit is not None and omit[k]:
-                    for name in omit[k]:
-                        del scans[name]  # a sensor that publishes nothing this step
-                obs = Observation(
-                    i0 + k, step, t, odom_rows[k], delta_rows[k], scans,
-                    tuple(dets[k]) if dets is not None else (),
-                    stalled[k],
-                    g_inbox[k] if g_inbox is not None else (),
-                    g_events[k] if g_events is not None else (),
-                )
+                    if len(rows) == 1:
+                        name, r, a, m = rows[0]
+                        scans = {name: RangeScan(r[k], a, m)}
+                    else:
+                        scans = {name: RangeScan(r[k], a, m) for name, r, a, m in rows}
+                    if omit is not None and omit[k]:
+                        for name in omit[k]:
+                            del scans[name]  # a sensor that publishes nothing this step
+                    obs = Observation(
+                        i0 + k, step, t, odom_rows[k], delta_rows[k], scans,
+                        tuple(dets[k]) if dets is not None else (),
+                        stalled[k],
+                        g_inbox[k] if g_inbox is not None else (),
+                        g_events[k] if g_events is not None else (),
+                    )
                 self.calling = (gi, k, step, _now())
                 try:  # the brain's own code: whatever it raises (even sys.exit) is reported as its failure
                     out = brain.step(obs) if timer is None else timer.call(brain.step, obs)

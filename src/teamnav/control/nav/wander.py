@@ -106,6 +106,32 @@ def pick_sensor(params: WanderParams, info: RobotInfo) -> SensorInfo:
         ) from None
 
 
+_F64 = np.dtype(np.float64)
+_ROW_CALL: Any = None
+
+
+def _row_call() -> Any:
+    """:func:`~teamnav.control.nav.wander_kernel.wander_row`'s compiled code for a 1-D float64
+    scan of any layout, called without numba's type dispatch (which costs about as much as the
+    kernel itself: every other argument's type is fixed by :class:`Wander`, and
+    :meth:`Wander.step` converts a scan of another kind first). The dispatcher itself where
+    this numba keeps its compiled code elsewhere."""
+    global _ROW_CALL
+    if _ROW_CALL is None:
+        call = K.wander_row
+        try:
+            from numba import types as nt
+
+            sig = (nt.Array(nt.float64, 1, "A"), nt.Array(nt.bool_, 2, "C"), nt.Array(nt.float64, 1, "C"), nt.float64,
+                   nt.boolean, nt.int64)
+            K.wander_row.compile(sig)
+            call = K.wander_row.overloads[sig].entry_point
+        except (AttributeError, KeyError, TypeError):
+            pass
+        _ROW_CALL = call
+    return _ROW_CALL
+
+
 def _steps(duration_s: float, dt_s: float) -> float:
     return float(max(0, round(duration_s / dt_s)))
 
@@ -198,12 +224,16 @@ class Wander:
         self.params = params
         self.info = info
         self.sensor = sensor.name
-        self._p = kernel_params(params, float(sensor.max_range_m), float(info.dt_s))
-        self._keys = np.array([draw_key(rng)], dtype=np.uint64)
-        self._state = K.initial_state(1)
-        self._stalled = np.zeros(1, dtype=np.bool_)
-        self._v = np.zeros(1)
-        self._w = np.zeros(1)
+        # Parameters, state, beams nearest ±90° and key in one vector (K.R_*): one array to pass.
+        self._row = np.zeros(K.N_ROW, dtype=np.float64)
+        self._row[:K.N_PARAMS] = kernel_params(params, float(sensor.max_range_m), float(info.dt_s))
+        self._row[K.R_STATE:K.R_STATE + K.N_STATE] = K.initial_state(1)[0]
+        self._row.view(np.uint64)[K.R_KEY] = draw_key(rng)
+        self._angles: Any = None  # the beam directions the classes below were computed from
+        self._angles_fixed = False  # they are an array nobody can change (its own, read-only)
+        self._cls = np.zeros((K.N_CLASSES, 0), dtype=np.bool_)
+        self._n_beams = 0
+        self._action = Action(0.0, 0.0)  # the command in self._row (K.R_V, K.R_W) before the first step
 
     def step(self, obs: Observation) -> tuple[Action, list[Message]]:
         """Command for this step from the robot's own scan and stall flag; sends nothing."""
@@ -213,16 +243,37 @@ class Wander:
             raise ValueError(
                 f"observation of robot {obs.robot_id} must carry scan {self.sensor!r}, has {sorted(obs.scans)}"
             ) from None
-        ranges = np.ascontiguousarray(scan.ranges_m, dtype=np.float64).reshape(1, -1)
-        angles = np.ascontiguousarray(scan.angles_rad, dtype=np.float64)
-        self._stalled[0] = obs.stalled
-        K.wander_step(ranges, angles, float(scan.max_range_m), self._stalled, self._keys,
-                      np.int64(obs.step), self._p, self._state, self._v, self._w)
-        return Action(float(self._v[0]), float(self._w[0])), []
+        ranges = scan.ranges_m
+        if not (type(ranges) is np.ndarray and ranges.dtype is _F64 and ranges.ndim == 1):
+            ranges = np.ascontiguousarray(ranges, dtype=np.float64).reshape(-1)
+        angles = scan.angles_rad
+        if angles is not self._angles or not self._angles_fixed:
+            self._classify(angles)
+        if len(ranges) != self._n_beams:
+            raise ValueError(f"scan {self.sensor!r} of robot {obs.robot_id}: {len(ranges)} ranges for "
+                             f"{self._n_beams} beam angles")
+        call = _ROW_CALL or _row_call()
+        v, w, same = call(ranges, self._cls, self._row, float(scan.max_range_m), bool(obs.stalled), obs.step)
+        if not same:  # an Action is immutable: the same command bit for bit is handed out again
+            self._action = Action(v, w)
+        return self._action, []
+
+    def _classify(self, angles) -> None:
+        """The beam classes of ``angles`` (kept while the scans carry this same unchangeable array)."""
+        a = np.ascontiguousarray(angles, dtype=np.float64).reshape(-1)
+        if self._cls.shape[1] != a.shape[0] or self._angles is None or not np.array_equal(a, self._angles_copy):
+            cls, perp_l, perp_r = K.beam_classes(a, self._row)
+            self._cls = cls
+            self._n_beams = a.shape[0]
+            self._row[K.R_PERP_L] = perp_l
+            self._row[K.R_PERP_R] = perp_r
+            self._angles_copy = a.copy()
+        self._angles = angles
+        self._angles_fixed = type(angles) is np.ndarray and angles.base is None and not angles.flags.writeable
 
     def log(self) -> dict[str, Any]:
         """The current mode (0 cruise, 1 turn, 2 back off, 3/4 taking an opening) and wall side."""
-        return {"mode": int(self._state[0, K.S_MODE]), "wall": int(self._state[0, K.S_WALL])}
+        return {"mode": int(self._row[K.R_STATE + K.S_MODE]), "wall": int(self._row[K.R_STATE + K.S_WALL])}
 
 
 class WanderBatched:

@@ -3,9 +3,11 @@
 Random exploration as Vaughan et al. use it (*Blazing a trail* §4; *Try to see it my way*
 §3): follow walls, take side openings with a fixed probability, turn away from what blocks
 the way. :mod:`teamnav.control.nav.wander` wraps this kernel twice, as a per-robot
-:class:`~teamnav.control.nav.wander.Wander` (n = 1 row) and as a batched
-:class:`~teamnav.control.nav.wander.WanderBatched` (n rows), so both forms drive exactly
-the same by construction.
+:class:`~teamnav.control.nav.wander.Wander` (:func:`wander_row`: one row, its beam classes
+computed once and everything else in one vector, so a call from Python costs little) and as
+a batched :class:`~teamnav.control.nav.wander.WanderBatched` (:func:`wander_step`: n rows);
+both run the one loop :func:`_wander_rows`, so both forms drive exactly the same by
+construction.
 
 Randomness is counter-based so that it does not depend on how robots are grouped: robot i
 holds one 64-bit ``key`` (drawn once from its own ``Generator``), and the k-th uniform number
@@ -133,49 +135,29 @@ def _random_turn_steps(p: np.ndarray, key: np.uint64, step: np.int64) -> float:
     return p[P_MIN_TURN_STEPS] + extra
 
 
-@njit(cache=True)
-def wander_step(
-    ranges_m: np.ndarray,
-    angles_rad: np.ndarray,
-    max_range_m: float,
-    stalled: np.ndarray,
-    keys: np.ndarray,
-    step: np.int64,
-    p: np.ndarray,
-    state: np.ndarray,
-    v_out: np.ndarray,
-    omega_out: np.ndarray,
-) -> None:
-    """Decide every row's command and advance its state in place.
+# Beam classes: the rows of the array :func:`beam_classes` returns.
+C_FRONT = 0  # |angle| <= front half-angle
+C_SIDE_L = 1  # left side sector
+C_SIDE_R = 2  # right side sector
+C_HALF_L = 3  # left half (|angle| <= side max, angle > 0)
+C_HALF_R = 4  # right half
+N_CLASSES = 5
 
-    Parameters
-    ----------
-    ranges_m : ndarray of shape (n, B), float64
-        Each robot's ranges [m] (``max_range_m`` = no return).
-    angles_rad : ndarray of shape (B,), float64
-        Beam directions in the body frame [rad] (any layout; wrapped here).
-    max_range_m : float
-        The sensor's maximum range [m].
-    stalled : ndarray of shape (n,), bool
-        Each robot's stall flag.
-    keys : ndarray of shape (n,), uint64
-        Each robot's RNG key.
-    step : int
-        Step index (the counter of the counter-based RNG).
-    p : ndarray of shape (N_PARAMS,), float64
-        Parameters, see ``P_*``.
-    state : ndarray of shape (n, N_STATE), float64
-        Per-robot state, see ``S_*``; updated in place.
-    v_out, omega_out : ndarray of shape (n,), float64
-        Receive the commands [m/s], [rad/s].
+
+@njit(cache=True)
+def beam_classes(angles_rad: np.ndarray, p: np.ndarray) -> tuple:
+    """Each beam's classes, and the side beams nearest ±90°, from the beam directions and ``p``.
+
+    Returns
+    -------
+    cls : ndarray of shape (N_CLASSES, B), bool
+        ``cls[C_*, b]``: beam b is in that class.
+    perp_l, perp_r : int
+        The left / right side beam nearest +90° / -90° (-1: none).
     """
-    n, nb = ranges_m.shape
-    # Beam classes, once per call: front / left side / right side / left half / right half.
-    front = np.zeros(nb, np.bool_)
-    side_l = np.zeros(nb, np.bool_)
-    side_r = np.zeros(nb, np.bool_)
-    half_l = np.zeros(nb, np.bool_)
-    half_r = np.zeros(nb, np.bool_)
+    nb = angles_rad.shape[0]
+    cls = np.zeros((N_CLASSES, nb), np.bool_)
+    front, side_l, side_r, half_l, half_r = cls[C_FRONT], cls[C_SIDE_L], cls[C_SIDE_R], cls[C_HALF_L], cls[C_HALF_R]
     perp_l = -1
     perp_r = -1
     best_l = 1e9
@@ -202,6 +184,14 @@ def wander_step(
                 best_r = d
                 perp_r = b
 
+    return cls, perp_l, perp_r
+
+
+@njit(cache=True, inline="always")
+def _wander_rows(ranges_m, front, side_l, side_r, half_l, half_r, perp_l, perp_r, max_range_m, stalled, keys, step, p,
+                 state, v_out, omega_out) -> None:
+    """:func:`wander_step` with the beam classes given (both forms of the wanderer run this loop)."""
+    n, nb = ranges_m.shape
     for i in range(n):
         # ---------------------------------------------------------- what the scan says
         fmin = max_range_m
@@ -347,6 +337,77 @@ def wander_step(
         state[i, S_PREV_SIDE_R] = sr
         v_out[i] = v
         omega_out[i] = w
+
+
+# ----------------------------------------------------------------- one robot (the per-robot Wander)
+# Its parameters (P_*), state, beams nearest ±90°, key, stall flag and command in one float64
+# vector: a call from Python then passes three arrays (each costs ~70 ns to hand to numba).
+R_STATE = N_PARAMS  # the state columns S_* start here
+R_PERP_L = R_STATE + N_STATE  # index of the beam nearest +90° (-1: none), as a float
+R_PERP_R = R_PERP_L + 1
+R_KEY = R_PERP_L + 2  # the RNG key's 64 bits (read through a uint64 view)
+R_STALLED = R_KEY + 1  # this step's stall flag (1.0 / 0.0)
+R_V = R_STALLED + 1  # the command decided (0.0, 0.0 before the first call)
+R_W = R_V + 1
+N_ROW = R_W + 1
+
+
+@njit(cache=True)
+def wander_row(ranges: np.ndarray, cls: np.ndarray, row: np.ndarray, max_range_m: float, stalled: bool,
+               step: np.int64) -> tuple:
+    """One robot's ``(v, omega, same)``: :func:`_wander_rows` on one row, with the beam classes
+    ``cls`` computed once (:func:`beam_classes`) and ``row`` (shape (N_ROW,), ``R_*``) holding
+    the parameters, the state (updated in place), the key and the command (``same``: bit for
+    bit the command of the previous call, so the caller may hand out its previous Action)."""
+    bits = row.view(np.uint64)
+    last_v = bits[R_V]
+    last_w = bits[R_W]
+    row[R_STALLED] = 1.0 if stalled else 0.0
+    _wander_rows(ranges[np.newaxis, :], cls[C_FRONT], cls[C_SIDE_L], cls[C_SIDE_R], cls[C_HALF_L], cls[C_HALF_R],
+                 np.int64(row[R_PERP_L]), np.int64(row[R_PERP_R]), max_range_m,
+                 row[R_STALLED:R_STALLED + 1], row.view(np.uint64)[R_KEY:R_KEY + 1], np.int64(step), row,
+                 row[np.newaxis, R_STATE:R_STATE + N_STATE], row[R_V:R_V + 1], row[R_W:R_W + 1])
+    return row[R_V], row[R_W], bits[R_V] == last_v and bits[R_W] == last_w
+
+
+@njit(cache=True)
+def wander_step(
+    ranges_m: np.ndarray,
+    angles_rad: np.ndarray,
+    max_range_m: float,
+    stalled: np.ndarray,
+    keys: np.ndarray,
+    step: np.int64,
+    p: np.ndarray,
+    state: np.ndarray,
+    v_out: np.ndarray,
+    omega_out: np.ndarray,
+) -> None:
+    """Decide every row's command and advance its state in place.
+
+    Parameters
+    ----------
+    ranges_m : ndarray of shape (n, B), float64
+        Each robot's ranges [m] (``max_range_m`` = no return).
+    angles_rad : ndarray of shape (B,), float64
+        Beam directions in the body frame [rad] (any layout; wrapped here).
+    max_range_m : float
+        The sensor's maximum range [m].
+    stalled : ndarray of shape (n,), bool
+        Each robot's stall flag.
+    keys : ndarray of shape (n,), uint64
+        Each robot's RNG key.
+    step : int
+        Step index (the counter of the counter-based RNG).
+    p : ndarray of shape (N_PARAMS,), float64
+        Parameters, see ``P_*``.
+    state : ndarray of shape (n, N_STATE), float64
+        Per-robot state, see ``S_*``; updated in place.
+    v_out, omega_out : ndarray of shape (n,), float64
+        Receive the commands [m/s], [rad/s].
+    """
+    cls, perp_l, perp_r = beam_classes(angles_rad, p)  # once per call
+    _wander_rows(ranges_m, cls[C_FRONT], cls[C_SIDE_L], cls[C_SIDE_R], cls[C_HALF_L], cls[C_HALF_R], perp_l, perp_r, max_range_m, stalled, keys, step, p, state, v_out, omega_out)
 
 
 def initial_state(n: int) -> np.ndarray:
