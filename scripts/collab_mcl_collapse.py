@@ -90,11 +90,15 @@ TEAMNAV_CHECKS: dict[str, tuple[str, str, dict[int, dict]]] = {
                       {0: {"wander": {"cruise_speed_mps": 0.3, "turn_rate_radps": 0.8, "p_turn_at_opening": 0.5}}}),
     "hallway-draws0": ("collab-mcl-hallway", "§5.2.1, inject_min_draws 0 and inject_sender_lost_prior 0 "
                        "(the brain's defaults)", {0: {"inject_min_draws": 0, "inject_sender_lost_prior": 0.0}}),
-    "hexagon": ("collab-mcl-hexagon", "§5.2.2 as the scenario is (sonar 0.1, laser 0.01)", {}),
+    "hexagon": ("collab-mcl-hexagon", "§5.2.2 as the scenario is", {}),
     "hexagon-laser0.03": ("collab-mcl-hexagon", "§5.2.2, laser likelihood exponent 0.03 (the first version)",
                           {1: {"likelihood_exponent": 0.03}}),
     "hexagon-heading0.5": ("collab-mcl-hexagon", "§5.2.2, inject_heading_belief_share 0.5 (the brain's default)",
                            {0: {"inject_heading_belief_share": 0.5}, 1: {"inject_heading_belief_share": 0.5}}),
+    # rule 9 (2026-11-29) ran the two above when the scenario still had uniform headings (0); the
+    # scenario now has the brain's default, so "hexagon" and "hexagon-heading0.5" are the same set-up
+    "hexagon-heading0": ("collab-mcl-hexagon", "§5.2.2, inject_heading_belief_share 0 (uniform draw headings)",
+                         {0: {"inject_heading_belief_share": 0.0}, 1: {"inject_heading_belief_share": 0.0}}),
 }
 
 PART_SCENARIO = {"detection": "collab-mcl-detection", "hallway": "collab-mcl-hallway", "hexagon": "collab-mcl-hexagon"}

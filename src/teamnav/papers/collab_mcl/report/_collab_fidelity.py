@@ -70,8 +70,9 @@ TEAMNAV_REFS: dict[str, str] = {
                            "laser 0.01, §5.1 0.03) was for the beam models the fills replaced",
     "inject_fraction": "sensor resetting on a received tree (Lenser & Veloso 2000): what moves the §5.1 and §5.2 rows "
                        "of this column ('with sensor resetting')",
-    "inject_heading_belief_share": "draws' headings not from the own belief; hexagon: chosen on report seeds 0-7 "
-                                   "(in-sample); §5.1 and hallway: tuning seeds 1000-1039",
+    "inject_heading_belief_share": "draws' headings not from the own belief; §5.1 and hallway: tuning seeds "
+                                   "1000-1039 (the hexagon's uniform headings, chosen on report seeds, gave way to "
+                                   "the brain's default by rule 9, tuning seeds 1000-1019)",
     "inject_heading_scan_share": "draws' headings picked by the scan; tuning seeds 1000-1039 (§5.1)",
     "inject_lost_prior": "§5.1: 0.6, re-chosen on tuning seeds 1000-1019 (rule 7 of docs/report/collab-mcl.md, "
                          "2026-11-29: lowest mean final error of Robin, 0.1-0.9); elsewhere the brain's 0.3, chosen "
