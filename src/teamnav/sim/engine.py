@@ -95,6 +95,11 @@ __all__ = ["Simulation"]
 
 _now = time.perf_counter
 _refs = sys.getrefcount
+#: Refilling handed-over observations reads reference counts, whose values are CPython's and
+#: version-specific (3.14 borrows stack references, so a kept object can show the count of a
+#: dropped one). Only on the versions whose counts the refill tests pin; elsewhere every step
+#: builds new objects, as before the refill.
+_REFILL_OK = sys.implementation.name == "cpython" and sys.version_info[:2] in ((3, 11), (3, 12), (3, 13))
 
 # The slots of an Observation and a RangeScan, written directly when the engine refills the
 # objects it handed over last step (both classes are frozen to brains; see _observe_and_decide).
@@ -844,7 +849,7 @@ class Simulation:
             # name and getrefcount's argument; the dict and the scan also have their holder).
             # Such a brain cannot tell the objects apart from new ones, and the arrays in them
             # are fresh as always; a brain that kept any of them gets new ones.
-            refill = len(rows) == 1 and omit is None
+            refill = _REFILL_OK and len(rows) == 1 and omit is None
             handed = grp.handed
             if refill:
                 if len(handed) != len(grp.brain):
