@@ -1,0 +1,167 @@
+"""The group-brain path: a compiled group brain runs the same runs, bit for bit, as the per-robot
+reference brains it stands for (``docs/design/group-brains.md``).
+
+The compiled piece so far is R1 alone (Sgorbissa & Arkin §2, §5, §6; Tables 1-2's "R1 alone"
+rows): ``los-explorer-v1`` with the potential field or Avoid-Past as algorithm A, in both of
+the report's columns (teamnav's gap-fills, and the paper as written: ``paper_column_r1``).
+Each identity run steps the reference (``Simulation(...)``) and the group brain
+(``Simulation(..., group_brains=True)``) side by side from the same scenario and seed and
+demands, at every step, the same true poses, odometry, commands (the body-frame direction
+of each step) and the same log of R1 (modes, Tr/Pr/Nt, targets, counters), and at the end the
+same steps per target. 2500 steps reach targets, Avoid-Past's decay (inflation
+``2^(t/h)``), goal switches, slides (teamnav column) and the collision guard; the first
+version of the compiled step differed only at step 1632 (a constant ``2.0 ** x`` compiled to
+``exp2``), so short runs would not do.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from teamnav import load_scenario
+from teamnav.control.nav.local import compiled as N
+from teamnav.experiments.spec import build_grid
+from teamnav.papers.los_help.tasks import _alone, task_targets_xy
+from teamnav.sim.engine import Simulation
+
+STEPS = 2500
+
+
+def _scenario(navigator: str, paper: bool, task: int, **extra):
+    """R1 alone on office_simple (Table 1's scenario), one of the tuning tasks' target lists."""
+    if paper:
+        ov = dict(_alone(navigator))  # the paper column's settings, R1 alone
+    else:
+        ov = {"robots.0.params.navigator": navigator, "robots.1.count": 0, "robots.2.count": 0,
+              "robots.3.count": 0}
+    ov["robots.0.params.targets_xy"] = task_targets_xy("simple", task)
+    ov.update(extra)
+    return load_scenario("los-help-simple", overrides=ov, duration_s=STEPS * 0.1, seed=0)
+
+
+def _same_log(la: dict, lb: dict, k: int) -> None:
+    layers_a, layers_b = la.pop("layers", None), lb.pop("layers", None)
+    assert la == lb, f"logs differ at step {k}"
+    assert list(la) == list(lb)
+    assert (layers_a is None) == (layers_b is None)
+    if layers_a is not None:
+        assert list(layers_a) == list(layers_b)
+        for name in layers_a:
+            assert np.array_equal(layers_a[name]["data"], layers_b[name]["data"]), (name, k)
+            assert layers_a[name]["data"].shape == layers_b[name]["data"].shape
+            assert {k2: v for k2, v in layers_a[name].items() if k2 != "data"} == \
+                   {k2: v for k2, v in layers_b[name].items() if k2 != "data"}
+
+
+def _side_by_side(scn, steps: int = STEPS):
+    ref = Simulation(build_grid(scn), scn)
+    grp = Simulation(build_grid(scn), scn, group_brains=True)
+    assert len(grp.group_teams) == 1, "the group brain must run R1"
+    r_ref, r_grp = ref.brains[0][0], grp.brains[0][0]
+    _same_log(r_ref.log(), r_grp.log(), 0)
+    for _ in range(steps):
+        ref.step()
+        grp.step()
+        k = ref.step_index
+        assert np.array_equal(ref.state.poses(), grp.state.poses()), f"true poses differ at step {k}"
+        assert np.array_equal(ref.odometry.pose, grp.odometry.pose), f"odometry differs at step {k}"
+        assert np.array_equal(ref._dir_cmd, grp._dir_cmd, equal_nan=True), f"commands differ at step {k}"
+        _same_log(r_ref.log(), r_grp.log(), k)
+    assert r_ref.target_steps == r_grp.target_steps
+    for attr in ("finished", "gave_up", "targets_reached", "target_index", "moves", "msgs_sent", "bytes_sent",
+                 "msgs_received", "mode"):
+        assert getattr(r_ref, attr) == getattr(r_grp, attr), attr
+    return r_ref
+
+
+@pytest.mark.parametrize("paper", [False, True], ids=["teamnav", "paper"])
+@pytest.mark.parametrize("navigator", ["avoid_past", "potential_field"])
+@pytest.mark.parametrize("task", [1001, 1002])
+def test_r1_alone_compiled_is_the_reference_bit_for_bit(navigator, paper, task):
+    r1 = _side_by_side(_scenario(navigator, paper, task))
+    if navigator == "avoid_past":
+        assert r1.targets_reached >= 3  # the identity covers goal switches
+    assert r1.moves > STEPS // 2 and r1.mode_steps["own_goal"] == STEPS + 1  # step 0 decides too
+    assert r1._nav is not None  # algorithm A drove (the potential field alone is soon trapped, §6)
+
+
+def test_identity_covers_giving_up_layers_and_memory_scope():
+    """A step budget that runs out (gave_up), the goal and ghost layers, Avoid-Past's memory
+    forgotten at each new goal (``memory_scope="goal"``) and without decay."""
+    scn = _scenario("avoid_past", False, 1003, **{
+        "robots.0.params.max_steps_per_target": 150, "robots.0.params.log_layers": True,
+        "robots.0.params.navigator_params": {"memory_scope": "goal", "memory_half_life_steps": None}})
+    r1 = _side_by_side(scn, 1200)
+    assert r1.gave_up and r1.mode == "gave_up"
+
+
+def test_identity_without_targets():
+    scn = _scenario("potential_field", True, 1001, **{"robots.0.params.targets_xy": []})
+    r1 = _side_by_side(scn, 5)
+    assert r1.finished and r1.mode == "done"
+
+
+def test_teams_with_helpers_keep_the_reference_brains():
+    """R1 with a helper is not compiled yet: the group brain declines and both robots run
+    their per-robot brains (the run is then the reference's by construction)."""
+    ov = {"robots.0.params.navigator": "avoid_past", "robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0}
+    scn = load_scenario("los-help-simple", overrides=ov, duration_s=1.0, seed=0)
+    sim = Simulation(build_grid(scn), scn, group_brains=True)
+    assert sim.group_teams == []
+    assert type(sim.brains[0][0]).__name__ == "LosExplorer"
+
+
+def test_subclasses_do_not_inherit_the_group_brain():
+    """A brain that extends R1's step (the beyond section's trail explorer) is not run by R1's
+    group brain: only the class that names ``group_brain`` is."""
+    from teamnav.control.group import group_brain_class
+    from teamnav.papers.los_help.brains.explorer import LosExplorer
+
+    class Extended(LosExplorer):
+        pass
+
+    assert group_brain_class(LosExplorer) is not None
+    assert group_brain_class(Extended) is None
+
+
+def test_py_hypot_is_pythons_hypot():
+    """CPython's ``math.hypot`` is not libm's (which numba calls): the compiled step uses a
+    port of CPython's algorithm. Random magnitudes over 20 decades, signs, zeros, subnormals,
+    infinities and NaN."""
+    rng = np.random.default_rng(7)
+    xs = rng.standard_normal(20000) * 10.0 ** rng.integers(-10, 10, 20000)
+    ys = rng.standard_normal(20000) * 10.0 ** rng.integers(-10, 10, 20000)
+    special = [0.0, -0.0, 5e-324, -2.5e-320, 1e-310, 1e308, -1.7e308, math.inf, -math.inf, math.nan, 3.0]
+    pairs = list(zip(xs.tolist(), ys.tolist())) + [(a, b) for a in special for b in special]
+    for x, y in pairs:
+        want, got = math.hypot(x, y), N.py_hypot(x, y)
+        assert (want == got and math.copysign(1, want) == math.copysign(1, got)) or (want != want and got != got), \
+            (x, y, want, got)
+
+
+def test_compiled_dot_sums_as_numpys_matmul():
+    """The potential field sums its terms with numpy's matmul (OpenBLAS ``dgemv``); the compiled
+    field calls ``np.dot``, which numba sends to SciPy's BLAS. Bit-identical runs rest on the two
+    summing in one order (a plain loop does not), checked here for the shapes the field uses."""
+    from numba import njit
+
+    @njit
+    def dot(c, a):
+        return np.dot(c, a)
+
+    rng = np.random.default_rng(3)
+    for n in list(range(1, 40)) + [72, 100, 360, 529, 600]:
+        c = rng.standard_normal(n)
+        a = rng.standard_normal((n, 2))
+        assert np.array_equal(dot(c, a), c @ a), n
+
+
+def test_py_wrap_is_wrap_scalar():
+    from teamnav.control.nav.local.base import wrap_scalar
+
+    for a in np.concatenate([np.linspace(-20, 20, 4001), [math.pi, -math.pi, 3 * math.pi, -0.0, 1e17, math.nan]]):
+        want, got = wrap_scalar(float(a)), N.py_wrap(float(a))
+        assert want == got or (want != want and got != got), a
