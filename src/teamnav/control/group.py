@@ -129,6 +129,8 @@ def pad_detections(per_robot: Sequence[Sequence[Any]] | None, n: int) -> tuple[n
     """``(det_count, det_id, det_range_m, det_bearing_rad)`` of :class:`GroupObservation` from
     each robot's tuple of :class:`~teamnav.control.types.Detection` (None: none at all)."""
     k = max((len(d) for d in per_robot), default=0) if per_robot is not None else 0
+    if k == 0:  # nobody detected anybody (the common case: fresh empty arrays, no filling)
+        return np.zeros(n, dtype=np.int64), np.empty((n, 0), dtype=np.int64), np.empty((n, 0)), np.empty((n, 0))
     count = np.zeros(n, dtype=np.int64)
     ids = np.full((n, k), -1, dtype=np.int64)
     rng = np.full((n, k), np.nan)

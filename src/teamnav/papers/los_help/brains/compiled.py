@@ -202,12 +202,15 @@ def _head_to(r, gx, gy, end_margin, px, py, th, c, s, ranges, angles, max_range,
 def r1_alone_step(step, odom, ranges, angles, max_range, gap, epar, efst, eist, targets, target_steps,
                   npar, nfst, nist, grid, normals, out_dir, grow):
     """One step of every row (see the module docstring); ``out_dir[r]``: the body-frame
-    direction of robot r's next step, NaN for none. Returns 1 without changing anything when
-    a row's Avoid-Past visit would fall outside its grid (``grow``: row, cell i, cell j; the
-    caller grows the grid and calls again), else 0."""
+    direction of robot r's next step, NaN for none. Returns, without changing anything, 1
+    when a row's Avoid-Past visit would fall outside its grid (``grow``: row, cell i, cell j;
+    the caller grows the grid and calls again) and 2 when a row has fewer than two normals
+    left (the caller refills the buffers and calls again); else 0 after the step."""
     n = odom.shape[0]
     for r in range(n):
         if eist[r, J_FINISHED] == 0:
+            if nist[r, N.I_NORMAL] > N.NORMALS - 2:
+                return 2
             out, ci, cj = N.visit_cell_outside(npar, nist, grid, r, odom[r, 0], odom[r, 1])
             if out:
                 grow[0] = r
@@ -443,23 +446,28 @@ class LosExplorerGroup:
         self._gap = 0.0
         self._dir = np.empty(n)
         self._grow = np.zeros(3, dtype=np.int64)
-        self._zeros = np.zeros(n)
+        self._n = n
         self.robots = [_R1View(self, r) for r in range(n)]
 
     def step_group(self, obs: GroupObservation) -> GroupAction:
         """One step of every robot (the kernel :func:`r1_alone_step`)."""
         angles = obs.angles_rad[self.laser]
         if self._gap_for is not angles:  # as the reference: the beam layout's gap, measured once
-            self._gap_for, self._gap = angles, max_beam_gap(np.ascontiguousarray(angles, dtype=np.float64))
+            self._a64 = np.ascontiguousarray(angles, dtype=np.float64)
+            self._gap_for, self._gap = angles, max_beam_gap(self._a64)
         ranges = np.ascontiguousarray(obs.ranges_m[self.laser], dtype=np.float64)
-        a64 = np.ascontiguousarray(angles, dtype=np.float64)
         odom = np.ascontiguousarray(obs.odom_pose, dtype=np.float64)
-        N.refill_normals(self.nist, self.normals, self.rngs)
         step = int(obs.step)
         max_range = float(obs.max_range_m[self.laser])
-        while r1_alone_step(step, odom, ranges, a64, max_range, self._gap, self.epar, self.efst, self.eist,
-                            self.targets, self.target_steps, self.npar, self.nfst, self.nist, self.grid,
-                            self.normals, self._dir, self._grow):
-            r, ci, cj = (int(v) for v in self._grow)
-            self.grid = N.grow_grid(self.grid, self.nist, r, ci, cj)
-        return GroupAction(self._zeros.copy(), self._zeros.copy(), self._dir.copy(), [])
+        while True:
+            code = r1_alone_step(step, odom, ranges, self._a64, max_range, self._gap, self.epar, self.efst, self.eist,
+                                 self.targets, self.target_steps, self.npar, self.nfst, self.nist, self.grid,
+                                 self.normals, self._dir, self._grow)
+            if code == 0:
+                break
+            if code == 1:
+                r, ci, cj = (int(v) for v in self._grow)
+                self.grid = N.grow_grid(self.grid, self.nist, r, ci, cj)
+            else:
+                N.refill_normals(self.nist, self.normals, self.rngs)
+        return GroupAction(np.zeros(self._n), np.zeros(self._n), self._dir.copy(), [])
