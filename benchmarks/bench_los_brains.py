@@ -33,7 +33,7 @@ It prints, last, one line per configuration and one for their median, in the for
 ``LOS team step, 4 robots (teamnav, potential_field): base / this tree = 1.05x``.
 
 ``--group-brains``: CPU per team step of the compiled group brains (``Simulation(...,
-group_brains=True)``, ``docs/design/group-brains.md``) against the Python reference brains, in
+group_brains=True)``, ``docs/concepts/group-brains.md``) against the Python reference brains, in
 this tree, for every team the group brains compile so far: R1 alone (Tables 1-2's first row)
 on office_simple, tuning task 1001, each column (teamnav, paper as written) and navigator
 (potential field, Avoid-Past). Reference and compiled alternate ``--repeats`` rounds, each run

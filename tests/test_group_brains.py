@@ -1,5 +1,5 @@
 """The group-brain path: a compiled group brain runs the same runs, bit for bit, as the per-robot
-reference brains it stands for (``docs/design/group-brains.md``).
+reference brains it stands for (``docs/concepts/group-brains.md``).
 
 The compiled piece so far is R1 alone (Sgorbissa & Arkin §2, §5, §6; Tables 1-2's "R1 alone"
 rows): ``los-explorer-v1`` with the potential field or Avoid-Past as algorithm A, in both of

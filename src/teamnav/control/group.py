@@ -6,7 +6,7 @@ a class that steps every robot of a team at once, its state held as arrays (one 
 robot), its step compiled. The per-robot class stays the readable reference; a run with
 ``Simulation(..., group_brains=True)`` uses the group brain wherever it says it can run the
 robots' parameters (:meth:`GroupBrain.unsupported` returns None) and gives the same run, bit
-for bit (the group brain's identity test says so). See ``docs/design/group-brains.md``.
+for bit (the group brain's identity test says so). See ``docs/concepts/group-brains.md``.
 
 What a group brain is given is what the per-robot brains of its robots are given, row by
 row, and nothing else (truth and belief never mix): :class:`GroupObservation`. What it gives

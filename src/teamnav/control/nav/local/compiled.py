@@ -1,7 +1,7 @@
 """The potential field and Avoid-Past (Sgorbissa & Arkin §6, algorithms A = 1 and 2) for many
 robots in one compiled call: state as named columns of arrays, one row per robot.
 
-This is the group-brain form (``docs/design/group-brains.md``) of
+This is the group-brain form (``docs/concepts/group-brains.md``) of
 :class:`~teamnav.control.nav.local.potential_field.PotentialField` and
 :class:`~teamnav.control.nav.local.avoid_past.AvoidPast`, which stay the readable reference.
 The law is theirs, operation for operation, so that a row gives the same bits as the

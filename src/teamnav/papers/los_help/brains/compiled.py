@@ -1,7 +1,7 @@
 """R1 of the line-of-sight help system compiled whole, for robots without teammates: the group
 brain of ``los-explorer-v1`` (Sgorbissa & Arkin §2, §5, §6; Tables 1-2's "R1 alone" rows).
 
-The first piece of the group-brain path (``docs/design/group-brains.md``): the explorer of
+The first piece of the group-brain path (``docs/concepts/group-brains.md``): the explorer of
 :mod:`.explorer` (the readable reference) as one numba step over every row of a group, its
 state as named columns of arrays, with the potential field or Avoid-Past as algorithm A
 (:mod:`teamnav.control.nav.local.compiled`). It covers the explorer's step where no teammate
