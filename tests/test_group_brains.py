@@ -165,3 +165,110 @@ def test_py_wrap_is_wrap_scalar():
     for a in np.concatenate([np.linspace(-20, 20, 4001), [math.pi, -math.pi, 3 * math.pi, -0.0, 1e17, math.nan]]):
         want, got = wrap_scalar(float(a)), N.py_wrap(float(a))
         assert want == got or (want != want and got != got), a
+
+
+# ---------------------------------------------------------------------------- the engine side
+# A toy brain and its group brain: both decide with the same pure function of the robot's own
+# observation, and record what they were given, so the test can compare, row by row, what the
+# group brain receives with what each per-robot brain receives (truth and belief never mix).
+from teamnav.control import NoParams  # noqa: E402
+from teamnav.control.group import GroupAction  # noqa: E402
+from teamnav.control.types import Action, Message  # noqa: E402
+
+
+def _decide(rid: int, odom, ranges, n_det: int, n_inbox: int) -> tuple[float, float]:
+    return 0.2 + 0.01 * n_inbox, (0.3 if float(np.min(ranges)) > 1.0 else -0.6) + 0.05 * n_det - 0.01 * rid + 0.0 * odom[2]
+
+
+class EchoGroup:
+    def __init__(self, params, rngs, infos):
+        self.ids = [int(i.robot_id) for i in infos]
+        self.seen = []
+        self.robots = [_EchoView() for _ in infos]
+
+    @classmethod
+    def unsupported(cls, params, infos):
+        return None
+
+    def step_group(self, obs):
+        self.seen.append(obs)
+        n = len(self.ids)
+        v, w = np.zeros(n), np.zeros(n)
+        out = []
+        for r, rid in enumerate(self.ids):
+            v[r], w[r] = _decide(rid, obs.odom_pose[r], obs.ranges_m["laser"][r], int(obs.det_count[r]),
+                                 len(obs.inbox[r]))
+            out.append((rid, Message(rid, obs.time_s, {"step": obs.step}, kind="echo")))
+        return GroupAction(v, w, np.full(n, np.nan), out)
+
+
+class _EchoView:
+    def log(self):
+        return {}
+
+
+class Echo:
+    Params = NoParams
+    group_brain = EchoGroup
+
+    def __init__(self, params, rng, info):
+        self.id = int(info.robot_id)
+        self.seen = []
+
+    def step(self, obs):
+        self.seen.append(obs)
+        v, w = _decide(self.id, obs.odom_pose, obs.scans["laser"].ranges_m, len(obs.detections), len(obs.inbox))
+        return Action(v, w), [Message(self.id, obs.time_s, {"step": obs.step}, kind="echo")]
+
+    def log(self):
+        return {}
+
+
+def _toy_config():
+    from teamnav.sim.config import DetectorConfig, RadioConfig, RobotGroupConfig, SimConfig
+
+    echo = f"{__name__}:Echo"
+    det = DetectorConfig(range_noise_std_m=0.05, bearing_noise_std_deg=2.0)
+    groups = (RobotGroupConfig(name="a", count=2, controller=echo, detector=det),
+              RobotGroupConfig(name="none", count=0, controller=echo, detector=det),
+              RobotGroupConfig(name="b", count=1, controller=echo, detector=det),
+              RobotGroupConfig(name="other", count=1, controller="wander-v1", detector=det),
+              RobotGroupConfig(name="c", count=2, controller=echo, detector=det))
+    return SimConfig(robots=groups, radio=RadioConfig(mode="range", range_m=4.0), seed=11)
+
+
+def test_teams_of_consecutive_groups_see_what_per_robot_brains_see():
+    """Groups naming one group brain form a team when consecutive (a group without robots does
+    not break it, another controller does); each row of the team's observation is the robot's
+    own observation (odometry, scan, detections, inbox, stall flag), and the runs are the same."""
+    from teamnav.world.grid import OccupancyGrid
+
+    grid = OccupancyGrid.empty(8.0, 6.0, 0.05)
+    ref = Simulation(grid, _toy_config())
+    grp = Simulation(grid, _toy_config(), group_brains=True)
+    assert [(start, stop, members) for _, start, stop, members in grp.group_teams] == [(0, 3, (0, 2)), (4, 6, (4,))]
+    ref.run(60)
+    grp.run(60)
+    assert np.array_equal(ref.state.poses(), grp.state.poses())
+    per_robot = {b.id: b.seen for g in ref.brains if isinstance(g, list) for b in g if isinstance(b, Echo)}
+    delivered = detected = 0
+    for team, start, stop, _ in grp.group_teams:
+        assert len(team.seen) == 61  # the first decision and 60 steps
+        for k, gobs in enumerate(team.seen):
+            for r, rid in enumerate(range(start, stop)):
+                o = per_robot[rid][k]
+                assert gobs.robot_ids[r] == rid and gobs.step == o.step and gobs.time_s == o.time_s
+                assert np.array_equal(gobs.odom_pose[r], o.odom_pose)
+                assert np.array_equal(gobs.odom_delta[r], o.odom_delta)
+                assert bool(gobs.stalled[r]) == o.stalled
+                assert np.array_equal(gobs.ranges_m["laser"][r], o.scans["laser"].ranges_m)
+                assert np.array_equal(gobs.angles_rad["laser"], o.scans["laser"].angles_rad)
+                c = int(gobs.det_count[r])
+                assert c == len(o.detections)
+                for j, d in enumerate(o.detections):
+                    assert (gobs.det_id[r, j], gobs.det_range_m[r, j], gobs.det_bearing_rad[r, j]) == \
+                           (d.robot_id, d.range_m, d.bearing_rad)
+                assert [(m.sender, m.body) for m in gobs.inbox[r]] == [(m.sender, m.body) for m in o.inbox]
+                delivered += len(o.inbox)
+                detected += c
+    assert delivered > 0 and detected > 0  # messages were carried and teammates detected
