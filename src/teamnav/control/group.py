@@ -25,10 +25,12 @@ from typing import Any, Protocol, Sequence, runtime_checkable
 import numpy as np
 
 from teamnav.control.protocol import RobotInfo
+from teamnav.control.types import _fast_frozen_init
 
 __all__ = ["GroupAction", "GroupBrain", "GroupObservation", "empty_inbox", "group_brain_class", "pad_detections"]
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class GroupObservation:
     """One step's observations of every robot of a team, row r for ``robot_ids[r]``.
@@ -80,6 +82,7 @@ class GroupObservation:
     events: tuple | None
 
 
+@_fast_frozen_init
 @dataclass(frozen=True, slots=True)
 class GroupAction:
     """Every robot's command of this step and the messages it sends.

@@ -117,9 +117,14 @@ def _sensor_factories():
 
 def _group_brain_class():
     """:func:`teamnav.control.group.group_brain_class` (imported lazily)."""
-    from teamnav.control.group import group_brain_class
+    return _group_api().group_brain_class
 
-    return group_brain_class
+
+def _group_api():
+    """:mod:`teamnav.control.group` (imported lazily: runs without group brains never load it)."""
+    from teamnav.control import group
+
+    return group
 
 
 def _check_bodies():
@@ -183,7 +188,8 @@ class Simulation:
     time_s : float
         ``step_index * dt_s`` [s].
     brains : list
-        Per group: a list of per-robot controllers, or the group's batched controller.
+        Per group: a list of per-robot controllers, or the group's batched controller (with
+        ``group_brains``: for a team's groups, the group brain's per-robot views).
     recorder : Recorder
     group_of : ndarray of shape (N,), int64
         Group index of every robot (read-only).
@@ -962,28 +968,34 @@ class Simulation:
         """One call of a group brain for its team: each robot's own readings, odometry,
         detections, inbox and events as arrays (:class:`~teamnav.control.group.GroupObservation`),
         its commands into the command arrays, its messages to the radio (robot order)."""
-        from teamnav.control.group import GroupAction, GroupObservation, empty_inbox, pad_detections
-
         first, last = members[0][0], members[-1][0]
         sl = slice(first.sl.start, last.sl.stop)
         n = sl.stop - sl.start
-        if len(members) == 1:
-            ranges = {name: r for name, r, _, _ in members[0][1]}
+        readings = members[0][1]
+        if len(members) == 1 and len(readings) == 1:
+            name, r, a, m = readings[0]
+            ranges, angles, max_range = {name: r}, {name: a}, {name: m}
+        elif len(members) == 1:
+            ranges = {name: r for name, r, _, _ in readings}
         else:
             ranges = {name: np.concatenate([dict((nm, rr) for nm, rr, _, _ in rd)[name] for _, rd, _ in members])
                       for name, _, _, _ in members[0][1]}
-        angles = {name: a for name, _, a, _ in members[0][1]}
-        max_range = {name: m for name, _, _, m in members[0][1]}
-        dets = None
-        if any(d is not None for _, _, d in members):
-            dets = [row for grp, _, d in members for row in (d if d is not None else ((),) * grp.cfg.count)]
-        count, ids, rng, brg = pad_detections(dets, n)
-        obs = GroupObservation(
-            robot_ids=np.arange(sl.start, sl.stop, dtype=np.int64), step=step, time_s=t, odom_pose=odom[sl],
-            odom_delta=delta[sl], stalled=self.state.stalled[sl].copy(), ranges_m=ranges, angles_rad=angles,
-            max_range_m=max_range, det_count=count, det_id=ids, det_range_m=rng, det_bearing_rad=brg,
-            inbox=tuple(inboxes[sl]) if inboxes is not None else empty_inbox(n),
-            events=tuple(events[sl]) if events is not None else None,
+        if not (len(members) == 1 and len(readings) == 1):
+            angles = {name: a for name, _, a, _ in readings}
+            max_range = {name: m for name, _, _, m in readings}
+        if len(members) == 1:
+            dets = members[0][2]
+        else:
+            dets = None
+            if any(d is not None for _, _, d in members):
+                dets = [row for grp, _, d in members for row in (d if d is not None else ((),) * grp.cfg.count)]
+        count, ids, rng, brg = _group_api().pad_detections(dets, n)
+        api = _group_api()
+        obs = api.GroupObservation(
+            np.arange(sl.start, sl.stop, dtype=np.int64), step, t, odom[sl], delta[sl], self.state.stalled[sl].copy(),
+            ranges, angles, max_range, count, ids, rng, brg,
+            tuple(inboxes[sl]) if inboxes is not None else ((),) * n,
+            tuple(events[sl]) if events is not None else None,
         )
         timer = self._brain_timer
         self.calling = (first.index, None, step, _now())
@@ -992,7 +1004,7 @@ class Simulation:
             self.calling = None
         except (Exception, SystemExit) as exc:
             raise self._brain_failed(first, None, step, exc) from exc
-        if not isinstance(act, GroupAction):
+        if not isinstance(act, api.GroupAction):
             raise self._bad_return(first, None, step, f"step_group() must return a GroupAction, got {_short(act)}")
         self._v_cmd[sl] = act.v_mps
         self._w_cmd[sl] = act.omega_radps
