@@ -42,6 +42,9 @@ does, and a configuration whose runs differ says DIFFER. It prints, last, one li
 configuration and then one per team size, in the form
 ``LOS team step, 1 robots: compiled / reference = 1.4x`` (reference CPU over compiled CPU,
 median of the configurations). ``--quick`` ends with these lines too (1000 steps, one round).
+``--group-brains --group-tasks 1001,1002``: whole tasks instead (200 targets, the scenario's
+own budget per target, ``stop_when_finished``), reference then compiled in one process per
+task, saying whether every output, the run's metrics and the steps per target are the same.
 
 ``--targets N``: instead of a fixed number of steps, each run is the first N targets of task 1
 (the scenario's own step budget per target and ``stop_when_finished``), and the table gives
@@ -136,6 +139,9 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--group-worker", nargs=4, metavar=("NAV", "PAPER", "COMPILED", "STEPS"), help=argparse.SUPPRESS)
     ap.add_argument("--group-brains", action="store_true",
                     help="CPU per team step, compiled group brains vs the Python reference (this tree)")
+    ap.add_argument("--group-tasks", help="with --group-brains: whole tuning tasks (comma-separated), identity "
+                                          "of outputs and metrics, reference vs compiled")
+    ap.add_argument("--group-task-worker", nargs=3, metavar=("NAV", "PAPER", "TASK"), help=argparse.SUPPRESS)
     ap.add_argument("--team-step", action="store_true",
                     help="CPU per 1000 team steps at 4 robots, both columns x 3 navigators, base vs this tree")
     ap.add_argument("--targets", type=int, default=0, help="time whole tasks of the first N targets of task 1")
@@ -167,6 +173,12 @@ def main(argv: list[str] | None = None) -> None:
     if args.kernels:
         _kernels()
         return
+    if args.group_task_worker:
+        nav, paper, task = args.group_task_worker
+        print(json.dumps(_group_task_worker(nav, paper == "1", int(task))))
+        return
+    if args.group_brains and args.group_tasks:
+        return _group_tasks([int(t) for t in args.group_tasks.split(",")])
     if args.group_brains:
         return _group_brains(1000 if args.quick else args.steps, 1 if args.quick else max(1, args.repeats))
     steps = 600 if args.quick else args.steps
@@ -428,23 +440,81 @@ def _team_steps(base: Path, new: Path, steps: int, repeats: int, base_name: str,
 GROUP_NAVIGATORS = ("potential_field", "avoid_past")
 
 
-def _group_worker(navigator: str, paper: bool, compiled: bool, steps: int) -> dict:
-    """(in the measuring process) CPU of ``steps`` warm steps of R1 alone on office_simple
-    (tuning task TEAM_TASK), with the Python brain or its compiled group brain, and a digest of
-    everything the run put out (as ``_team_worker``)."""
-    import hashlib
-
-    import numpy as np
-
-    from los_fingerprint import _default
-    from teamnav import load_scenario
+def _group_overrides(navigator: str, paper: bool, task: int) -> dict:
     from teamnav.papers.los_help.tasks import _alone, task_targets_xy
 
     if paper:
         ov = dict(_alone(navigator))  # the paper column's settings, R1 alone (the tuning sweeps' cases)
     else:
         ov = {"robots.0.params.navigator": navigator, "robots.1.count": 0, "robots.2.count": 0, "robots.3.count": 0}
-    ov["robots.0.params.targets_xy"] = task_targets_xy("simple", TEAM_TASK)
+    ov["robots.0.params.targets_xy"] = task_targets_xy("simple", task)
+    return ov
+
+
+def _digest(res) -> str:
+    """SHA-256 of a run's outputs (as ``--team-step``): poses, odometry, stalls, logs, events, radio totals."""
+    import hashlib
+
+    import numpy as np
+
+    from los_fingerprint import _default
+
+    d = res.data
+    h = hashlib.sha256()
+    for a in (d.true_pose, d.odom_pose):
+        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    h.update(np.ascontiguousarray(d.stalled).astype(np.uint8).tobytes())
+    h.update(json.dumps([d.logs, d.event_log, d.messages_sent, d.bytes_sent, d.messages_delivered],
+                        sort_keys=True, default=_default).encode())
+    return h.hexdigest()
+
+
+def _group_task_worker(navigator: str, paper: bool, task: int) -> dict:
+    """(in the measuring process) one whole task of R1 alone, reference then compiled."""
+    from teamnav import load_scenario
+    from teamnav.experiments.runner import run
+
+    out = {}
+    for compiled in (False, True):
+        scn = load_scenario(MAPS["simple"], overrides=_group_overrides(navigator, paper, task), seed=0)
+        t0 = time.process_time()
+        res = run(scn, progress=False, group_brains=compiled)
+        cpu = time.process_time() - t0
+        r1 = res.sim.brains[0][0]
+        out["compiled" if compiled else "reference"] = {
+            "digest": _digest(res), "metrics": json.dumps(res.metrics, sort_keys=True, default=str),
+            "target_steps": list(r1.target_steps), "steps": int(res.sim.step_index), "cpu_s": cpu,
+            "teams": len(res.sim.group_teams)}
+    return out
+
+
+def _group_tasks(tasks: list[int]) -> None:
+    """Whole tasks, reference vs compiled: the same outputs, metrics and steps per target?"""
+    print(f"R1 alone on office_simple, whole tasks {tasks} (200 targets, the scenario's budget per target); "
+          f"load {os.getloadavg()[0]:.1f}")
+    env = dict(os.environ, PYTHONPATH=str(REPO / "src"), NUMBA_NUM_THREADS="1")
+    bad = 0
+    for paper, nav, task in itertools.product((False, True), GROUP_NAVIGATORS, tasks):
+        res = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--group-task-worker", nav,
+                              "1" if paper else "0", str(task)], env=env, check=True, capture_output=True, text=True)
+        r = json.loads(res.stdout.strip().splitlines()[-1])
+        a, b = r["reference"], r["compiled"]
+        same = {k: a[k] == b[k] for k in ("digest", "metrics", "target_steps", "steps")}
+        bad += not all(same.values()) or b["teams"] != 1
+        print(f"{'paper' if paper else 'teamnav':8s} {nav:16s} task {task}: {a['steps']:7d} steps, "
+              f"{len(a['target_steps']):3d} targets; outputs, metrics, steps per target: "
+              f"{'same' if all(same.values()) else 'DIFFER ' + str(same)}; CPU reference {a['cpu_s']:.1f} s, "
+              f"compiled {b['cpu_s']:.1f} s", flush=True)
+    print(f"{bad} of {2 * len(GROUP_NAVIGATORS) * len(tasks)} whole tasks differ")
+
+
+def _group_worker(navigator: str, paper: bool, compiled: bool, steps: int) -> dict:
+    """(in the measuring process) CPU of ``steps`` warm steps of R1 alone on office_simple
+    (tuning task TEAM_TASK), with the Python brain or its compiled group brain, and a digest of
+    everything the run put out (as ``_team_worker``)."""
+    from teamnav import load_scenario
+
+    ov = _group_overrides(navigator, paper, TEAM_TASK)
     ov["robots.0.params.max_steps_per_target"] = 100_000_000
     from teamnav.experiments.runner import run
 
@@ -454,14 +524,7 @@ def _group_worker(navigator: str, paper: bool, compiled: bool, steps: int) -> di
                                     group_brains=compiled)
     if compiled and not res.sim.group_teams:
         raise SystemExit("the group brain did not run R1")
-    d = res.data
-    h = hashlib.sha256()
-    for a in (d.true_pose, d.odom_pose):
-        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
-    h.update(np.ascontiguousarray(d.stalled).astype(np.uint8).tobytes())
-    h.update(json.dumps([d.logs, d.event_log, d.messages_sent, d.bytes_sent, d.messages_delivered],
-                        sort_keys=True, default=_default).encode())
-    return {"cpu_s": total, "brain_s": brain_s, "steps": int(res.sim.step_index), "digest": h.hexdigest()}
+    return {"cpu_s": total, "brain_s": brain_s, "steps": int(res.sim.step_index), "digest": _digest(res)}
 
 
 def _group_measure(navigator: str, paper: bool, compiled: bool, steps: int) -> dict:
