@@ -114,6 +114,18 @@ def test_teams_with_helpers_keep_the_reference_brains():
     assert type(sim.brains[0][0]).__name__ == "LosExplorer"
 
 
+def test_runs_with_faults_keep_the_reference_brains():
+    """Faults shape each robot's observation (a scan not published, phantom detections), which
+    the group observation does not carry yet: such runs use the per-robot brains; an empty
+    ``faults`` section is no fault and keeps the group brain."""
+    base = {"robots.0.params.navigator": "avoid_past", "robots.1.count": 0, "robots.2.count": 0, "robots.3.count": 0}
+    with_fault = {**base, "faults": {"blackouts": [{"t0_s": 0.5, "t1_s": 0.8}]}}
+    for ov, teams in ((with_fault, 0), ({**base, "faults": {}}, 1)):
+        scn = load_scenario("los-help-simple", overrides=ov, duration_s=1.0, seed=0)
+        sim = Simulation(build_grid(scn), scn, group_brains=True)
+        assert len(sim.group_teams) == teams
+
+
 def test_subclasses_do_not_inherit_the_group_brain():
     """A brain that extends R1's step (the beyond section's trail explorer) is not run by R1's
     group brain: only the class that names ``group_brain`` is."""

@@ -300,7 +300,8 @@ class Simulation:
                 raise ValueError(f"{label}: controller {g.controller!r}: batched controllers command (v, omega) and "
                                  f"need kinematics 'unicycle', got {g.kinematics!r}")
             group_cls = None
-            if (group_brains and not batched and g.count and config.faults is None and launch is None
+            if (group_brains and not batched and g.count and launch is None
+                    and (config.faults is None or config.faults.empty)
                     and "group_brain" in vars(cls)):
                 group_cls = _group_brain_class()(cls)
             if group_cls is not None:
