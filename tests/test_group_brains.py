@@ -284,3 +284,44 @@ def test_teams_of_consecutive_groups_see_what_per_robot_brains_see():
                 delivered += len(o.inbox)
                 detected += c
     assert delivered > 0 and detected > 0  # messages were carried and teammates detected
+
+
+def test_stale_numba_caches_of_callers_are_renewed(tmp_path):
+    """numba's cache checks only the compiled function's own file: a caller cached before its
+    callee changed runs the callee's old code. ``renew_stale_caches`` stamps the callees'
+    sources and empties the caller's cache when they change (the compiled group brains call
+    it at import)."""
+    import subprocess
+    import sys
+    import textwrap
+
+    pkg = tmp_path / "stalepkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    callee = pkg / "callee.py"
+    (pkg / "caller.py").write_text(textwrap.dedent("""
+        import sys
+        from numba import njit
+        from stalepkg import callee
+
+        @njit(cache=True)
+        def outer(x):
+            return callee.inner(x)
+
+        if "--renew" in sys.argv:
+            from teamnav.control.group import renew_stale_caches
+            renew_stale_caches([outer], [callee.__file__])
+        print(outer(1))
+        """))
+    env = {**__import__("os").environ, "PYTHONPATH": f"{tmp_path}:{__import__('os').pathsep.join(sys.path)}"}
+
+    def run(value: int, *flags: str) -> int:
+        callee.write_text(f"from numba import njit\n\n@njit(cache=True)\ndef inner(x):\n    return x + {value}\n")
+        out = subprocess.run([sys.executable, "-c", "import sys; sys.argv += %r; import stalepkg.caller" % (list(flags),)],
+                             env=env, cwd=tmp_path, check=True, capture_output=True, text=True)
+        return int(out.stdout.split()[-1])
+
+    assert run(1) == 2
+    assert run(10) == 2  # stale: the caller's cache still holds the old callee
+    assert run(10, "--renew") == 11
+    assert run(200, "--renew") == 201  # (sizes differ: the callee's own cache sees its change whatever the clock)

@@ -18,8 +18,10 @@ flag, ``log()``, counters that experiments read) is one view object per robot,
 
 from __future__ import annotations
 
+import hashlib
 import importlib
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Protocol, Sequence, runtime_checkable
 
 import numpy as np
@@ -27,7 +29,8 @@ import numpy as np
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import _fast_frozen_init
 
-__all__ = ["GroupAction", "GroupBrain", "GroupObservation", "empty_inbox", "group_brain_class", "pad_detections"]
+__all__ = ["GroupAction", "GroupBrain", "GroupObservation", "empty_inbox", "group_brain_class", "pad_detections",
+           "renew_stale_caches"]
 
 
 @_fast_frozen_init
@@ -152,3 +155,38 @@ def empty_inbox(n: int) -> tuple:
     """n empty inboxes."""
     return ((),) * n
 
+
+
+def renew_stale_caches(dispatchers: Sequence[Any], sources: Sequence[str | Path]) -> bool:
+    """Empty the numba caches of ``dispatchers`` when a module they call has changed.
+
+    numba's on-disk cache (``cache=True``) checks only the source file of the function it
+    compiled: a compiled group brain calls numba functions of other modules (the reference's
+    kernels, the compiled navigators), and after one of those changes it would go on running
+    their old code from the cache. A stamp of the ``sources`` (the callee modules' files) is
+    kept beside each cache; when it no longer matches, the cache's index is emptied (the
+    kernel compiles afresh, once) and the stamp rewritten. Returns whether any was renewed.
+    A cache folder that cannot be written is left alone.
+    """
+    digest = hashlib.sha256()
+    for src in sorted(str(p) for p in sources):
+        digest.update(src.encode())
+        digest.update(Path(src).read_bytes())
+    stamp = digest.hexdigest()
+    renewed = False
+    for d in dispatchers:
+        cache = getattr(d, "_cache", None)
+        path = getattr(cache, "cache_path", None)
+        if path is None:
+            continue
+        mark = Path(path) / f"{Path(d.py_func.__code__.co_filename).stem}.{d.py_func.__name__}.deps"
+        try:
+            if mark.is_file() and mark.read_text() == stamp:
+                continue
+            cache.flush()
+            mark.parent.mkdir(parents=True, exist_ok=True)
+            mark.write_text(stamp)
+            renewed = True
+        except OSError:
+            continue
+    return renewed

@@ -471,3 +471,22 @@ class LosExplorerGroup:
             else:
                 N.refill_normals(self.nist, self.normals, self.rngs)
         return GroupAction(np.zeros(self._n), np.zeros(self._n), self._dir.copy(), [])
+
+
+def _renew_caches() -> None:
+    """This module's kernels call the compiled navigators and the reference's kernels (base,
+    goal_sharing, the navigators'): renew their numba caches when one of those changes
+    (:func:`~teamnav.control.group.renew_stale_caches`)."""
+    import sys
+
+    from teamnav.control.group import renew_stale_caches
+    from teamnav.control.nav.local import avoid_past, base, potential_field
+    from teamnav.papers.los_help.brains import goal_sharing
+
+    here = sys.modules[__name__]
+    kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
+               and f.py_func.__module__ == __name__]
+    renew_stale_caches(kernels, [m.__file__ for m in (N, avoid_past, base, potential_field, goal_sharing)])
+
+
+_renew_caches()
