@@ -325,3 +325,44 @@ def test_stale_numba_caches_of_callers_are_renewed(tmp_path):
     assert run(10) == 2  # stale: the caller's cache still holds the old callee
     assert run(10, "--renew") == 11
     assert run(200, "--renew") == 201  # (sizes differ: the callee's own cache sees its change whatever the clock)
+
+
+# ---------------------------------------------------------------------------- packed messages
+def _random_msgs(rng, m: int, count: int):
+    from teamnav.papers.los_help.brains.messages import GoalShare, LosHelpMsg, Sighting, VisReport
+
+    for _ in range(count):
+        ns, ng, nr = (int(rng.integers(0, m + 1)) for _ in range(3))
+        sights = tuple(Sighting(int(rng.integers(0, m)), float(rng.uniform(-math.pi, math.pi)),
+                                float(rng.uniform(0.1, 8.0))) for _ in range(ns))
+        goals = tuple(GoalShare(int(rng.integers(0, m)), int(rng.integers(1, 10**6)), float(rng.normal(0, 20)),
+                                float(rng.normal(0, 20))) for _ in range(ng))
+        reports = []
+        for _ in range(nr):
+            via = [float(rng.normal(0, 5)) if rng.random() < 0.6 else None for _ in range(3)]
+            reports.append(VisReport(int(rng.integers(0, m)), int(rng.integers(1, 10**6)), float(rng.uniform(0, 40)), *via))
+        tr = [None, False, True][int(rng.integers(0, 3))]
+        yield LosHelpMsg(int(rng.integers(0, 10**7)), sights, goals, tuple(reports), tr)
+
+
+def test_packed_messages_round_trip_and_size_as_the_message():
+    """A line-of-sight message packed into one row and back is the same message (every number,
+    None where a field is not sent), and the radio sizes the row as the message (traffic counts
+    and bandwidth caps unchanged)."""
+    from teamnav.control.types import Message, payload_size_bytes
+    from teamnav.papers.los_help.brains.messages import message_size_bytes
+    from teamnav.papers.los_help.brains.packed import PackedLosMsg, pack, row_width, unpack
+
+    rng = np.random.default_rng(5)
+    for m in (1, 2, 4, 9):
+        for msg in _random_msgs(rng, m, 200):
+            row = pack(msg, m)
+            assert row.shape == (row_width(m),)
+            assert unpack(row) == msg
+            body = PackedLosMsg(row)
+            assert payload_size_bytes(body) == payload_size_bytes(msg)
+            assert Message(0, 0.0, body, kind="los_help").size_bytes() == message_size_bytes(msg)
+    from teamnav.papers.los_help.brains.messages import LosHelpMsg
+
+    with pytest.raises(ValueError):
+        pack(LosHelpMsg(1, pose=(0.0, 0.0, 0.0)), 2)
