@@ -10,13 +10,15 @@ import time
 from typing import Any, Sequence
 
 
-def timed_run(scn: Any, methods: Sequence[str] = ("step", "log")) -> tuple[float, float, Any]:
+def timed_run(scn: Any, methods: Sequence[str] = ("step", "log"), **run_kwargs: Any) -> tuple[float, float, Any]:
     """Run the loaded scenario ``scn`` once; (total CPU [s], CPU inside the brains [s], run result).
 
     CPU is ``time.process_time`` (this process only: other work on a shared machine changes it
     less than wall time). The brains' ``methods`` (those a brain has) are wrapped with a CPU clock
     for this run only: ``Simulation.__init__`` is patched while the run lasts and restored after.
     Imports teamnav inside, so that a caller's ``PYTHONPATH`` picks the tree measured.
+    ``run_kwargs`` go to :func:`teamnav.experiments.runner.run` (``group_brains=True``: the
+    group brains' ``step_group`` counts as inside the brains).
     """
     from teamnav.experiments.runner import run
     from teamnav.sim import engine
@@ -27,9 +29,10 @@ def timed_run(scn: Any, methods: Sequence[str] = ("step", "log")) -> tuple[float
 
     def init(self, *args, **kwargs):
         orig_init(self, *args, **kwargs)
-        for group in self.brains:
+        teams = [team for team, *_ in getattr(self, "group_teams", [])]
+        for group in [*self.brains, *([t] for t in teams)]:
             for brain in group if isinstance(group, list) else [group]:
-                for meth in methods:
+                for meth in (*methods, "step_group"):
                     f = getattr(brain, meth, None)
                     if not callable(f):
                         continue
@@ -45,7 +48,7 @@ def timed_run(scn: Any, methods: Sequence[str] = ("step", "log")) -> tuple[float
     engine.Simulation.__init__ = init
     try:
         t0 = clock()
-        result = run(scn, progress=False)
+        result = run(scn, progress=False, **run_kwargs)
         total = clock() - t0
     finally:
         engine.Simulation.__init__ = orig_init

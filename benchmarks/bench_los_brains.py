@@ -21,6 +21,7 @@ Usage::
     python benchmarks/bench_los_brains.py --kernels                  # each fast path vs its numpy version
     python benchmarks/bench_los_brains.py --paper-rules --only visbug21   # the paper-as-written column
     python benchmarks/bench_los_brains.py --team-step --base-commit 37d70e6   # 4-robot team steps, both columns
+    python benchmarks/bench_los_brains.py --group-brains             # compiled group brains vs the reference
 
 ``--team-step``: CPU seconds per 1000 team steps of R1..R4 on office_simple (R1 on tuning task
 1001, Table 1's helpers' routes), for each column (teamnav, paper as written) and navigator
@@ -30,6 +31,20 @@ outputs (true and odometry poses, every brain's log, events, radio totals) are h
 configuration whose hashes differ between the trees says so.
 It prints, last, one line per configuration and one for their median, in the form
 ``LOS team step, 4 robots (teamnav, potential_field): base / this tree = 1.05x``.
+
+``--group-brains``: CPU per team step of the compiled group brains (``Simulation(...,
+group_brains=True)``, ``docs/concepts/group-brains.md``) against the Python reference brains, in
+this tree, for every team the group brains compile so far: R1 alone (Tables 1-2's first row)
+on office_simple, tuning task 1001, each column (teamnav, paper as written) and navigator
+(potential field, Avoid-Past). Reference and compiled alternate ``--repeats`` rounds, each run
+in a fresh process after an untimed warm-up; each run's outputs are hashed as ``--team-step``
+does, and a configuration whose runs differ says DIFFER. It prints, last, one line per
+configuration and then one per team size, in the form
+``LOS team step, 1 robots: compiled / reference = 1.4x`` (reference CPU over compiled CPU,
+median of the configurations). ``--quick`` ends with these lines too (1000 steps, one round).
+``--group-brains --group-tasks 1001,1002``: whole tasks instead (200 targets, the scenario's
+own budget per target, ``stop_when_finished``), reference then compiled in one process per
+task, saying whether every output, the run's metrics and the steps per target are the same.
 
 ``--targets N``: instead of a fixed number of steps, each run is the first N targets of task 1
 (the scenario's own step budget per target and ``stop_when_finished``), and the table gives
@@ -121,6 +136,12 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--worker", nargs=5, metavar=("MAP", "CASE", "TEAM", "STEPS", "TARGETS"), help=argparse.SUPPRESS)
     ap.add_argument("--team-worker", nargs=3, metavar=("CASE", "PAPER", "STEPS"), help=argparse.SUPPRESS)
+    ap.add_argument("--group-worker", nargs=4, metavar=("NAV", "PAPER", "COMPILED", "STEPS"), help=argparse.SUPPRESS)
+    ap.add_argument("--group-brains", action="store_true",
+                    help="CPU per team step, compiled group brains vs the Python reference (this tree)")
+    ap.add_argument("--group-tasks", help="with --group-brains: whole tuning tasks (comma-separated), identity "
+                                          "of outputs and metrics, reference vs compiled")
+    ap.add_argument("--group-task-worker", nargs=3, metavar=("NAV", "PAPER", "TASK"), help=argparse.SUPPRESS)
     ap.add_argument("--team-step", action="store_true",
                     help="CPU per 1000 team steps at 4 robots, both columns x 3 navigators, base vs this tree")
     ap.add_argument("--targets", type=int, default=0, help="time whole tasks of the first N targets of task 1")
@@ -145,9 +166,21 @@ def main(argv: list[str] | None = None) -> None:
         c, paper, n = args.team_worker
         print(json.dumps(_team_worker(c, paper == "1", int(n))))
         return
+    if args.group_worker:
+        nav, paper, compiled, n = args.group_worker
+        print(json.dumps(_group_worker(nav, paper == "1", compiled == "1", int(n))))
+        return
     if args.kernels:
         _kernels()
         return
+    if args.group_task_worker:
+        nav, paper, task = args.group_task_worker
+        print(json.dumps(_group_task_worker(nav, paper == "1", int(task))))
+        return
+    if args.group_brains and args.group_tasks:
+        return _group_tasks([int(t) for t in args.group_tasks.split(",")])
+    if args.group_brains:
+        return _group_brains(1000 if args.quick else args.steps, 1 if args.quick else max(1, args.repeats))
     steps = 600 if args.quick else args.steps
     repeats = 1 if args.quick else max(1, args.repeats)
     base = Path(args.base_src) if args.base_src else _base_src(args.base_commit)
@@ -181,6 +214,8 @@ def main(argv: list[str] | None = None) -> None:
     if ratios:
         print(f"ratio base/new per step: min {min(ratios):.2f}, median {statistics.median(ratios):.2f}, "
               f"max {max(ratios):.2f} (CPU time.process_time, one numba thread)")
+    if args.quick and not args.only:
+        _group_brains(1000, 1)  # last: the compiled group brains' lines per team size
 
 
 def _kernels() -> None:
@@ -397,6 +432,141 @@ def _team_steps(base: Path, new: Path, steps: int, repeats: int, base_name: str,
             print(line)
         print(f"LOS team step, 4 robots: base / this tree = {statistics.median(ratios):.2f}x "
               f"(median of {len(ratios)} configurations)")
+
+
+
+# ---------------------------------------------------------------------------- group brains
+#: The teams the group brains compile so far: R1 alone (team size 1), per navigator of R1.
+GROUP_NAVIGATORS = ("potential_field", "avoid_past")
+
+
+def _group_overrides(navigator: str, paper: bool, task: int) -> dict:
+    from teamnav.papers.los_help.tasks import _alone, task_targets_xy
+
+    if paper:
+        ov = dict(_alone(navigator))  # the paper column's settings, R1 alone (the tuning sweeps' cases)
+    else:
+        ov = {"robots.0.params.navigator": navigator, "robots.1.count": 0, "robots.2.count": 0, "robots.3.count": 0}
+    ov["robots.0.params.targets_xy"] = task_targets_xy("simple", task)
+    return ov
+
+
+def _digest(res) -> str:
+    """SHA-256 of a run's outputs (as ``--team-step``): poses, odometry, stalls, logs, events, radio totals."""
+    import hashlib
+
+    import numpy as np
+
+    from los_fingerprint import _default
+
+    d = res.data
+    h = hashlib.sha256()
+    for a in (d.true_pose, d.odom_pose):
+        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    h.update(np.ascontiguousarray(d.stalled).astype(np.uint8).tobytes())
+    h.update(json.dumps([d.logs, d.event_log, d.messages_sent, d.bytes_sent, d.messages_delivered],
+                        sort_keys=True, default=_default).encode())
+    return h.hexdigest()
+
+
+def _group_task_worker(navigator: str, paper: bool, task: int) -> dict:
+    """(in the measuring process) one whole task of R1 alone, reference then compiled."""
+    from teamnav import load_scenario
+    from teamnav.experiments.runner import run
+
+    out = {}
+    for compiled in (False, True):
+        scn = load_scenario(MAPS["simple"], overrides=_group_overrides(navigator, paper, task), seed=0)
+        t0 = time.process_time()
+        res = run(scn, progress=False, group_brains=compiled)
+        cpu = time.process_time() - t0
+        r1 = res.sim.brains[0][0]
+        out["compiled" if compiled else "reference"] = {
+            "digest": _digest(res), "metrics": json.dumps(res.metrics, sort_keys=True, default=str),
+            "target_steps": list(r1.target_steps), "steps": int(res.sim.step_index), "cpu_s": cpu,
+            "teams": len(res.sim.group_teams)}
+    return out
+
+
+def _group_tasks(tasks: list[int]) -> None:
+    """Whole tasks, reference vs compiled: the same outputs, metrics and steps per target?"""
+    print(f"R1 alone on office_simple, whole tasks {tasks} (200 targets, the scenario's budget per target); "
+          f"load {os.getloadavg()[0]:.1f}")
+    env = dict(os.environ, PYTHONPATH=str(REPO / "src"), NUMBA_NUM_THREADS="1")
+    bad = 0
+    for paper, nav, task in itertools.product((False, True), GROUP_NAVIGATORS, tasks):
+        res = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--group-task-worker", nav,
+                              "1" if paper else "0", str(task)], env=env, check=True, capture_output=True, text=True)
+        r = json.loads(res.stdout.strip().splitlines()[-1])
+        a, b = r["reference"], r["compiled"]
+        same = {k: a[k] == b[k] for k in ("digest", "metrics", "target_steps", "steps")}
+        bad += not all(same.values()) or b["teams"] != 1
+        print(f"{'paper' if paper else 'teamnav':8s} {nav:16s} task {task}: {a['steps']:7d} steps, "
+              f"{len(a['target_steps']):3d} targets; outputs, metrics, steps per target: "
+              f"{'same' if all(same.values()) else 'DIFFER ' + str(same)}; CPU reference {a['cpu_s']:.1f} s, "
+              f"compiled {b['cpu_s']:.1f} s", flush=True)
+    print(f"{bad} of {2 * len(GROUP_NAVIGATORS) * len(tasks)} whole tasks differ")
+
+
+def _group_worker(navigator: str, paper: bool, compiled: bool, steps: int) -> dict:
+    """(in the measuring process) CPU of ``steps`` warm steps of R1 alone on office_simple
+    (tuning task TEAM_TASK), with the Python brain or its compiled group brain, and a digest of
+    everything the run put out (as ``_team_worker``)."""
+    from teamnav import load_scenario
+
+    ov = _group_overrides(navigator, paper, TEAM_TASK)
+    ov["robots.0.params.max_steps_per_target"] = 100_000_000
+    from teamnav.experiments.runner import run
+
+    run(load_scenario(MAPS["simple"], overrides=ov, duration_s=20.0, seed=0), progress=False,
+        group_brains=compiled)  # warm-up
+    total, brain_s, res = timed_run(load_scenario(MAPS["simple"], overrides=ov, duration_s=steps * 0.1, seed=0),
+                                    group_brains=compiled)
+    if compiled and not res.sim.group_teams:
+        raise SystemExit("the group brain did not run R1")
+    return {"cpu_s": total, "brain_s": brain_s, "steps": int(res.sim.step_index), "digest": _digest(res)}
+
+
+def _group_measure(navigator: str, paper: bool, compiled: bool, steps: int) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(REPO / "src"), NUMBA_NUM_THREADS="1")
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--group-worker", navigator,
+                          "1" if paper else "0", "1" if compiled else "0", str(steps)],
+                         env=env, check=True, capture_output=True, text=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _group_brains(steps: int, repeats: int) -> None:
+    """CPU per team step, compiled group brains vs the Python reference (see ``--group-brains``)."""
+    load0 = os.getloadavg()[0]
+    t0 = time.process_time()
+    print(f"R1 alone on office_simple, tuning task {TEAM_TASK}, {steps} steps per run, {repeats} round(s), medians "
+          f"of CPU (time.process_time, one numba thread), this tree ({REPO}), load {load0:.1f}")
+    print(f"{'column':8s} {'navigator':16s} {'ref ms/step':>11s} {'(brains)':>9s} {'compiled':>9s} {'(brains)':>9s} "
+          f"{'ratio':>6s} {'brains':>7s}  outputs")
+    lines, ratios = [], []
+    for paper, nav in itertools.product((False, True), GROUP_NAVIGATORS):
+        col = "paper" if paper else "teamnav"
+        for compiled in (False, True):  # untimed: fills numba's cache for what this configuration reaches
+            _group_measure(nav, paper, compiled, min(steps, 500))
+        ref, cmp_ = [], []
+        for _ in range(repeats):  # alternate: both see the same load
+            ref.append(_group_measure(nav, paper, False, steps))
+            cmp_.append(_group_measure(nav, paper, True, steps))
+        same = len({r["digest"] for r in ref + cmp_}) == 1
+        rt = statistics.median(1000 * r["cpu_s"] / r["steps"] for r in ref)
+        rb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in ref)
+        ct = statistics.median(1000 * r["cpu_s"] / r["steps"] for r in cmp_)
+        cb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in cmp_)
+        ratios.append(rt / ct)
+        print(f"{col:8s} {nav:16s} {rt:11.4f} {rb:9.4f} {ct:9.4f} {cb:9.4f} {rt / ct:6.2f} {rb / cb:7.2f}  "
+              f"{'identical' if same else 'DIFFER'}", flush=True)
+        lines.append(f"LOS team step, 1 robots ({col}, {nav}): compiled / reference = {rt / ct:.2f}x")
+    print(f"(brains: CPU inside the brains' step and log, or the group brain's step_group and the views' log; "
+          f"load {load0:.1f} -> {os.getloadavg()[0]:.1f}; this script's own CPU {time.process_time() - t0:.1f} s, "
+          f"the runs' in their processes)")
+    for line in lines:
+        print(line)
+    print(f"LOS team step, 1 robots: compiled / reference = {statistics.median(ratios):.2f}x")
 
 
 if __name__ == "__main__":

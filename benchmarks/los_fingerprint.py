@@ -104,9 +104,12 @@ def _paper_rules_set(map_key: str) -> dict:
     return dict(paper_rules_spec(resolve_spec({"simple": "los-table1", "complex": "los-table2"}[map_key])).set)
 
 
-def run_one(map_key: str, case: str, team: str, err_max: float, steps: int, paper_rules: bool = False) -> tuple[str, dict]:
+def run_one(map_key: str, case: str, team: str, err_max: float, steps: int, paper_rules: bool = False,
+            group_brains: bool = False) -> tuple[str, dict]:
     """(sha256, readable summary) of one run; ``paper_rules``: both brains as the paper wrote them
-    (the report's "paper as written" column), the case's navigator and sharing flag on top."""
+    (the report's "paper as written" column), the case's navigator and sharing flag on top;
+    ``group_brains``: the compiled group brains where they exist (the summary says how many robots
+    they ran), which must give the same hash."""
     import numpy as np
 
     from teamnav import load_scenario
@@ -120,7 +123,7 @@ def run_one(map_key: str, case: str, team: str, err_max: float, steps: int, pape
         ov[f"robots.{k}.detector.err_max"] = err_max
     ov["record_every"] = 1
     scn = load_scenario(MAPS[map_key], overrides=ov, duration_s=steps * 0.1, seed=0)
-    res = run(scn, progress=False)
+    res = run(scn, progress=False, group_brains=group_brains)
     d = res.data
     h = hashlib.sha256()
     h.update(np.ascontiguousarray(d.true_pose, dtype=np.float64).tobytes())
@@ -141,6 +144,7 @@ def run_one(map_key: str, case: str, team: str, err_max: float, steps: int, pape
         h.update(json.dumps(s, sort_keys=True).encode())
     summary["steps"] = int(res.sim.step_index)
     h.update(str(summary["steps"]).encode())
+    summary["compiled_robots"] = sum(stop - start for _, start, stop, _ in res.sim.group_teams)  # not hashed
     return h.hexdigest(), summary
 
 
@@ -161,6 +165,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--paper-rules", action="store_true",
                     help="the same 24 runs with both brains at paper_rules: true (the report's paper-as-written "
                          "column; its own reference files, los_fingerprints_paper.json and los_fingerprints_paper_epyc.json)")
+    ap.add_argument("--group-brains", action="store_true",
+                    help="run with the compiled group brains where they exist (docs/concepts/group-brains.md): "
+                         "the same files must match")
     args = ap.parse_args(argv)
     import teamnav
 
@@ -188,7 +195,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.only and not any(s in key for s in args.only):
             continue
         t0 = time.process_time()
-        digest, summary = run_one(map_key, case, team, err, args.steps, args.paper_rules)
+        digest, summary = run_one(map_key, case, team, err, args.steps, args.paper_rules, args.group_brains)
         cpu = time.process_time() - t0
         out["runs"][key] = {"sha256": digest, "summary": summary}
         status = ""
@@ -198,7 +205,8 @@ def main(argv: list[str] | None = None) -> int:
             bad += want is not None and want != digest
         r1 = summary["robot0"]
         print(f"{key:36s} {digest[:16]} reached {r1['targets_reached']:3d} msgs {r1['msgs_sent']:5d} "
-              f"cpu {cpu:6.1f}s{status}", flush=True)
+              f"cpu {cpu:6.1f}s{status}" + (f"  compiled robots {summary['compiled_robots']}" if args.group_brains else ""),
+              flush=True)
     print(f"total CPU {time.process_time() - t_all:.1f} s; {len(out['runs'])} runs; {bad} differ")
     if args.save:
         with open(args.save, "w") as f:

@@ -347,6 +347,7 @@ def run(
     force: bool = False,
     brain_timeout_s: float | None = None,
     wait: bool = False,
+    group_brains: bool = False,
 ) -> RunResult:
     """Run ``scenario`` for ``duration_s`` and compute its metrics; optionally write a run folder.
 
@@ -371,6 +372,9 @@ def run(
         When another process is writing ``out_dir`` (it holds its claim, ``.NAME.lock`` beside
         it: :func:`teamnav.files.claim`), wait for it to finish instead of refusing; then
         ``out_dir`` is checked again (without ``force``, the other run's folder is kept).
+    group_brains : bool
+        Step teams whose brains have a compiled group brain in one call of it
+        (:class:`~teamnav.sim.engine.Simulation`'s ``group_brains``; the same run, bit for bit).
 
     Returns
     -------
@@ -417,7 +421,7 @@ def run(
     try:
         grid = build_grid(scenario)
         try:
-            sim = Simulation(grid, scenario, known_map=grid if scenario.give_map else None)
+            sim = Simulation(grid, scenario, known_map=grid if scenario.give_map else None, group_brains=group_brains)
         except (ScenarioError, BrainError):  # a brain that cannot be built names itself
             raise
         except ValueError as exc:

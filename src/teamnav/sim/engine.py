@@ -137,6 +137,18 @@ def _sensor_factories():
     return build_range_sensor, RobotDetector
 
 
+def _group_brain_class():
+    """:func:`teamnav.control.group.group_brain_class` (imported lazily)."""
+    return _group_api().group_brain_class
+
+
+def _group_api():
+    """:mod:`teamnav.control.group` (imported lazily: runs without group brains never load it)."""
+    from teamnav.control import group
+
+    return group
+
+
 def _check_bodies():
     """:func:`teamnav.sim.sensors.robot_hits.check_bodies` (imported lazily)."""
     from teamnav.sim.sensors.robot_hits import check_bodies
@@ -166,6 +178,8 @@ class _Group:
     # refilled when nobody kept any of them (see Simulation._observe_and_decide); None: none yet.
     handed: list = field(default_factory=list)
     extras_last: bool = False  # last step's observations carried an inbox, events or detections
+    team: Any = None  # the group brain that steps its robots (``group_brains``), None: per-robot brains
+    team_last: bool = False  # the last group of its team: the team steps after its readings
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -185,6 +199,11 @@ class Simulation:
         Robots, sensors, odometry, radio, places, ``dt_s``, ``seed``, ``record_every``.
     known_map : OccupancyGrid, optional
         A map given to every robot as prior knowledge (``RobotInfo.known_map``).
+    group_brains : bool, default False
+        Step a team of per-robot brains whose controller names a group brain
+        (:mod:`teamnav.control.group`) in one call of that group brain, where it says it runs
+        those robots exactly as the reference brains do; elsewhere (and in runs with faults or a
+        ``launch``) the per-robot brains run as without it. ``group_teams`` lists what ran so.
 
     Attributes
     ----------
@@ -195,7 +214,8 @@ class Simulation:
     time_s : float
         ``step_index * dt_s`` [s].
     brains : list
-        Per group: a list of per-robot controllers, or the group's batched controller.
+        Per group: a list of per-robot controllers, or the group's batched controller (with
+        ``group_brains``: for a team's groups, the group brain's per-robot views).
     recorder : Recorder
     group_of : ndarray of shape (N,), int64
         Group index of every robot (read-only).
@@ -215,7 +235,8 @@ class Simulation:
     (10, 1.0)
     """
 
-    def __init__(self, grid: OccupancyGrid, config: SimConfig, *, known_map: OccupancyGrid | None = None) -> None:
+    def __init__(self, grid: OccupancyGrid, config: SimConfig, *, known_map: OccupancyGrid | None = None,
+                 group_brains: bool = False) -> None:
         if not isinstance(grid, OccupancyGrid):
             raise ValueError(f"grid must be an OccupancyGrid, got {type(grid).__name__}")
         if not isinstance(config, SimConfig):
@@ -269,6 +290,7 @@ class Simulation:
         self._infos: list[RobotInfo] = []
         self._groups: list[_Group] = []
         self.brains: list[Any] = []
+        pending: list[tuple] = []  # groups whose controller names a group brain (``group_brains``)
         offsets = np.concatenate([[0], np.cumsum(counts)]).astype(int)
         factories = None
         for gi, g in enumerate(groups):
@@ -306,17 +328,16 @@ class Simulation:
             if batched and g.kinematics != "unicycle":
                 raise ValueError(f"{label}: controller {g.controller!r}: batched controllers command (v, omega) and "
                                  f"need kinematics 'unicycle', got {g.kinematics!r}")
-            k = None
-            try:  # the brain's own code: whatever it raises (even sys.exit) is reported as its failure
-                if batched:
-                    brain = cls(params, rngs, infos)
-                else:
-                    brain = []
-                    for k in range(g.count):
-                        brain.append(cls(params, rngs[k], infos[k]))
-            except (Exception, SystemExit) as exc:
-                raise BrainBuildError(str(g.controller), robot_label(g.name, k, sl.start + k if k is not None else None),
-                                      None, describe(exc)) from exc
+            group_cls = None
+            if (group_brains and not batched and g.count and launch is None
+                    and (config.faults is None or config.faults.empty)
+                    and "group_brain" in vars(cls)):
+                group_cls = _group_brain_class()(cls)
+            if group_cls is not None:
+                brain = None  # built with its team below (or per robot, where the group brain declines)
+                pending.append((gi, cls, group_cls, params, rngs, infos))
+            else:
+                brain = self._build_brains(cls, batched, params, rngs, infos, g, sl)
             sens_rngs = [np.random.default_rng(s) for s in sens_group_ss[gi].spawn(len(sensors))]
             grp = _Group(index=gi, cfg=g, sl=sl, ids=np.arange(sl.start, sl.stop, dtype=np.int64), batched=batched,
                          brain=brain)
@@ -332,7 +353,7 @@ class Simulation:
                 grp.sensors, grp.rngs, cfgs = [sensors[k]], [sens_rngs[k]], [g.sensors[k]]
             else:
                 grp.sensors, grp.rngs, cfgs = sensors, sens_rngs, list(g.sensors)
-                grp.has_log = callable(getattr(brain[0], "log", None)) if brain else False
+                grp.has_log = callable(getattr(brain[0], "log", None)) if brain else group_cls is not None
                 grp.whole = bool(getattr(cls, "observes_whole_group", False))
                 if g.detector is not None:
                     grp.detector = factories[1](g.detector, grid)
@@ -349,6 +370,10 @@ class Simulation:
             self._groups.append(grp)
             self.brains.append(brain)
 
+        #: the teams stepped by a group brain: (group brain, first robot id, end robot id, group indices)
+        self.group_teams: list[tuple[Any, int, int, tuple[int, ...]]] = []
+        if pending:
+            self._build_teams(pending)
         self._plan_shared_sensing()
         self._any_per_robot = any(not grp.batched for grp in self._groups)
         self.radio = Radio(config.radio, grid, n, np.random.default_rng(radio_ss), dt_s=self.dt_s) if self._any_per_robot else None
@@ -428,6 +453,67 @@ class Simulation:
             self.recorder.declare_layer("detections", "segments", description="robot detector: observer to detected robot")
             self.recorder.declare_layer("messages", "segments", description="radio message delivered: sender to receiver")
         self._record()
+
+    def _build_brains(self, cls, batched: bool, params, rngs: list, infos: list, g, sl: slice):
+        """A group's brains: its batched controller, or one per-robot controller per robot."""
+        k = None
+        try:  # the brain's own code: whatever it raises (even sys.exit) is reported as its failure
+            if batched:
+                return cls(params, rngs, infos)
+            brain = []
+            for k in range(g.count):
+                brain.append(cls(params, rngs[k], infos[k]))
+            return brain
+        except (Exception, SystemExit) as exc:
+            raise BrainBuildError(str(g.controller), robot_label(g.name, k, sl.start + k if k is not None else None),
+                                  None, describe(exc)) from exc
+
+    def _build_teams(self, pending: list) -> None:
+        """Teams of consecutive groups (groups without robots between them do not count) whose
+        controllers name the same group brain, each built as one group brain from its robots'
+        params, streams and infos, in robot order; a team the group brain declines
+        (``unsupported``) gets its per-robot brains, as without ``group_brains``."""
+        runs: list[list[tuple]] = []
+        for item in pending:
+            gi = item[0]
+            prev = runs[-1][-1] if runs else None
+            if (prev is not None and prev[2] is item[2]
+                    and all(self._groups[j].cfg.count == 0 for j in range(prev[0] + 1, gi))):
+                runs[-1].append(item)
+            else:
+                runs.append([item])
+        for run in runs:
+            group_cls = run[0][2]
+            params = []
+            rngs: list = []
+            infos: list = []
+            for gi, _, _, p, rs, inf in run:
+                params += [p] * len(rs)
+                rngs += rs
+                infos += inf
+            why = group_cls.unsupported(params, infos)
+            if why is None:
+                first = self._groups[run[0][0]]
+                try:
+                    team = group_cls(params, rngs, infos)
+                except (Exception, SystemExit) as exc:
+                    raise BrainBuildError(str(first.cfg.controller), robot_label(first.cfg.name, None, None), None,
+                                          describe(exc)) from exc
+                start = first.sl.start
+                members = tuple(gi for gi, *_ in run)
+                for gi in members:
+                    grp = self._groups[gi]
+                    grp.brain = team.robots[grp.sl.start - start:grp.sl.stop - start]
+                    grp.team = team
+                    self.brains[gi] = grp.brain
+                self._groups[members[-1]].team_last = True
+                self.group_teams.append((team, start, self._groups[members[-1]].sl.stop, members))
+            else:
+                for gi, cls, _, p, rs, inf in run:
+                    grp = self._groups[gi]
+                    grp.brain = self._build_brains(cls, False, p, rs, inf, grp.cfg, grp.sl)
+                    grp.has_log = callable(getattr(grp.brain[0], "log", None)) if grp.brain else False
+                    self.brains[gi] = grp.brain
 
     def _record_moving_places(self) -> None:
         """One ``moving_places`` sample (robot -1) with every moving place where
@@ -786,6 +872,7 @@ class Simulation:
         fx = self.faults
         omit = None
         timer = self._brain_timer
+        team_readings: list = []
         for grp in self._groups:
             sl = grp.sl
             gx, gy, gth = xs[sl], ys[sl], ths[sl]
@@ -826,6 +913,12 @@ class Simulation:
                 self._record_sensing(grp, [(r[0], r[1]) for r in readings], dets)
             if grp.whole and fx is None:
                 continue  # its controller reads self.observed
+            if grp.team is not None:  # stepped by its group brain once its team's last group is sensed
+                team_readings.append((grp, readings, dets))
+                if grp.team_last:
+                    self._step_team(grp.team, team_readings, step, t, odom, delta, inboxes, events, outgoing)
+                    team_readings = []
+                continue
             stalled = s.stalled[sl].tolist()
             # Per robot, only what must be per robot (an outside Python brain pays this path on
             # every step): row views, one Observation, the call; commands go into Python lists,
@@ -945,6 +1038,53 @@ class Simulation:
             else:
                 self.radio.send(outgoing, xs, ys, muted=fx.radio_off if fx.any_radio_off else None, blocked=fx.blackout,
                                 step=step)
+
+    def _step_team(self, team, members: list, step: int, t: float, odom, delta, inboxes, events, outgoing: list) -> None:
+        """One call of a group brain for its team: each robot's own readings, odometry,
+        detections, inbox and events as arrays (:class:`~teamnav.control.group.GroupObservation`),
+        its commands into the command arrays, its messages to the radio (robot order)."""
+        first, last = members[0][0], members[-1][0]
+        sl = slice(first.sl.start, last.sl.stop)
+        n = sl.stop - sl.start
+        readings = members[0][1]
+        if len(members) == 1 and len(readings) == 1:
+            name, r, a, m = readings[0]
+            ranges, angles, max_range = {name: r}, {name: a}, {name: m}
+        elif len(members) == 1:
+            ranges = {name: r for name, r, _, _ in readings}
+        else:
+            ranges = {name: np.concatenate([dict((nm, rr) for nm, rr, _, _ in rd)[name] for _, rd, _ in members])
+                      for name, _, _, _ in members[0][1]}
+        if not (len(members) == 1 and len(readings) == 1):
+            angles = {name: a for name, _, a, _ in readings}
+            max_range = {name: m for name, _, _, m in readings}
+        if len(members) == 1:
+            dets = members[0][2]
+        else:
+            dets = None
+            if any(d is not None for _, _, d in members):
+                dets = [row for grp, _, d in members for row in (d if d is not None else ((),) * grp.cfg.count)]
+        count, ids, rng, brg = _group_api().pad_detections(dets, n)
+        api = _group_api()
+        obs = api.GroupObservation(
+            np.arange(sl.start, sl.stop, dtype=np.int64), step, t, odom[sl], delta[sl], self.state.stalled[sl].copy(),
+            ranges, angles, max_range, count, ids, rng, brg,
+            tuple(inboxes[sl]) if inboxes is not None else ((),) * n,
+            tuple(events[sl]) if events is not None else None,
+        )
+        timer = self._brain_timer
+        self.calling = (first.index, None, step, _now())
+        try:
+            act = team.step_group(obs) if timer is None else timer.call(team.step_group, obs)
+            self.calling = None
+        except (Exception, SystemExit) as exc:
+            raise self._brain_failed(first, None, step, exc) from exc
+        if not isinstance(act, api.GroupAction):
+            raise self._bad_return(first, None, step, f"step_group() must return a GroupAction, got {_short(act)}")
+        self._v_cmd[sl] = act.v_mps
+        self._w_cmd[sl] = act.omega_radps
+        self._dir_cmd[sl] = act.direction_rad
+        outgoing.extend(act.outbox)
 
     def _write_commands(self, grp: _Group, step: int, vs: list, ws: list, ds: list) -> None:
         """A per-robot group's commands, from its brains' Actions, into the command arrays; a

@@ -1,0 +1,130 @@
+"""The line-of-sight help message (Sgorbissa & Arkin §3.1, §4.4, §5) as one float64 row, for the
+compiled team step (``docs/concepts/group-brains.md``, "Messages").
+
+A compiled team writes and reads messages as rows of one array; the radio carries each row as a
+message body (:class:`PackedLosMsg`), sized exactly as the :class:`~.messages.LosHelpMsg` it
+stands for, so that traffic counts and bandwidth caps do not change. :func:`pack` and
+:func:`unpack` convert between the two without loss (the tests run both ways), so compiled and
+Python brains can share one radio.
+
+Row layout for a team of at most ``m`` robots (``row_width(m)`` numbers; §4.4: O(M)):
+
+- header ``H_*``: step, Tr (-1: not shared, 0, 1), and the counts of sightings, goals and
+  reports;
+- ``m`` sightings of 3 (robot id, bearing [rad], range [m]), from ``sightings_at(m)``;
+- ``m`` goal terms of 4 (owner, Id, x, y in the sender's body frame), from ``goals_at(m)``;
+- ``m`` reports of 6 (owner, Id, D, via x, via y, via D; NaN: a via field not sent), from
+  ``reports_at(m)``.
+
+Unused entries are NaN. Integers (ids, steps, counts) are exact in a float64 up to 2^53. The
+``pose`` and ``pose_cov`` fields (the beyond section's ``frame_source`` other than
+``"bearings"``) have no place in the row: those brains are not compiled.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from teamnav.control.types import register_payload_sizer
+from teamnav.papers.los_help.brains.messages import GoalShare, LosHelpMsg, Sighting, VisReport
+
+__all__ = ["PackedLosMsg", "pack", "row_width", "unpack"]
+
+H_STEP = 0
+H_TROUBLE = 1
+H_N_SIGHT = 2
+H_N_GOAL = 3
+H_N_REPORT = 4
+N_HEADER = 5
+SIGHT_W = 3
+GOAL_W = 4
+REPORT_W = 6
+
+
+def sightings_at(m: int) -> int:
+    return N_HEADER
+
+
+def goals_at(m: int) -> int:
+    return N_HEADER + SIGHT_W * m
+
+
+def reports_at(m: int) -> int:
+    return N_HEADER + (SIGHT_W + GOAL_W) * m
+
+
+def row_width(m: int) -> int:
+    """Numbers in a row for a team of at most ``m`` robots."""
+    return N_HEADER + (SIGHT_W + GOAL_W + REPORT_W) * m
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PackedLosMsg:
+    """A message body that is one packed row (read-only); sized as its :class:`LosHelpMsg`."""
+
+    row: np.ndarray
+
+    def size_bytes(self) -> int:
+        """``payload_size_bytes`` of the :class:`LosHelpMsg` this row packs (its sizer's formula:
+        8 for the step, 24 per sighting, 32 per goal, 24 per report and 8 per via field sent,
+        1 for a Tr bit)."""
+        r = self.row
+        m = (r.shape[0] - N_HEADER) // (SIGHT_W + GOAL_W + REPORT_W)
+        n_r = int(r[H_N_REPORT])
+        n = 8 + 24 * int(r[H_N_SIGHT]) + 32 * int(r[H_N_GOAL]) + 24 * n_r
+        at = reports_at(m)
+        for k in range(n_r):
+            for j in (3, 4, 5):
+                if not math.isnan(r[at + REPORT_W * k + j]):
+                    n += 8
+        if r[H_TROUBLE] >= 0:
+            n += 1
+        return n
+
+
+register_payload_sizer(PackedLosMsg, PackedLosMsg.size_bytes)
+
+
+def pack(msg: LosHelpMsg, m: int) -> np.ndarray:
+    """``msg`` as a row for a team of at most ``m`` robots (see the module docstring)."""
+    if msg.pose is not None or msg.pose_cov is not None:
+        raise ValueError("a packed row carries no pose (frame_source 'bearings' only)")
+    if max(len(msg.sightings), len(msg.goals), len(msg.reports)) > m:
+        raise ValueError(f"more than m={m} sightings, goals or reports")
+    row = np.full(row_width(m), np.nan)
+    row[H_STEP] = msg.step
+    row[H_TROUBLE] = -1.0 if msg.trouble is None else float(bool(msg.trouble))
+    row[H_N_SIGHT], row[H_N_GOAL], row[H_N_REPORT] = len(msg.sightings), len(msg.goals), len(msg.reports)
+    at = sightings_at(m)
+    for k, s in enumerate(msg.sightings):
+        row[at + SIGHT_W * k:at + SIGHT_W * (k + 1)] = (s.robot_id, s.bearing_rad, s.range_m)
+    at = goals_at(m)
+    for k, g in enumerate(msg.goals):
+        row[at + GOAL_W * k:at + GOAL_W * (k + 1)] = (g.owner, g.goal_id, g.gx_m, g.gy_m)
+    at = reports_at(m)
+    for k, r in enumerate(msg.reports):
+        row[at + REPORT_W * k:at + REPORT_W * (k + 1)] = (
+            r.owner, r.goal_id, r.d_m, *(math.nan if v is None else v for v in (r.via_x_m, r.via_y_m, r.via_d_m)))
+    return row
+
+
+def unpack(row: np.ndarray) -> LosHelpMsg:
+    """The :class:`LosHelpMsg` a row packs (exactly: the same numbers, ints as ints)."""
+    m = (row.shape[0] - N_HEADER) // (SIGHT_W + GOAL_W + REPORT_W)
+    tr = row[H_TROUBLE]
+    at = sightings_at(m)
+    sights = tuple(Sighting(int(row[at + SIGHT_W * k]), float(row[at + SIGHT_W * k + 1]),
+                            float(row[at + SIGHT_W * k + 2])) for k in range(int(row[H_N_SIGHT])))
+    at = goals_at(m)
+    goals = tuple(GoalShare(int(row[at + GOAL_W * k]), int(row[at + GOAL_W * k + 1]), float(row[at + GOAL_W * k + 2]),
+                            float(row[at + GOAL_W * k + 3])) for k in range(int(row[H_N_GOAL])))
+    at = reports_at(m)
+    reports = []
+    for k in range(int(row[H_N_REPORT])):
+        e = row[at + REPORT_W * k:at + REPORT_W * (k + 1)]
+        via = tuple(None if math.isnan(v) else float(v) for v in e[3:6])
+        reports.append(VisReport(int(e[0]), int(e[1]), float(e[2]), *via))
+    return LosHelpMsg(int(row[H_STEP]), sights, goals, tuple(reports), None if tr < 0 else bool(tr))
