@@ -377,7 +377,8 @@ def test_gap_fill_table_takes_the_scenario_values():
     ours = load_scenario("collab-mcl-hallway").robots[0].params
     g = {x.field: x for x in gap_fills(MCLWanderParams, ours)}
     assert g["inject_fraction"].teamnav_value == 0.1 and g["inject_fraction"].paper_value == 0.0
-    assert g["likelihood_exponent"].teamnav_value == 0.1 and g["likelihood_exponent"].paper_value == 1.0
+    # untempered in both columns since the sonar fill (rule 8 of docs/report/collab-mcl.md)
+    assert g["likelihood_exponent"].teamnav_value == 1.0 == g["likelihood_exponent"].paper_value
     assert g["receive_gate"].teamnav_value is True and g["receive_gate"].paper_value is False
 
 
