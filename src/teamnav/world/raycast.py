@@ -162,13 +162,21 @@ def _quadrant(dx, dy):
 
 @njit(cache=True, inline="always")
 def _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
+    """:func:`_jump_s` with the steps' signs taken from the direction."""
+    return _jump_s(clear, q, 1 if dx >= 0.0 else -1, 1 if dy >= 0.0 else -1, fx, fy, dx, dy, idx, idy, r, c, v, tmax)
+
+
+@njit(cache=True, inline="always")
+def _jump_s(clear, q, sx, sy, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
     """One jump of a ray standing in padded cell ``(r, c)`` with clearance code ``v > 0``.
 
     ``clear[:, :, q]`` is the padded clearance map of the ray's quadrant ``q`` (0 =
     blocking, ``k + 1`` = the ``(k+1) x (k+1)`` square of cells from ``(r, c)`` towards the
     quadrant is free); its outer ring is blocking, so no bounds checks are needed. Grid cell
     ``(r, c)`` is ``clear[r + 1, c + 1, q]``; ``(fx, fy)`` is the ray origin in grid cell
-    units, ``(dx, dy)`` its unit direction, ``idx, idy`` their inverses.
+    units, ``(dx, dy)`` its unit direction, ``idx, idy`` their inverses, ``sx, sy`` the
+    column and row steps of the quadrant (``1 if dx >= 0 else -1``, the same for ``dy``):
+    called with them as constants, the compiled jump has no selects on the signs.
 
     Returns ``(r, c, v, t, done)``: the cell entered at distance ``t`` [cells] and its code,
     ``done`` when the ray ended there (blocking cell, or ``t`` capped at ``tmax``).
@@ -176,10 +184,8 @@ def _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
     case and the ways a ray ends.
     """
     k = np.int64(v) - 1
-    sx = 1 if dx >= 0.0 else -1
-    sy = 1 if dy >= 0.0 else -1
-    offx = 0 if dx >= 0.0 else -1  # plane ahead of padded column c is at grid x = c + offx
-    offy = 0 if dy >= 0.0 else -1
+    offx = 0 if sx > 0 else -1  # plane ahead of padded column c is at grid x = c + offx
+    offy = 0 if sy > 0 else -1
     ck = c + sx * k  # far column / row of the free square
     rk = r + sy * k
     # exit of the free square: planes ck+offx and rk+offy
@@ -229,13 +235,35 @@ def _jump(clear, q, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
     return r, c, v, t, v == 0
 
 
+@njit(cache=True, inline="always")
+def _wave(clear, q, sx, sy, act, n, fx, fy, dxs, dys, idxs, idys, rs, cs, vs, tmax, out, p, res):
+    """Advance the ``n`` rays ``act[:n]`` of pose ``p``, all in quadrant ``q`` (steps ``sx, sy``),
+    one jump per sweep until every one has ended; ``out[p, b]`` receives ray ``b``'s range [m]."""
+    while n > 0:
+        m = 0
+        for a in range(n):
+            b = act[a]
+            r, c, v, t, done = _jump_s(clear, q, sx, sy, fx, fy, dxs[b], dys[b], idxs[b], idys[b], rs[b], cs[b], vs[b],
+                                       tmax)
+            # without branches (whether a ray ends is unpredictable): a ray that goes on
+            # overwrites its range at a later jump; act[m] with m <= a was already read
+            out[p, b] = t * res
+            rs[b] = r
+            cs[b] = c
+            vs[b] = v
+            act[m] = b
+            m += 0 if done else 1
+        n = m
+
+
 @njit(cache=True)
 def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
     """Fill ``out[p0:p1]`` (ranges [m]); poses in world metres, ``ct/st`` per pose, ``cb/sb`` per beam.
 
     All beams of a pose advance together, one jump per sweep over the rays still going
     (a wavefront): the jumps of different rays are independent, so their memory loads
-    overlap instead of each ray waiting on its own chain of cache misses.
+    overlap instead of each ray waiting on its own chain of cache misses. The rays of one
+    quadrant go together, with the quadrant's signs as constants (:func:`_jump_s`).
     """
     inv = 1.0 / res
     nb = cb.shape[0]
@@ -246,8 +274,7 @@ def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
     rs = np.empty(nb, np.int64)
     cs = np.empty(nb, np.int64)
     vs = np.empty(nb, np.uint8)
-    qs = np.empty(nb, np.int64)
-    act = np.empty(nb, np.uint64)  # unsigned: no wraparound code on the state loads
+    act = np.empty((4, nb), np.uint64)  # rays of each quadrant; unsigned: no wraparound code
     for p in range(p0, p1):
         fx = (xs[p] - ox) * inv
         fy = (ys[p] - oy) * inv
@@ -255,7 +282,10 @@ def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
         if not ok:
             out[p, :] = 0.0
             continue
-        n = 0
+        n0 = 0
+        n1 = 0
+        n2 = 0
+        n3 = 0
         for b in range(nb):
             dx, dy = _ray_dir(ct[p], st[p], cb[b], sb[b])
             dxs[b] = dx
@@ -263,26 +293,26 @@ def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
             idxs[b] = _inv(dx)
             idys[b] = _inv(dy)
             q = _quadrant(dx, dy)
-            qs[b] = q
             rs[b] = r0
             cs[b] = c0
             vs[b] = _code(clear, r0, c0, q)
-            act[n] = b
-            n += 1
-        while n > 0:
-            m = 0
-            for a in range(n):
-                b = act[a]
-                r, c, v, t, done = _jump(clear, qs[b], fx, fy, dxs[b], dys[b], idxs[b], idys[b], rs[b], cs[b], vs[b], tmax)
-                # without branches (whether a ray ends is unpredictable): a ray that goes on
-                # overwrites its range at a later jump; act[m] with m <= a was already read
-                out[p, b] = t * res
-                rs[b] = r
-                cs[b] = c
-                vs[b] = v
-                act[m] = b
-                m += 0 if done else 1
-            n = m
+            if q == 0:
+                act[0, n0] = b
+                n0 += 1
+            elif q == 1:
+                act[1, n1] = b
+                n1 += 1
+            elif q == 2:
+                act[2, n2] = b
+                n2 += 1
+            else:
+                act[3, n3] = b
+                n3 += 1
+        # quadrant q = (dx < 0) + 2 (dy < 0): sx = -1 for q = 1, 3; sy = -1 for q = 2, 3
+        _wave(clear, 0, 1, 1, act[0], n0, fx, fy, dxs, dys, idxs, idys, rs, cs, vs, tmax, out, p, res)
+        _wave(clear, 1, -1, 1, act[1], n1, fx, fy, dxs, dys, idxs, idys, rs, cs, vs, tmax, out, p, res)
+        _wave(clear, 2, 1, -1, act[2], n2, fx, fy, dxs, dys, idxs, idys, rs, cs, vs, tmax, out, p, res)
+        _wave(clear, 3, -1, -1, act[3], n3, fx, fy, dxs, dys, idxs, idys, rs, cs, vs, tmax, out, p, res)
 
 
 @njit(cache=True)
