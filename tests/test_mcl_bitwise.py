@@ -15,13 +15,16 @@ such a platform change, never to make a code change pass.
 from __future__ import annotations
 
 import hashlib
+import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from numba import njit
 
 from teamnav.control.protocol import SensorInfo
-from teamnav.localization import MCL, KLDParams, MCLParams
+from teamnav.localization import MCL, BeamModelParams, KLDParams, MCLParams
+from teamnav.localization.beam_model import MAX_READING_TOL_M, BeamTable
 from teamnav.world import load_map
 from teamnav.world.raycast import RayCaster
 
@@ -77,6 +80,48 @@ def _replay(case: str) -> str:
 @pytest.mark.parametrize("case", sorted(DIGESTS))
 def test_filter_replay_is_bit_identical(case):
     assert _replay(case) == DIGESTS[case]
+
+
+@njit
+def _every_term_table(z, grid, eta_hit, eta_short, z_hit, z_short, z_max, z_rand, sigma, lam, zmax, out):
+    """The beam table as first written: every term of every entry evaluated, then its log."""
+    inv_norm = 1.0 / (sigma * math.sqrt(2.0 * math.pi))
+    for b in range(z.shape[0]):
+        zb = z[b]
+        is_max = zb >= zmax - MAX_READING_TOL_M
+        if is_max:
+            zb = zmax
+        base = z_max if is_max else z_rand / zmax
+        e_short = lam * math.exp(-lam * zb)
+        for j in range(grid.shape[0]):
+            ze = grid[j]
+            d = (zb - ze) / sigma
+            p = base
+            if d * d < 1400.0:
+                p += z_hit * eta_hit[j] * inv_norm * math.exp(-0.5 * d * d)
+            if zb <= ze and ze > 0.0:
+                p += z_short * eta_short[j] * e_short
+            out[b, j] = math.log(p)
+    return out
+
+
+@pytest.mark.parametrize("mix", [(0.8, 0.1, 0.05, 0.05), (0.97, 0.0, 0.0, 0.03), (0.5, 0.3, 0.2, 1e-9),
+                                 (0.2, 0.2, 0.1, 0.5), (1.0 - 1e-300, 0.0, 0.0, 1e-300)])
+@pytest.mark.parametrize("sigma", [0.01, 0.1, 0.7])
+def test_beam_table_skips_only_what_cannot_change_a_bit(mix, sigma):
+    """The table skips the Gaussian where it is below the last bit of the rest: still the bits
+    of evaluating every term (max-range readings, z_max = 0, a tiny z_rand included)."""
+    z_hit, z_short, z_max, z_rand = mix
+    params = BeamModelParams(z_hit=z_hit, z_short=z_short, z_max=z_max, z_rand=z_rand, sigma_hit_m=sigma,
+                             table_step_m=0.02)
+    zmax = 8.0
+    bt = BeamTable(params, zmax)
+    z = np.concatenate([np.random.default_rng(3).uniform(0.0, zmax, 40), [0.0, 1e-9, zmax, zmax - 1e-7, 0.5 * zmax]])
+    got = bt(z)
+    with np.errstate(divide="ignore"):
+        want = _every_term_table(z, bt.grid, bt.eta_hit, bt.eta_short, z_hit, z_short, z_max, z_rand, sigma,
+                                 params.lambda_short_per_m, zmax, np.empty_like(got))
+    assert np.array_equal(got.view(np.uint64), want.view(np.uint64))
 
 
 if __name__ == "__main__":  # prints the digests of the implementation at hand
