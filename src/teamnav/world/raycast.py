@@ -229,7 +229,10 @@ def _jump_s(clear, q, sx, sy, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
         c = ca_
         r = ra_
     else:
-        of = min(max(ifl + 1, min(oc, ok)), max(oc, ok))
+        # min(oc, ok) and max(oc, ok), the signs known and k >= 0: selects instead of compares
+        lo = (r if sy > 0 else rk) if ex else (c if sx > 0 else ck)
+        hi = (rk if sy > 0 else r) if ex else (ck if sx > 0 else c)
+        of = min(max(ifl + 1, lo), hi)
         c = ck + sx if ex else of
         r = of if ex else rk + sy
     v = _code(clear, r, c, q)
