@@ -108,7 +108,7 @@ def _code_ol(clear, r, c, q):
 
     def dense(clear, r, c, q):
         # unsigned indices: numba then skips its negative-index wraparound (every index here is
-        # >= 0: a ray stops at the blocking outer ring), 6 % of a 1k-particle MCL update
+        # >= 0: a ray stops at the blocking outer ring): 6 % of the ray casting of an MCL update
         return clear[np.uint64(r), np.uint64(c), np.uint64(q)]
     return dense
 
