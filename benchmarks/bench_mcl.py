@@ -255,6 +255,7 @@ def main() -> None:
     print("| particles | method | ms / update | M particle-beams/s | vs amcl | CPU ms / update | vs amcl (CPU) "
           "| vs NumPy |")
     print("| ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    summary = {}  # particles -> (CPU ratio, wall ratio) of the plain beam model against amcl
     for n in sizes:
         pb = n * N_BEAMS
         peers = {
@@ -281,6 +282,8 @@ def main() -> None:
             vn = f"{ref_n / t:.1f}x" if ref_n else "-"
             print(f"| {n:,} | {name} | {t * 1e3:.2f} | {pb / t / 1e6:.2f} | {va} | {cpu[name] * 1e3:.2f} | {vc} "
                   f"| {vn} |", flush=True)
+            if ref_ac and name == "teamnav beam (exact ray casting)":
+                summary[n] = (ref_ac / cpu[name], ref_a / t)
     if amcl is None:
         print("\namcl is not installed in this interpreter; for the AMCL column run:\n"
               "  python -m venv /tmp/amcl-venv && /tmp/amcl-venv/bin/pip install amcl numpy numba scipy pillow "
@@ -308,6 +311,12 @@ def main() -> None:
           f"wall / CPU: build {best['build'] * 1e3:.2f} / {cpu_['build'] * 1e3:.2f} ms, query 10 000 points "
           f"{best['query'] * 1e3:.2f} / {cpu_['query'] * 1e3:.2f} ms (threaded kernel "
           f"{best['query threaded'] * 1e3:.2f} / {cpu_['query threaded'] * 1e3:.2f} ms)")
+    # last, one line per size a script can read (1k last: the goal is >= 5x there, on one thread)
+    print()
+    for n in sorted(summary, key=lambda k: (k == 1000, k)):
+        c, w = summary[n]
+        goal = f"; goal >= 5x {'met' if c >= 5.0 else 'not met'}" if n == 1000 else ""
+        print(f"MCL {n / 1000:g}k particles: teamnav / amcl = {c:.2f}x (CPU), {w:.2f}x (wall){goal}")
 
 if __name__ == "__main__":
     main()
