@@ -196,10 +196,13 @@ def _hallway_rows(alone_s, team_s):
 
 
 @pytest.mark.parametrize("team_shift_s, holds", [(-60.0, True), (-5.0, False)])
-def test_hallway_verdict_needs_a_paired_reduction_beyond_two_standard_errors(team_shift_s, holds):
+def test_hallway_verdict_needs_a_paired_reduction_beyond_two_standard_errors(team_shift_s, holds, monkeypatch):
     from types import SimpleNamespace
 
+    from teamnav.papers.collab_mcl.report import _collab_fidelity as fid
     from teamnav.papers.collab_mcl.report.section import _hallway
+
+    monkeypatch.setitem(fid.HALLWAY_ALONE, "holds", True)  # the rule itself (rule 10's precondition aside)
 
     alone = [100.0, 300.0, 200.0, 400.0, 150.0, 250.0, 350.0, 180.0]       # a large run-to-run spread
     jitter = [10.0, -10.0, 5.0, -5.0, 8.0, -8.0, 3.0, -3.0]
@@ -209,6 +212,10 @@ def test_hallway_verdict_needs_a_paired_reduction_beyond_two_standard_errors(tea
     comparison = _hallway(SimpleNamespace(quick=False, sweep=lambda *a, **k: res))[0]
     assert comparison.holds is holds and comparison.column == "paper"
     assert "faster together in" in comparison.ours
+    # without §5.2.1's single-robot behaviour on tuning seeds the claim is not judged (rule 10)
+    monkeypatch.setitem(fid.HALLWAY_ALONE, "holds", False)
+    unmet = _hallway(SimpleNamespace(quick=False, sweep=lambda *a, **k: res))[0]
+    assert unmet.holds is None and "precondition not met" in unmet.ours + unmet.differs
 
 
 def test_claim_file_report_seeds_and_the_rules_changed_with_their_data():

@@ -203,9 +203,21 @@ def test_a_claim_that_needs_an_unmet_precondition_reads_precondition_not_met(mon
     assert fid.gated_judge(claims["single-detection"], good)[0] is True
     # a claim that does not need it is judged as the claim file says either way
     monkeypatch.setitem(fid.PRECONDITION, "holds", False)
+    monkeypatch.setitem(fid.HALLWAY_ALONE, "holds", True)
     hv = {"together_ttl_mean_s": 100.0, "alone_ttl_mean_s": 200.0, "together_final_localized": 1.0,
           "alone_final_localized": 1.0, "paired_change_upper_s": -10.0, "n_pairs": 8.0}
     assert fid.gated_judge(claims["hallway-faster"], hv)[0] is True
     block = fid.precondition_block()
     assert block.holds is False and set(block.claims) == {"single-detection", "fp-breaks"}
     assert block.record()["seeds"] == "1000-1009"
+    # rule 10: hallway-faster rests on §5.2.1's single robots, hexagon-together on §5.2.2's
+    monkeypatch.setitem(fid.HALLWAY_ALONE, "holds", False)
+    h, text = fid.gated_judge(claims["hallway-faster"], hv)
+    assert h is None and text.startswith("precondition not met (§5.2.1") and "the rule would read: " in text
+    blocks = {b.claims[0]: b for b in fid.precondition_blocks()}
+    assert set(blocks) == {"single-detection", "hallway-faster", "hexagon-together"}
+    hexv = {"together_min_localized": 1.0, "alone_best_localized": 0.4, "together_all_runs_frac": 1.0}
+    monkeypatch.setitem(fid.HEXAGON_ALONE, "holds", True)
+    assert fid.gated_judge(claims["hexagon-together"], hexv)[0] is True
+    monkeypatch.setitem(fid.HEXAGON_ALONE, "holds", False)
+    assert fid.gated_judge(claims["hexagon-together"], hexv)[0] is None

@@ -11,9 +11,10 @@ every one in two columns beside the paper's number:
   dropped from the scenario (:func:`teamnav.papers.trails.report._trails.paper_rules_spec`);
 - "teamnav": the scenarios as they are (our gap-fills).
 
-First, §5.1's precondition (:func:`~._collab_fidelity.precondition_block`: Robin alone still
-multi-modal when it passes the lab, measured on tuning seeds and shown as measured; the claims that need
-it read "precondition not met" when it does not hold) and the ledger of both columns
+First, the preconditions (:func:`~._collab_fidelity.precondition_blocks`: §5.1's Robin alone still
+multi-modal when it passes the lab, §5.2.1's single robots needing minutes in the hallway, §5.2.2's
+single robots keeping their symmetric places; measured on tuning seeds and shown as measured; the
+claims that need one read "precondition not met" when it does not hold) and the ledger of both columns
 (:func:`~._collab_fidelity.ledger_blocks`, ``shared/FIDELITY.md`` §2). Every comparison names the column
 its verdict is judged on.
 
@@ -79,7 +80,7 @@ from teamnav.papers.collab_mcl.report._collab_common import (  # noqa: F401
     COLUMNS, HEAD, _band, _col_sweep, _metric, _ms, _ok, _param, _rule_text, _seeds, _series, _verdicts,
     judged_column,
 )
-from teamnav.papers.collab_mcl.report._collab_fidelity import gated_judge, ledger_blocks, precondition_block
+from teamnav.papers.collab_mcl.report._collab_fidelity import gated_judge, ledger_blocks, precondition_blocks
 from teamnav.papers.collab_mcl.report._collab_delayed import _delayed
 from teamnav.papers.collab_mcl.report._collab_detection import (  # noqa: F401
     PICTURED_SEED, QUICK_DETECTION, _detection, detection_belief_rows, detection_values,
@@ -309,7 +310,7 @@ def build(ctx) -> list:
                          "\"teamnav\" (the scenarios' gap-fills); verdicts by the rules of "
                          "papers/collab_mcl/claims/collab-mcl.yaml, on report seeds (tuning seeds are >= 1000)."
                          + (" Quick mode: few robots and samples, 1-2 seeds, short runs." if ctx.quick else "")),
-                    precondition_block(), *ledger_blocks()]
+                    *precondition_blocks(), *ledger_blocks()]
     vals: dict = {col: {} for col, _ in COLUMNS}  # {column: {claim id: {metric: value}}}, filled by the parts
     for part in (_hallway, _hexagon, _detection, _beyond, _delayed):
         blocks += part(ctx, vals)
