@@ -169,8 +169,9 @@ def _hallway(ctx, out: dict | None = None) -> list:
             "The teamnav column (with sensor resetting) adds, beyond the paper (each a scenario setting): sensor "
             "resetting on received "
             "trees (inject_fraction) whose headings come from the receiver's scan, "
-            "a tempered likelihood (0.1), selective resampling, provenance and a "
-            "receive-side 2.5 m gate; both columns use the wanderer without side openings (the paper's robots "
+            "selective resampling, provenance and a "
+            "receive-side 2.5 m gate; both columns use the sonar model of the fill (16 cones, sigma_hit 0.8 m, "
+            "untempered, chosen against a grid filter on tuning seeds) and the wanderer without side openings (the paper's robots "
             "follow an operator or a random walk)." + _rule_text(claim, verdicts, n_text),
             column=judged_column(claim),
         ),
@@ -258,8 +259,9 @@ def _hexagon(ctx, out: dict | None = None) -> list:
                    "guards "
                    "double counting beyond §2.3's two rules: received trees become draws weighted by the chance "
                    "the receiver is lost, the answer tree carries only the answering robot's own belief, a tree "
-                   "holding the receiver's own recent information through a third robot is dropped (provenance), "
-                   "and the likelihoods are tempered (sonar 0.1, laser 0.01)." + _rule_text(claim, verdicts, n_text),
+                   "holding the receiver's own recent information through a third robot is dropped (provenance). "
+                   "Both columns use the beam fills (sonar 16 cones, laser 10 of 180 beams, sigma_hit 0.8 m each, "
+                   "untempered)." + _rule_text(claim, verdicts, n_text),
                    column=judged_column(claim)),
         Plot("Fig. 14: error vs time by sensor kind", "time [s]", "mean distance of samples to the true pose [m]",
              series, hlines=[(1.5, "localized (1.5 m)")], caption="Bands: 95 % confidence interval over runs."),
