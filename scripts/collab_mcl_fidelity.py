@@ -102,7 +102,16 @@ def calibrate_run(job) -> dict:
             "cpu_s": round(time.process_time() - t0, 1)}
 
 
-def precondition_run(seed: int, robin_min: int | None = None) -> dict:
+def _with_update(ov: dict, update: tuple[float, float] | None) -> dict:
+    """Every group's filter updates every ``update`` = (metres, degrees) of motion (rule 11's set-up
+    fix; the scenarios' 0.2 m / 15 deg otherwise)."""
+    if update is not None:
+        for k in [k for k in ov if k.endswith(".params")]:
+            ov[k] = {**ov[k], "min_update_m": update[0], "min_update_deg": update[1]}
+    return ov
+
+
+def precondition_run(seed: int, robin_min: int | None = None, update: tuple[float, float] | None = None) -> dict:
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
     from teamnav.papers.collab_mcl.maps import LAB_DOOR_X
@@ -113,10 +122,11 @@ def precondition_run(seed: int, robin_min: int | None = None) -> dict:
     ov = {f"robots.{i}.params": {**p, "collaborate": False} if i == 1 else p for i, p in params.items()}
     if robin_min is not None:
         ov["robots.1.params"]["min_particles"] = robin_min
+    ov = _with_update(ov, update)
     t0 = time.process_time()
     res = run(load_scenario(scen, overrides=ov, seed=seed, duration_s=110.0), progress=False)
-    out = {"part": "precondition", "seed": seed, "robin_min": robin_min, "t_s": None, "heaviest_mode": None,
-           "error_m": None}
+    out = {"part": "precondition", "seed": seed, "robin_min": robin_min, "update": update, "t_s": None,
+           "heaviest_mode": None, "error_m": None}
     for t, truth, pts, v in _records(res.data, 1):
         if truth[0] >= LAB_DOOR_X:
             out.update({"t_s": t, "heaviest_mode": heaviest_mode(pts), "n_particles": v.get("n_particles"),
@@ -126,7 +136,7 @@ def precondition_run(seed: int, robin_min: int | None = None) -> dict:
     return out
 
 
-def modes_run(seed: int, column: str = "paper") -> dict:
+def modes_run(seed: int, column: str = "paper", update: tuple[float, float] | None = None) -> dict:
     from teamnav.experiments.runner import run
     from teamnav.experiments.spec import load_scenario
     from teamnav.papers.collab_mcl.metrics import belief_modes
@@ -138,9 +148,10 @@ def modes_run(seed: int, column: str = "paper") -> dict:
     for i, p in params.items():
         ov[f"robots.{i}.params"] = {**p, "collaborate": False}
         ov[f"robots.{i}.count"] = 1
+    ov = _with_update(ov, update)
     t0 = time.process_time()
     res = run(load_scenario(scen, overrides=ov, seed=seed, duration_s=200.0), progress=False)
-    out = {"part": "modes", "column": column, "seed": seed}
+    out = {"part": "modes", "column": column, "seed": seed, "update": update}
     for robot, kind in ((0, "sonar"), (1, "laser")):
         recs = list(_records(res.data, robot))
         t, truth, pts, v = recs[-1]
@@ -158,16 +169,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--column", choices=["paper", "teamnav"], default="paper", help="modes: which column")
     ap.add_argument("--robin-min", type=int, default=None, help="precondition: Robin's min_particles (rule 6)")
+    ap.add_argument("--update", default=None, help="precondition / modes: 'M,DEG', every group's filter update "
+                                                    "interval (rule 11); default the scenarios' 0.2 m / 15 deg")
     ap.add_argument("--out", default=None)
     a = ap.parse_args(argv)
+    update = tuple(float(x) for x in a.update.split(",")) if a.update else None
     seeds = parse_seeds(a.seeds)
     if a.part == "calibrate":
         fn, jobs = calibrate_run, [(g, s) for g in a.groups.split(",") for s in seeds]
     else:
         import functools
 
-        fn = (functools.partial(precondition_run, robin_min=a.robin_min) if a.part == "precondition"
-              else functools.partial(modes_run, column=a.column))
+        fn = (functools.partial(precondition_run, robin_min=a.robin_min, update=update) if a.part == "precondition"
+              else functools.partial(modes_run, column=a.column, update=update))
         jobs = seeds
     t0 = time.time()
     rows = []
