@@ -69,8 +69,6 @@ FACTORS: dict[str, tuple[str, dict, str]] = {
                     {"beam": {"sigma_hit_m": 1.0}, "min_particles": 5000}, "unspecified (gap-fill)"),
     "update": ("filter update every 1.0 m / 45 deg instead of 0.2 m / 15 deg",
                {"min_update_m": 1.0, "min_update_deg": 45.0}, "unspecified (gap-fill)"),
-    "update0.5": ("filter update every 0.5 m / 30 deg instead of 0.2 m / 15 deg (rule 11's first set-up fix)",
-                  {"min_update_m": 0.5, "min_update_deg": 30.0}, "unspecified (gap-fill)"),
     "temper": ("likelihood exponent 1 -> 0.03 (teamnav's)", {"likelihood_exponent": 0.03}, "not the paper (eq. 12)"),
     "ess": ("resample only when ESS < 50 % (teamnav's)", {"resample_ess_fraction": 0.5}, "not the paper (§3.1)"),
 }
