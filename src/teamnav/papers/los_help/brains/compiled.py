@@ -102,13 +102,19 @@ _DEG = math.pi / 180.0  # CPython's math.radians multiplies by this
 
 
 @njit(cache=True)
-def _sees(r, x, y, margin, px, py, c, s, ranges, angles, gap, vis_r):
-    """``_LosBrain._sees``: V(R) of a point (own frame), §2."""
+def _in_body(x, y, px, py, c, s):
+    """A point in the robot's own frame at (px, py) with heading cos/sin (c, s): (bx, by, distance)."""
     dx = x - px
     dy = y - py
     bx = c * dx + s * dy
     by = -s * dx + c * dy
-    d = N.py_hypot(bx, by)
+    return bx, by, N.py_hypot(bx, by)
+
+
+@njit(cache=True)
+def _sees(r, x, y, margin, px, py, c, s, ranges, angles, gap, vis_r):
+    """``_LosBrain._sees``: V(R) of a point (own frame), §2."""
+    bx, by, d = _in_body(x, y, px, py, c, s)
     if d > vis_r:
         return False
     if d < 1e-9:
@@ -119,11 +125,7 @@ def _sees(r, x, y, margin, px, py, c, s, ranges, angles, gap, vis_r):
 @njit(cache=True)
 def _keeps(r, x, y, px, py, c, s, ranges, angles, gap, vis_r):
     """``_LosBrain._keeps``: the lenient test that keeps a goal seen directly (``keep_direct_view``)."""
-    dx = x - px
-    dy = y - py
-    bx = c * dx + s * dy
-    by = -s * dx + c * dy
-    d = N.py_hypot(bx, by)
+    bx, by, d = _in_body(x, y, px, py, c, s)
     if d > vis_r:
         return False
     if d < 1e-9:
