@@ -127,7 +127,7 @@ def _row_call() -> Any:
             K.wander_row.compile(sig)
             call = K.wander_row.overloads[sig].entry_point
         except (AttributeError, KeyError, TypeError):
-            pass
+            call = K.wander_row  # numba keeps its compiled code elsewhere: the dispatcher, as documented
         _ROW_CALL = call
     return _ROW_CALL
 
