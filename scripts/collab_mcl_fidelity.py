@@ -169,11 +169,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--column", choices=["paper", "teamnav"], default="paper", help="modes: which column")
     ap.add_argument("--robin-min", type=int, default=None, help="precondition: Robin's min_particles (rule 6)")
-    ap.add_argument("--update", default=None, help="precondition / modes: 'M,DEG', every group's filter update "
+    def _interval(text: str) -> tuple[float, float]:
+        try:
+            m, deg = (float(x) for x in text.split(","))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected 'METRES,DEGREES' (e.g. 1.0,45), got {text!r}") from None
+        if not (m > 0 and deg > 0):
+            raise argparse.ArgumentTypeError(f"expected two numbers > 0, got {text!r}")
+        return m, deg
+
+    ap.add_argument("--update", type=_interval, default=None, help="precondition / modes: 'M,DEG', every group's filter update "
                                                     "interval (rule 11); default the scenarios' 0.2 m / 15 deg")
     ap.add_argument("--out", default=None)
     a = ap.parse_args(argv)
-    update = tuple(float(x) for x in a.update.split(",")) if a.update else None
+    update = a.update
     seeds = parse_seeds(a.seeds)
     if a.part == "calibrate":
         fn, jobs = calibrate_run, [(g, s) for g in a.groups.split(",") for s in seeds]
