@@ -17,6 +17,10 @@ from teamnav import _moved_paths  # noqa: E402  (old import paths of the papers'
 
 _moved_paths.install()
 
+from teamnav import _kernel_caches  # noqa: E402  (numba caches renewed when a kernel's callee changed)
+
+_kernel_caches.renew()
+
 __all__ = ["__version__", "load_scenario", "run", "sweep"]
 
 if TYPE_CHECKING:  # pragma: no cover
