@@ -13,11 +13,12 @@ from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
-from teamnav import _moved_paths  # noqa: E402  (old import paths of the papers' modules, one release)
+from teamnav import _moved_paths  # old import paths of the papers' modules, one release
 
 _moved_paths.install()
 
-from teamnav import _kernel_caches  # noqa: E402  (numba caches renewed when a kernel's callee changed)
+# numba's caches of the kernels whose callees in another module changed are renewed
+from teamnav import _kernel_caches
 
 _kernel_caches.renew()
 
