@@ -65,7 +65,7 @@ def _app() -> typer.Typer:
 
 def test_a_flagged_sweep_stores_the_same_trials_and_reaches_the_engine(tmp_path):
     # the CLI: the same stored rows (ids, configuration hash, every metric) with and without the flag
-    base = ["sweep", "los-help-simple", *sum((["--set", s] for s in R1_ALONE), []), "--seeds", "1000-1000",
+    base = ["sweep", "los-help-simple", *[a for s in R1_ALONE for a in ("--set", s)], "--seeds", "1000-1000",
             "--duration", str(DURATION_S), "-j", "1", "-q"]
     plain = CliRunner().invoke(_app(), [*base, "--out", str(tmp_path / "plain")])
     flagged = CliRunner().invoke(_app(), [*base, "--out", str(tmp_path / "flagged"), "--group-brains"])
@@ -80,7 +80,7 @@ def test_a_flagged_sweep_stores_the_same_trials_and_reaches_the_engine(tmp_path)
 
     # the flag reaches the engine in the worker, through a section's own trial function too
     # (the report's context passes it to every sweep); without it, the per-robot brains run
-    kw = dict(set=R1_ALONE, seeds=[1000], duration_s=DURATION_S, trial_fn=probe_trial)
+    kw = {"set": R1_ALONE, "seeds": [1000], "duration_s": DURATION_S, "trial_fn": probe_trial}
     shared = LocalExecutor(1, keep_pool=True)  # one worker start for both sweeps, as a report shares it
     try:
         sweep("los-help-simple", out_dir=tmp_path / "probe_plain", executor=shared, progress=False, **kw)
