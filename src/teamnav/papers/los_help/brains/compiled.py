@@ -3,8 +3,9 @@ brain of ``los-explorer-v1`` (Sgorbissa & Arkin §2, §5, §6; Tables 1-2's "R1 
 
 The first piece of the group-brain path (``docs/concepts/group-brains.md``): the explorer of
 :mod:`.explorer` (the readable reference) as one numba step over every row of a group, its
-state as named columns of arrays, with the potential field or Avoid-Past as algorithm A
-(:mod:`teamnav.control.nav.local.compiled`). It covers the explorer's step where no teammate
+state as named columns of arrays, with the potential field or Avoid-Past
+(:mod:`teamnav.control.nav.local.compiled`) or VisBug-21
+(:mod:`teamnav.control.nav.local.visbug21_compiled`) as algorithm A. It covers the explorer's step where no teammate
 exists (``team_size == 1``), which is all of it that R1 alone reaches:
 
 1. the pose of this step (its odometry) and the scan (``laser``);
@@ -15,7 +16,8 @@ exists (``team_size == 1``), which is all of it that R1 alone reaches:
    ``keep_direct_view``, kept while any beam near it does) or not;
 4. seeing it, it heads straight for it while the corridor is wide enough for its body (else,
    with ``slide_when_blocked``, along the nearest free direction; else A); not seeing it, A
-   drives towards it;
+   drives towards it; when VisBug-21 finds the goal unreachable the robot stays put that
+   step, and with ``restart_navigator_on_give_up`` A starts afresh the next (``nav_restarts``);
 5. §5: Pr, Tr, Nt from this step's progress (with no teammate, state sharing changes nothing
    else: nobody to follow, nothing to say);
 6. no broadcast (§4.4: a robot sends when it sees a teammate).
