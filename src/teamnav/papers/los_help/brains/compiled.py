@@ -484,6 +484,8 @@ class LosExplorerGroup:
         self.vpar = np.array(vpar)
         self.vfst, self.vist = V.vb_state(self.vpar)
         self.nfst, self.nist, self.grid, self.normals = N.new_state(n)
+        # VisBug-21 rows read no normals: never "low", so a refill never draws from their Generators
+        self.nist[self.epar[:, Q_VISBUG] != 0.0, N.I_NORMAL] = 0
         self._gap_for: Any = None
         self._gap = 0.0
         self._dir = np.empty(n)
