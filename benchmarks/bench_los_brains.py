@@ -36,7 +36,8 @@ It prints, last, one line per configuration and one for their median, in the for
 group_brains=True)``, ``docs/concepts/group-brains.md``) against the Python reference brains, in
 this tree, for every team the group brains compile so far: R1 alone (Tables 1-2's first row)
 on office_simple, tuning task 1001, each column (teamnav, paper as written) and navigator
-(potential field, Avoid-Past). Reference and compiled alternate ``--repeats`` rounds, each run
+(potential field, Avoid-Past, VisBug-21; ``--only paper/visbug21`` keeps the configurations
+whose ``COLUMN/NAVIGATOR`` holds one of the strings). Reference and compiled alternate ``--repeats`` rounds, each run
 in a fresh process after an untimed warm-up; each run's outputs are hashed as ``--team-step``
 does, and a configuration whose runs differ says DIFFER. It prints, last, one line per
 configuration and then one per team size, in the form
@@ -44,7 +45,8 @@ configuration and then one per team size, in the form
 median of the configurations). ``--quick`` ends with these lines too (1000 steps, one round).
 ``--group-brains --group-tasks 1001,1002``: whole tasks instead (200 targets, the scenario's
 own budget per target, ``stop_when_finished``), reference then compiled in one process per
-task, saying whether every output, the run's metrics and the steps per target are the same.
+task, saying whether every output, the run's metrics and the steps per target are the same
+(``--only`` as above).
 
 ``--targets N``: instead of a fixed number of steps, each run is the first N targets of task 1
 (the scenario's own step budget per target and ``stop_when_finished``), and the table gives
@@ -178,9 +180,10 @@ def main(argv: list[str] | None = None) -> None:
         print(json.dumps(_group_task_worker(nav, paper == "1", int(task))))
         return
     if args.group_brains and args.group_tasks:
-        return _group_tasks([int(t) for t in args.group_tasks.split(",")])
+        return _group_tasks([int(t) for t in args.group_tasks.split(",")], args.only)
     if args.group_brains:
-        return _group_brains(1000 if args.quick else args.steps, 1 if args.quick else max(1, args.repeats))
+        return _group_brains(1000 if args.quick else args.steps, 1 if args.quick else max(1, args.repeats),
+                             args.only)
     steps = 600 if args.quick else args.steps
     repeats = 1 if args.quick else max(1, args.repeats)
     base = Path(args.base_src) if args.base_src else _base_src(args.base_commit)
@@ -437,7 +440,7 @@ def _team_steps(base: Path, new: Path, steps: int, repeats: int, base_name: str,
 
 # ---------------------------------------------------------------------------- group brains
 #: The teams the group brains compile so far: R1 alone (team size 1), per navigator of R1.
-GROUP_NAVIGATORS = ("potential_field", "avoid_past")
+GROUP_NAVIGATORS = ("potential_field", "avoid_past", "visbug21")
 
 
 def _group_overrides(navigator: str, paper: bool, task: int) -> dict:
@@ -488,13 +491,16 @@ def _group_task_worker(navigator: str, paper: bool, task: int) -> dict:
     return out
 
 
-def _group_tasks(tasks: list[int]) -> None:
+def _group_tasks(tasks: list[int], only: list[str] | None = None) -> None:
     """Whole tasks, reference vs compiled: the same outputs, metrics and steps per target?"""
     print(f"R1 alone on office_simple, whole tasks {tasks} (200 targets, the scenario's budget per target); "
           f"load {os.getloadavg()[0]:.1f}")
     env = dict(os.environ, PYTHONPATH=str(REPO / "src"), NUMBA_NUM_THREADS="1")
-    bad = 0
+    bad = ran = 0
     for paper, nav, task in itertools.product((False, True), GROUP_NAVIGATORS, tasks):
+        if only and not any(o in f"{'paper' if paper else 'teamnav'}/{nav}" for o in only):
+            continue
+        ran += 1
         res = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--group-task-worker", nav,
                               "1" if paper else "0", str(task)], env=env, check=True, capture_output=True, text=True)
         r = json.loads(res.stdout.strip().splitlines()[-1])
@@ -505,7 +511,7 @@ def _group_tasks(tasks: list[int]) -> None:
               f"{len(a['target_steps']):3d} targets; outputs, metrics, steps per target: "
               f"{'same' if all(same.values()) else 'DIFFER ' + str(same)}; CPU reference {a['cpu_s']:.1f} s, "
               f"compiled {b['cpu_s']:.1f} s", flush=True)
-    print(f"{bad} of {2 * len(GROUP_NAVIGATORS) * len(tasks)} whole tasks differ")
+    print(f"{bad} of {ran} whole tasks differ")
 
 
 def _group_worker(navigator: str, paper: bool, compiled: bool, steps: int) -> dict:
@@ -535,7 +541,7 @@ def _group_measure(navigator: str, paper: bool, compiled: bool, steps: int) -> d
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def _group_brains(steps: int, repeats: int) -> None:
+def _group_brains(steps: int, repeats: int, only: list[str] | None = None) -> None:
     """CPU per team step, compiled group brains vs the Python reference (see ``--group-brains``)."""
     load0 = os.getloadavg()[0]
     t0 = time.process_time()
@@ -546,6 +552,8 @@ def _group_brains(steps: int, repeats: int) -> None:
     lines, ratios = [], []
     for paper, nav in itertools.product((False, True), GROUP_NAVIGATORS):
         col = "paper" if paper else "teamnav"
+        if only and not any(o in f"{col}/{nav}" for o in only):
+            continue
         for compiled in (False, True):  # untimed: fills numba's cache for what this configuration reaches
             _group_measure(nav, paper, compiled, min(steps, 500))
         ref, cmp_ = [], []

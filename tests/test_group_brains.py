@@ -2,8 +2,8 @@
 reference brains it stands for (``docs/concepts/group-brains.md``).
 
 The compiled piece so far is R1 alone (Sgorbissa & Arkin §2, §5, §6; Tables 1-2's "R1 alone"
-rows): ``los-explorer-v1`` with the potential field or Avoid-Past as algorithm A, in both of
-the report's columns (teamnav's gap-fills, and the paper as written: ``paper_column_r1``).
+rows): ``los-explorer-v1`` with the potential field, Avoid-Past or VisBug-21 as algorithm A, in
+both of the report's columns (teamnav's gap-fills, and the paper as written: ``paper_column_r1``).
 Each identity run steps the reference (``Simulation(...)``) and the group brain
 (``Simulation(..., group_brains=True)``) side by side from the same scenario and seed and
 demands, at every step, the same true poses, odometry, commands (the body-frame direction
@@ -56,7 +56,8 @@ def _same_log(la: dict, lb: dict, k: int) -> None:
                    {k2: v for k2, v in layers_b[name].items() if k2 != "data"}
 
 
-def _side_by_side(scn, steps: int = STEPS):
+def _side_by_side(scn, steps: int = STEPS, watch=None):
+    """Step both; ``watch(reference R1)`` after every step (what the run reached)."""
     ref = Simulation(build_grid(scn), scn)
     grp = Simulation(build_grid(scn), scn, group_brains=True)
     assert len(grp.group_teams) == 1, "the group brain must run R1"
@@ -70,20 +71,28 @@ def _side_by_side(scn, steps: int = STEPS):
         assert np.array_equal(ref.odometry.pose, grp.odometry.pose), f"odometry differs at step {k}"
         assert np.array_equal(ref._dir_cmd, grp._dir_cmd, equal_nan=True), f"commands differ at step {k}"
         _same_log(r_ref.log(), r_grp.log(), k)
+        if watch is not None:
+            watch(r_ref)
     assert r_ref.target_steps == r_grp.target_steps
     for attr in ("finished", "gave_up", "targets_reached", "target_index", "moves", "msgs_sent", "bytes_sent",
-                 "msgs_received", "mode"):
+                 "msgs_received", "mode", "nav_restarts"):
         assert getattr(r_ref, attr) == getattr(r_grp, attr), attr
     return r_ref
 
 
 @pytest.mark.parametrize("paper", [False, True], ids=["teamnav", "paper"])
-@pytest.mark.parametrize("navigator", ["avoid_past", "potential_field"])
+@pytest.mark.parametrize("navigator", ["avoid_past", "potential_field", "visbug21"])
 @pytest.mark.parametrize("task", [1001, 1002])
 def test_r1_alone_compiled_is_the_reference_bit_for_bit(navigator, paper, task):
-    r1 = _side_by_side(_scenario(navigator, paper, task))
-    if navigator == "avoid_past":
+    modes = set()
+    r1 = _side_by_side(_scenario(navigator, paper, task),
+                       watch=lambda b: modes.add(b._nav.mode) if navigator == "visbug21" and b._nav else None)
+    if navigator in ("avoid_past", "visbug21"):
         assert r1.targets_reached >= 3  # the identity covers goal switches
+    if navigator == "visbug21":  # both of VisBug's steps: towards Ti on the M-line, along the boundary
+        from teamnav.control.nav.local.visbug21 import MODE_FOLLOW, MODE_TO_GOAL
+
+        assert {MODE_TO_GOAL, MODE_FOLLOW} <= modes
     assert r1.moves > STEPS // 2 and r1.mode_steps["own_goal"] == STEPS + 1  # step 0 decides too
     assert r1._nav is not None  # algorithm A drove (the potential field alone is soon trapped, §6)
 
@@ -96,6 +105,55 @@ def test_identity_covers_giving_up_layers_and_memory_scope():
         "robots.0.params.navigator_params": {"memory_scope": "goal", "memory_half_life_steps": None}})
     r1 = _side_by_side(scn, 1200)
     assert r1.gave_up and r1.mode == "gave_up"
+
+
+_VISBUG_CASES = {
+    # Bug2's termination test with return_tol_m wide enough that a walk round a room is a lap:
+    # the goal is "unreachable" and A starts afresh (restart_navigator_on_give_up) ...
+    "restart": (False, 1001, {"return_tol_m": 2.0}, True),
+    # ... or, without the restart, gives no heading from then on (the paper column's VisBug)
+    "unreachable": (True, 1001, {"return_tol_m": 3.0, "turn": "right", "boundary_shortcut": True}, False),
+    # the alternating walk, with turn="left"
+    "reverse": (True, 1002, {"return_tol_m": 2.0, "turn": "left", "boundary_shortcut": True,
+                             "reverse_walk_factor": 1.5}, True),
+}
+
+
+@pytest.mark.parametrize("case", sorted(_VISBUG_CASES))
+def test_visbug_identity_covers_giving_up_reversals_and_the_numpy_calls(case, monkeypatch):
+    """VisBug-21's rarer branches, bit for bit: Bug2's termination test, A started afresh
+    after it or left giving no heading, the alternating walk (``reverse_walk_factor``),
+    ``turn="left"``, and the leave test's seen-free run (one of the two calls kept in numpy;
+    the other, the boundary target's bearings, runs at most steps of the paper column)."""
+    from teamnav.control.nav.local import visbug21
+    from teamnav.control.nav.local.visbug21 import MODE_UNREACHABLE
+
+    paper, task, nav, restart = _VISBUG_CASES[case]
+    calls = {"seen_free": 0}
+    seen_free = visbug21.seen_free
+
+    def counted(*a, **k):
+        calls["seen_free"] += 1
+        return seen_free(*a, **k)
+
+    monkeypatch.setattr(visbug21, "seen_free", counted)  # the reference's and the group brain's calls
+    extra = {"robots.0.params.navigator_params": nav, "robots.0.params.restart_navigator_on_give_up": restart}
+    reached = {"unreachable": 0, "reversed": 0}
+
+    def watch(b):
+        if b._nav is not None:
+            reached["unreachable"] += b._nav.mode == MODE_UNREACHABLE
+            lim = b._nav._reverse_limit_m
+            reached["reversed"] += math.isfinite(lim) and lim != b._nav._reverse_reach_m
+
+    r1 = _side_by_side(_scenario("visbug21", paper, task, **extra), watch=watch)
+    assert calls["seen_free"] > 0
+    if case == "restart":
+        assert r1.nav_restarts > 0
+    elif case == "unreachable":
+        assert reached["unreachable"] > 100 and r1.nav_restarts == 0
+    else:
+        assert reached["reversed"] > 0
 
 
 def test_identity_without_targets():

@@ -420,6 +420,10 @@ def run(
     debug: bool = typer.Option(
         False, "--debug", help="On a failure, show the traceback (a controller's own, when it failed).",
     ),
+    group_brains: bool = typer.Option(
+        False, "--group-brains", help="Step teams through their compiled group brains where they have one (the same "
+        "run, bit for bit).",
+    ),
 ) -> None:
     """Run a scenario, write its run folder and print its metrics.
 
@@ -441,7 +445,7 @@ def run(
             scn = load_scenario(scenario, overrides=set_ or None, seed=seed, duration_s=duration)
         target = out if out is not None else _default_out(scn.name)
         result = run_scenario(scn, out_dir=target, progress=False if quiet else None, gif=gif, force=force,
-                              brain_timeout_s=brain_timeout, wait=wait)
+                              brain_timeout_s=brain_timeout, wait=wait, group_brains=group_brains)
         if html:
             from teamnav.viz.replay import build_replay
 

@@ -112,10 +112,13 @@ def execute(task: TrialTask) -> TrialResult:
     c0 = time.process_time()  # the worker runs one trial at a time: its CPU time is the trial's
     metrics = error = trace = None
     try:
+        from teamnav.experiments.runner import group_brains_default
+
         scenario = task.trial.load()
         fn = task.trial_fn if task.trial_fn is not None else run_trial
         out = Path(task.artifacts_dir) if task.artifacts_dir else None
-        metrics = _check_metrics(fn(scenario, out))
+        with group_brains_default(getattr(task, "group_brains", False)):  # reaches any trial function's run()
+            metrics = _check_metrics(fn(scenario, out))
         status = "ok"
     except Exception as exc:  # noqa: BLE001 - a failing trial is data, not a crash
         status = "failed"

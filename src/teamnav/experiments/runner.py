@@ -54,7 +54,8 @@ from teamnav.files import ClaimError, claim, current_umask, destination_problem,
 from teamnav.world.mapio import YAML_SUFFIXES, read_map_yaml, save_map
 
 __all__ = [
-    "OutputDirError", "RunResult", "check_scenario", "clean_stale_staging", "current_umask", "robot_radii", "run", "run_data",
+    "OutputDirError", "RunResult", "check_scenario", "clean_stale_staging", "current_umask", "group_brains_default",
+    "robot_radii", "run", "run_data",
 ]
 
 #: a progress bar appears once a run has taken this long [s]
@@ -65,6 +66,29 @@ BRAIN_WAIT_S = 2.0
 #: the time is the first run of the built-in scenarios on a 2-core machine (demo ~20 s, the
 #: MCL ones more; measured by benchmarks/bench_startup.py)
 COMPILING = "compiling numba kernels (first run only, ~20-60 s; later runs load them from the cache)"
+
+
+#: what ``run(group_brains=None)`` uses: False, or True inside :func:`group_brains_default`
+_GROUP_BRAINS_DEFAULT = False
+
+
+@contextlib.contextmanager
+def group_brains_default(on: bool):
+    """Within the block, :func:`run` without an explicit ``group_brains`` steps teams through
+    their compiled group brains (``on``) or the per-robot brains.
+
+    This is how ``teamnav sweep --group-brains`` and ``teamnav report --group-brains`` reach every
+    trial, whatever its trial function (a section's own function calls :func:`run` without
+    knowing of the option). It is not part of any scenario, configuration hash or trial id: a
+    run with group brains is the same run, bit for bit, so stored trials are shared.
+    """
+    global _GROUP_BRAINS_DEFAULT
+    before = _GROUP_BRAINS_DEFAULT
+    _GROUP_BRAINS_DEFAULT = bool(on)
+    try:
+        yield
+    finally:
+        _GROUP_BRAINS_DEFAULT = before
 
 
 class OutputDirError(ValueError):
@@ -347,7 +371,7 @@ def run(
     force: bool = False,
     brain_timeout_s: float | None = None,
     wait: bool = False,
-    group_brains: bool = False,
+    group_brains: bool | None = None,
 ) -> RunResult:
     """Run ``scenario`` for ``duration_s`` and compute its metrics; optionally write a run folder.
 
@@ -372,9 +396,11 @@ def run(
         When another process is writing ``out_dir`` (it holds its claim, ``.NAME.lock`` beside
         it: :func:`teamnav.files.claim`), wait for it to finish instead of refusing; then
         ``out_dir`` is checked again (without ``force``, the other run's folder is kept).
-    group_brains : bool
+    group_brains : bool or None
         Step teams whose brains have a compiled group brain in one call of it
         (:class:`~teamnav.sim.engine.Simulation`'s ``group_brains``; the same run, bit for bit).
+        None (default): False, or True inside :func:`group_brains_default` (a sweep or report
+        run with ``--group-brains``).
 
     Returns
     -------
@@ -404,6 +430,8 @@ def run(
     from teamnav.experiments.signals import sigterm_deferred, sigterm_raises
     from teamnav.sim.engine import Simulation
 
+    if group_brains is None:
+        group_brains = _GROUP_BRAINS_DEFAULT
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
     else:

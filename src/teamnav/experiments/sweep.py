@@ -153,6 +153,7 @@ def sweep(
     retry_failed: bool = True,
     artifacts: bool = False,
     trial_fn: Callable[..., Mapping[str, Any]] | None = None,
+    group_brains: bool = False,
 ) -> SweepResult:
     """Run a sweep into ``out_dir``, resuming what an earlier call left.
 
@@ -192,6 +193,11 @@ def sweep(
         ``trial_fn(scenario, out_dir) -> {metric: number}`` replaces the default (a full
         :func:`~teamnav.experiments.runner.run`); it must be picklable (a module-level
         function) and runs in the workers.
+    group_brains : bool
+        Every trial's runs step teams through their compiled group brains where they have one
+        (:func:`~teamnav.experiments.runner.group_brains_default`, which any trial function's
+        :func:`~teamnav.experiments.runner.run` follows). The same runs bit for bit: it is not
+        part of any trial id or configuration hash, and trials stored without it are reused.
 
     Returns
     -------
@@ -241,7 +247,8 @@ def sweep(
     result = SweepResult(spec.sweep_name, out / STORE_NAME, len(trials))
     # SIGTERM as Ctrl-C: the workers are stopped and the store closed before the process ends
     try:
-        _run_into_store(out, spec, trials, runner, trial_fn, artifacts, retry_failed, progress, result, t0)
+        _run_into_store(out, spec, trials, runner, trial_fn, artifacts, retry_failed, progress, result, t0,
+                        bool(group_brains))
     except (StoreError, sqlite3.Error, OSError) as exc:
         # a full disk or a folder that cannot be written: one line, and a folder this call made
         # and stored nothing in is not left behind (a store with results stays: it resumes)
@@ -257,7 +264,8 @@ def sweep(
 
 
 def _run_into_store(out: Path, spec: Any, trials: list[Trial], runner: Any, trial_fn: Any, artifacts: bool,
-                    retry_failed: bool, progress: bool, result: "SweepResult", t0: float) -> None:
+                    retry_failed: bool, progress: bool, result: "SweepResult", t0: float,
+                    group_brains: bool = False) -> None:
     """:func:`sweep`'s work once the folder exists: skip what the store holds, run the rest."""
     from teamnav.experiments.executors import TrialTask
     from teamnav.experiments.signals import sigterm_raises
@@ -279,7 +287,8 @@ def _run_into_store(out: Path, spec: Any, trials: list[Trial], runner: Any, tria
         store.register_sweep(spec.sweep_name, spec.model_dump(mode="json"))
         art = out / "trials" if artifacts else None
         todo = longest_first(todo, trials, store.rows())  # both cores busy to the end: the longest trials start first
-        tasks = [TrialTask(t, trial_fn, str(art / t.trial_id) if art is not None else None) for t in todo]
+        tasks = [TrialTask(t, trial_fn, str(art / t.trial_id) if art is not None else None, group_brains)
+                 for t in todo]
         by_id = {t.trial_id: t for t in todo}
         bar = _Bar(spec.sweep_name, len(todo), result.skipped, show=progress and bool(todo))
 

@@ -70,6 +70,9 @@ def sweep_command(
     retry_failed: bool = typer.Option(True, "--retry-failed/--skip-failed", help="Rerun trials stored as failed (default) or skip them."),
     artifacts: bool = typer.Option(False, "--artifacts", help="Also write each trial's run folder under OUT/trials/."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar; one summary line at the end."),
+    group_brains: bool = typer.Option(
+        False, "--group-brains", help="Step teams through their compiled group brains where they have one (the same "
+        "runs, bit for bit; stored trials are reused either way)."),
 ) -> None:
     """Run a sweep (grid x seeds) into OUT/results.sqlite.
 
@@ -98,6 +101,7 @@ def sweep_command(
                 progress=not quiet,
                 retry_failed=retry_failed,
                 artifacts=artifacts,
+                group_brains=group_brains,
             )
     except (SweepError, ScenarioError, StoreError, MapError, OutputDirError) as exc:
         err.print(f"error: {exc}", markup=False)

@@ -77,12 +77,14 @@ class Trial:
 # ---------------------------------------------------------------------------- what travels
 @dataclass(frozen=True)
 class TrialTask:
-    """What a worker gets: the trial, the trial function (None: :func:`run_trial`) and the
-    run folder to write (None: none)."""
+    """What a worker gets: the trial, the trial function (None: :func:`run_trial`), the
+    run folder to write (None: none), and whether its runs step teams through their compiled
+    group brains (``group_brains``: not part of the trial's identity, the same run bit for bit)."""
 
     trial: "Trial"
     trial_fn: Callable[..., Mapping[str, Any]] | None = None
     artifacts_dir: str | None = None
+    group_brains: bool = False
 
 
 @dataclass(frozen=True)

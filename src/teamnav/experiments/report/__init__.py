@@ -387,12 +387,17 @@ def run_report(
     address: str | None = None,
     progress: bool = True,
     wait: bool = False,
+    group_brains: bool = False,
 ) -> ReportResult:
     """Build the report and say how each section went (see :func:`build_report`).
 
     The report folder is claimed for the whole build (:func:`teamnav.files.claim`): a second
     report into the same folder refuses (:class:`~teamnav.files.ClaimError`), or waits with
     ``wait``; the claim goes on every way out (Ctrl-C and SIGTERM included).
+
+    ``group_brains``: every run of the report steps teams through their compiled group brains
+    where they have one (``docs/concepts/group-brains.md``): the same runs bit for bit, so it
+    enters no trial id or configuration hash and stored trials are reused either way.
 
     Returns
     -------
@@ -431,11 +436,16 @@ def run_report(
             out.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise ReportError(f"--out {out}: cannot be written ({exc.strerror or exc}); choose another --out") from None
-        return _run_report_claimed(out, keys, sections, quick, executor, workers, address, progress, t_start)
+        from teamnav.experiments.runner import group_brains_default
+
+        with group_brains_default(group_brains):  # the runs a section makes itself, outside its sweeps
+            return _run_report_claimed(out, keys, sections, quick, executor, workers, address, progress, t_start,
+                                       group_brains)
 
 
 def _run_report_claimed(out: Path, keys: list[str], sections: dict, quick: bool, executor: str, workers: int | None,
-                        address: str | None, progress: bool, t_start: float) -> ReportResult:
+                        address: str | None, progress: bool, t_start: float,
+                        group_brains: bool = False) -> ReportResult:
     """:func:`run_report` once the report folder is claimed."""
     from teamnav.experiments.executors import LocalExecutor
     from teamnav.experiments.report.context import SweepContext
@@ -453,7 +463,7 @@ def _run_report_claimed(out: Path, keys: list[str], sections: dict, quick: bool,
 
     def make_ctx(key: str) -> SweepContext:
         return SweepContext(out, quick=quick, executor=executor, workers=workers, address=address, progress=progress,
-                            section=key, runner=shared)
+                            section=key, runner=shared, group_brains=group_brains)
 
     index = out / "index.html"
     outcomes: list[SectionOutcome] = []

@@ -70,6 +70,9 @@ def report_command(
     workers: Optional[int] = typer.Option(None, "--workers", "-j", metavar="N", help="Trials at once (default: all CPUs)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bars or section lines; print only the report's path."),
     wait: bool = typer.Option(False, "--wait", help="If another teamnav report is writing the same --out folder, wait for it instead of refusing."),
+    group_brains: bool = typer.Option(
+        False, "--group-brains", help="Step teams through their compiled group brains where they have one (the same "
+        "runs, bit for bit; stored trials are reused either way)."),
 ) -> None:
     """Write an HTML report: each paper's claims beside our numbers.
 
@@ -82,7 +85,7 @@ def report_command(
     err = Console(stderr=True, highlight=False, soft_wrap=True)
     try:
         result = run_report(experiments, out, quick=quick, executor=executor, workers=workers, address=address, progress=not quiet,
-                            wait=wait)
+                            wait=wait, group_brains=group_brains)
     except (ReportError, SweepError, ClaimError) as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(EXIT_BAD_INPUT) from None

@@ -22,7 +22,7 @@ from teamnav.experiments.sweep import SweepResult
 __all__ = ["ReportSweepResult", "SweepContext"]
 
 #: sweep() arguments that belong to the report, not to the section
-_REPORT_OWNED = ("out_dir", "workers", "progress", "executor", "address")
+_REPORT_OWNED = ("out_dir", "workers", "progress", "executor", "address", "group_brains")
 
 
 @dataclass
@@ -66,6 +66,9 @@ class SweepContext:
         An executor object every sweep of this context uses instead of a new ``executor`` per
         sweep (``run_report`` shares one ``LocalExecutor(keep_pool=True)`` across the report's
         sweeps, so the worker processes start once per report, not once per sweep).
+    group_brains : bool
+        Every sweep's trials step teams through their compiled group brains where they have
+        one (``teamnav report --group-brains``; the same runs, bit for bit).
 
     Attributes
     ----------
@@ -88,6 +91,7 @@ class SweepContext:
         progress: bool = False,
         section: str = "",
         runner: Any = None,
+        group_brains: bool = False,
     ) -> None:
         self.out_dir = Path(out_dir)
         self.quick = bool(quick)
@@ -97,6 +101,7 @@ class SweepContext:
         self.progress = bool(progress)
         self.section = section
         self.runner = runner
+        self.group_brains = bool(group_brains)
         self.sweeps: list[dict[str, Any]] = []
 
     @property
@@ -115,7 +120,7 @@ class SweepContext:
             As :func:`teamnav.experiments.sweep.sweep`.
         **kwargs
             sweep's keyword arguments except ``out_dir``, ``workers``, ``progress``,
-            ``executor`` and ``address`` (the report sets those).
+            ``executor``, ``address`` and ``group_brains`` (the report sets those).
 
         Returns
         -------
@@ -147,6 +152,7 @@ class SweepContext:
             workers=self.workers,
             address=self.address,
             progress=self.progress,
+            group_brains=self.group_brains,
             **kwargs,
         )
         ids = frozenset(t.trial_id for t in expand(spec))

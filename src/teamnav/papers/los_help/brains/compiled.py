@@ -3,8 +3,9 @@ brain of ``los-explorer-v1`` (Sgorbissa & Arkin §2, §5, §6; Tables 1-2's "R1 
 
 The first piece of the group-brain path (``docs/concepts/group-brains.md``): the explorer of
 :mod:`.explorer` (the readable reference) as one numba step over every row of a group, its
-state as named columns of arrays, with the potential field or Avoid-Past as algorithm A
-(:mod:`teamnav.control.nav.local.compiled`). It covers the explorer's step where no teammate
+state as named columns of arrays, with the potential field or Avoid-Past
+(:mod:`teamnav.control.nav.local.compiled`) or VisBug-21
+(:mod:`teamnav.control.nav.local.visbug21_compiled`) as algorithm A. It covers the explorer's step where no teammate
 exists (``team_size == 1``), which is all of it that R1 alone reaches:
 
 1. the pose of this step (its odometry) and the scan (``laser``);
@@ -15,7 +16,8 @@ exists (``team_size == 1``), which is all of it that R1 alone reaches:
    ``keep_direct_view``, kept while any beam near it does) or not;
 4. seeing it, it heads straight for it while the corridor is wide enough for its body (else,
    with ``slide_when_blocked``, along the nearest free direction; else A); not seeing it, A
-   drives towards it;
+   drives towards it; when VisBug-21 finds the goal unreachable the robot stays put that
+   step, and with ``restart_navigator_on_give_up`` A starts afresh the next (``nav_restarts``);
 5. §5: Pr, Tr, Nt from this step's progress (with no teammate, state sharing changes nothing
    else: nobody to follow, nothing to say);
 6. no broadcast (§4.4: a robot sends when it sees a teammate).
@@ -38,6 +40,7 @@ from numba import njit
 from teamnav.control.group import GroupAction, GroupObservation
 from teamnav.control.nav.local import NAVIGATORS
 from teamnav.control.nav.local import compiled as N
+from teamnav.control.nav.local import visbug21_compiled as V
 from teamnav.control.nav.local.base import corridor_clear
 from teamnav.control.protocol import RobotInfo
 from teamnav.papers.los_help.brains.goal_sharing import beam_near_reaches, max_beam_gap, nearest_beam_visible
@@ -58,7 +61,9 @@ Q_KEEP = 9  # keep_direct_view
 Q_SHARING = 10  # goal_sharing
 Q_RESET_TR = 11  # reset_trouble_on_target
 Q_CR = 12  # trouble_cr (Cr of §5)
-N_Q = 13
+Q_VISBUG = 13  # 1.0: algorithm A is VisBug-21 (vpar/vfst/vist), 0.0: the potential field or Avoid-Past
+Q_RESTART = 14  # restart_navigator_on_give_up
+N_Q = 15
 
 # ----------------------------------------------------------------- state columns
 X_PX = 0  # this step's pose (own odometry frame)
@@ -91,7 +96,8 @@ J_NAV_SET = 17  # A has been given a goal (``_nav_goal`` is not None)
 J_STEPS_OWN = 18  # mode_steps per mode (a mode is "met" once its count is positive)
 J_STEPS_DONE = 19
 J_STEPS_GAVE_UP = 20
-N_J = 21
+J_NAV_RESTARTS = 21  # nav_restarts (VisBug-21 gave up on the goal and was started afresh)
+N_J = 22
 
 MODE_OWN_GOAL = 0
 MODE_DONE = 1
@@ -143,22 +149,39 @@ def _corridor(r, heading, length, th, ranges, angles, max_range, epar):
 
 
 @njit(cache=True)
-def _navigate(r, gx, gy, px, py, th, ranges, angles, max_range, efst, eist, npar, nfst, nist, grid, normals):
+def _navigate(r, gx, gy, px, py, th, ranges, angles, max_range, epar, efst, eist, npar, nfst, nist, grid, normals,
+              nav):
     """``_Driving._navigate`` towards the own goal (never a temporary point alone): (heading
-    relative to the body, progressing). A is the potential field or Avoid-Past, which always
-    give a heading once a goal is set."""
+    relative to the body or NaN for none, progressing). The potential field and Avoid-Past
+    always give a heading once a goal is set; VisBug-21 gives none once it finds the goal
+    unreachable, and then (``restart_navigator_on_give_up``) is started afresh for the next step."""
+    visbug = epar[r, Q_VISBUG] != 0.0
     if eist[r, J_NAV_SET] == 0 or efst[r, X_NAV_GX] != gx or efst[r, X_NAV_GY] != gy:
-        N.set_goal(npar, nfst, nist, grid, r, gx, gy, False)
+        if visbug:
+            V.vb_set_goal(nav[0], nav[1], nav[2], r, gx, gy)
+        else:
+            N.set_goal(npar, nfst, nist, grid, r, gx, gy, False)
         eist[r, J_NAV_SET] = 1
         efst[r, X_NAV_GX] = gx
         efst[r, X_NAV_GY] = gy
-    h = N.direction(npar, nfst, nist, grid, normals, r, px, py, th, ranges[r], angles, max_range)
-    return N.py_wrap(h - th), N.progressing(npar, nist, r)
+    if not visbug:
+        h = N.direction(npar, nfst, nist, grid, normals, r, px, py, th, ranges[r], angles, max_range)
+        return N.py_wrap(h - th), N.progressing(npar, nist, r)
+    vpar, vfst, vist, order, a_sorted = nav
+    h = V.vb_direction(vpar, vfst, vist, r, px, py, th, ranges[r], angles, order, a_sorted, max_range)
+    progressing = V.vb_progressing(vpar, vfst, vist, r)
+    if h != h:
+        if epar[r, Q_RESTART] != 0.0:  # A gave up: a fresh navigator next step (``self._nav = None``)
+            V.vb_new_navigator(vpar, vfst, vist, r)
+            eist[r, J_NAV_SET] = 0
+            eist[r, J_NAV_RESTARTS] += 1
+        return math.nan, progressing
+    return N.py_wrap(h - th), progressing
 
 
 @njit(cache=True)
 def _head_to(r, gx, gy, end_margin, px, py, th, c, s, ranges, angles, max_range, gap, epar, efst, eist,
-             npar, nfst, nist, grid, normals):
+             npar, nfst, nist, grid, normals, nav):
     """``_Driving._head_to`` the own goal in sight (key ``("goal", target_index)``): (heading
     relative to the body or NaN, progressing)."""
     step_m = epar[r, Q_STEP]
@@ -196,21 +219,24 @@ def _head_to(r, gx, gy, end_margin, px, py, th, c, s, ranges, angles, max_range,
                         efst[r, X_SLIDE_SIDE] = sgn
                         eist[r, J_SLIDES] += 1
                         return N.py_wrap(h - th), progressing
-    d, _ = _navigate(r, gx, gy, px, py, th, ranges, angles, max_range, efst, eist, npar, nfst, nist, grid, normals)
+    d, _ = _navigate(r, gx, gy, px, py, th, ranges, angles, max_range, epar, efst, eist, npar, nfst, nist, grid,
+                     normals, nav)
     return d, progressing
 
 
 @njit(cache=True)
 def r1_alone_step(step, odom, ranges, angles, max_range, gap, epar, efst, eist, targets, target_steps,
-                  npar, nfst, nist, grid, normals, out_dir, grow):
+                  npar, nfst, nist, grid, normals, out_dir, grow, nav):
     """One step of every row (see the module docstring); ``out_dir[r]``: the body-frame
     direction of robot r's next step, NaN for none. Returns, without changing anything, 1
     when a row's Avoid-Past visit would fall outside its grid (``grow``: row, cell i, cell j;
     the caller grows the grid and calls again) and 2 when a row has fewer than two normals
-    left (the caller refills the buffers and calls again); else 0 after the step."""
+    left (the caller refills the buffers and calls again); else 0 after the step. ``nav``:
+    VisBug-21's ``(vpar, vfst, vist, order, a_sorted)`` (:mod:`~teamnav.control.nav.local.visbug21_compiled`)
+    for the rows whose algorithm A it is."""
     n = odom.shape[0]
     for r in range(n):
-        if eist[r, J_FINISHED] == 0:
+        if eist[r, J_FINISHED] == 0 and epar[r, Q_VISBUG] == 0.0:
             if nist[r, N.I_NORMAL] > N.NORMALS - 2:
                 return 2
             out, ci, cj = N.visit_cell_outside(npar, nist, grid, r, odom[r, 0], odom[r, 1])
@@ -276,11 +302,11 @@ def r1_alone_step(step, odom, ranges, angles, max_range, gap, epar, efst, eist, 
             if eist[r, J_DIRECT] == 1:
                 eist[r, J_GOAL_SEEN] += 1
                 d, progressing = _head_to(r, gx, gy, 0.5 * epar[r, Q_TOL], px, py, th, c, s, ranges, angles,
-                                          max_range, gap, epar, efst, eist, npar, nfst, nist, grid, normals)
+                                          max_range, gap, epar, efst, eist, npar, nfst, nist, grid, normals, nav)
             else:  # _unseen_goal -> _drive: A towards the goal
                 eist[r, J_LAST] = 0
-                d, progressing = _navigate(r, gx, gy, px, py, th, ranges, angles, max_range, efst, eist, npar, nfst,
-                                           nist, grid, normals)
+                d, progressing = _navigate(r, gx, gy, px, py, th, ranges, angles, max_range, epar, efst, eist, npar,
+                                           nfst, nist, grid, normals, nav)
             # §5: TroubleState.update(progressing)
             bound = eist[r, J_NT_TR] * int(epar[r, Q_CR])
             if progressing:
@@ -323,7 +349,8 @@ class _R1View:
     mode = property(lambda self: MODES[self._i(J_MODE)])
     target_steps = property(lambda self: [int(v) for v in self._g.target_steps[self._r, :self._i(J_REACHED)]])
     # what R1 alone never does (no teammate, no message, A never gives up)
-    msgs_sent = bytes_sent = msgs_received = nav_restarts = promised_steps = temp_switches = 0
+    nav_restarts = property(lambda self: self._i(J_NAV_RESTARTS))
+    msgs_sent = bytes_sent = msgs_received = promised_steps = temp_switches = 0
     temp_dropped = ghosts_unreachable = vias_taken = trouble_helpers_dropped = 0
 
     @property
@@ -349,7 +376,7 @@ class _R1View:
             "msgs_sent": 0,
             "bytes_sent": 0,
             "msgs_received": 0,
-            "nav_restarts": 0,
+            "nav_restarts": self.nav_restarts,
             "known_goals": 0,
             "ghosts": 0,
             "own_d_m": own_d,
@@ -388,8 +415,12 @@ class LosExplorerGroup:
                 return f"params of type {type(p).__name__}"
             if int(info.team_size) != 1:
                 return "teammates (only R1 alone is compiled so far)"
-            if p.navigator not in ("potential_field", "avoid_past"):
-                return f"navigator {p.navigator!r} (compiled: potential_field, avoid_past)"
+            if p.navigator not in ("potential_field", "avoid_past", "visbug21"):
+                return f"navigator {p.navigator!r} (compiled: potential_field, avoid_past, visbug21)"
+            if p.navigator == "visbug21":
+                nav_p = NAVIGATORS[p.navigator].Params(**dict(p.navigator_params))
+                if nav_p.turn not in V.TURNS:
+                    return f"VisBug-21 turn {nav_p.turn!r} (a draw per goal; compiled: {', '.join(V.TURNS)})"
             if p.frame_source != "bearings":
                 return f"frame_source {p.frame_source!r}"
             if p.laser not in info.sensors:
@@ -414,7 +445,7 @@ class LosExplorerGroup:
         self.epar = np.zeros((n, N_Q))
         self.efst = np.zeros((n, N_X))
         self.eist = np.zeros((n, N_J), dtype=np.int64)
-        npar = []
+        npar, vpar = [], []
         for r, (p, info) in enumerate(zip(params, infos)):
             sensor = info.sensors[p.laser]
             step_m, radius = float(info.step_length_m), float(info.radius_m)
@@ -434,6 +465,7 @@ class LosExplorerGroup:
             e[Q_SHARING] = float(p.goal_sharing)
             e[Q_RESET_TR] = float(p.reset_trouble_on_target)
             e[Q_CR] = float(p.trouble_cr)
+            e[Q_RESTART] = float(p.restart_navigator_on_give_up)
             self.efst[r, X_SLIDE_SIDE] = 1.0
             self.eist[r, J_NT] = len(p.targets_xy)
             self.eist[r, J_NT_TR] = 1
@@ -441,9 +473,19 @@ class LosExplorerGroup:
                 self.eist[r, J_FINISHED] = 1
                 self.eist[r, J_MODE] = MODE_DONE
             nav_p = NAVIGATORS[p.navigator].Params(**dict(p.navigator_params))
-            npar.append(N.nav_params(p.navigator, nav_p, step_m, radius))
+            if p.navigator == "visbug21":
+                e[Q_VISBUG] = 1.0
+                npar.append(np.zeros(N.N_P))  # unused (the potential field's row)
+                vpar.append(V.vb_params(nav_p, step_m, radius))
+            else:
+                npar.append(N.nav_params(p.navigator, nav_p, step_m, radius))
+                vpar.append(np.zeros(V.NV_P))  # unused
         self.npar = np.array(npar)
+        self.vpar = np.array(vpar)
+        self.vfst, self.vist = V.vb_state(self.vpar)
         self.nfst, self.nist, self.grid, self.normals = N.new_state(n)
+        # VisBug-21 rows read no normals: never "low", so a refill never draws from their Generators
+        self.nist[self.epar[:, Q_VISBUG] != 0.0, N.I_NORMAL] = 0
         self._gap_for: Any = None
         self._gap = 0.0
         self._dir = np.empty(n)
@@ -457,6 +499,8 @@ class LosExplorerGroup:
         if self._gap_for is not angles:  # as the reference: the beam layout's gap, measured once
             self._a64 = np.ascontiguousarray(angles, dtype=np.float64)
             self._gap_for, self._gap = angles, max_beam_gap(self._a64)
+            order, a_sorted = V.beam_order(self._a64)  # VisBug's obstacle cut, per beam layout
+            self._nav = (self.vpar, self.vfst, self.vist, order, a_sorted)
         ranges = np.ascontiguousarray(obs.ranges_m[self.laser], dtype=np.float64)
         odom = np.ascontiguousarray(obs.odom_pose, dtype=np.float64)
         step = int(obs.step)
@@ -464,7 +508,7 @@ class LosExplorerGroup:
         while True:
             code = r1_alone_step(step, odom, ranges, self._a64, max_range, self._gap, self.epar, self.efst, self.eist,
                                  self.targets, self.target_steps, self.npar, self.nfst, self.nist, self.grid,
-                                 self.normals, self._dir, self._grow)
+                                 self.normals, self._dir, self._grow, self._nav)
             if code == 0:
                 break
             if code == 1:
@@ -482,13 +526,14 @@ def _renew_caches() -> None:
     import sys
 
     from teamnav.control.group import renew_stale_caches
-    from teamnav.control.nav.local import avoid_past, base, potential_field
+    from teamnav.control.nav.local import avoid_past, base, potential_field, visbug21, visbug21_geometry
     from teamnav.papers.los_help.brains import goal_sharing
 
     here = sys.modules[__name__]
     kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
                and f.py_func.__module__ == __name__]
-    renew_stale_caches(kernels, [m.__file__ for m in (N, avoid_past, base, potential_field, goal_sharing)])
+    renew_stale_caches(kernels, [m.__file__ for m in (N, V, avoid_past, base, potential_field, visbug21,
+                                                      visbug21_geometry, goal_sharing)])
 
 
 _renew_caches()
