@@ -334,3 +334,50 @@ def test_noise_row_matches_keyed_rows(sigma, p_max, p_short):
         s0 = np.uint64((int(key) + i * nb * 64 * int(rs_mod._GAMMA)) % 2**64)  # row i's first stream state
         rs_mod._noise_row(got[i], s0, p_max + p_short > 0.0, sigma > 0.0, sigma, p_max, p_short, 10.0, slow)
     np.testing.assert_array_equal(got, want)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_open_space_poses_skip_the_traversal_bit_for_bit(seed, tiled):
+    """A pose whose four free squares reach past tmax + 1 cells gets tmax * res on every ray
+    without a traversal: the same bits as traversing each ray (``_cast_pose_capped`` without
+    caps), on an open map (codes up to the 255 cap, dense or tiled), for limits just below,
+    at and above the free squares, poses on grid lines and axis-parallel rays included."""
+    rng = np.random.default_rng(seed)
+    res = float(rng.choice([0.02, 0.05, 1.0]))
+    h, w = int(rng.integers(40, 400)), int(rng.integers(40, 400))
+    cells = np.zeros((h, w), np.uint8)
+    for _ in range(int(rng.integers(0, 4))):
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        cells[r0:r0 + int(rng.integers(1, 20)), c0:c0 + int(rng.integers(1, 3))] = WALL
+    grid = OccupancyGrid(cells, res, (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3))))
+    blocking = grid.blocking(None)
+    dense = rc_mod.clearance_map(blocking)
+    clear = rc_mod.clearance_tiles(blocking) if tiled else dense
+    n, nb = 40, int(rng.integers(1, 12))
+    ox, oy = grid.origin_xy_m
+    fx = rng.uniform(0.0, w, n)
+    fy = rng.uniform(0.0, h, n)
+    on_line = rng.random(n) < 0.3
+    fx[on_line] = np.floor(fx[on_line])  # poses on grid lines
+    both = on_line & (rng.random(n) < 0.5)
+    fy[both] = np.floor(fy[both])
+    xs, ys = ox + fx * res, oy + fy * res
+    th = np.where(rng.random(n) < 0.3, rng.choice([0.0, math.pi / 2, math.pi, -math.pi / 2], n), rng.uniform(-4, 4, n))
+    ang = np.where(rng.random(nb) < 0.3, rng.choice([0.0, math.pi / 2, math.pi], nb), rng.uniform(-math.pi, math.pi, nb))
+    ct, st_, cb, sb = np.cos(th), np.sin(th), np.cos(ang), np.sin(ang)
+    inv = 1.0 / res
+    scratch = [np.empty(nb), np.empty(nb), np.empty(nb), np.empty(nb), np.empty(nb, np.int64), np.empty(nb, np.int64),
+               np.empty(nb, np.uint8), np.empty(nb, np.int64), np.empty(nb, np.int64)]
+    for tmax in (float(rng.uniform(1.0, 20.0)), float(rng.integers(5, 300)), float(rng.integers(5, 300)) - 1e-9,
+                 251.0, 253.0, 253.00000000000003, 300.0):
+        full = np.empty((n, nb))
+        rc_mod._cast_serial(clear, ox, oy, res, xs, ys, ct, st_, cb, sb, tmax, full, 0, n)
+        for p in range(n):
+            out = np.empty(nb)
+            rc_mod._cast_pose_capped(dense, (xs[p] - ox) * inv, (ys[p] - oy) * inv, res, ct[p], st_[p], cb, sb, tmax,
+                                     np.zeros(nb), False, out, *scratch)
+            np.testing.assert_array_equal(full[p], out)
+            r, c = int((ys[p] - oy) * inv) + 1, int((xs[p] - ox) * inv) + 1
+            if 0 < r < h + 1 and 0 < c < w + 1 and int(dense[r, c].min()) - 2 >= tmax:  # a skipped pose
+                np.testing.assert_array_equal(out, tmax * res)

@@ -305,6 +305,17 @@ def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
                 for b in range(nb):
                     ranges[first + b] = 0.0
                 continue
+            # open space (most of a swarm's poses): when the free squares of all four quadrants
+            # reach past tmax + 1 cells, every ray's first jump ends at tmax (a jump from the start
+            # cell runs more than code - 1 cells before it can stop, and the spare cell covers the
+            # last-bit rounding of the direction), so each range is tmax * res, what the wavefront
+            # writes, without a traversal
+            free = np.int64(min(min(_code(clear, r0, c0, 0), _code(clear, r0, c0, 1)),
+                                min(_code(clear, r0, c0, 2), _code(clear, r0, c0, 3)))) - 2
+            if free >= tmax:
+                for b in range(nb):
+                    ranges[first + b] = tmax * res
+                continue
             for b in range(nb):
                 i = first + b
                 dx, dy = _ray_dir(ct[p], st[p], cb[b], sb[b])
