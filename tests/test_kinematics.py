@@ -314,3 +314,60 @@ def test_discs_hit_walls_touching_is_allowed():
     xs = np.array([0.375, 0.375 + 1e-9, 0.25, 0.2])
     hit = discs_hit_walls(b, clear, (0.0, 0.0, 0.125), xs, np.full(4, 0.625), np.full(4, 0.25))
     assert hit.tolist() == [False, True, False, True]  # 0.2 - 0.25 < 0: leaves the map
+
+
+def _move_reference(blocking, clear, geo, x, y, th, r, pre, arc, turn):
+    """move_discs written out without a hash: robot i against every other disc where it is now
+    (the kernel's own arithmetic), in index order."""
+    x, y, th = x.copy(), y.copy(), th.copy()
+    stalled = np.zeros(len(x), bool)
+    for i in range(len(x)):
+        th0 = th[i] + pre[i]
+        if arc[i] != 0.0:
+            n = max(1, math.ceil(abs(arc[i]) / (SUBSTEP_FRACTION * r[i])))
+            bx, by = x[i], y[i]
+            for k in range(1, n + 1):
+                px, py, _ = arc_point(x[i], y[i], th0, arc[i], turn[i], k / n)
+                hit = bool(discs_hit_walls(blocking, clear, geo, np.array([px]), np.array([py]), np.array([r[i]]))[0])
+                for j in range(len(x)):
+                    dx, dy, rr = px - x[j], py - y[j], r[i] + r[j]
+                    if j != i and dx * dx + dy * dy < rr * rr:
+                        hit = True
+                if hit:
+                    stalled[i] = True
+                    break
+                bx, by = px, py
+            x[i], y[i] = bx, by
+        th[i] = wrap(th0 + turn[i])
+    return x, y, th, stalled
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_move_discs_hash_finds_every_contact(seed):
+    """The hash only chooses which robots are tested: a crowd of mixed sizes and arcs (some
+    standing, some parked far outside the map, many touching) moves exactly as with every
+    robot tested against every other."""
+    rng = np.random.default_rng(seed)
+    cells = np.zeros((60, 60), np.uint8)
+    cells[0, :] = cells[-1, :] = cells[:, 0] = cells[:, -1] = WALL
+    g = OccupancyGrid(cells, 0.1)
+    b = g.blocking(None)
+    clear = distance_field(b, 0.1)
+    geo = np.array([0.0, 0.0, 0.1])
+    n = int(rng.integers(2, 80))
+    r = rng.choice([0.05, 0.1, 0.2, 0.3], n) * rng.uniform(0.5, 1.0, n)
+    x, y = rng.uniform(0.5, 5.5, n), rng.uniform(0.5, 5.5, n)
+    if rng.random() < 0.5:  # a tight crowd: many pairs in contact or within one arc
+        x, y = rng.uniform(2.5, 3.5, n), rng.uniform(2.5, 3.5, n)
+    th = rng.uniform(-4, 4, n)
+    arc = rng.uniform(-0.4, 0.6, n) * rng.choice([0.0, 0.1, 1.0], n)
+    park = rng.random(n) < 0.1
+    x[park], y[park], arc[park] = 1e6 + np.arange(park.sum()), -1e6, 0.0  # waiting robots, parked
+    turn = rng.uniform(-1.5, 1.5, n)
+    pre = np.where(rng.random(n) < 0.2, rng.uniform(-1, 1, n), 0.0)
+    want = _move_reference(b, clear, geo, x, y, th, r, pre, arc, turn)
+    stalled = np.zeros(n, bool)
+    move_discs(x, y, th, r, pre, arc, turn, b, clear, geo, True, stalled)
+    for got, ref in zip((x, y, th, stalled), want):
+        np.testing.assert_array_equal(got, ref)

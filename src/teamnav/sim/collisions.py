@@ -27,8 +27,11 @@ Resolution rule (one :func:`move_discs` call moves everyone)
 Wall checks first look up the distance field of the blocking mask (one read decides for a
 robot more than ``radius + sqrt(2) * res`` from any wall) and only next to walls test the
 cells under the disc's bounding box exactly. Robot–robot candidates come from a uniform
-spatial hash of the start-of-step positions with cell side ``2 * (max radius + max arc)``,
-so a step costs O(N) for a swarm, not O(N²).
+spatial hash of the start-of-step positions with cell side ``4 * (max radius + max arc)``;
+robot ``i`` looks up the cells within ``r_i + max radius + |arc_i| + max arc`` of its start
+point (1 to 4 of them), so a step costs O(N) for a swarm, not O(N²). Which candidates are
+looked up decides nothing but the cost: each is tested exactly, and every robot that can
+touch robot ``i`` is among them.
 """
 
 from __future__ import annotations
@@ -48,6 +51,13 @@ __all__ = ["SUBSTEP_FRACTION", "discs_hit_walls", "move_discs"]
 
 #: Largest distance between two collision samples along a path, as a fraction of the radius.
 SUBSTEP_FRACTION: float = 0.25
+#: Side of the robot hash's cells in units of the farthest two robots' start points can be
+#: apart and still meet, ``2 (max radius + max arc)``: with 2, a robot looks up 1 to 4 cells
+#: (the square its own reach spans), not the 3 x 3 around its cell.
+_CELL_REACHES: float = 2.0
+#: Added to that reach [m]: covers the rounding of arc samples and of the cell arithmetic,
+#: so that no robot that could meet another is ever left out of its look-up.
+_HASH_MARGIN_M: float = 1e-6
 _SQRT2 = math.sqrt(2.0)
 
 
@@ -171,7 +181,9 @@ def move_discs(x, y, th, radius, pre_turn, arc, turn, blocking, clear_m, geo, co
         for i in range(n):
             rmax = max(rmax, radius[i])
             smax = max(smax, abs(arc[i]))
-        cell = 2.0 * (rmax + smax)
+        cell = _CELL_REACHES * 2.0 * (rmax + smax)
+        if not cell > 0.0:  # nobody has a size or moves: no robot looks anything up
+            cell = 1.0
         for i in range(n):
             kx[i] = int(math.floor(x[i] / cell))
             ky[i] = int(math.floor(y[i] / cell))
@@ -193,13 +205,23 @@ def move_discs(x, y, th, radius, pre_turn, arc, turn, blocking, clear_m, geo, co
             nsub = max(1, int(math.ceil(abs(a) / (SUBSTEP_FRACTION * ri))))
             bx = x[i]
             by = y[i]
+            kx0 = kx1 = ky0 = ky1 = 0
+            if use_hash:
+                # the hash cells a robot overlapping i this step can start in: the two start
+                # points are less than ri + rj + |a_i| + |a_j| apart (every sample of an arc lies
+                # within its length of its start), plus a margin for rounding
+                reach = ri + rmax + abs(a) + smax + _HASH_MARGIN_M
+                kx0 = int(math.floor((x[i] - reach) / cell))
+                kx1 = int(math.floor((x[i] + reach) / cell))
+                ky0 = int(math.floor((y[i] - reach) / cell))
+                ky1 = int(math.floor((y[i] + reach) / cell))
             for k in range(1, nsub + 1):
                 px, py, _ = arc_point(x[i], y[i], th0, a, turn[i], k / nsub)
                 hit = _disc_hits_wall(blocking, clear_m, sh, ox, oy, res, cs, sn, px, py, ri)
                 if not hit and use_hash:
-                    for dxk in range(-1, 2):
-                        for dyk in range(-1, 2):
-                            b = _bucket(kx[i] + dxk, ky[i] + dyk, mask)
+                    for cx in range(kx0, kx1 + 1):
+                        for cy in range(ky0, ky1 + 1):
+                            b = _bucket(cx, cy, mask)
                             for q in range(start[b], start[b + 1]):
                                 j = items[q]
                                 if j != i:

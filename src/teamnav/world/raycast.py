@@ -743,10 +743,14 @@ def _run(clear, ox, oy, res, xs, ys, thetas, beams, max_range_m, out, parallel):
     return _run_cs(clear, ox, oy, res, xs, ys, thetas, np.cos(beams), np.sin(beams), max_range_m, out, parallel)
 
 
-def _run_cs(clear, ox, oy, res, xs, ys, thetas, cb, sb, max_range_m, out, parallel):
-    """:func:`_run` with the beams' ``cos`` and ``sin`` given (a sensor computes them once)."""
-    ct = np.cos(thetas)
-    st = np.sin(thetas)
+def _run_cs(clear, ox, oy, res, xs, ys, thetas, cb, sb, max_range_m, out, parallel, cs_theta=None):
+    """:func:`_run` with the beams' ``cos`` and ``sin`` given (a sensor computes them once),
+    and those of ``thetas`` too when ``cs_theta = (np.cos(thetas), np.sin(thetas))``."""
+    if cs_theta is None:
+        ct = np.cos(thetas)
+        st = np.sin(thetas)
+    else:
+        ct, st = cs_theta
     tmax = max_range_m / res
     if xs.shape[0] == 0 or cb.shape[0] == 0:
         return out
@@ -877,15 +881,17 @@ class RayCaster:
         thetas = self.grid.kernel_theta(thetas)
         return _run(self.clearance, ox, oy, self._res, xs, ys, thetas, beams, self.max_range_m, out, bool(parallel))
 
-    def _cast_cs(self, xs, ys, thetas, cos_b, sin_b, parallel: bool) -> np.ndarray:
+    def _cast_cs(self, xs, ys, thetas, cos_b, sin_b, parallel: bool, cs_theta=None) -> np.ndarray:
         """:meth:`cast_xyt` without input checks, the beams given by their ``cos`` and ``sin``
         (``np.cos(angles_rad)``, ``np.sin(angles_rad)``), into a fresh (P, B) array: the
-        engine's per-step path, for contiguous finite float64 (P,) poses."""
+        engine's per-step path, for contiguous finite float64 (P,) poses. ``cs_theta``:
+        ``(np.cos(thetas), np.sin(thetas))`` when the caller has them (used on an unrotated
+        map, whose kernel headings are ``thetas`` themselves)."""
         out = np.empty((xs.shape[0], cos_b.shape[0]), dtype=np.float64)
         xs, ys, ox, oy = self.grid.kernel_frame(xs, ys)
-        thetas = self.grid.kernel_theta(thetas)
-        return _run_cs(self.clearance, ox, oy, self._res, xs, ys, thetas, cos_b, sin_b, self.max_range_m,
-                       out, parallel)
+        kth = self.grid.kernel_theta(thetas)
+        return _run_cs(self.clearance, ox, oy, self._res, xs, ys, kth, cos_b, sin_b, self.max_range_m,
+                       out, parallel, cs_theta if kth is thetas else None)
 
 
 def brute_force_reference(

@@ -689,11 +689,12 @@ class RangeSensor:
             # few rays a robot (proximity rings): a fixed cost per robot of the one pass
             # outweighs what it saves; three passes over all robots give the same bits
             parallel = n * nr >= PARALLEL_MIN_RAYS
-            true = self.caster._cast_cs(xs, ys, thetas, self._cos_rays, self._sin_rays, parallel)
+            cs_theta = (np.cos(thetas), np.sin(thetas))  # once for the cast and the robot hits
+            true = self.caster._cast_cs(xs, ys, thetas, self._cos_rays, self._sin_rays, parallel, cs_theta)
             if use_hits:
                 all_x, all_y, all_r, self_idx = bodies
                 robot_hits_unchecked(xs, ys, thetas, self._plan, all_x, all_y, all_r, self_idx, true, self.max_range_m,
-                                     0.0, parallel)
+                                     0.0, parallel, cs_theta)
             if self.rays_per_beam > 1:
                 true = true.reshape(n, self.angles_rad.shape[0], self.rays_per_beam).min(axis=2)
             if key is None:

@@ -475,20 +475,22 @@ def beam_plan(angles_rad: np.ndarray) -> BeamPlan:
 
 
 def robot_hits_unchecked(xs, ys, thetas, plan: BeamPlan, all_x, all_y, all_r, self_idx, ranges, max_range_m,
-                         cell_m, parallel: bool) -> np.ndarray:
+                         cell_m, parallel: bool, cs_theta=None) -> np.ndarray:
     """:func:`apply_robot_hits` without input checks, for callers whose arrays are known good.
 
     ``xs, ys, thetas, all_x, all_y, all_r`` contiguous float64, ``self_idx`` int64,
     ``ranges`` (n, R) C-contiguous float64, ``plan`` from :func:`beam_plan`, ``cell_m`` the
-    hash cell side [m] or 0 for :func:`default_cell_m`. The engine's sensors call this every
-    step.
+    hash cell side [m] or 0 for :func:`default_cell_m`, ``cs_theta`` None or
+    ``(np.cos(thetas), np.sin(thetas))`` when the caller has them. The engine's sensors call
+    this every step.
     """
     if xs.shape[0] == 0 or all_x.shape[0] == 0 or ranges.shape[1] == 0:
         return ranges
     kernel = _robot_hits_parallel if parallel else _robot_hits_serial
     # cos/sin by NumPy, as robot_hits_reference: the rays' directions agree to the last bit
-    kernel(xs, ys, np.cos(thetas), np.sin(thetas), self_idx, plan.beams, plan.even, all_x, all_y, all_r,
-           float(max_range_m), float(cell_m), ranges)
+    ct, st = (np.cos(thetas), np.sin(thetas)) if cs_theta is None else cs_theta
+    kernel(xs, ys, ct, st, self_idx, plan.beams, plan.even, all_x, all_y, all_r, float(max_range_m), float(cell_m),
+           ranges)
     return ranges
 
 
