@@ -381,3 +381,38 @@ def test_open_space_poses_skip_the_traversal_bit_for_bit(seed, tiled):
             r, c = int((ys[p] - oy) * inv) + 1, int((xs[p] - ox) * inv) + 1
             if 0 < r < h + 1 and 0 < c < w + 1 and int(dense[r, c].min()) - 2 >= tmax:  # a skipped pose
                 np.testing.assert_array_equal(out, tmax * res)
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_one_pass_in_open_space_matches_former_path(seed, parallel):
+    """Poses with more than 4 m of free map all around take the discs up to 8 m before the cast
+    (``_OPEN_NEAR_M``), the others up to 4 m: the ranges are the former path's bit for bit,
+    in an open walled arena crowded with robots (as bench_scale's laser case)."""
+    rng = np.random.default_rng(seed)
+    res = float(rng.choice([0.05, 0.1]))
+    side = int(rng.integers(250, 450))
+    cells = np.zeros((side, side), np.uint8)
+    cells[0, :] = cells[-1, :] = cells[:, 0] = cells[:, -1] = WALL
+    grid = OccupancyGrid(cells, res, (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3))))
+    sensor = build_range_sensor(LaserConfig(n_beams=int(rng.choice([90, 181])), fov_deg=float(rng.choice([180.0, 360.0])),
+                                            max_range_m=float(rng.choice([6.0, 10.0, 30.0])), noise_std_m=0.01,
+                                            sees_robots=True), grid)
+    n_all = int(rng.integers(20, 250))
+    ox, oy = grid.origin_xy_m
+    all_x = ox + rng.uniform(0.3, side * res - 0.3, n_all)
+    all_y = oy + rng.uniform(0.3, side * res - 0.3, n_all)
+    all_r = rng.uniform(0.05, 0.3, n_all)
+    sensing = np.sort(rng.choice(n_all, size=min(n_all, 60), replace=False))
+    xs, ys = all_x[sensing].copy(), all_y[sensing].copy()
+    th = rng.uniform(-10.0, 10.0, sensing.shape[0])
+    gx, gy, gr = grazing_bodies(rng, sensor, xs, ys, th, 40)
+    bodies = (np.concatenate([all_x, gx]), np.concatenate([all_y, gy]), np.concatenate([all_r, gr]),
+              sensing.astype(np.int64))
+    old = rs_mod.PARALLEL_MIN_RAYS
+    try:
+        rs_mod.PARALLEL_MIN_RAYS = 0 if parallel else 10**12
+        got = sensor._pass(xs, ys, th, bodies, None)
+    finally:
+        rs_mod.PARALLEL_MIN_RAYS = old
+    np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, None))
