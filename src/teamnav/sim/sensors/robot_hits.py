@@ -26,6 +26,8 @@ any other set of directions a binary search over the sorted directions; the bear
 from a polynomial ``atan2`` good to 4e-8 rad, well inside the margin. Every ray of a window is
 intersected with the same arithmetic as :func:`robot_hits_reference`, so the result is
 identical to testing every ray against every disc (the tests compare bit for bit).
+A robot without another disc within that reach (a first look at its cells, with the same
+window and test) skips the rest: its row could not change.
 Sensing robots are spread over numba's threads (``prange``) once there are
 ``PARALLEL_MIN_RAYS`` rays: on the 2-core development machine smaller calls gained nothing.
 Cost per step: O(N) for the hash plus O(sum over i of (candidates_i + window rays_i)).
