@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/bench_engine.py [--quick] [--cases laser,swarm] [--robots 10,100,1000]
                                       [--irsim-python PATH] [--enki-python PATH] [--threads N]
-                                      [--profile CASE] [--baseline-src DIR [--rounds K]]
+                                      [--profile CASE] [--baseline-src DIR [--rounds K]] [--steps K]
 
 (a) ``laser``: N robots with a 180-beam, 10 m laser on the MIT basement map (0.05 m/px),
     wandering: teamnav's per-robot ``wander-v1`` (a Python Controller per robot) and batched
@@ -30,7 +30,8 @@ case-form-N) prints a cProfile of that run's timed steps instead.
 the same run: each round times the baseline and this tree, each in a fresh subprocess
 (``--measure-one``), ``--rounds`` times alternating, and prints the best of each with the ratio
 and the CPU time per step (the fair reading on a shared machine; with ``--threads 1`` CPU
-time is the step's own).
+time is the step's own). ``--steps K`` times ``K`` steps per repeat instead of the plan's
+count (which falls to one step at 10 000 robots): e.g. ``--robots 10000 --steps 20``.
 """
 
 from __future__ import annotations
@@ -148,7 +149,8 @@ def measure_cpu(case: str, form: str, n: int, steps: int, warmup: int, repeats: 
             "cpu_ms_per_step": cpu / steps * 1e3, "steps": steps}
 
 
-def compare_baseline(src: str, cells: list[tuple[str, str, int]], plan: Plan, threads: int | None, rounds: int) -> None:
+def compare_baseline(src: str, cells: list[tuple[str, str, int]], plan: Plan, threads: int | None, rounds: int,
+                     steps: int | None = None) -> None:
     """Time ``cells`` with the engine of source folder ``src`` and with this tree, alternating,
     each round in fresh subprocesses; print the best of each and the ratio."""
     src_dir = Path(src).resolve()
@@ -163,12 +165,15 @@ def compare_baseline(src: str, cells: list[tuple[str, str, int]], plan: Plan, th
             cmd += ["--threads", str(threads)]
         if plan is QUICK:
             cmd.append("--quick")
+        if steps is not None:
+            cmd += ["--steps", str(steps)]
         r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=1800)
         if r.returncode != 0:
             raise SystemExit(f"--measure-one {spec} under {path} failed:\n{r.stderr[-2000:]}")
         return json.loads(r.stdout.strip().splitlines()[-1])
 
-    print(f"\n### this tree ({here}) against the baseline ({src_dir}), same run, {rounds} rounds alternating\n")
+    print(f"\n### this tree ({here}) against the baseline ({src_dir}), same run, {rounds} rounds alternating "
+          f"(load average {os.getloadavg()[0]:.1f} at the start)\n")
     print("| cell | baseline cpu ms/step | this tree cpu ms/step | speed-up (cpu) | baseline robot-steps/s | "
           "this tree robot-steps/s | speed-up (wall) |")
     print("|---|---:|---:|---:|---:|---:|---:|")
@@ -186,6 +191,7 @@ def compare_baseline(src: str, cells: list[tuple[str, str, int]], plan: Plan, th
         print(f"| {spec} | {b['cpu_ms_per_step']:.2f} | {w['cpu_ms_per_step']:.2f} | "
               f"{b['cpu_ms_per_step'] / w['cpu_ms_per_step']:.2f}× | {b['robot_steps_per_s']:,.0f} | "
               f"{w['robot_steps_per_s']:,.0f} | {w['robot_steps_per_s'] / b['robot_steps_per_s']:.2f}× |", flush=True)
+    print(f"\n(load average {os.getloadavg()[0]:.1f} at the end)")
 
 
 def profile_teamnav(spec: str, steps: int) -> None:
@@ -280,6 +286,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="also time the engine of this src folder (another commit's tree) on the same cells, "
                          "alternating")
     ap.add_argument("--rounds", type=int, default=3, help="alternating rounds of --baseline-src (default 3)")
+    ap.add_argument("--steps", type=int, default=None,
+                    help="timed steps per repeat of every teamnav cell (default: the plan's, 1 at 10 000 robots)")
     ap.add_argument("--measure-one", metavar="CASE-FORM-N", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     plan = QUICK if a.quick else FULL
@@ -292,6 +300,12 @@ def main(argv: list[str] | None = None) -> int:
     for f in forms:
         if f not in ("python", "avoider", "batched"):
             raise SystemExit(f"--forms must list 'python', 'avoider' and/or 'batched', got {f!r}")
+    if a.steps is not None and a.steps < 1:
+        raise SystemExit(f"--steps must be >= 1, got {a.steps}")
+
+    def steps_for(n: int) -> int:
+        return a.steps if a.steps is not None else _steps(plan.teamnav_steps, n)
+
     if any(n < 1 for n in sizes):
         raise SystemExit(f"--robots must list positive team sizes, got {a.robots!r}")
     if a.threads is not None:
@@ -302,11 +316,11 @@ def main(argv: list[str] | None = None) -> int:
         numba.set_num_threads(min(a.threads, numba.config.NUMBA_NUM_THREADS))
     if a.profile:
         n = int(a.profile.rsplit("-", 1)[1])
-        profile_teamnav(a.profile, _steps(plan.teamnav_steps, n))
+        profile_teamnav(a.profile, steps_for(n))
         return 0
     if a.measure_one:
         case, form, n = a.measure_one.split("-")
-        print(json.dumps(measure_cpu(case, form, int(n), _steps(plan.teamnav_steps, int(n)), plan.warmup,
+        print(json.dumps(measure_cpu(case, form, int(n), steps_for(int(n)), plan.warmup,
                                      plan.teamnav_repeats)))
         return 0
 
@@ -331,7 +345,7 @@ def main(argv: list[str] | None = None) -> int:
             for form in forms:
                 if form == "avoider" and case != "swarm":
                     continue
-                res = measure_teamnav(case, form, n, _steps(plan.teamnav_steps, n), plan.warmup, plan.teamnav_repeats)
+                res = measure_teamnav(case, form, n, steps_for(n), plan.warmup, plan.teamnav_repeats)
                 row[form] = res["robot_steps_per_s"]
                 row[f"{form}_cpu"] = res["robot_steps_per_cpu_s"]
                 print(f"  {case:5s} teamnav {form:7s} N={n:5d}: {res['robot_steps_per_s']:>14,.0f} robot-steps/s "
@@ -354,7 +368,7 @@ def main(argv: list[str] | None = None) -> int:
         if a.rounds < 1:
             raise SystemExit(f"--rounds must be >= 1, got {a.rounds}")
         compare_baseline(a.baseline_src, [(c, f, n) for c in cases for n in sizes for f in forms], plan, a.threads,
-                         a.rounds)
+                         a.rounds, a.steps)
     return 0
 
 

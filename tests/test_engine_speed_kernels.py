@@ -334,3 +334,85 @@ def test_noise_row_matches_keyed_rows(sigma, p_max, p_short):
         s0 = np.uint64((int(key) + i * nb * 64 * int(rs_mod._GAMMA)) % 2**64)  # row i's first stream state
         rs_mod._noise_row(got[i], s0, p_max + p_short > 0.0, sigma > 0.0, sigma, p_max, p_short, 10.0, slow)
     np.testing.assert_array_equal(got, want)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_open_space_poses_skip_the_traversal_bit_for_bit(seed, tiled):
+    """A pose whose four free squares reach past tmax + 1 cells gets tmax * res on every ray
+    without a traversal: the same bits as traversing each ray (``_cast_pose_capped`` without
+    caps), on an open map (codes up to the 255 cap, dense or tiled), for limits just below,
+    at and above the free squares, poses on grid lines and axis-parallel rays included."""
+    rng = np.random.default_rng(seed)
+    res = float(rng.choice([0.02, 0.05, 1.0]))
+    h, w = int(rng.integers(40, 400)), int(rng.integers(40, 400))
+    cells = np.zeros((h, w), np.uint8)
+    for _ in range(int(rng.integers(0, 4))):
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        cells[r0:r0 + int(rng.integers(1, 20)), c0:c0 + int(rng.integers(1, 3))] = WALL
+    grid = OccupancyGrid(cells, res, (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3))))
+    blocking = grid.blocking(None)
+    dense = rc_mod.clearance_map(blocking)
+    clear = rc_mod.clearance_tiles(blocking) if tiled else dense
+    n, nb = 40, int(rng.integers(1, 12))
+    ox, oy = grid.origin_xy_m
+    fx = rng.uniform(0.0, w, n)
+    fy = rng.uniform(0.0, h, n)
+    on_line = rng.random(n) < 0.3
+    fx[on_line] = np.floor(fx[on_line])  # poses on grid lines
+    both = on_line & (rng.random(n) < 0.5)
+    fy[both] = np.floor(fy[both])
+    xs, ys = ox + fx * res, oy + fy * res
+    th = np.where(rng.random(n) < 0.3, rng.choice([0.0, math.pi / 2, math.pi, -math.pi / 2], n), rng.uniform(-4, 4, n))
+    ang = np.where(rng.random(nb) < 0.3, rng.choice([0.0, math.pi / 2, math.pi], nb), rng.uniform(-math.pi, math.pi, nb))
+    ct, st_, cb, sb = np.cos(th), np.sin(th), np.cos(ang), np.sin(ang)
+    inv = 1.0 / res
+    scratch = [np.empty(nb), np.empty(nb), np.empty(nb), np.empty(nb), np.empty(nb, np.int64), np.empty(nb, np.int64),
+               np.empty(nb, np.uint8), np.empty(nb, np.int64), np.empty(nb, np.int64)]
+    for tmax in (float(rng.uniform(1.0, 20.0)), float(rng.integers(5, 300)), float(rng.integers(5, 300)) - 1e-9,
+                 251.0, 253.0, 253.00000000000003, 300.0):
+        full = np.empty((n, nb))
+        rc_mod._cast_serial(clear, ox, oy, res, xs, ys, ct, st_, cb, sb, tmax, full, 0, n)
+        for p in range(n):
+            out = np.empty(nb)
+            rc_mod._cast_pose_capped(dense, (xs[p] - ox) * inv, (ys[p] - oy) * inv, res, ct[p], st_[p], cb, sb, tmax,
+                                     np.zeros(nb), False, out, *scratch)
+            np.testing.assert_array_equal(full[p], out)
+            r, c = int((ys[p] - oy) * inv) + 1, int((xs[p] - ox) * inv) + 1
+            if 0 < r < h + 1 and 0 < c < w + 1 and int(dense[r, c].min()) - 2 >= tmax:  # a skipped pose
+                np.testing.assert_array_equal(out, tmax * res)
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_one_pass_in_open_space_matches_former_path(seed, parallel):
+    """Poses with more than 4 m of free map all around take the discs up to 8 m before the cast
+    (``_OPEN_NEAR_M``), the others up to 4 m: the ranges are the former path's bit for bit,
+    in an open walled arena crowded with robots (as bench_scale's laser case)."""
+    rng = np.random.default_rng(seed)
+    res = float(rng.choice([0.05, 0.1]))
+    side = int(rng.integers(250, 450))
+    cells = np.zeros((side, side), np.uint8)
+    cells[0, :] = cells[-1, :] = cells[:, 0] = cells[:, -1] = WALL
+    grid = OccupancyGrid(cells, res, (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3))))
+    sensor = build_range_sensor(LaserConfig(n_beams=int(rng.choice([90, 181])), fov_deg=float(rng.choice([180.0, 360.0])),
+                                            max_range_m=float(rng.choice([6.0, 10.0, 30.0])), noise_std_m=0.01,
+                                            sees_robots=True), grid)
+    n_all = int(rng.integers(20, 250))
+    ox, oy = grid.origin_xy_m
+    all_x = ox + rng.uniform(0.3, side * res - 0.3, n_all)
+    all_y = oy + rng.uniform(0.3, side * res - 0.3, n_all)
+    all_r = rng.uniform(0.05, 0.3, n_all)
+    sensing = np.sort(rng.choice(n_all, size=min(n_all, 60), replace=False))
+    xs, ys = all_x[sensing].copy(), all_y[sensing].copy()
+    th = rng.uniform(-10.0, 10.0, sensing.shape[0])
+    gx, gy, gr = grazing_bodies(rng, sensor, xs, ys, th, 40)
+    bodies = (np.concatenate([all_x, gx]), np.concatenate([all_y, gy]), np.concatenate([all_r, gr]),
+              sensing.astype(np.int64))
+    old = rs_mod.PARALLEL_MIN_RAYS
+    try:
+        rs_mod.PARALLEL_MIN_RAYS = 0 if parallel else 10**12
+        got = sensor._pass(xs, ys, th, bodies, None)
+    finally:
+        rs_mod.PARALLEL_MIN_RAYS = old
+    np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, None))

@@ -314,3 +314,110 @@ def test_discs_hit_walls_touching_is_allowed():
     xs = np.array([0.375, 0.375 + 1e-9, 0.25, 0.2])
     hit = discs_hit_walls(b, clear, (0.0, 0.0, 0.125), xs, np.full(4, 0.625), np.full(4, 0.25))
     assert hit.tolist() == [False, True, False, True]  # 0.2 - 0.25 < 0: leaves the map
+
+
+def _move_reference(blocking, clear, geo, x, y, th, r, pre, arc, turn):
+    """move_discs written out without a hash: robot i against every other disc where it is now
+    (the kernel's own arithmetic), in index order."""
+    x, y, th = x.copy(), y.copy(), th.copy()
+    stalled = np.zeros(len(x), bool)
+    for i in range(len(x)):
+        th0 = th[i] + pre[i]
+        if arc[i] != 0.0:
+            n = max(1, math.ceil(abs(arc[i]) / (SUBSTEP_FRACTION * r[i])))
+            bx, by = x[i], y[i]
+            for k in range(1, n + 1):
+                px, py, _ = arc_point(x[i], y[i], th0, arc[i], turn[i], k / n)
+                hit = bool(discs_hit_walls(blocking, clear, geo, np.array([px]), np.array([py]), np.array([r[i]]))[0])
+                for j in range(len(x)):
+                    dx, dy, rr = px - x[j], py - y[j], r[i] + r[j]
+                    if j != i and dx * dx + dy * dy < rr * rr:
+                        hit = True
+                if hit:
+                    stalled[i] = True
+                    break
+                bx, by = px, py
+            x[i], y[i] = bx, by
+        th[i] = wrap(th0 + turn[i])
+    return x, y, th, stalled
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_move_discs_hash_finds_every_contact(seed):
+    """The hash only chooses which robots are tested: a crowd of mixed sizes and arcs (some
+    standing, some parked far outside the map, many touching) moves exactly as with every
+    robot tested against every other."""
+    rng = np.random.default_rng(seed)
+    cells = np.zeros((60, 60), np.uint8)
+    cells[0, :] = cells[-1, :] = cells[:, 0] = cells[:, -1] = WALL
+    g = OccupancyGrid(cells, 0.1)
+    b = g.blocking(None)
+    clear = distance_field(b, 0.1)
+    geo = np.array([0.0, 0.0, 0.1])
+    n = int(rng.integers(2, 150))
+    r = rng.choice([0.02, 0.05, 0.1, 0.3]) * rng.uniform(0.5, 1.0, n)
+    x, y = rng.uniform(0.5, 5.5, n), rng.uniform(0.5, 5.5, n)
+    if rng.random() < 0.5:  # a tight crowd: many pairs in contact or within one arc
+        x, y = rng.uniform(2.5, 3.5, n), rng.uniform(2.5, 3.5, n)
+    if rng.random() < 0.5:
+        r[:] = r[0]  # one size: the reach of the look-up is as tight as it gets
+    th = rng.uniform(-4, 4, n)
+    arc = rng.uniform(-1.0, 1.5, n) * r * rng.choice([0.0, 0.5, 2.0], n)
+    for i in range(1, n):  # most robots just out of reach of an earlier one, in any direction
+        if rng.random() < 0.7:
+            j = int(rng.integers(0, i))
+            d = r[i] + r[j] + rng.uniform(0.0, 1.0) * (abs(arc[i]) + abs(arc[j])) + rng.choice([0.0, 1e-12, 1e-3])
+            a = rng.uniform(-math.pi, math.pi)
+            x[i], y[i] = x[j] + d * math.cos(a), y[j] + d * math.sin(a)
+            th[i] = a + math.pi + rng.uniform(-0.5, 0.5)  # heading back towards it
+    park = (rng.random(n) < 0.1) & (rng.random() < 0.3)  # in some crowds: the hashed buckets
+    x[park], y[park], arc[park] = 1e6 + np.arange(park.sum()), -1e6, 0.0  # waiting robots, parked
+    turn = rng.uniform(-1.5, 1.5, n)
+    pre = np.where(rng.random(n) < 0.2, rng.uniform(-1, 1, n), 0.0)
+    want = _move_reference(b, clear, geo, x, y, th, r, pre, arc, turn)
+    stalled = np.zeros(n, bool)
+    move_discs(x, y, th, r, pre, arc, turn, b, clear, geo, True, stalled)
+    for got, ref in zip((x, y, th, stalled), want):
+        np.testing.assert_array_equal(got, ref)
+
+
+@pytest.mark.parametrize("layout", ["dense", "hashed"])
+def test_move_discs_contact_at_the_edge_of_the_look_up_in_every_direction(layout):
+    """Robot 1 drives straight at robot 0, whose disc it reaches just before the end of its
+    arc (start points 2r + arc - 1 nm apart), in 16 directions and from 40 places across the
+    cells of the grid of start points: it always stalls, as with every robot tested against
+    every other. "dense": still robots spread over the arena (the grid spans their box);
+    "hashed": one robot parked far away (the buckets are hashed)."""
+    cells = np.zeros((200, 200), np.uint8)
+    cells[0, :] = cells[-1, :] = cells[:, 0] = cells[:, -1] = WALL
+    g = OccupancyGrid(cells, 0.1)
+    b = g.blocking(None)
+    clear = distance_field(b, 0.1)
+    geo = np.array([0.0, 0.0, 0.1])
+    rad, a = 0.08, 0.05
+    rng = np.random.default_rng(3)
+    if layout == "dense":
+        fill_x = np.concatenate([[1.0, 19.0], rng.uniform(1.0, 19.0, 60)])
+        fill_y = np.concatenate([[1.0, 19.0], rng.uniform(10.0, 19.0, 60)])
+    else:
+        fill_x, fill_y = np.array([1e6]), np.array([-1e6])
+    for k in range(16):
+        phi = k * math.pi / 8
+        for s in np.linspace(0.0, 2.1, 40):
+            d = 2 * rad + a - 1e-9
+            x1, y1 = 5.0 + s, 5.0 + 0.77 * s
+            x = np.concatenate([[x1 + d * math.cos(phi), x1], fill_x])
+            y = np.concatenate([[y1 + d * math.sin(phi), y1], fill_y])
+            n = x.shape[0]
+            th = np.zeros(n)
+            th[1] = phi
+            arc = np.zeros(n)
+            arc[1] = a
+            r = np.full(n, rad)
+            want = _move_reference(b, clear, geo, x, y, th, r, np.zeros(n), arc, np.zeros(n))
+            stalled = np.zeros(n, bool)
+            move_discs(x, y, th, r, np.zeros(n), arc, np.zeros(n), b, clear, geo, True, stalled)
+            assert stalled[1] and want[3][1]
+            np.testing.assert_array_equal(x, want[0])
+            np.testing.assert_array_equal(y, want[1])

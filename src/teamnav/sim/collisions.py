@@ -26,9 +26,13 @@ Resolution rule (one :func:`move_discs` call moves everyone)
 
 Wall checks first look up the distance field of the blocking mask (one read decides for a
 robot more than ``radius + sqrt(2) * res`` from any wall) and only next to walls test the
-cells under the disc's bounding box exactly. Robot–robot candidates come from a uniform
-spatial hash of the start-of-step positions with cell side ``2 * (max radius + max arc)``,
-so a step costs O(N) for a swarm, not O(N²).
+cells under the disc's bounding box exactly. Robot–robot candidates come from a grid of the
+start-of-step positions with cell side ``4 * (max radius + max arc)`` (dense over the robots'
+bounding box, or hashed buckets when that box is too sparse); robot ``i`` looks up the cells
+within ``r_i + max radius + |arc_i| + max arc`` of its start point (1 to 4 of them), so a
+step costs O(N) for a swarm, not O(N²). Which candidates are
+looked up decides nothing but the cost: each is tested exactly, and every robot that can
+touch robot ``i`` is among them.
 """
 
 from __future__ import annotations
@@ -48,6 +52,18 @@ __all__ = ["SUBSTEP_FRACTION", "discs_hit_walls", "move_discs"]
 
 #: Largest distance between two collision samples along a path, as a fraction of the radius.
 SUBSTEP_FRACTION: float = 0.25
+#: Side of the robot hash's cells in units of the farthest two robots' start points can be
+#: apart and still meet, ``2 (max radius + max arc)``: with 2, a robot looks up 1 to 4 cells
+#: (the square its own reach spans), not the 3 x 3 around its cell.
+_CELL_REACHES: float = 2.0
+#: Most cells a robot of the dense grid of start points (beyond, buckets hashed by cell).
+_CELLS_PER_ROBOT: int = 4
+#: Most the dense grid's cell side may grow past the hash's (a swarm of one robot a square
+#: metre, Thymio-sized: 0.38 m to about 0.5 m) before the buckets are hashed instead.
+_DENSE_GROWTH: float = 4.0
+#: Added to that reach [m]: covers the rounding of arc samples and of the cell arithmetic,
+#: so that no robot that could meet another is ever left out of its look-up.
+_HASH_MARGIN_M: float = 1e-6
 _SQRT2 = math.sqrt(2.0)
 
 
@@ -155,34 +171,69 @@ def move_discs(x, y, th, radius, pre_turn, arc, turn, blocking, clear_m, geo, co
     sn = geo[4] if geo.shape[0] > 4 else 0.0
     use_hash = collide and n > 1
     sh = _field_shift(blocking, clear_m)
-    # ---- spatial hash of start-of-step positions (counting sort into buckets)
+    # ---- start-of-step positions in cells (counting sort): a dense grid over the robots'
+    # bounding box (rows of cells contiguous: one range per column of a look-up), or, when
+    # that box would need more than _CELLS_PER_ROBOT cells a robot (robots parked far away,
+    # a sparse team on a huge map), hashed buckets
+    dense = False
+    x0 = 0.0
+    y0 = 0.0
+    nky = 1
+    nkx = 1
     size = 1
-    while size < 2 * n:
-        size *= 2
-    mask = size - 1
-    kx = np.empty(n if use_hash else 0, np.int64)
-    ky = np.empty(n if use_hash else 0, np.int64)
-    start = np.zeros(size + 1 if use_hash else 0, np.int64)
-    items = np.empty(n if use_hash else 0, np.int64)
     cell = 1.0
+    rmax = 0.0
+    smax = 0.0
     if use_hash:
-        rmax = 0.0
-        smax = 0.0
         for i in range(n):
             rmax = max(rmax, radius[i])
             smax = max(smax, abs(arc[i]))
-        cell = 2.0 * (rmax + smax)
+        cell = _CELL_REACHES * 2.0 * (rmax + smax)
+        if not cell > 0.0:  # nobody has a size or moves: no robot looks anything up
+            cell = 1.0
+        x0 = x[0]
+        x1 = x[0]
+        y0 = y[0]
+        y1 = y[0]
         for i in range(n):
-            kx[i] = int(math.floor(x[i] / cell))
-            ky[i] = int(math.floor(y[i] / cell))
-            start[_bucket(kx[i], ky[i], mask) + 1] += 1
+            x0 = min(x0, x[i])
+            x1 = max(x1, x[i])
+            y0 = min(y0, y[i])
+            y1 = max(y1, y[i])
+        # the dense grid's cells may grow up to _DENSE_GROWTH times (fewer cells, more robots in each)
+        dcell = cell
+        fx = math.floor((x1 - x0) / dcell) + 1.0
+        fy = math.floor((y1 - y0) / dcell) + 1.0
+        while fx * fy > _CELLS_PER_ROBOT * n + 16 and dcell < _DENSE_GROWTH * cell:
+            dcell *= 1.25
+            fx = math.floor((x1 - x0) / dcell) + 1.0
+            fy = math.floor((y1 - y0) / dcell) + 1.0
+        dense = fx * fy <= _CELLS_PER_ROBOT * n + 16
+        if dense:
+            cell = dcell
+            nkx = int(fx)
+            nky = int(fy)
+            size = nkx * nky
+        else:
+            while size < 2 * n:
+                size *= 2
+    mask = size - 1
+    key = np.empty(n if use_hash else 0, np.int64)
+    start = np.zeros(size + 1 if use_hash else 0, np.int64)
+    items = np.empty(n if use_hash else 0, np.int64)
+    if use_hash:
+        for i in range(n):
+            if dense:
+                key[i] = int(math.floor((x[i] - x0) / cell)) * nky + int(math.floor((y[i] - y0) / cell))
+            else:
+                key[i] = _bucket(int(math.floor(x[i] / cell)), int(math.floor(y[i] / cell)), mask)
+            start[key[i] + 1] += 1
         for b in range(size):
             start[b + 1] += start[b]
         fill = start[:size].copy()
         for i in range(n):
-            b = _bucket(kx[i], ky[i], mask)
-            items[fill[b]] = i
-            fill[b] += 1
+            items[fill[key[i]]] = i
+            fill[key[i]] += 1
     # ---- move robots one by one
     for i in range(n):
         th0 = th[i] + pre_turn[i]
@@ -193,14 +244,37 @@ def move_discs(x, y, th, radius, pre_turn, arc, turn, blocking, clear_m, geo, co
             nsub = max(1, int(math.ceil(abs(a) / (SUBSTEP_FRACTION * ri))))
             bx = x[i]
             by = y[i]
+            kx0 = kx1 = ky0 = ky1 = 0
+            if use_hash:
+                # the cells a robot overlapping i this step can start in: the two start points
+                # are less than ri + rj + |a_i| + |a_j| apart (every sample of an arc lies within
+                # its length of its start), plus a margin for rounding
+                reach = ri + rmax + abs(a) + smax + _HASH_MARGIN_M
+                if dense:
+                    kx0 = max(0, int(math.floor((x[i] - reach - x0) / cell)))
+                    kx1 = min(nkx - 1, int(math.floor((x[i] + reach - x0) / cell)))
+                    ky0 = max(0, int(math.floor((y[i] - reach - y0) / cell)))
+                    ky1 = min(nky - 1, int(math.floor((y[i] + reach - y0) / cell)))
+                else:
+                    kx0 = int(math.floor((x[i] - reach) / cell))
+                    kx1 = int(math.floor((x[i] + reach) / cell))
+                    ky0 = int(math.floor((y[i] - reach) / cell))
+                    ky1 = int(math.floor((y[i] + reach) / cell))
             for k in range(1, nsub + 1):
                 px, py, _ = arc_point(x[i], y[i], th0, a, turn[i], k / nsub)
                 hit = _disc_hits_wall(blocking, clear_m, sh, ox, oy, res, cs, sn, px, py, ri)
                 if not hit and use_hash:
-                    for dxk in range(-1, 2):
-                        for dyk in range(-1, 2):
-                            b = _bucket(kx[i] + dxk, ky[i] + dyk, mask)
-                            for q in range(start[b], start[b + 1]):
+                    for cx in range(kx0, kx1 + 1):
+                        # dense: the column's cells ky0..ky1 in one range; hashed: one bucket a cell
+                        for cy in range(ky0, ky0 + 1 if dense else ky1 + 1):
+                            if dense:
+                                q0 = start[cx * nky + ky0]
+                                q1 = start[cx * nky + ky1 + 1]
+                            else:
+                                bk = _bucket(cx, cy, mask)
+                                q0 = start[bk]
+                                q1 = start[bk + 1]
+                            for q in range(q0, q1):
                                 j = items[q]
                                 if j != i:
                                     ddx = px - x[j]

@@ -305,6 +305,17 @@ def _cast_serial(clear, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
                 for b in range(nb):
                     ranges[first + b] = 0.0
                 continue
+            # open space (most of a swarm's poses): when the free squares of all four quadrants
+            # reach past tmax + 1 cells, every ray's first jump ends at tmax (a jump from the start
+            # cell runs more than code - 1 cells before it can stop, and the spare cell covers the
+            # last-bit rounding of the direction), so each range is tmax * res, what the wavefront
+            # writes, without a traversal
+            free = np.int64(min(min(_code(clear, r0, c0, 0), _code(clear, r0, c0, 1)),
+                                min(_code(clear, r0, c0, 2), _code(clear, r0, c0, 3)))) - 2
+            if free >= tmax:
+                for b in range(nb):
+                    ranges[first + b] = tmax * res
+                continue
             for b in range(nb):
                 i = first + b
                 dx, dy = _ray_dir(ct[p], st[p], cb[b], sb[b])
@@ -732,10 +743,14 @@ def _run(clear, ox, oy, res, xs, ys, thetas, beams, max_range_m, out, parallel):
     return _run_cs(clear, ox, oy, res, xs, ys, thetas, np.cos(beams), np.sin(beams), max_range_m, out, parallel)
 
 
-def _run_cs(clear, ox, oy, res, xs, ys, thetas, cb, sb, max_range_m, out, parallel):
-    """:func:`_run` with the beams' ``cos`` and ``sin`` given (a sensor computes them once)."""
-    ct = np.cos(thetas)
-    st = np.sin(thetas)
+def _run_cs(clear, ox, oy, res, xs, ys, thetas, cb, sb, max_range_m, out, parallel, cs_theta=None):
+    """:func:`_run` with the beams' ``cos`` and ``sin`` given (a sensor computes them once),
+    and those of ``thetas`` too when ``cs_theta = (np.cos(thetas), np.sin(thetas))``."""
+    if cs_theta is None:
+        ct = np.cos(thetas)
+        st = np.sin(thetas)
+    else:
+        ct, st = cs_theta
     tmax = max_range_m / res
     if xs.shape[0] == 0 or cb.shape[0] == 0:
         return out
@@ -866,15 +881,17 @@ class RayCaster:
         thetas = self.grid.kernel_theta(thetas)
         return _run(self.clearance, ox, oy, self._res, xs, ys, thetas, beams, self.max_range_m, out, bool(parallel))
 
-    def _cast_cs(self, xs, ys, thetas, cos_b, sin_b, parallel: bool) -> np.ndarray:
+    def _cast_cs(self, xs, ys, thetas, cos_b, sin_b, parallel: bool, cs_theta=None) -> np.ndarray:
         """:meth:`cast_xyt` without input checks, the beams given by their ``cos`` and ``sin``
         (``np.cos(angles_rad)``, ``np.sin(angles_rad)``), into a fresh (P, B) array: the
-        engine's per-step path, for contiguous finite float64 (P,) poses."""
+        engine's per-step path, for contiguous finite float64 (P,) poses. ``cs_theta``:
+        ``(np.cos(thetas), np.sin(thetas))`` when the caller has them (used on an unrotated
+        map, whose kernel headings are ``thetas`` themselves)."""
         out = np.empty((xs.shape[0], cos_b.shape[0]), dtype=np.float64)
         xs, ys, ox, oy = self.grid.kernel_frame(xs, ys)
-        thetas = self.grid.kernel_theta(thetas)
-        return _run_cs(self.clearance, ox, oy, self._res, xs, ys, thetas, cos_b, sin_b, self.max_range_m,
-                       out, parallel)
+        kth = self.grid.kernel_theta(thetas)
+        return _run_cs(self.clearance, ox, oy, self._res, xs, ys, kth, cos_b, sin_b, self.max_range_m,
+                       out, parallel, cs_theta if kth is thetas else None)
 
 
 def brute_force_reference(

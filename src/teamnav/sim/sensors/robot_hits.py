@@ -26,6 +26,8 @@ any other set of directions a binary search over the sorted directions; the bear
 from a polynomial ``atan2`` good to 4e-8 rad, well inside the margin. Every ray of a window is
 intersected with the same arithmetic as :func:`robot_hits_reference`, so the result is
 identical to testing every ray against every disc (the tests compare bit for bit).
+A robot without another disc within that reach (a first look at its cells, with the same
+window and test) skips the rest: its row could not change.
 Sensing robots are spread over numba's threads (``prange``) once there are
 ``PARALLEL_MIN_RAYS`` rays: on the 2-core development machine smaller calls gained nothing.
 Cost per step: O(N) for the hash plus O(sum over i of (candidates_i + window rays_i)).
@@ -74,6 +76,8 @@ _EVEN_TOL_RAD: float = 1e-12
 _ALL = (-np.inf, np.inf, -np.inf, np.inf)
 #: Hash cells per robot at most (the cell side grows beyond that: sparse, huge worlds).
 _CELLS_PER_ROBOT: int = 4
+#: Sensing robots per chunk of :func:`_robot_hits_parallel` (one pair of scratch arrays each).
+_HITS_CHUNK: int = 64
 
 
 # ---------------------------------------------------------------------------- kernels
@@ -194,18 +198,50 @@ def _build_hash(all_x, all_y, all_r, cell_m, max_cells):
 
 
 @njit(cache=True)
-def _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out):
-    """Shorten row ``i`` of ``out`` (map ranges, modified in place) by other robots' discs.
+def _robot_hits_rows(i0, i1, xs, ys, ct, st, self_idx, beams, even, hsh, out):
+    """Shorten rows ``i0:i1`` of ``out`` (map ranges, modified in place) by other robots' discs.
 
     A disc is skipped before any angle is computed when ``d - r`` is beyond the longest map
     ray of robot ``i`` (no hit on it could shorten a ray); :func:`_robot_hits_row` does the rest.
+    The rays' world directions go to scratch arrays allocated once for the rows (each row
+    fills them before reading them): two allocations per robot cost a 7-ray proximity ring
+    more than its intersections.
     """
     nb = out.shape[1]
-    reach = 0.0
-    for b in range(nb):
-        reach = max(reach, out[i, b])
-    _robot_hits_row(xs[i], ys[i], ct[i], st[i], self_idx[i], 0.0, reach, beams, even, hsh, out[i], np.empty(nb),
-                    np.empty(nb), True, _ALL)
+    rdx = np.empty(nb)
+    rdy = np.empty(nb)
+    sx, sy, sr, sid, start, x0, y0, cell, nkx, nky, rmax = hsh
+    for i in range(i0, i1):
+        reach = 0.0
+        for b in range(nb):
+            reach = max(reach, out[i, b])
+        if reach <= 0.0:
+            continue
+        # a first look at the discs within reach, with _robot_hits_row's own window and test:
+        # most robots of a sparse swarm have none, and then the row would change nothing
+        px = xs[i]
+        py = ys[i]
+        me = self_idx[i]
+        lim0 = reach + _REACH_SLACK_M
+        half = lim0 + rmax
+        kx0 = max(0, int(math.floor((px - half - x0) / cell)))
+        kx1 = min(nkx - 1, int(math.floor((px + half - x0) / cell)))
+        ky0 = max(0, int(math.floor((py - half - y0) / cell)))
+        ky1 = min(nky - 1, int(math.floor((py + half - y0) / cell)))
+        near = False
+        if ky0 <= ky1:
+            for kx in range(kx0, kx1 + 1):
+                for s in range(start[kx * nky + ky0], start[kx * nky + ky1 + 1]):
+                    gx = sx[s] - px
+                    gy = sy[s] - py
+                    lim = lim0 + sr[s]
+                    if gx * gx + gy * gy < lim * lim and sid[s] != me:
+                        near = True
+                        break
+                if near:
+                    break
+        if near:
+            _robot_hits_row(px, py, ct[i], st[i], me, 0.0, reach, beams, even, hsh, out[i], rdx, rdy, True, _ALL)
 
 
 @njit(cache=True, inline="always")
@@ -348,7 +384,7 @@ def _robot_hits_row(px, py, cti, sti, me, inner, reach, beams, even, hsh, row, r
 @njit(cache=True)
 def _prepare(all_x, all_y, all_r, max_range_m, cell_m):
     """:func:`_build_hash` (cell side :func:`default_cell_m` when ``cell_m <= 0``) plus the
-    largest radius, as the ``hsh`` tuple of :func:`_robot_hits_one`."""
+    largest radius, as the ``hsh`` tuple of :func:`_robot_hits_rows`."""
     rmax = 0.0
     for j in range(all_r.shape[0]):
         rmax = max(rmax, all_r[j])
@@ -361,19 +397,21 @@ def _prepare(all_x, all_y, all_r, max_range_m, cell_m):
 
 @njit(cache=True, parallel=True)
 def _robot_hits_parallel(xs, ys, ct, st, self_idx, beams, even, all_x, all_y, all_r, max_range_m, cell_m, out):
-    """:func:`_robot_hits_one` for every sensing robot, spread over numba's threads."""
+    """:func:`_robot_hits_rows` for every sensing robot, in chunks of :data:`_HITS_CHUNK`
+    spread over numba's threads."""
     hsh = _prepare(all_x, all_y, all_r, max_range_m, cell_m)
-    for i in prange(xs.shape[0]):
-        _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out)
+    n = xs.shape[0]
+    for c in prange((n + _HITS_CHUNK - 1) // _HITS_CHUNK):
+        _robot_hits_rows(c * _HITS_CHUNK, min(n, (c + 1) * _HITS_CHUNK), xs, ys, ct, st, self_idx, beams, even, hsh,
+                         out)
 
 
 @njit(cache=True)
 def _robot_hits_serial(xs, ys, ct, st, self_idx, beams, even, all_x, all_y, all_r, max_range_m, cell_m, out):
-    """:func:`_robot_hits_one` for every sensing robot, in this thread (one call: small teams
+    """:func:`_robot_hits_rows` for every sensing robot, in this thread (one call: small teams
     pay a single dispatch)."""
     hsh = _prepare(all_x, all_y, all_r, max_range_m, cell_m)
-    for i in range(xs.shape[0]):
-        _robot_hits_one(i, xs, ys, ct, st, self_idx, beams, even, hsh, out)
+    _robot_hits_rows(0, xs.shape[0], xs, ys, ct, st, self_idx, beams, even, hsh, out)
 
 
 @njit(cache=True)
@@ -396,7 +434,7 @@ def _reference_kernel(xs, ys, ct, st, cb, sb, self_idx, all_x, all_y, all_r, out
 
 # ---------------------------------------------------------------------------- API
 class BeamPlan(NamedTuple):
-    """What :func:`_robot_hits_one` needs to know of a sensor's ray directions (built once).
+    """What :func:`_robot_hits_rows` needs to know of a sensor's ray directions (built once).
 
     Attributes
     ----------
@@ -439,20 +477,22 @@ def beam_plan(angles_rad: np.ndarray) -> BeamPlan:
 
 
 def robot_hits_unchecked(xs, ys, thetas, plan: BeamPlan, all_x, all_y, all_r, self_idx, ranges, max_range_m,
-                         cell_m, parallel: bool) -> np.ndarray:
+                         cell_m, parallel: bool, cs_theta=None) -> np.ndarray:
     """:func:`apply_robot_hits` without input checks, for callers whose arrays are known good.
 
     ``xs, ys, thetas, all_x, all_y, all_r`` contiguous float64, ``self_idx`` int64,
     ``ranges`` (n, R) C-contiguous float64, ``plan`` from :func:`beam_plan`, ``cell_m`` the
-    hash cell side [m] or 0 for :func:`default_cell_m`. The engine's sensors call this every
-    step.
+    hash cell side [m] or 0 for :func:`default_cell_m`, ``cs_theta`` None or
+    ``(np.cos(thetas), np.sin(thetas))`` when the caller has them. The engine's sensors call
+    this every step.
     """
     if xs.shape[0] == 0 or all_x.shape[0] == 0 or ranges.shape[1] == 0:
         return ranges
     kernel = _robot_hits_parallel if parallel else _robot_hits_serial
     # cos/sin by NumPy, as robot_hits_reference: the rays' directions agree to the last bit
-    kernel(xs, ys, np.cos(thetas), np.sin(thetas), self_idx, plan.beams, plan.even, all_x, all_y, all_r,
-           float(max_range_m), float(cell_m), ranges)
+    ct, st = (np.cos(thetas), np.sin(thetas)) if cs_theta is None else cs_theta
+    kernel(xs, ys, ct, st, self_idx, plan.beams, plan.even, all_x, all_y, all_r, float(max_range_m), float(cell_m),
+           ranges)
     return ranges
 
 
