@@ -12,7 +12,7 @@ One :meth:`Simulation.step` (STYLE habit 4, f1tenth's "move everyone first, then
 6. sense: each group's range sensors in one call per sensor, the robot detector in one call
    per group; groups whose sensors are alike share one pass (one detector truth pass for
    equal detector configurations, one cast for equal range sensors: see
-   :meth:`Simulation._plan_shared_sensing`), each group still drawing from its own streams;
+   :class:`~teamnav.sim.shared_sensing.SharedSensing`), each group still drawing from its own streams;
 7. build observations (fresh arrays, belief only) and call the brains: each per-robot
    :class:`~teamnav.control.protocol.Controller` with its :class:`Observation`, each
    :class:`~teamnav.control.protocol.BatchedController` once with a
@@ -82,9 +82,11 @@ from teamnav.sim.collisions import discs_hit_walls, move_discs
 from teamnav.sim.config import SimConfig, resolve_robot, resolve_sensor
 from teamnav.sim.events import Places
 from teamnav.sim.kinematics import motion_primitives
+from teamnav.sim.launch import OneAtATime
 from teamnav.sim.odometry import Odometry
 from teamnav.sim.radio import Radio
 from teamnav.sim.recorder import Recorder
+from teamnav.sim.shared_sensing import SharedSensing
 from teamnav.sim.start import start_poses
 from teamnav.sim.state import RobotState
 from teamnav.world.distance import COARSE_FIELD_CELLS, clearance_bound, distance_field
@@ -269,7 +271,7 @@ class Simulation:
         launch = config.launch
         if launch is None:
             poses = start_poses(grid, groups, np.random.default_rng(start_ss), self._clear_m)
-        else:  # everyone at the spot; those not yet started are kept out of the arena (_hide)
+        else:  # everyone at the spot; those not yet started are kept out of the arena (OneAtATime.hide)
             poses = np.tile([launch.spot[0], launch.spot[1], wrap_angle(math.radians(launch.spot[2]))], (n, 1))
             radii = np.repeat([g.radius_m for g in groups], [g.count for g in groups]).astype(np.float64)
             if discs_hit_walls(self._blocking, self._clear_m, grid.geo, poses[:, 0], poses[:, 1], radii).any():
@@ -374,7 +376,7 @@ class Simulation:
         self.group_teams: list[tuple[Any, int, int, tuple[int, ...]]] = []
         if pending:
             self._build_teams(pending)
-        self._plan_shared_sensing()
+        self._sharing = SharedSensing(self._groups, self.state)
         self._any_per_robot = any(not grp.batched for grp in self._groups)
         self.radio = Radio(config.radio, grid, n, np.random.default_rng(radio_ss), dt_s=self.dt_s) if self._any_per_robot else None
         self.places = Places(config.places, self.state.x_m, self.state.y_m)
@@ -395,17 +397,12 @@ class Simulation:
         self.waiting: np.ndarray | None = None
         #: step at which each robot started (-1 while it waits; None without ``launch``)
         self.launched_at: np.ndarray | None = None
+        #: the one-at-a-time start (None without ``launch``)
+        self._launch: OneAtATime | None = None
         if launch is not None:
-            self.waiting = np.ones(n, dtype=np.bool_)
-            self.waiting[0] = False
-            self.launched_at = np.full(n, -1, dtype=np.int64)
-            self.launched_at[0] = 0
-            self._odom0 = self.odometry.pose.copy()
-            self._spot = poses[0].copy()
-            # off-stage parking while hidden: far outside the map, 10 m apart (no sensor reaches)
-            ox, oy = grid.origin_xy_m
-            self._park_x = ox - 1.0e4 - 10.0 * np.arange(n, dtype=np.float64)
-            self._park_y = np.full(n, oy - 1.0e4)
+            self._launch = OneAtATime(n, poses[0].copy(), launch.clear_m, self.odometry.pose, grid.origin_xy_m)
+            self.waiting = self._launch.waiting
+            self.launched_at = self._launch.launched_at
         #: what the latest observations were built from, for readers of whole groups at once
         #: (:mod:`teamnav.env`): ``(step, odometry poses (n, 3), odometry deltas (n, 3) or None,
         #: {group index: [(sensor name, ranges (count, B), beam angles, max range)]}, inboxes,
@@ -428,7 +425,7 @@ class Simulation:
         self.step_index = 0
         self.recorder = Recorder(n, config.record_every)
         self.recorder.events = self.places.log
-        if launch is not None:  # robot 0 starts at step 0 (the others in _launch_next)
+        if launch is not None:  # robot 0 starts at step 0 (the others in OneAtATime.launch_next)
             self.places.log.append({"step": 0, "t_s": 0.0, "robot": 0, "place": None, "event": None, "launched": True})
         #: the run's faults (None without a ``faults`` section, or with an empty one)
         self.faults = None
@@ -638,7 +635,7 @@ class Simulation:
             fx.begin_step(self.step_index)
         waiting = self.waiting
         if waiting is not None:
-            self._launch_next()
+            self._launch.launch_next(self.step_index, self.time_s, s, self.odometry, self.places.log)
             waiting = self.waiting if self.waiting.any() else None
             if waiting is not None:  # a robot that waits is commanded nothing (set_commands included)
                 self._v_cmd[waiting] = 0.0
@@ -650,11 +647,11 @@ class Simulation:
         motion_primitives(self._holonomic, self._v_cmd, self._w_cmd, self._dir_cmd, self._max_v, self._max_w,
                           self._step_m, self.dt_s, s.v_mps, s.omega_radps, self._pre, self._arc, self._turn)
         if waiting is not None:
-            self._hide(waiting)
+            self._launch.hide(s, waiting)
         move_discs(s.x_m, s.y_m, s.theta_rad, s.radius_m, self._pre, self._arc, self._turn, self._blocking,
                    self._clear_m, self._geo, self.config.robot_collisions, s.stalled)
         if waiting is not None:
-            self._unhide(waiting)
+            self._launch.unhide(s, waiting)
         self.odometry.step(self._x0, self._y0, self._th0, s.x_m, s.y_m, s.theta_rad)
         if fx is not None and fx.kidnap_due:
             fx.kidnap(s)  # after the odometry step: odometry never feels the jump
@@ -673,11 +670,11 @@ class Simulation:
         if inboxes is not None and self._rec_sensing and self.recorder.wants(self.step_index):
             self._record_messages(inboxes)
         if waiting is not None:
-            self._hide(waiting)  # unseen by every sensor and out of radio reach while it waits
+            self._launch.hide(s, waiting)  # unseen by every sensor and out of radio reach while it waits
             try:
                 self._observe_and_decide(events, inboxes)
             finally:
-                self._unhide(waiting)
+                self._launch.unhide(s, waiting)
         else:
             self._observe_and_decide(events, inboxes)
         if self.recorder.wants(self.step_index):
@@ -686,43 +683,6 @@ class Simulation:
             h(self)
 
     # ------------------------------------------------------------------ internals
-    def _launch_next(self) -> None:
-        """Start the next waiting robot (lowest id) when every started robot is at least
-        ``launch.clear_m`` from the spot (:class:`~teamnav.sim.config.LaunchConfig`); its
-        odometry starts from the spot."""
-        waiting = self.waiting
-        if not waiting.any():
-            return
-        s = self.state
-        on = ~waiting
-        d2 = (s.x_m[on] - self._spot[0]) ** 2 + (s.y_m[on] - self._spot[1]) ** 2
-        clear = float(self.config.launch.clear_m)
-        if d2.size and float(d2.min()) < clear * clear:
-            return
-        i = int(np.flatnonzero(waiting)[0])
-        waiting[i] = False
-        self.launched_at[i] = self.step_index
-        s.x_m[i], s.y_m[i], s.theta_rad[i] = self._spot
-        s.v_mps[i] = 0.0
-        s.omega_radps[i] = 0.0
-        s.stalled[i] = False
-        self.odometry.pose[i] = self._odom0[i]
-        self.odometry.delta[i] = 0.0
-        self.places.log.append({"step": int(self.step_index), "t_s": float(self.time_s), "robot": i, "place": None,
-                                "event": None, "launched": True})
-
-    def _hide(self, waiting: np.ndarray) -> None:
-        """Park the waiting robots far outside the map (``_unhide`` puts them back at the spot)."""
-        s = self.state
-        s.x_m[waiting] = self._park_x[waiting]
-        s.y_m[waiting] = self._park_y[waiting]
-
-    def _unhide(self, waiting: np.ndarray) -> None:
-        s = self.state
-        s.x_m[waiting] = self._spot[0]
-        s.y_m[waiting] = self._spot[1]
-        s.theta_rad[waiting] = self._spot[2]
-
     def _check_faults(self) -> None:
         """Faults on robots of batched groups that their brain could never feel are refused:
         a batched group senses only its controller's range sensor and has no detector."""
@@ -746,103 +706,6 @@ class Simulation:
                                      f"ranges; expected that sensor with reading 'no_return', got "
                                      f"{entry.sensor!r} with {entry.reading!r}")
 
-    def _plan_shared_sensing(self) -> None:
-        """Group the per-robot groups' sensing that can run in one call per step.
-
-        - Detectors with equal configurations: the noise-free part (range, field of view,
-          line of sight) once for all their observers
-          (:meth:`~teamnav.sim.sensors.detector.RobotDetector._detect_groups`); each group
-          still draws its noise from its own stream.
-        - Range sensors that cast the same rays (same materials, ray directions, range and
-          robot bodies): one cast for the robots of all those groups while the call stays
-          below the sensors' parallel threshold; each group's noise from its own stream and
-          its own key, into an array of its own.
-
-        Every stream sees the same draws as with one call per group, so a run is the same bit
-        for bit; a 4-robot team of one-robot groups (Sgorbissa & Arkin's R1..R4) pays one
-        detector call and one cast per step instead of four.
-        """
-        from teamnav.sim.sensors.robot_hits import PARALLEL_MIN_RAYS
-
-        self._det_sets: list[tuple[Any, list[_Group]]] = []
-        self._scan_sets: list[tuple[Any, list[tuple[_Group, int]], np.ndarray, Any]] = []
-        for grp in self._groups:
-            if grp.batched:
-                continue
-            if grp.detector is not None:
-                for det, members in self._det_sets:
-                    if det.cfg == grp.detector.cfg:
-                        members.append(grp)
-                        break
-                else:
-                    self._det_sets.append((grp.detector, [grp]))
-        scan_sets: list[tuple[tuple, list[tuple[_Group, int]]]] = []
-        for grp in self._groups:
-            if grp.batched:
-                continue
-            for k, sensor in enumerate(grp.sensors):
-                key = (sensor.sees, sensor.ray_angles_rad.tobytes(), sensor.rays_per_beam, sensor.angles_rad.shape[0],
-                       sensor.max_range_m, sensor.sees_robots, grp.bodies[k] is not None)
-                n_rays = sensor.ray_angles_rad.shape[0]
-                for skey, members in scan_sets:
-                    rows = sum(g.cfg.count for g, _ in members) + grp.cfg.count
-                    if skey == key and rows * n_rays < PARALLEL_MIN_RAYS:
-                        members.append((grp, k))
-                        break
-                else:
-                    scan_sets.append((key, [(grp, k)]))
-        for _, members in scan_sets:
-            if len(members) < 2:
-                continue
-            idx = np.concatenate([g.ids for g, _ in members])
-            g0, k0 = members[0]
-            bodies = None
-            if g0.bodies[k0] is not None:
-                bodies = (self.state.x_m, self.state.y_m, self.state.radius_m, idx)
-            # equal noise parameters: every group's noise in one kernel call, with its own key
-            noise = {(g.sensors[k].noise_std_m, g.sensors[k].p_max, g.sensors[k].p_short) for g, k in members}
-            starts = np.cumsum([0] + [g.cfg.count for g, _ in members]).astype(np.int64)
-            self._scan_sets.append((g0.sensors[k0], members, idx, bodies, starts if len(noise) == 1 else None))
-        self._shared_scan = {(g.index, k) for _, members, _, _, _ in self._scan_sets for g, k in members}
-
-    def _shared_readings(self) -> dict:
-        """This step's ranges of the shared casts: ``{(group index, sensor k): (n, B) array}``."""
-        from teamnav.sim.sensors.range_sensors import _counter_noise_blocks, _keyed_noise, draw_noise_key
-
-        s = self.state
-        out = {}
-        for sensor, members, idx, bodies, starts in self._scan_sets:
-            true = sensor._true_ranges(s.x_m[idx], s.y_m[idx], s.theta_rad[idx], bodies)
-            if starts is not None:
-                keys = np.array([draw_noise_key(grp.rngs[k]) for grp, k in members], dtype=np.uint64)
-                ranges = np.empty(true.shape)  # fresh this step; each group reads its own rows
-                _counter_noise_blocks(true, keys, starts, sensor.noise_std_m, sensor.p_max, sensor.p_short,
-                                      sensor.max_range_m, ranges)
-                sl = starts.tolist()
-                for j, (grp, k) in enumerate(members):
-                    out[(grp.index, k)] = ranges[sl[j]:sl[j + 1]]
-                continue
-            r0 = 0
-            for grp, k in members:
-                r1 = r0 + grp.cfg.count
-                own = grp.sensors[k]
-                ranges = np.empty((r1 - r0, true.shape[1]))
-                out[(grp.index, k)] = _keyed_noise(true[r0:r1], draw_noise_key(grp.rngs[k]), own.noise_std_m, own.p_max,
-                                                   own.p_short, own.max_range_m, ranges)
-                r0 = r1
-        return out
-
-    def _shared_detections(self) -> dict:
-        """This step's detections, ``{group index: list of tuples of Detection}``."""
-        s = self.state
-        out = {}
-        for det, members in self._det_sets:
-            found = det._detect_groups(s.x_m, s.y_m, s.theta_rad, s.radius_m, [g.ids for g in members],
-                                       [g.detector_rng for g in members], self._ids_all)
-            for grp, d in zip(members, found):
-                out[grp.index] = d
-        return out
-
     def _record(self) -> None:
         logs = None
         if any(g.has_log for g in self._groups):
@@ -864,8 +727,9 @@ class Simulation:
         odom = self.odometry.pose.copy()  # fresh belief arrays for this step's observations
         outgoing: list[tuple[int, Message]] = []
         xs, ys, ths = s.x_m, s.y_m, s.theta_rad
-        shared = self._shared_readings() if self._scan_sets else None
-        dets_of = self._shared_detections() if self._det_sets else None
+        sharing = self._sharing
+        shared = sharing.readings(s) if sharing.scan_sets else None
+        dets_of = sharing.detections(s, self._ids_all) if sharing.det_sets else None
         delta = self.odometry.delta.copy() if self._any_per_robot else None  # fresh, one copy for all groups
         scans_of: dict[int, list] = {}
         self.observed = (step, odom, delta, scans_of, inboxes, events, dets_of)
@@ -898,7 +762,7 @@ class Simulation:
                 continue
             readings = [
                 (sensor.name,
-                 shared[(grp.index, k)] if shared is not None and (grp.index, k) in self._shared_scan
+                 shared[(grp.index, k)] if shared is not None and (grp.index, k) in sharing.shared_scan
                  else sensor._sense(gx, gy, gth, rng, bodies),
                  angles, float(sensor.max_range_m))
                 for k, (sensor, rng, angles, bodies) in enumerate(zip(grp.sensors, grp.rngs, grp.angles, grp.bodies))
