@@ -751,3 +751,21 @@ def test_a_precondition_that_does_not_hold_reads_not_met_on_the_paper_column_onl
     assert ours.holds is True
     assert paper.holds is (True if pre_holds else None)
     assert ("precondition not met" in paper.differs) is (not pre_holds)
+
+
+def test_the_paper_columns_failures_name_breakdowns_without_drift_as_not_the_papers_mechanism():
+    """FIDELITY §1: a failure of the 2000 paper column that also happens without drift is not the
+    mechanism the paper reports (§5.1); the section says so beside the verdict, and says the
+    opposite when the column never breaks down without drift."""
+    from teamnav.papers.trails.report.blazing_a_trail import failure_cause_text
+
+    fails = {"first-trail": (False, ""), "team-vs-one-robot": (True, ""), "drift-breakdown": (True, "")}
+    k0 = [{"case": "x0", "breakdown_censored": c} for c in (0, 1, 0, 1, 1)]
+    k1 = [{"case": "x1", "breakdown_censored": 0} for _ in range(5)]
+    text = failure_cause_text(fails, k0 + k1, 3600.0)
+    assert "fails first-trail:" in text and "team-vs-one-robot" not in text
+    assert "in 2 of 5 runs of 60 min" in text and "not shown to be the paper's" in text
+    ok = failure_cause_text(fails, [dict(r, breakdown_censored=1) for r in k0] + k1, 3600.0)
+    assert "never broke down (5 runs of 60 min)" in ok and "the mechanism the paper reports" in ok
+    assert failure_cause_text(fails, k1, 3600.0).endswith("is not known here.")
+    assert failure_cause_text({"first-trail": (True, ""), "team-vs-one-robot": (None, "")}, k0, 3600.0) == ""
