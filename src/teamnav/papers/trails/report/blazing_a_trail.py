@@ -501,9 +501,10 @@ def failure_cause_text(paper_verdicts: dict, drift_rows, drift_dur_s: float) -> 
             "(the drift sweep's k = 0). The paper puts its breakdown on drift alone (§5.1: until 20 minutes \"all "
             "robots made consistently correct turning decisions\"). Our robots turn round by the paper's 180° rule "
             "(§4.2: \"If the robot is heading in approximately the opposite direction to the trail it makes a sharp "
-            "180° right turn\") through two values the paper does not give: the crumbs' threshold radius and what "
-            "\"approximately opposite\" means (ledger: fills). So these verdicts are measured, but their cause is "
-            "not shown to be the paper's.")
+            "180° right turn\") through two values the paper does not give: the crumbs' threshold radius (2 m, a fill "
+            "in the ledger) and what \"approximately opposite\" means (Navigate's reverse_threshold_deg, 150°, the "
+            "library default, untuned). So these verdicts are measured, but their cause is not shown to be the "
+            "paper's.")
 
 
 def _n_broke(rows) -> str:
