@@ -1,0 +1,351 @@
+"""Compiled goal sharing (``papers/los_help/brains/goal_sharing_compiled.py``) is the reference's,
+bit for bit (Sgorbissa & Arkin §3-§4; ``docs/concepts/group-brains.md``).
+
+The recorder runs a 4-robot team (R1 explorer, helpers R2..R4) of the reference brains and
+captures, for every robot and step, what its goal sharing receives at its seam with the brain:
+
+- inputs: the step, the odometry pose, the sightings (id → range, bearing), the call of
+  ``set_own_goal`` made by the robot's task this step, the inbox (the delivered
+  :class:`LosHelpMsg` and their senders), the scan of its visibility tests (``_vis_r64``), and
+  what the brain's decision did to it (``mark_reached``, ``go_via`` with its answer), and the
+  Tr bit sent;
+- outputs: the known goals and the stored paths (every field, in dict order) after ``refresh``
+  and after the step, the outgoing message (packed) and ``msgs_received``.
+
+Two replays of those inputs must give the same outputs: the reference's own goal sharing
+(``GoalSharing`` with the brain's ``_receive`` / ``_broadcast``: this checks that the capture is
+complete), and the compiled kernels, all robots of the team in one call per phase. Floats are
+compared by their bits. Nothing is stored on disk: the capture runs in the test.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from teamnav import load_scenario
+from teamnav.experiments.spec import build_grid
+from teamnav.papers.los_help.brains import goal_sharing_compiled as GC
+from teamnav.papers.los_help.brains.brain import _LosBrain
+from teamnav.papers.los_help.brains.goal_sharing import GoalSharing
+from teamnav.papers.los_help.brains.messages import LosHelpMsg
+from teamnav.papers.los_help.brains.packed import pack, row_width
+from teamnav.papers.los_help.tasks import task_targets_xy, team_overrides
+from teamnav.sim.engine import Simulation
+
+STEPS = 1500
+M = 4  # owner slots: R1..R4 are robots 0..3
+
+
+def _scenario(task: int, paper: bool, **extra):
+    """The full team R1..R4 on office_simple, one tuning task's targets; ``paper``: every robot
+    with ``paper_rules: true`` (the report's paper column)."""
+    ov = dict(team_overrides("simple", 3))
+    ov["robots.0.params.targets_xy"] = task_targets_xy("simple", task)
+    if paper:
+        for k in range(4):
+            ov[f"robots.{k}.params.paper_rules"] = True
+    ov.update(extra)
+    return load_scenario("los-help-simple", overrides=ov, duration_s=STEPS * 0.1, seed=0)
+
+
+# ----------------------------------------------------------------- the recorder
+class _RecordingSharing(GoalSharing):
+    """The reference's GoalSharing, noting what the brain does to it (the class of a brain's
+    ``sharing`` is swapped for this one after construction)."""
+
+    def set_own_goal(self, k, goal_xy=None):
+        self.rec_own = (k, None if goal_xy is None else (float(goal_xy[0]), float(goal_xy[1])))
+        super().set_own_goal(k, goal_xy)
+
+    def refresh(self, *args, **kwargs):
+        super().refresh(*args, **kwargs)
+        self.rec_after_refresh = _snapshot(self)
+
+    def mark_reached(self, owner):
+        self.rec_events.append(("mark", int(owner)))
+        super().mark_reached(owner)
+
+    def go_via(self, owner, step):
+        res = super().go_via(owner, step)
+        self.rec_events.append(("via", int(owner), int(step), bool(res)))
+        return res
+
+
+def _snapshot(gs: GoalSharing):
+    """Known goals and paths in dict order, every field (paths as ``GC.path_columns``)."""
+    known = [(g.owner, g.goal_id, g.gx_m, g.gy_m) for g in gs.known.values()]
+    paths = [(o, GC.path_columns(p)) for o, p in gs.paths.items()]
+    own = None if gs.own_k is None else (gs.own_k, *gs.own_goal)
+    return known, paths, own
+
+
+def record(scn, steps: int = STEPS):
+    """Run the reference team ``steps`` steps; returns (per-robot setup, per-step records)."""
+    sim = Simulation(build_grid(scn), scn)
+    brains = [b for grp in sim.brains for b in grp]
+    assert [b.me for b in brains] == list(range(len(brains))) and len(brains) == M
+    setup = []
+    for b in brains:
+        gs = b.sharing
+        gs.__class__ = _RecordingSharing
+        setup.append(dict(params=b.params, me=b.me, team_size=b.team_size, radius=b.radius_m, step_m=b.step_m,
+                          vis_r=b.vis_radius_m, own=None if gs.own_k is None else (gs.own_k, gs.own_goal)))
+    frames: list[list[dict]] = []
+    current: list[dict] = []
+
+    def wrap(b):
+        orig = b.step
+
+        def step(obs):
+            gs = b.sharing
+            gs.rec_own, gs.rec_events, gs.rec_after_refresh = None, [], None
+            inbox = [m for m in obs.inbox if isinstance(m.body, LosHelpMsg)]
+            action, outbox = orig(obs)
+            k = int(obs.step)
+            body = outbox[0].body if outbox else None
+            current.append(dict(
+                me=b.me, step=k, time_s=float(obs.time_s), pose=(b._px, b._py, b._th), sight=dict(b._history[k][1]),
+                own=gs.rec_own, inbox=inbox, vis=b._vis_r64.copy(), angles=b._a64, gap=b._gap_rad,
+                events=list(gs.rec_events), after_refresh=gs.rec_after_refresh, after=_snapshot(gs), out=body,
+                msgs_received=b.msgs_received))
+            return action, outbox
+
+        b.step = step
+
+    for b in brains:
+        wrap(b)
+    for _ in range(steps):
+        sim.step()
+    by_step: dict[int, list[dict]] = {}
+    for f in current:
+        by_step.setdefault(f["step"], []).append(f)
+    for k in sorted(by_step):
+        frame = sorted(by_step[k], key=lambda f: f["me"])  # robot order
+        assert [f["me"] for f in frame] == list(range(M)), k
+        frames.append(frame)
+    return setup, frames
+
+
+# ----------------------------------------------------------------- replay 1: the reference's own goal sharing
+class _RefReplay:
+    """The reference's goal-sharing part of a brain's step (``_LosBrain``'s own methods), fed the
+    captured inputs: what the compiled kernels stand for, and the timing peer."""
+
+    _receive = _LosBrain._receive
+    _bearing_frame = _LosBrain._bearing_frame
+    _body_to_odom = _LosBrain._body_to_odom
+    _broadcast = _LosBrain._broadcast
+    _sees = _LosBrain._sees
+    _keeps = _LosBrain._keeps
+    _set_pose = _LosBrain._set_pose
+    _me_xy = _LosBrain._me_xy
+
+    def __init__(self, s: dict) -> None:
+        p = s["params"]
+        self.params, self.me, self.team_size = p, s["me"], s["team_size"]
+        self.vis_radius_m, self.radius_m = s["vis_r"], s["radius"]
+        self.sharing = GoalSharing(self.me, self.team_size, delayed=p.delayed_visibility,
+                                   point_margin_m=2.5 * self.radius_m,
+                                   report_margin_m=p.report_margin_steps * s["step_m"], lead_on=p.lead_on,
+                                   relay_hop_limit=p.relay_hop_limit)
+        if s["own"] is not None:
+            self.sharing.set_own_goal(*s["own"])
+        self._history = {}
+        self._prev_xy = None
+        self._scan = True
+        self.msgs_received = self.msgs_sent = self.bytes_sent = 0
+        self.trouble = SimpleNamespace(tr=False)
+
+    def step(self, f: dict):
+        p = self.params
+        k = f["step"]
+        self._set_pose(np.array(f["pose"]))
+        self._vis_r64, self._a64, self._gap_rad = f["vis"], f["angles"], f["gap"]
+        sightings = f["sight"]
+        self._history[k] = ((self._px, self._py, self._th), sightings)
+        for old in [j for j in self._history if j <= k - 4]:
+            del self._history[old]
+        gs = self.sharing
+        if p.goal_sharing:
+            gs.begin_step()
+        if f["own"] is not None:
+            gs.set_own_goal(*f["own"])
+        self._receive(SimpleNamespace(inbox=f["inbox"]))
+        me = self._me_xy()
+        if p.goal_sharing:
+            gs.refresh(me, self._prev_xy, self._sees, k, keeps=self._keeps if p.keep_direct_view else None)
+        after_refresh = _snapshot(gs) if p.goal_sharing else None
+        vias = []
+        for e in f["events"]:
+            if e[0] == "mark":
+                gs.mark_reached(e[1])
+            else:
+                vias.append(gs.go_via(e[1], e[2]))
+        if f["out"] is not None and f["out"].trouble is not None:
+            self.trouble.tr = f["out"].trouble
+        out = self._broadcast(SimpleNamespace(step=k, time_s=f["time_s"]), sightings)
+        self._prev_xy = me
+        return after_refresh, vias, out
+
+
+# ----------------------------------------------------------------- replay 2: the compiled kernels
+def _bits(a) -> bytes:
+    a = np.array(a, dtype=np.float64)
+    return np.where(np.isnan(a), np.nan, a).tobytes()  # one NaN; -0.0 and 0.0 stay apart
+
+
+def _same_snapshot(ga: GC.GoalSharingArrays, r: int, snap, where: str) -> None:
+    known, paths, own = snap
+    assert ga.known_goals(r) == known, f"known goals differ: {where}"
+    assert _bits([k[2:] for k in ga.known_goals(r)]) == _bits([k[2:] for k in known]), where
+    got = ga.path_rows(r)
+    assert [o for o, _ in got] == [o for o, _ in paths], f"paths (owners, dict order) differ: {where}"
+    for (o, a), (_, b) in zip(got, paths):
+        assert _bits(a) == _bits(b), f"path to R{o + 1}'s goal differs: {where}: {a} vs {b}"
+    assert ga.own_goal(r) == own, where
+
+
+def _inputs(frame: list[dict], width: int):
+    n = len(frame)
+    pose = np.array([f["pose"] for f in frame])
+    sight = np.full((n, M, 2), np.nan)
+    for r, f in enumerate(frame):
+        for rid, (rng_m, b) in f["sight"].items():
+            sight[r, rid] = rng_m, b
+    own_set = np.array([f["own"] is not None for f in frame], dtype=np.int64)
+    own_k = np.array([-1 if f["own"] is None or f["own"][0] is None else f["own"][0] for f in frame],
+                     dtype=np.int64)
+    own_xy = np.array([(0.0, 0.0) if f["own"] is None or f["own"][1] is None else f["own"][1] for f in frame])
+    rows, senders, start = [], [], [0]
+    for f in frame:
+        for m in f["inbox"]:
+            rows.append(pack(m.body, M))
+            senders.append(m.sender)
+        start.append(len(rows))
+    in_rows = np.array(rows).reshape(-1, width)
+    vis = np.array([f["vis"] for f in frame])
+    trouble = np.array([-1.0 if f["out"] is None or f["out"].trouble is None else float(f["out"].trouble)
+                        for f in frame])
+    return (pose, sight, own_set, own_k, own_xy, in_rows, np.array(senders, dtype=np.int64),
+            np.array(start, dtype=np.int64), vis, trouble)
+
+
+def compiled_replay(setup, frames, check: bool = True) -> GC.GoalSharingArrays:
+    """Replay the captured inputs through the compiled kernels; with ``check``, demand the
+    reference's outputs at every step and robot."""
+    f0 = frames[0]
+    ga = GC.GoalSharingArrays([s["params"] for s in setup], [s["me"] for s in setup],
+                              [s["team_size"] for s in setup], [s["radius"] for s in setup],
+                              [s["step_m"] for s in setup], [s["vis_r"] for s in setup], [f["gap"] for f in f0], M)
+    angles = np.ascontiguousarray(f0[0]["angles"])
+    for f in f0:
+        assert np.array_equal(f["angles"], angles)
+    for r, s in enumerate(setup):
+        if s["own"] is not None:
+            ga.set_own_goal(r, *s["own"])
+    width = row_width(M)
+    for frame in frames:
+        k = frame[0]["step"]
+        pose, sight, own_set, own_k, own_xy, in_rows, senders, start, vis, trouble = _inputs(frame, width)
+        ga.begin_step(k, pose, sight, own_set, own_k, own_xy, in_rows, senders, start, vis, angles)
+        for r, f in enumerate(frame):
+            if check and f["after_refresh"] is not None:
+                _same_snapshot(ga, r, f["after_refresh"], f"step {k}, R{r + 1}, after refresh")
+            for e in f["events"]:
+                if e[0] == "mark":
+                    GC.gs_mark_reached(ga.paths, r, e[1])
+                else:
+                    got = GC.gs_go_via(ga.paths, r, e[1], e[2])
+                    assert not check or got == e[3], f"go_via differs: step {k}, R{r + 1}"
+        sent = ga.end_step(k, pose, sight, trouble)
+        if not check:
+            continue
+        for r, f in enumerate(frame):
+            where = f"step {k}, R{r + 1}"
+            _same_snapshot(ga, r, f["after"], where + ", after the step")
+            assert int(ga.gist[r, GC.I_MSGS_RECEIVED]) == f["msgs_received"], where
+            assert bool(sent[r]) == (f["out"] is not None), f"sent differs: {where}"
+            if f["out"] is not None:
+                assert _bits(ga.out[r]) == _bits(pack(f["out"], M)), f"message differs: {where}"
+    return ga
+
+
+def reference_replay(setup, frames, check: bool = True) -> None:
+    reps = [_RefReplay(s) for s in setup]
+    for frame in frames:
+        for r, f in enumerate(frame):
+            after_refresh, vias, out = reps[r].step(f)
+            if not check:
+                continue
+            where = f"step {f['step']}, R{r + 1}"
+            assert _bits_snap(after_refresh) == _bits_snap(f["after_refresh"]), where
+            assert _bits_snap(_snapshot(reps[r].sharing)) == _bits_snap(f["after"]), where
+            assert vias == [e[3] for e in f["events"] if e[0] == "via"], where
+            assert bool(out) == (f["out"] is not None), where
+            if out:
+                assert _bits(pack(out[0].body, M)) == _bits(pack(f["out"], M)), where
+            assert reps[r].msgs_received == f["msgs_received"], where
+
+
+def _bits_snap(snap):
+    if snap is None:
+        return None
+    known, paths, own = snap
+    return known, [(o, _bits(p)) for o, p in paths], own
+
+
+# ----------------------------------------------------------------- the tests
+@pytest.fixture(scope="module")
+def captures():
+    cache: dict = {}
+
+    def get(task: int, paper: bool):
+        if (task, paper) not in cache:
+            cache[(task, paper)] = record(_scenario(task, paper))
+        return cache[(task, paper)]
+
+    return get
+
+
+def _coverage(frames) -> dict[str, int]:
+    """What the run reached (so that the identity is not trivially about empty memories)."""
+    kinds = {"direct": 0, "self": 0, "ghost": 0}
+    c = {"msgs": 0, "relayed": 0, "reports": 0, "marks": 0, "vias": 0, **kinds}
+    for frame in frames:
+        for f in frame:
+            c["msgs"] += len(f["inbox"])
+            if f["out"] is not None:
+                c["relayed"] += sum(1 for g in f["out"].goals if g.owner != f["out"].goals[0].owner)
+                c["reports"] += len(f["out"].reports)
+            for _o, p in f["after"][1]:
+                c[GC.KINDS[int(p[GC.P_KIND])]] += 1
+            c["marks"] += sum(1 for e in f["events"] if e[0] == "mark")
+            c["vias"] += sum(1 for e in f["events"] if e[0] == "via" and e[3])
+    return c
+
+
+@pytest.mark.parametrize("paper", [False, True], ids=["teamnav", "paper"])
+@pytest.mark.parametrize("task", [1001, 1002])
+def test_compiled_goal_sharing_is_the_reference_bit_for_bit(captures, task, paper):
+    setup, frames = captures(task, paper)
+    c = _coverage(frames)
+    assert c["msgs"] > 500 and c["reports"] > 100 and c["relayed"] > 100, c
+    assert c["direct"] > 0 and c["self"] > 0 and c["ghost"] > 0, c
+    reference_replay(setup, frames)  # the capture holds every input
+    compiled_replay(setup, frames)
+
+
+def test_reflected_visibility_and_state_sharing(captures):
+    """V_R only (``delayed_visibility`` false, §3: non-direct points forgotten each step) with the
+    Tr bit of §5 in the messages."""
+    scn = _scenario(1003, False, **{f"robots.{k}.params.{f}": v for k in range(4)
+                                    for f, v in (("delayed_visibility", False), ("state_sharing", True))})
+    setup, frames = record(scn, 800)
+    assert any(f["out"] is not None and f["out"].trouble is not None for fr in frames for f in fr)
+    reference_replay(setup, frames)
+    compiled_replay(setup, frames)
