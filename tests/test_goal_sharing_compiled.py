@@ -161,7 +161,7 @@ class _RefReplay:
         self.msgs_received = self.msgs_sent = self.bytes_sent = 0
         self.trouble = SimpleNamespace(tr=False)
 
-    def step(self, f: dict):
+    def step(self, f: dict, snap: bool = True):
         p = self.params
         k = f["step"]
         self._set_pose(np.array(f["pose"]))
@@ -179,7 +179,7 @@ class _RefReplay:
         me = self._me_xy()
         if p.goal_sharing:
             gs.refresh(me, self._prev_xy, self._sees, k, keeps=self._keeps if p.keep_direct_view else None)
-        after_refresh = _snapshot(gs) if p.goal_sharing else None
+        after_refresh = _snapshot(gs) if snap and p.goal_sharing else None
         vias = []
         for e in f["events"]:
             if e[0] == "mark":
@@ -235,9 +235,8 @@ def _inputs(frame: list[dict], width: int):
             np.array(start, dtype=np.int64), vis, trouble)
 
 
-def compiled_replay(setup, frames, check: bool = True) -> GC.GoalSharingArrays:
-    """Replay the captured inputs through the compiled kernels; with ``check``, demand the
-    reference's outputs at every step and robot."""
+def compiled_setup(setup, frames) -> tuple[GC.GoalSharingArrays, np.ndarray]:
+    """The compiled state of the recorded team, with the brains' goals at construction, and the beam angles."""
     f0 = frames[0]
     ga = GC.GoalSharingArrays([s["params"] for s in setup], [s["me"] for s in setup],
                               [s["team_size"] for s in setup], [s["radius"] for s in setup],
@@ -248,15 +247,29 @@ def compiled_replay(setup, frames, check: bool = True) -> GC.GoalSharingArrays:
     for r, s in enumerate(setup):
         if s["own"] is not None:
             ga.set_own_goal(r, *s["own"])
+    return ga, angles
+
+
+def compiled_inputs(frames) -> list[tuple]:
+    """Each step's inputs as the kernels take them (the inbox as stacked packed rows)."""
     width = row_width(M)
-    for frame in frames:
-        k = frame[0]["step"]
-        pose, sight, own_set, own_k, own_xy, in_rows, senders, start, vis, trouble = _inputs(frame, width)
+    return [(frame[0]["step"], *_inputs(frame, width), [f["events"] for f in frame]) for frame in frames]
+
+
+def compiled_replay(setup, frames, check: bool = True, inputs=None) -> GC.GoalSharingArrays:
+    """Replay the captured inputs through the compiled kernels; with ``check``, demand the
+    reference's outputs at every step and robot."""
+    ga, angles = compiled_setup(setup, frames)
+    if inputs is None:
+        inputs = compiled_inputs(frames)
+    for frame, (k, pose, sight, own_set, own_k, own_xy, in_rows, senders, start, vis, trouble, events) in zip(
+            frames, inputs):
         ga.begin_step(k, pose, sight, own_set, own_k, own_xy, in_rows, senders, start, vis, angles)
-        for r, f in enumerate(frame):
+        for r, ev in enumerate(events):
+            f = frame[r]
             if check and f["after_refresh"] is not None:
                 _same_snapshot(ga, r, f["after_refresh"], f"step {k}, R{r + 1}, after refresh")
-            for e in f["events"]:
+            for e in ev:
                 if e[0] == "mark":
                     GC.gs_mark_reached(ga.paths, r, e[1])
                 else:
@@ -279,7 +292,7 @@ def reference_replay(setup, frames, check: bool = True) -> None:
     reps = [_RefReplay(s) for s in setup]
     for frame in frames:
         for r, f in enumerate(frame):
-            after_refresh, vias, out = reps[r].step(f)
+            after_refresh, vias, out = reps[r].step(f, check)
             if not check:
                 continue
             where = f"step {f['step']}, R{r + 1}"
