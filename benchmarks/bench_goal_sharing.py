@@ -26,7 +26,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
-import test_goal_sharing_compiled as T  # noqa: E402
+import test_goal_sharing_compiled as T
 
 
 def main() -> None:

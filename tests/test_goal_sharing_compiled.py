@@ -10,7 +10,9 @@ captures, for every robot and step, what its goal sharing receives at its seam w
   what the brain's decision did to it (``mark_reached``, ``go_via`` with its answer), and the
   Tr bit sent;
 - outputs: the known goals and the stored paths (every field, in dict order) after ``refresh``
-  and after the step, the outgoing message (packed) and ``msgs_received``.
+  and after the step, the outgoing message (packed), ``msgs_received``, and the teammates'
+  Tr bits of §5 with where each sender stood (``_teammate_tr``, ``_teammate_tr_xy``), which
+  the receive path also yields.
 
 Two replays of those inputs must give the same outputs: the reference's own goal sharing
 (``GoalSharing`` with the brain's ``_receive`` / ``_broadcast``: this checks that the capture is
@@ -21,17 +23,18 @@ compared by their bits. Nothing is stored on disk: the capture runs in the test.
 from __future__ import annotations
 
 import math
-import time
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from teamnav import load_scenario
 from teamnav.experiments.spec import build_grid
 from teamnav.papers.los_help.brains import goal_sharing_compiled as GC
 from teamnav.papers.los_help.brains.brain import _LosBrain
-from teamnav.papers.los_help.brains.goal_sharing import GoalSharing
+from teamnav.papers.los_help.brains.goal_sharing import GoalSharing, sender_frame
 from teamnav.papers.los_help.brains.messages import LosHelpMsg
 from teamnav.papers.los_help.brains.packed import pack, row_width
 from teamnav.papers.los_help.tasks import task_targets_xy, team_overrides
@@ -112,7 +115,7 @@ def record(scn, steps: int = STEPS):
                 me=b.me, step=k, time_s=float(obs.time_s), pose=(b._px, b._py, b._th), sight=dict(b._history[k][1]),
                 own=gs.rec_own, inbox=inbox, vis=b._vis_r64.copy(), angles=b._a64, gap=b._gap_rad,
                 events=list(gs.rec_events), after_refresh=gs.rec_after_refresh, after=_snapshot(gs), out=body,
-                msgs_received=b.msgs_received))
+                msgs_received=b.msgs_received, tr=dict(b._teammate_tr), tr_xy=dict(b._teammate_tr_xy)))
             return action, outbox
 
         b.step = step
@@ -282,6 +285,10 @@ def compiled_replay(setup, frames, check: bool = True, inputs=None) -> GC.GoalSh
             where = f"step {k}, R{r + 1}"
             _same_snapshot(ga, r, f["after"], where + ", after the step")
             assert int(ga.gist[r, GC.I_MSGS_RECEIVED]) == f["msgs_received"], where
+            assert ga.teammate_tr(r) == f["tr"], f"Tr bits differ: {where}"
+            got_xy = ga.teammate_tr_xy(r)
+            assert list(got_xy) == list(f["tr_xy"]), f"Tr senders differ: {where}"
+            assert _bits(list(got_xy.values())) == _bits(list(f["tr_xy"].values())), f"Tr positions differ: {where}"
             assert bool(sent[r]) == (f["out"] is not None), f"sent differs: {where}"
             if f["out"] is not None:
                 assert _bits(ga.out[r]) == _bits(pack(f["out"], M)), f"message differs: {where}"
@@ -303,6 +310,7 @@ def reference_replay(setup, frames, check: bool = True) -> None:
             if out:
                 assert _bits(pack(out[0].body, M)) == _bits(pack(f["out"], M)), where
             assert reps[r].msgs_received == f["msgs_received"], where
+            assert reps[r]._teammate_tr == f["tr"] and reps[r]._teammate_tr_xy == f["tr_xy"], where
 
 
 def _bits_snap(snap):
@@ -359,6 +367,68 @@ def test_reflected_visibility_and_state_sharing(captures):
     scn = _scenario(1003, False, **{f"robots.{k}.params.{f}": v for k in range(4)
                                     for f, v in (("delayed_visibility", False), ("state_sharing", True))})
     setup, frames = record(scn, 800)
-    assert any(f["out"] is not None and f["out"].trouble is not None for fr in frames for f in fr)
+    assert sum(f["out"] is not None and f["out"].trouble is not None for fr in frames for f in fr) > 100
+    assert sum(len(f["tr_xy"]) for fr in frames for f in fr) > 100
     reference_replay(setup, frames)
     compiled_replay(setup, frames)
+
+
+# ----------------------------------------------------------------- the rules alone, on random sequences
+_angle = st.floats(-7.0, 7.0, allow_nan=False)
+
+
+@given(_angle, _angle, st.floats(0.0, 20.0, allow_nan=False))
+def test_sender_frame_kernel_is_the_reference(b1, b2, d):
+    """§3.1's frame from mutual bearings, θ21 = 180° + α21 − α12, the same bits."""
+    assert _bits(GC._sender_frame(b1, b2, d)) == _bits(sender_frame(b1, b2, d))
+
+
+_coord = st.sampled_from([-2.0, -0.5, 0.0, 0.3, 0.5, 1.0, 1.7, 2.0, 3.0])  # few values: ties and equal points
+_owner = st.sampled_from([0, 0, 0, 1, 2, 3])  # the robot's own goal (0) most often: lead_on, go_via
+_report = st.tuples(st.just("report"), _owner, st.sampled_from([1, 2, 2, 3, 5]), st.integers(1, 3), _coord, _coord,
+                    st.sampled_from([0.0, 0.5, 1.0, 2.5, 0.5, 1.0, 2.0, -1.0, math.inf, math.nan]), _coord, _coord,
+                    st.one_of(st.none(), st.tuples(_coord, _coord, st.sampled_from([0.0, 1.0, 2.0, math.inf]))))
+_op = st.one_of(
+    st.tuples(st.just("goal"), _owner, st.integers(1, 6), _coord, _coord),
+    _report, _report, _report,
+    st.tuples(st.just("mark"), _owner),
+    st.tuples(st.just("via"), _owner, st.integers(0, 50)),
+    st.tuples(st.just("own"), st.sampled_from([None, 1, 1, 1, 2]), _coord, _coord),
+)
+
+
+@settings(max_examples=500, deadline=None)
+@given(st.lists(_op, min_size=5, max_size=40), st.booleans(), st.sampled_from([0.0, 0.2, 0.5]), st.integers(2, 3))
+def test_rules_on_random_sequences_are_the_reference(ops, lead_on, margin, team):
+    """The Id rule (§3.1, §4.1), D arbitration with the report margin and ``lead_on`` (§4.2),
+    ``mark_reached`` and ``go_via`` on random sequences with ties, against ``GoalSharing``."""
+    me = 0
+    ref = GoalSharing(me, team, report_margin_m=margin, lead_on=lead_on)
+    p = SimpleNamespace(frame_source="bearings", goal_sharing=True, delayed_visibility=True,
+                        report_margin_steps=margin, lead_on=lead_on, relay_hop_limit=True, share_via=True,
+                        keep_direct_view=False, state_sharing=False)
+    ga = GC.GoalSharingArrays([p], [me], [team], [0.2], [1.0], [8.0], [0.1], M)
+    start = [("own", 1, 1.0, 2.0)] + [("goal", o, team, 0.5 * o, -1.0) for o in (1, 2, 3)]  # goals to report on
+    for op in start + ops:
+        if op[0] == "goal":
+            _, o, gid, x, y = op
+            assert GC._receive_goal(ga.gpar, ga.gist, ga.known, ga.kord, ga.paths, 0, o, gid, x, y) == \
+                ref.receive_goal(o, gid, (x, y))
+        elif op[0] == "report":
+            _, o, gid, rep, rx, ry, d, mx, my, via = op
+            vx, vy, vd = via if via is not None else (math.nan, math.nan, math.nan)
+            got = GC._receive_report(ga.gpar, ga.gist, ga.known, ga.paths, 0, o, gid, rep, rx, ry, d, mx, my, 7, vx,
+                                     vy, vd)
+            assert got == ref.receive_report(o, gid, rep, (rx, ry), d, me_xy=(mx, my), step=7,
+                                             via_xy=None if via is None else via[:2],
+                                             via_d_m=None if via is None else via[2])
+        elif op[0] == "mark":
+            GC.gs_mark_reached(ga.paths, 0, op[1])
+            ref.mark_reached(op[1])
+        elif op[0] == "via":
+            assert GC.gs_go_via(ga.paths, 0, op[1], op[2]) == ref.go_via(op[1], op[2])
+        else:
+            _, k, x, y = op
+            ga.set_own_goal(0, k, (x, y))
+            ref.set_own_goal(k, (x, y))
+        _same_snapshot(ga, 0, _snapshot(ref), str(op))

@@ -21,7 +21,9 @@ One step of a brain, in the reference's order, and where it is here:
    :func:`gs_begin_step`;
 3. the robot's own task sets its goal k (``set_own_goal``; a new k forgets the old path):
    :func:`gs_begin_step`, from the ``own_set`` / ``own_k`` / ``own_xy`` columns;
-4. the inbox: for each message of a sender seen at the sending step that carries the sender's
+4. the inbox: each sender's Tr bit (§5) and, when the robot saw the sender at the sending
+   step, where it stood then (the brain's ``_teammate_tr`` / ``_teammate_tr_xy``, which §5's
+   trouble following reads); for each message of a sender seen at the sending step that carries the sender's
    bearing of the receiver, the sender's frame from the mutual bearings (§3.1, θ21 = 180° + α21
    − α12), the goals mapped to the receiver's own frame and the Id rule (§3.1, §4.1: accept
    an Id ≥ the stored one; a new goal index forgets the path), then the reports arbitrated by
@@ -48,7 +50,9 @@ State, one row per robot (named columns, as the compiled R1):
 - ``paths`` (n, M, N_P): the stored path to each owner's goal, columns ``P_*`` (kind 0: none);
   ``P_SEQ`` numbers insertions, so that the outgoing reports keep the reference's dict order;
 - ``hist_step`` (n, 4), ``hist_pose`` (n, 4, 3), ``hist_sight`` (n, 4, M, 2): the ring of the last
-  four steps' poses and sightings (range, bearing; NaN: not seen), slot ``step % 4``.
+  four steps' poses and sightings (range, bearing; NaN: not seen), slot ``step % 4``;
+- ``tr`` (n, M), ``tr_xy`` (n, M, 2) with their arrival orders ``tr_ord`` / ``tr_xy_ord``: the Tr
+  bits of this step's inbox (see :func:`gs_begin_step`).
 
 ``M`` is the number of owner slots: robot ids must be below it. ``G_IDM`` is the M of
 ``Id = k·M`` (the brains' ``team_size``), which may differ from the slots.
@@ -57,7 +61,8 @@ State, one row per robot (named columns, as the compiled R1):
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -66,7 +71,8 @@ from teamnav.control.nav.local import compiled as N
 from teamnav.papers.los_help.brains import packed as PK
 from teamnav.papers.los_help.brains.compiled import _keeps, _sees
 
-__all__ = ["GoalSharingArrays", "gs_begin_step", "gs_end_step", "gs_go_via", "gs_mark_reached", "HISTORY_STEPS"]
+__all__ = ["HISTORY_STEPS", "GoalSharingArrays", "gs_begin_step", "gs_end_step", "gs_go_via", "gs_mark_reached",
+           "path_columns"]
 
 #: Steps of own pose and sightings kept to pair delayed messages with (``brain._HISTORY_STEPS``).
 HISTORY_STEPS = 4
@@ -93,7 +99,9 @@ I_N_KNOWN = 1  # entries of kord
 I_SEQ = 2  # next insertion number of paths
 I_HAS_PREV = 3  # a previous position exists
 I_MSGS_RECEIVED = 4  # LosHelpMsg messages from others read (the brain's msgs_received)
-N_I = 5
+I_N_TR = 5  # entries of tr_ord: teammates whose Tr bit arrived this step
+I_N_TR_XY = 6  # entries of tr_xy_ord: those of them seen at the sending step
+N_I = 7
 
 # ----------------------------------------------------------------- float state (gfst)
 F_OWN_GX = 0
@@ -160,7 +168,7 @@ def _receive_goal(gpar, gist, known, kord, paths, r, owner, gid, gx, gy):
     if owner == me:
         return False
     og_f = known[r, owner, 0]
-    if og_f == og_f:  # known
+    if not math.isnan(og_f):  # known
         og = int(og_f)
         if not gid >= og:
             return False
@@ -191,7 +199,7 @@ def _receive_report(gpar, gist, known, paths, r, owner, gid, reporter, rx, ry, d
         stored_id = k * int(gpar[r, G_IDM])
     else:
         g = known[r, owner, 0]
-        if g != g:
+        if math.isnan(g):
             return False
         stored_id = int(g)
     m = int(gpar[r, G_IDM])
@@ -237,27 +245,53 @@ def _sender_frame(b_sender_in_me, b_me_in_sender, distance):
 
 @njit(cache=True)
 def _receive(r, gpar, gist, known, kord, paths, hist_step, hist_pose, hist_sight, in_rows, in_sender, lo, hi,
-             m_slots):
-    """``_LosBrain._receive`` (its goal-sharing part) for row ``r``: messages ``lo:hi`` of the inbox."""
+             m_slots, tr, tr_ord, tr_xy, tr_xy_ord):
+    """``_LosBrain._receive`` for row ``r``: messages ``lo:hi`` of the inbox; the teammates' Tr
+    bits (§5) and where each stood when it sent it, then goal sharing (§3.1, §4)."""
     me = int(gpar[r, G_ME])
     sharing = gpar[r, G_SHARING] != 0.0
     at_s = PK.N_HEADER
     at_g = PK.N_HEADER + PK.SIGHT_W * m_slots
     at_r = PK.N_HEADER + (PK.SIGHT_W + PK.GOAL_W) * m_slots
+    for o in range(m_slots):  # the brain's _teammate_tr and _teammate_tr_xy start empty each step
+        tr[r, o] = -1.0
+        tr_xy[r, o, 0] = math.nan
+        tr_xy[r, o, 1] = math.nan
+    gist[r, I_N_TR] = 0
+    gist[r, I_N_TR_XY] = 0
     for i in range(lo, hi):
         s = in_sender[i]
         if s == me:
             continue
         gist[r, I_MSGS_RECEIVED] += 1
-        if not sharing:
-            continue
         row = in_rows[i]
         step_k = int(row[PK.H_STEP])
         slot = step_k % HISTORY_STEPS
-        if hist_step[r, slot] != step_k:
+        in_hist = hist_step[r, slot] == step_k
+        bit = row[PK.H_TROUBLE]
+        if bit >= 0.0:  # the sender shares its state (§5)
+            if tr[r, s] < 0.0:
+                tr_ord[r, gist[r, I_N_TR]] = s
+                gist[r, I_N_TR] += 1
+            tr[r, s] = bit
+            if in_hist and not math.isnan(hist_sight[r, slot, s, 0]):
+                rng_s = hist_sight[r, slot, s, 0]
+                b_s = hist_sight[r, slot, s, 1]
+                bx = rng_s * math.cos(b_s)
+                by = rng_s * math.sin(b_s)
+                c0 = math.cos(hist_pose[r, slot, 2])
+                s0 = math.sin(hist_pose[r, slot, 2])
+                if math.isnan(tr_xy[r, s, 0]):
+                    tr_xy_ord[r, gist[r, I_N_TR_XY]] = s
+                    gist[r, I_N_TR_XY] += 1
+                tr_xy[r, s, 0] = hist_pose[r, slot, 0] + c0 * bx - s0 * by  # _body_to_odom
+                tr_xy[r, s, 1] = hist_pose[r, slot, 1] + s0 * bx + c0 * by
+        if not sharing:
+            continue
+        if not in_hist:
             continue  # no pose of mine at the sending step
         rng_m = hist_sight[r, slot, s, 0]
-        if rng_m != rng_m:
+        if math.isnan(rng_m):
             continue  # I did not see the sender then
         back = -1
         for j in range(int(row[PK.H_N_SIGHT])):
@@ -292,7 +326,7 @@ def _receive(r, gpar, gist, known, kord, paths, hist_step, hist_pose, hist_sight
             vd = row[e + 5]
             vx = math.nan
             vy = math.nan
-            if vd == vd:
+            if not math.isnan(vd):
                 ux = row[e + 3]
                 uy = row[e + 4]
                 bx = r0 + c * ux - sn * uy
@@ -358,7 +392,7 @@ def _refresh(r, step, px, py, c, s, vis, angles, gpar, gist, gfst, known, kord, 
 
 @njit(cache=True)
 def gs_begin_step(step, pose, sight, own_set, own_k, own_xy, in_rows, in_sender, in_start, vis, angles, gpar, gist,
-                  gfst, known, kord, paths, hist_step, hist_pose, hist_sight):
+                  gfst, known, kord, paths, hist_step, hist_pose, hist_sight, tr, tr_ord, tr_xy, tr_xy_ord):
     """Steps 1-5 of the module docstring for every row: the history ring, ``begin_step``, the own
     goal, the inbox, ``refresh``.
 
@@ -379,6 +413,11 @@ def gs_begin_step(step, pose, sight, own_set, own_k, own_xy, in_rows, in_sender,
         Each robot's scan for visibility tests (the brain's ``_vis_r64``).
     angles : (B,) float64
         The beam angles.
+    tr, tr_ord, tr_xy, tr_xy_ord : (n, M), (n, M), (n, M, 2), (n, M)
+        Written: the Tr bits (§5) that arrived this step by sender (-1: none) and the order
+        they arrived in (``I_N_TR`` entries), and where each sender stood (own frame) when it
+        sent, from the robot's own sighting of it then (NaN: not seen; ``I_N_TR_XY`` entries
+        in order): the brain's ``_teammate_tr`` and ``_teammate_tr_xy``.
     """
     n = pose.shape[0]
     m_slots = known.shape[1]
@@ -411,7 +450,7 @@ def gs_begin_step(step, pose, sight, own_set, own_k, own_xy, in_rows, in_sender,
                 gfst[r, F_OWN_GX] = own_xy[r, 0]
                 gfst[r, F_OWN_GY] = own_xy[r, 1]
         _receive(r, gpar, gist, known, kord, paths, hist_step, hist_pose, hist_sight, in_rows, in_sender,
-                 in_start[r], in_start[r + 1], m_slots)
+                 in_start[r], in_start[r + 1], m_slots, tr, tr_ord, tr_xy, tr_xy_ord)
         if sharing:
             _refresh(r, step, px, py, math.cos(th), math.sin(th), vis, angles, gpar, gist, gfst, known, kord, paths)
 
@@ -428,7 +467,7 @@ def gs_mark_reached(paths, r, owner):
 def gs_go_via(paths, r, owner, step):
     """``GoalSharing.go_via``: at the reached point, on to the reporter's via point (``share_via``);
     False (nothing changed) without one."""
-    if paths[r, owner, P_KIND] == KIND_NONE or paths[r, owner, P_VD] != paths[r, owner, P_VD]:
+    if paths[r, owner, P_KIND] == KIND_NONE or math.isnan(paths[r, owner, P_VD]):
         return False
     paths[r, owner, P_PX] = paths[r, owner, P_VX]
     paths[r, owner, P_PY] = paths[r, owner, P_VY]
@@ -480,7 +519,7 @@ def gs_end_step(step, pose, sight, trouble, gpar, gist, gfst, known, kord, paths
         py = pose[r, 1]
         n_sight = 0
         for o in range(m_slots):
-            if sight[r, o, 0] == sight[r, o, 0]:
+            if not math.isnan(sight[r, o, 0]):
                 n_sight += 1
         sharing = gpar[r, G_SHARING] != 0.0
         if n_sight > 0 and (sharing or gpar[r, G_STATE_SHARING] != 0.0):
@@ -498,7 +537,7 @@ def gs_end_step(step, pose, sight, trouble, gpar, gist, gfst, known, kord, paths
                 s = math.sin(th)
                 j = 0
                 for o in range(m_slots):  # sorted by robot id
-                    if sight[r, o, 0] == sight[r, o, 0]:
+                    if not math.isnan(sight[r, o, 0]):
                         e = at_s + PK.SIGHT_W * j
                         row[e] = o
                         row[e + 1] = sight[r, o, 1]
@@ -616,6 +655,10 @@ class GoalSharingArrays:
         self.hist_pose = np.zeros((n, HISTORY_STEPS, 3))
         self.hist_sight = np.full((n, HISTORY_STEPS, m, 2), np.nan)
         self.out = np.full((n, self.width), np.nan)
+        self.tr = np.full((n, m), -1.0)
+        self.tr_ord = np.full((n, m), -1, dtype=np.int64)
+        self.tr_xy = np.full((n, m, 2), np.nan)
+        self.tr_xy_ord = np.full((n, m), -1, dtype=np.int64)
 
     def set_own_goal(self, r: int, k: int | None, xy=None) -> None:
         """``GoalSharing.set_own_goal`` of row ``r`` (the brains call it at construction too)."""
@@ -633,7 +676,7 @@ class GoalSharingArrays:
                    angles) -> None:
         gs_begin_step(int(step), pose, sight, own_set, own_k, own_xy, in_rows, in_sender, in_start, vis, angles,
                       self.gpar, self.gist, self.gfst, self.known, self.kord, self.paths, self.hist_step,
-                      self.hist_pose, self.hist_sight)
+                      self.hist_pose, self.hist_sight, self.tr, self.tr_ord, self.tr_xy, self.tr_xy_ord)
 
     def end_step(self, step: int, pose, sight, trouble) -> np.ndarray:
         return gs_end_step(int(step), pose, sight, trouble, self.gpar, self.gist, self.gfst, self.known, self.kord,
@@ -654,6 +697,15 @@ class GoalSharingArrays:
         order = np.empty(self.m, dtype=np.int64)
         n_p = _path_order(self.paths, r, order)
         return [(int(o), self.paths[r, o, :P_SEQ].copy()) for o in order[:n_p]]
+
+    def teammate_tr(self, r: int) -> dict[int, bool]:
+        """The brain's ``_teammate_tr`` of row ``r`` (sender → Tr bit, in arrival order)."""
+        return {int(o): bool(self.tr[r, o]) for o in self.tr_ord[r, :int(self.gist[r, I_N_TR])]}
+
+    def teammate_tr_xy(self, r: int) -> dict[int, tuple[float, float]]:
+        """The brain's ``_teammate_tr_xy`` of row ``r`` (sender → where it stood when it sent)."""
+        return {int(o): (float(self.tr_xy[r, o, 0]), float(self.tr_xy[r, o, 1]))
+                for o in self.tr_xy_ord[r, :int(self.gist[r, I_N_TR_XY])]}
 
     def own_goal(self, r: int) -> tuple[int, float, float] | None:
         k = int(self.gist[r, I_OWN_K])
