@@ -432,3 +432,50 @@ def test_rules_on_random_sequences_are_the_reference(ops, lead_on, margin, team)
             ga.set_own_goal(0, k, (x, y))
             ref.set_own_goal(k, (x, y))
         _same_snapshot(ga, 0, _snapshot(ref), str(op))
+
+
+# ----------------------------------------------------------------- the helpers compiled, in the engine
+def _same_log(la: dict, lb: dict, where: str) -> None:
+    layers_a, layers_b = la.pop("layers", None), lb.pop("layers", None)
+    assert la == lb, f"logs differ: {where}: {la} vs {lb}"
+    assert list(la) == list(lb), where
+    assert (layers_a is None) == (layers_b is None), where
+    if layers_a is not None:
+        for name in layers_a:
+            assert _bits(layers_a[name]["data"]) == _bits(layers_b[name]["data"]), (name, where)
+
+
+def side_by_side(scn, steps: int):
+    """The reference R1..R4 and the same run with the helpers' group brain (R1, with teammates,
+    stays on its per-robot brain), step by step: true poses, odometry, commands, every robot's
+    log and the radio's totals must be equal."""
+    ref = Simulation(build_grid(scn), scn)
+    grp = Simulation(build_grid(scn), scn, group_brains=True)
+    assert len(grp.group_teams) == 1 and grp.group_teams[0][1:3] == (1, 4), "the helpers' group brain must run R2..R4"
+    brains_ref = [b for g in ref.brains for b in g]
+    brains_grp = [b for g in grp.brains for b in g]
+    for k in range(steps):
+        ref.step()
+        grp.step()
+        where = f"step {ref.step_index}"
+        assert np.array_equal(ref.state.poses(), grp.state.poses()), f"true poses differ at {where}"
+        assert np.array_equal(ref.odometry.pose, grp.odometry.pose), f"odometry differs at {where}"
+        assert np.array_equal(ref._dir_cmd, grp._dir_cmd, equal_nan=True), f"commands differ at {where}"
+        for i, (a, b) in enumerate(zip(brains_ref, brains_grp)):
+            _same_log(a.log(), b.log(), f"{where}, R{i + 1}")
+    return brains_ref, brains_grp
+
+
+@pytest.mark.parametrize("paper,task,navigator", [(False, 1001, None), (True, 1001, None),
+                                                   (False, 1002, "avoid_past"), (True, 1002, "potential_field")],
+                         ids=["teamnav", "paper", "teamnav-avoid_past", "paper-potential_field"])
+def test_helpers_group_brain_runs_the_reference_team(paper, task, navigator):
+    """R2..R4 compiled (their patrol, goal sharing, the broadcast) beside R1's per-robot brain,
+    which reads their messages: the same run, step by step, with the scenario's VisBug-21 or
+    another algorithm A for every robot."""
+    extra = {} if navigator is None else {f"robots.{k}.params.navigator": navigator for k in range(4)}
+    refs, grps = side_by_side(_scenario(task, paper, **extra), STEPS)
+    for a, b in zip(refs[1:], grps[1:]):
+        assert a.waypoints_reached == b.waypoints_reached and a.mode_steps == b.mode_steps
+        assert a.msgs_sent > 100 and a.msgs_received > 100
+    assert refs[0].msgs_received > 100 and refs[0].targets_reached >= 1
