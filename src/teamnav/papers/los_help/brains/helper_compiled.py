@@ -41,7 +41,11 @@ from teamnav.control.types import Message
 from teamnav.papers.los_help.brains import compiled as C
 from teamnav.papers.los_help.brains import goal_sharing_compiled as GC
 from teamnav.papers.los_help.brains.goal_sharing import max_beam_gap, see_past_teammates
-from teamnav.papers.los_help.brains.messages import MESSAGE_KIND, LosHelpMsg, message_size_bytes
+from teamnav.papers.los_help.brains.messages import (
+    MESSAGE_KIND,
+    LosHelpMsg,
+    message_size_bytes,
+)
 from teamnav.papers.los_help.brains.packed import pack, unpack
 
 __all__ = ["LosHelperGroup", "helpers_advance", "helpers_decide"]
@@ -176,7 +180,7 @@ class _HelperView:
     """Robot r's face of :class:`LosHelperGroup`: what experiments read off a
     :class:`~.helper.LosHelper` (``log()`` and its counters; like it, no ``finished``)."""
 
-    def __init__(self, group: "LosHelperGroup", r: int) -> None:
+    def __init__(self, group: LosHelperGroup, r: int) -> None:
         self._g = group
         self._r = r
         self.me = int(group.infos[r].robot_id)
@@ -358,6 +362,7 @@ class LosHelperGroup:
         self._own_set = np.zeros(n, dtype=np.int64)
         self._own_k = np.zeros(n, dtype=np.int64)
         self._own_xy = np.zeros((n, 2))
+        self._sent: dict[int, tuple[LosHelpMsg, np.ndarray]] = {}
         self._n = n
         self.robots = [_HelperView(self, r) for r in range(n)]
 
@@ -397,12 +402,16 @@ class LosHelperGroup:
                 if vis is ranges:
                     vis = ranges.copy()
                 vis[r] = see_past_teammates(ranges[r], self._a64, max_range, det[:, 0], det[:, 1], self._radius[r])
-        # the inbox as packed rows (the reference reads LosHelpMsg bodies only)
+        # the inbox as packed rows (the reference reads LosHelpMsg bodies only); a body this
+        # group sent keeps its row (``_sent``: the bodies of the last steps, by identity)
         rows, senders, start = [], [], [0]
+        sent_rows = self._sent
         for box in obs.inbox:
             for msg in box:
-                if isinstance(msg.body, LosHelpMsg):
-                    rows.append(pack(msg.body, m))
+                body = msg.body
+                if isinstance(body, LosHelpMsg):
+                    known = sent_rows.get(id(body))
+                    rows.append(known[1] if known is not None and known[0] is body else pack(body, m))
                     senders.append(int(msg.sender))
             start.append(len(rows))
         in_rows = np.array(rows).reshape(-1, self.gs.width)
@@ -424,8 +433,13 @@ class LosHelperGroup:
         sent = self.gs.end_step(step, odom, sight, trouble)
         outbox = []
         t = float(obs.time_s)
+        if len(sent_rows) > 8 * n:  # keep a few steps' bodies (the radio delivers at the next step)
+            for key in list(sent_rows)[:len(sent_rows) - 4 * n]:
+                del sent_rows[key]
         for r in np.flatnonzero(sent):
-            body = unpack(self.gs.out[r])
+            row = self.gs.out[r].copy()
+            body = unpack(row)
+            sent_rows[id(body)] = (body, row)
             view = self.robots[r]
             outbox.append((view.me, Message(view.me, t, body, kind=MESSAGE_KIND)))
             view.msgs_sent += 1
@@ -439,7 +453,13 @@ def _renew_caches() -> None:
     import sys
 
     from teamnav.control.group import renew_stale_caches
-    from teamnav.control.nav.local import avoid_past, base, potential_field, visbug21, visbug21_geometry
+    from teamnav.control.nav.local import (
+        avoid_past,
+        base,
+        potential_field,
+        visbug21,
+        visbug21_geometry,
+    )
     from teamnav.papers.los_help.brains import goal_sharing
 
     here = sys.modules[__name__]
