@@ -36,13 +36,15 @@ It prints, last, one line per configuration and one for their median, in the for
 group_brains=True)``, ``docs/concepts/group-brains.md``) against the Python reference brains, in
 this tree, for every team the group brains compile so far: R1 alone (Tables 1-2's first row)
 on office_simple, tuning task 1001, each column (teamnav, paper as written) and navigator
-(potential field, Avoid-Past, VisBug-21; ``--only paper/visbug21`` keeps the configurations
+(potential field, Avoid-Past, VisBug-21), and R1..R4 with the helpers compiled and R1 on its
+per-robot brain (``team/visbug21``; ``--only paper/visbug21`` keeps the configurations
 whose ``COLUMN/NAVIGATOR`` holds one of the strings). Reference and compiled alternate ``--repeats`` rounds, each run
 in a fresh process after an untimed warm-up; each run's outputs are hashed as ``--team-step``
 does, and a configuration whose runs differ says DIFFER. It prints, last, one line per
 configuration and then one per team size, in the form
 ``LOS team step, 1 robots: compiled / reference = 1.4x`` (reference CPU over compiled CPU,
-median of the configurations). ``--quick`` ends with these lines too (1000 steps, one round).
+median of the configurations); the team's line says ``4 robots (helpers compiled, R1
+reference)``, not the issue's ``4 robots:``, until R1 with teammates is compiled too. ``--quick`` ends with these lines too (1000 steps, one round).
 ``--group-brains --group-tasks 1001,1002``: whole tasks instead (200 targets, the scenario's
 own budget per target, ``stop_when_finished``), reference then compiled in one process per
 task, saying whether every output, the run's metrics and the steps per target are the same
