@@ -108,11 +108,15 @@ def record(scn, steps: int = STEPS):
             gs = b.sharing
             gs.rec_own, gs.rec_events, gs.rec_after_refresh = None, [], None
             inbox = [m for m in obs.inbox if isinstance(m.body, LosHelpMsg)]
+            dets = [(-1 if d.robot_id is None else int(d.robot_id), float(d.range_m), float(d.bearing_rad))
+                    for d in obs.detections]
+            ranges = np.array(obs.scans[b.params.laser].ranges_m, dtype=np.float64)
+            max_range = float(obs.scans[b.params.laser].max_range_m)
             action, outbox = orig(obs)
             k = int(obs.step)
             body = outbox[0].body if outbox else None
             current.append(dict(
-                me=b.me, step=k, time_s=float(obs.time_s), pose=(b._px, b._py, b._th), sight=dict(b._history[k][1]),
+                me=b.me, dets=dets, see_past=bool(b.params.see_past_teammates), radius=b.radius_m, ranges=ranges, max_range=max_range, step=k, time_s=float(obs.time_s), pose=(b._px, b._py, b._th), sight=dict(b._history[k][1]),
                 own=gs.rec_own, inbox=inbox, vis=b._vis_r64.copy(), angles=b._a64, gap=b._gap_rad,
                 events=list(gs.rec_events), after_refresh=gs.rec_after_refresh, after=_snapshot(gs), out=body,
                 msgs_received=b.msgs_received, tr=dict(b._teammate_tr), tr_xy=dict(b._teammate_tr_xy)))
@@ -213,6 +217,29 @@ def _same_snapshot(ga: GC.GoalSharingArrays, r: int, snap, where: str) -> None:
     assert ga.own_goal(r) == own, where
 
 
+def _same_sensing(frame: list[dict], sight: np.ndarray, vis: np.ndarray) -> bool:
+    """``GC.team_sightings`` from the step's raw detections and scan gives the brains' sightings
+    and visibility scans (``_vis_r64``: with ``see_past_teammates``, the beams on teammates
+    filled in)."""
+    n = len(frame)
+    k = max(1, max(len(f["dets"]) for f in frame))
+    count = np.array([len(f["dets"]) for f in frame], dtype=np.int64)
+    ids = np.full((n, k), -1, dtype=np.int64)
+    rng, brg = np.full((n, k), np.nan), np.full((n, k), np.nan)
+    for r, f in enumerate(frame):
+        for j, (rid, rr, bb) in enumerate(f["dets"]):
+            ids[r, j], rng[r, j], brg[r, j] = rid, rr, bb
+    got_sight, got_vis = np.empty_like(sight), np.empty_like(vis)
+    see_past = np.array([f["see_past"] for f in frame])
+    radius = np.array([f["radius"] for f in frame])
+    GC.team_sightings(np.arange(n, dtype=np.int64), count, ids, rng, brg, np.array([f["ranges"] for f in frame]),
+                      np.ascontiguousarray(frame[0]["angles"]), frame[0]["max_range"], radius, see_past, got_sight,
+                      got_vis)
+    assert _bits(got_sight) == _bits(sight), f"sightings differ at step {frame[0]['step']}"
+    assert _bits(got_vis) == _bits(vis), f"visibility scans differ at step {frame[0]['step']}"
+    return True
+
+
 def _inputs(frame: list[dict], width: int):
     n = len(frame)
     pose = np.array([f["pose"] for f in frame])
@@ -232,6 +259,7 @@ def _inputs(frame: list[dict], width: int):
         start.append(len(rows))
     in_rows = np.array(rows).reshape(-1, width)
     vis = np.array([f["vis"] for f in frame])
+    assert _same_sensing(frame, sight, vis)
     trouble = np.array([-1.0 if f["out"] is None or f["out"].trouble is None else float(f["out"].trouble)
                         for f in frame])
     return (pose, sight, own_set, own_k, own_xy, in_rows, np.array(senders, dtype=np.int64),

@@ -70,9 +70,10 @@ from numba import njit
 from teamnav.control.nav.local import compiled as N
 from teamnav.papers.los_help.brains import packed as PK
 from teamnav.papers.los_help.brains.compiled import _keeps, _sees
+from teamnav.papers.los_help.brains.goal_sharing import see_past_teammates
 
 __all__ = ["HISTORY_STEPS", "GoalSharingArrays", "gs_begin_step", "gs_end_step", "gs_go_via", "gs_mark_reached",
-           "path_columns"]
+           "path_columns", "team_sightings"]
 
 #: Steps of own pose and sightings kept to pair delayed messages with (``brain._HISTORY_STEPS``).
 HISTORY_STEPS = 4
@@ -131,6 +132,46 @@ KIND_DIRECT = 1
 KIND_SELF = 2
 KIND_GHOST = 3
 KINDS = (None, "direct", "self", "ghost")
+
+
+# ----------------------------------------------------------------- sensing: sightings and the visibility scan
+@njit(cache=True)
+def team_sightings(ids, det_count, det_id, det_range, det_bearing, ranges, angles, max_range, radius, see_past, sight,
+                   vis):
+    """The first lines of ``_LosBrain.step`` for every row: this step's sightings by robot id
+    (``sight`` (n, M, 2): range, bearing; NaN: not seen) from the detection arrays (identities
+    only, not itself; a later detection of a robot replaces an earlier one, as the brain's
+    dict), and ``vis`` (n, B), the scan of the visibility tests: ``ranges`` with the beams that
+    end on a detected teammate filled in (``see_past_teammates``, where ``see_past[r]``).
+    Returns the number of sightings per row."""
+    n = ranges.shape[0]
+    m_slots = sight.shape[1]
+    counts = np.zeros(n, dtype=np.int64)
+    dr = np.empty(m_slots)
+    db = np.empty(m_slots)
+    for r in range(n):
+        for o in range(m_slots):
+            sight[r, o, 0] = math.nan
+            sight[r, o, 1] = math.nan
+        for j in range(det_count[r]):
+            rid = det_id[r, j]
+            if rid < 0 or rid == ids[r]:
+                continue
+            sight[r, rid, 0] = det_range[r, j]
+            sight[r, rid, 1] = det_bearing[r, j]
+        k = 0
+        for o in range(m_slots):
+            if not math.isnan(sight[r, o, 0]):
+                dr[k] = sight[r, o, 0]
+                db[k] = sight[r, o, 1]
+                k += 1
+        counts[r] = k
+        if k > 0 and see_past[r]:
+            # the masks of the detections are united, so their order does not matter
+            vis[r] = see_past_teammates(ranges[r], angles, max_range, dr[:k], db[:k], radius[r])
+        else:
+            vis[r] = ranges[r]
+    return counts
 
 
 # ----------------------------------------------------------------- paths: insert, delete

@@ -40,7 +40,7 @@ from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Message
 from teamnav.papers.los_help.brains import compiled as C
 from teamnav.papers.los_help.brains import goal_sharing_compiled as GC
-from teamnav.papers.los_help.brains.goal_sharing import max_beam_gap, see_past_teammates
+from teamnav.papers.los_help.brains.goal_sharing import max_beam_gap
 from teamnav.papers.los_help.brains.messages import (
     MESSAGE_KIND,
     LosHelpMsg,
@@ -352,8 +352,8 @@ class LosHelperGroup:
             if p.patrol_xy:  # LosHelper.__init__: set_own_goal(1, patrol[0])
                 self.gs.set_own_goal(r, 1, self.patrol[r, 0])
         self._ids = np.array(ids, dtype=np.int64)
-        self._see_past = [bool(p.see_past_teammates) for p in self.params]
-        self._radius = radius
+        self._see_past = np.array([bool(p.see_past_teammates) for p in self.params])
+        self._radius = np.array(radius, dtype=np.float64)
         self._state_sharing = np.array([p.state_sharing for p in self.params])
         self._gap_for: Any = None
         self._gap = 0.0
@@ -380,28 +380,11 @@ class LosHelperGroup:
         step = int(obs.step)
         max_range = float(obs.max_range_m[self.laser])
         n, m = self._n, self.m
-        # this step's sightings (the brain's dict: identities only, not itself; a later detection
-        # of the same robot replaces an earlier one) and the visibility scan (``_vis_r64``)
-        sight = np.full((n, m, 2), np.nan)
-        vis = ranges
-        for r in range(n):
-            cnt = int(obs.det_count[r])
-            if cnt == 0:
-                continue
-            me = self._ids[r]
-            seen: dict[int, tuple[float, float]] = {}
-            for j in range(cnt):
-                rid = int(obs.det_id[r, j])
-                if rid < 0 or rid == me:
-                    continue
-                seen[rid] = (float(obs.det_range_m[r, j]), float(obs.det_bearing_rad[r, j]))
-            for rid, rb in seen.items():
-                sight[r, rid] = rb
-            if seen and self._see_past[r]:
-                det = np.array(list(seen.values()), dtype=np.float64)
-                if vis is ranges:
-                    vis = ranges.copy()
-                vis[r] = see_past_teammates(ranges[r], self._a64, max_range, det[:, 0], det[:, 1], self._radius[r])
+        # this step's sightings and the visibility scan (the brain's ``_vis_r64``)
+        sight = np.empty((n, m, 2))
+        vis = np.empty_like(ranges)
+        GC.team_sightings(self._ids, obs.det_count, obs.det_id, obs.det_range_m, obs.det_bearing_rad, ranges, self._a64,
+                          max_range, self._radius, self._see_past, sight, vis)
         # the inbox as packed rows (the reference reads LosHelpMsg bodies only); a body this
         # group sent keeps its row (``_sent``: the bodies of the last steps, by identity)
         rows, senders, start = [], [], [0]
