@@ -494,14 +494,23 @@ def side_by_side(scn, steps: int):
     return brains_ref, brains_grp
 
 
-@pytest.mark.parametrize("paper,task,navigator", [(False, 1001, None), (True, 1001, None),
-                                                   (False, 1002, "avoid_past"), (True, 1002, "potential_field")],
-                         ids=["teamnav", "paper", "teamnav-avoid_past", "paper-potential_field"])
-def test_helpers_group_brain_runs_the_reference_team(paper, task, navigator):
+_SHARING = {
+    "state-only": {"goal_sharing": False, "state_sharing": True},  # §5 alone: messages carry only Tr
+    "reflected": {"delayed_visibility": False, "state_sharing": True},  # V_R (§3) with §5
+}
+
+
+@pytest.mark.parametrize("paper,task,navigator,sharing", [
+    (False, 1001, None, None), (True, 1001, None, None), (False, 1002, "avoid_past", None),
+    (True, 1002, "potential_field", None), (False, 1003, None, "state-only"), (True, 1003, None, "reflected")],
+    ids=["teamnav", "paper", "teamnav-avoid_past", "paper-potential_field", "teamnav-state-only", "paper-reflected"])
+def test_helpers_group_brain_runs_the_reference_team(paper, task, navigator, sharing):
     """R2..R4 compiled (their patrol, goal sharing, the broadcast) beside R1's per-robot brain,
     which reads their messages: the same run, step by step, with the scenario's VisBug-21 or
-    another algorithm A for every robot."""
+    another algorithm A for every robot, and with other sharing rules."""
     extra = {} if navigator is None else {f"robots.{k}.params.navigator": navigator for k in range(4)}
+    for field, value in (_SHARING[sharing] if sharing else {}).items():
+        extra.update({f"robots.{k}.params.{field}": value for k in range(4)})
     refs, grps = side_by_side(_scenario(task, paper, **extra), STEPS)
     for a, b in zip(refs[1:], grps[1:]):
         assert a.waypoints_reached == b.waypoints_reached and a.mode_steps == b.mode_steps
