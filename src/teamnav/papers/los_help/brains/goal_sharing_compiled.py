@@ -650,8 +650,8 @@ class GoalSharingArrays:
     params : sequence of Params
         Each robot's ``LosExplorerParams`` / ``LosHelperParams``, in row order.
     robot_ids : sequence of int
-    team_size : int
-        M of ``Id = k·M`` (the brains' ``team_size``: ``id_gain_k`` or the team size).
+    team_sizes : sequence of int
+        Each robot's M of ``Id = k·M`` (the brains' ``team_size``: ``id_gain_k`` or the team size).
     radius_m, step_m, vis_radius_m, gap_rad : sequences of float
         Each robot's radius, step length, visibility radius and largest beam gap.
     m_slots : int, optional

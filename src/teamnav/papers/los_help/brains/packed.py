@@ -124,6 +124,7 @@ def unpack(row: np.ndarray) -> LosHelpMsg:
     goals = tuple([GoalShare(int(v[e]), int(v[e + 1]), v[e + 2], v[e + 3])
                    for e in range(at, at + GOAL_W * int(v[H_N_GOAL]), GOAL_W)])
     at = reports_at(m)
-    reports = tuple([VisReport(int(v[e]), int(v[e + 1]), v[e + 2], *[None if x != x else x for x in v[e + 3:e + 6]])
+    reports = tuple([VisReport(int(v[e]), int(v[e + 1]), v[e + 2],
+                               *[None if math.isnan(x) else x for x in v[e + 3:e + 6]])
                      for e in range(at, at + REPORT_W * int(v[H_N_REPORT]), REPORT_W)])
     return LosHelpMsg(int(v[H_STEP]), sights, goals, reports, None if tr < 0 else bool(tr))
