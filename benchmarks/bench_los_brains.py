@@ -36,13 +36,15 @@ It prints, last, one line per configuration and one for their median, in the for
 group_brains=True)``, ``docs/concepts/group-brains.md``) against the Python reference brains, in
 this tree, for every team the group brains compile so far: R1 alone (Tables 1-2's first row)
 on office_simple, tuning task 1001, each column (teamnav, paper as written) and navigator
-(potential field, Avoid-Past, VisBug-21; ``--only paper/visbug21`` keeps the configurations
+(potential field, Avoid-Past, VisBug-21), and R1..R4 with the helpers compiled and R1 on its
+per-robot brain (``team/visbug21``; ``--only paper/visbug21`` keeps the configurations
 whose ``COLUMN/NAVIGATOR`` holds one of the strings). Reference and compiled alternate ``--repeats`` rounds, each run
 in a fresh process after an untimed warm-up; each run's outputs are hashed as ``--team-step``
 does, and a configuration whose runs differ says DIFFER. It prints, last, one line per
 configuration and then one per team size, in the form
 ``LOS team step, 1 robots: compiled / reference = 1.4x`` (reference CPU over compiled CPU,
-median of the configurations). ``--quick`` ends with these lines too (1000 steps, one round).
+median of the configurations); the team's line says ``4 robots (helpers compiled, R1
+reference)``, not the issue's ``4 robots:``, until R1 with teammates is compiled too. ``--quick`` ends with these lines too (1000 steps, one round).
 ``--group-brains --group-tasks 1001,1002``: whole tasks instead (200 targets, the scenario's
 own budget per target, ``stop_when_finished``), reference then compiled in one process per
 task, saying whether every output, the run's metrics and the steps per target are the same
@@ -441,12 +443,21 @@ def _team_steps(base: Path, new: Path, steps: int, repeats: int, base_name: str,
 # ---------------------------------------------------------------------------- group brains
 #: The teams the group brains compile so far: R1 alone (team size 1), per navigator of R1.
 GROUP_NAVIGATORS = ("potential_field", "avoid_past", "visbug21")
+#: ... and R1..R4 with the helpers R2..R4 compiled (R1, with teammates, on its per-robot brain),
+#: the scenario's VisBug-21 for every robot ("team/<navigator of R1>").
+GROUP_TEAMS = ("team/visbug21",)
 
 
 def _group_overrides(navigator: str, paper: bool, task: int) -> dict:
-    from teamnav.papers.los_help.tasks import _alone, task_targets_xy
+    from teamnav.papers.los_help.tasks import _alone, task_targets_xy, team_overrides
 
-    if paper:
+    if navigator.startswith("team/"):  # R1..R4; the paper column: every robot with paper_rules
+        ov = dict(team_overrides("simple", 3))
+        ov["robots.0.params.navigator"] = navigator[len("team/"):]
+        if paper:
+            for k in range(4):
+                ov[f"robots.{k}.params.paper_rules"] = True
+    elif paper:
         ov = dict(_alone(navigator))  # the paper column's settings, R1 alone (the tuning sweeps' cases)
     else:
         ov = {"robots.0.params.navigator": navigator, "robots.1.count": 0, "robots.2.count": 0, "robots.3.count": 0}
@@ -545,12 +556,13 @@ def _group_brains(steps: int, repeats: int, only: list[str] | None = None) -> No
     """CPU per team step, compiled group brains vs the Python reference (see ``--group-brains``)."""
     load0 = os.getloadavg()[0]
     t0 = time.process_time()
-    print(f"R1 alone on office_simple, tuning task {TEAM_TASK}, {steps} steps per run, {repeats} round(s), medians "
+    print(f"R1 alone, and R1..R4 with R2..R4 compiled (team/...), on office_simple, tuning task {TEAM_TASK}, "
+          f"{steps} steps per run, {repeats} round(s), medians "
           f"of CPU (time.process_time, one numba thread), this tree ({REPO}), load {load0:.1f}")
     print(f"{'column':8s} {'navigator':16s} {'ref ms/step':>11s} {'(brains)':>9s} {'compiled':>9s} {'(brains)':>9s} "
           f"{'ratio':>6s} {'brains':>7s}  outputs")
-    lines, ratios = [], []
-    for paper, nav in itertools.product((False, True), GROUP_NAVIGATORS):
+    lines, ratios, team_ratios = [], [], []
+    for paper, nav in itertools.product((False, True), GROUP_NAVIGATORS + GROUP_TEAMS):
         col = "paper" if paper else "teamnav"
         if only and not any(o in f"{col}/{nav}" for o in only):
             continue
@@ -565,16 +577,21 @@ def _group_brains(steps: int, repeats: int, only: list[str] | None = None) -> No
         rb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in ref)
         ct = statistics.median(1000 * r["cpu_s"] / r["steps"] for r in cmp_)
         cb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in cmp_)
-        ratios.append(rt / ct)
+        team = nav.startswith("team/")
+        (team_ratios if team else ratios).append(rt / ct)
         print(f"{col:8s} {nav:16s} {rt:11.4f} {rb:9.4f} {ct:9.4f} {cb:9.4f} {rt / ct:6.2f} {rb / cb:7.2f}  "
               f"{'identical' if same else 'DIFFER'}", flush=True)
-        lines.append(f"LOS team step, 1 robots ({col}, {nav}): compiled / reference = {rt / ct:.2f}x")
+        lines.append(f"LOS team step, {4 if team else 1} robots ({col}, {nav}): compiled / reference = {rt / ct:.2f}x")
     print(f"(brains: CPU inside the brains' step and log, or the group brain's step_group and the views' log; "
           f"load {load0:.1f} -> {os.getloadavg()[0]:.1f}; this script's own CPU {time.process_time() - t0:.1f} s, "
           f"the runs' in their processes)")
     for line in lines:
         print(line)
-    print(f"LOS team step, 1 robots: compiled / reference = {statistics.median(ratios):.2f}x")
+    if ratios:
+        print(f"LOS team step, 1 robots: compiled / reference = {statistics.median(ratios):.2f}x")
+    if team_ratios:  # not yet the whole team compiled: named apart from the issue's "4 robots:" line
+        print(f"LOS team step, 4 robots (helpers compiled, R1 reference): compiled / reference = "
+              f"{statistics.median(team_ratios):.2f}x")
 
 
 if __name__ == "__main__":

@@ -163,12 +163,14 @@ def test_identity_without_targets():
 
 
 def test_teams_with_helpers_keep_the_reference_brains():
-    """R1 with a helper is not compiled yet: the group brain declines and both robots run
-    their per-robot brains (the run is then the reference's by construction)."""
+    """R1 with a helper is not compiled yet: its group brain declines and R1 runs its
+    per-robot brain; the helper runs the helpers' group brain (its identity with the
+    reference: tests/test_goal_sharing_compiled.py)."""
     ov = {"robots.0.params.navigator": "avoid_past", "robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0}
     scn = load_scenario("los-help-simple", overrides=ov, duration_s=1.0, seed=0)
     sim = Simulation(build_grid(scn), scn, group_brains=True)
-    assert sim.group_teams == []
+    assert [type(t).__name__ for t, *_ in sim.group_teams] == ["LosHelperGroup"]
+    assert sim.group_teams[0][1:3] == (1, 2)
     assert type(sim.brains[0][0]).__name__ == "LosExplorer"
 
 

@@ -181,9 +181,10 @@ def _navigate(r, gx, gy, px, py, th, ranges, angles, max_range, epar, efst, eist
 
 @njit(cache=True)
 def _head_to(r, gx, gy, end_margin, px, py, th, c, s, ranges, angles, max_range, gap, epar, efst, eist,
-             npar, nfst, nist, grid, normals, nav):
-    """``_Driving._head_to`` the own goal in sight (key ``("goal", target_index)``): (heading
-    relative to the body or NaN, progressing)."""
+             npar, nfst, nist, grid, normals, nav, vis):
+    """``_Driving._head_to`` the own goal in sight (key ``("goal", J_IDX)``; a helper's
+    ``("waypoint", k)`` with k in J_IDX): (heading relative to the body or NaN, progressing).
+    ``vis``: the scan of the visibility test (the brain's ``_vis_r64``; R1 alone: ``ranges``)."""
     step_m = epar[r, Q_STEP]
     dist = N.py_hypot(gx - px, gy - py)
     progressing = True
@@ -203,7 +204,7 @@ def _head_to(r, gx, gy, end_margin, px, py, th, c, s, ranges, angles, max_range,
             length = step_m  # Python's max(step_m, dist - end_margin)
         if _corridor(r, heading, length, th, ranges, angles, max_range, epar):
             return N.py_wrap(heading - th), progressing
-        if epar[r, Q_SLIDE] != 0.0 and _sees(r, gx, gy, 2.0 * epar[r, Q_RADIUS], px, py, c, s, ranges, angles, gap,
+        if epar[r, Q_SLIDE] != 0.0 and _sees(r, gx, gy, 2.0 * epar[r, Q_RADIUS], px, py, c, s, vis, angles, gap,
                                               epar[r, Q_VIS_R]):
             # _slide_heading(heading, min(dist - end_margin, slide_lookahead_m))
             look = epar[r, Q_LOOKAHEAD]
@@ -302,7 +303,8 @@ def r1_alone_step(step, odom, ranges, angles, max_range, gap, epar, efst, eist, 
             if eist[r, J_DIRECT] == 1:
                 eist[r, J_GOAL_SEEN] += 1
                 d, progressing = _head_to(r, gx, gy, 0.5 * epar[r, Q_TOL], px, py, th, c, s, ranges, angles,
-                                          max_range, gap, epar, efst, eist, npar, nfst, nist, grid, normals, nav)
+                                          max_range, gap, epar, efst, eist, npar, nfst, nist, grid, normals, nav,
+                                          ranges)
             else:  # _unseen_goal -> _drive: A towards the goal
                 eist[r, J_LAST] = 0
                 d, progressing = _navigate(r, gx, gy, px, py, th, ranges, angles, max_range, epar, efst, eist, npar,
