@@ -395,7 +395,8 @@ class MCL(SampleSetState):
         self._ray_angles = np.ascontiguousarray((used[:, None] + offsets[None, :]).ravel())
         self._used_angles = used
         blocking = known_map.blocking(self.sees)
-        self._caster = RayCaster(known_map, self.sees, self.max_range_m) if params.sensor_model == "beam" else None
+        self._caster = (RayCaster(known_map, self.sees, self.max_range_m, stretched=True)
+                        if params.sensor_model == "beam" else None)
         self._beam_table = BeamTable(params.beam, self.max_range_m) if params.sensor_model == "beam" else None
         free = known_map.cells == FREE
         if params.init_clearance_m > 0:
