@@ -393,6 +393,7 @@ class MCL(SampleSetState):
             offsets = np.zeros(1)
         self._k = int(offsets.shape[0])
         self._ray_angles = np.ascontiguousarray((used[:, None] + offsets[None, :]).ravel())
+        self._ray_cs = (np.cos(self._ray_angles), np.sin(self._ray_angles))  # what cast_xyt computes per call
         self._used_angles = used
         blocking = known_map.blocking(self.sees)
         self._caster = (RayCaster(known_map, self.sees, self.max_range_m, stretched=True)
@@ -523,7 +524,9 @@ class MCL(SampleSetState):
                 self._rays = np.empty((n, r))
             p = self._particles
             threads = self._threads(n * r)
-            self._caster.cast_xyt(p[:, 0], p[:, 1], p[:, 2], self._ray_angles, out=self._rays, parallel=threads)
+            if not np.isfinite(p).all():
+                raise ValueError("particle poses must be finite")
+            self._caster._cast_into(p[:, 0], p[:, 1], p[:, 2], *self._ray_cs, self._rays, threads)
             self._table = table = self._beam_table(z, out=self._table)  # reuses the last scan's buffer
             kernel = beam_loglik_kernel if threads else beam_loglik_kernel_serial
             kernel(self._rays, self._k, table, 1.0 / self._beam_table.step_m, exponent, self._ll)

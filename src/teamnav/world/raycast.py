@@ -1196,6 +1196,16 @@ class RayCaster:
         return _run(self.clearance, ox, oy, self._res, xs, ys, thetas, beams, self.max_range_m, out, bool(parallel),
                     self.stretch)
 
+    def _cast_into(self, xs, ys, thetas, cos_b, sin_b, out: np.ndarray, parallel: bool) -> np.ndarray:
+        """:meth:`cast_xyt` into ``out`` (P, B) without input checks, the beams given by their
+        ``cos`` and ``sin`` (as :meth:`_cast_cs`): a filter's per-update path, for finite
+        float64 (P,) poses (copied when strided) and a C-contiguous float64 ``out``. The same
+        bits as :meth:`cast_xyt`."""
+        xs, ys, ox, oy = self.grid.kernel_frame(np.ascontiguousarray(xs), np.ascontiguousarray(ys))
+        thetas = self.grid.kernel_theta(np.ascontiguousarray(thetas))
+        return _run_cs(self.clearance, ox, oy, self._res, xs, ys, thetas, cos_b, sin_b, self.max_range_m, out,
+                       parallel, None, self.stretch)
+
     def _cast_cs(self, xs, ys, thetas, cos_b, sin_b, parallel: bool, cs_theta=None) -> np.ndarray:
         """:meth:`cast_xyt` without input checks, the beams given by their ``cos`` and ``sin``
         (``np.cos(angles_rad)``, ``np.sin(angles_rad)``), into a fresh (P, B) array: the
