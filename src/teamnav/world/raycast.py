@@ -468,12 +468,17 @@ def _jump_st(clear, ext, q, m, sx, sy, fx, fy, dx, dy, idx, idy, r, c, v, tmax):
     rk = r + sy * ky
     tx = ((ck + offx) - fx) * idx
     ty = ((rk + offy) - fy) * idy
+    # both exit points, then selects: whether the ray leaves through an x- or a y-plane is
+    # what a branch predictor would lose (5 % of the cast; written ``tx if ex else ty``, LLVM
+    # branches). ``min`` gives the same bits as that select: tx and ty are > 0 here (the pose
+    # is off the grid lines: _cast_serial_st), never NaN, and equal values are equal bits
+    oex = fy + tx * dy
+    oey = fx + ty * dx
     ex = tx < ty
-    t = tx if ex else ty
+    t = min(tx, ty)
     if t >= tmax:
         return r, c, v, tmax, True, False
-    od = dy if ex else dx
-    oe = (fy if ex else fx) + t * od
+    oe = oex if ex else oey
     fl = math.floor(oe)
     frac = oe - fl
     ifl = int(fl)
