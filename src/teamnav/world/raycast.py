@@ -514,6 +514,88 @@ def _wave_st(clear, ext, q, m, sx, sy, act, n, fxs, fys, dxs, dys, idxs, idys, r
     return nf
 
 
+@njit(cache=True, inline="always")
+def _scratch_st(nb):
+    """Scratch arrays of :func:`_cast_group_st` for poses of ``nb`` rays."""
+    nr = _POSES_PER_WAVE_ST * nb
+    return (np.empty(nr), np.empty(nr), np.empty(nr), np.empty(nr), np.empty(nr), np.empty(nr),
+            np.empty(nr, np.int64), np.empty(nr, np.int64), np.empty(nr, np.uint8),
+            np.empty((12, nr), np.uint64),  # 0-3: square traversal by quadrant; 4 + 2 q + m: stretched
+            np.zeros(12, np.int64), np.empty(nr, np.uint64), np.empty(nr))
+
+
+@njit(cache=True, inline="always")
+def _cast_group_st(clear, ext, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, g0, g1, scratch):
+    """Ranges [m] of poses ``g0 .. g1 - 1`` (at most :data:`_POSES_PER_WAVE_ST`) into
+    ``scratch[-1]``: ray ``b`` of pose ``p`` at ``(p - g0) * B + b`` (see :func:`_cast_serial_st`)."""
+    fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, act, cnt, fb, ranges = scratch
+    inv = 1.0 / res
+    nb = cb.shape[0]
+    gd = STRETCH_GUARD_CELLS
+    mc = STRETCH_MIN_COMPONENT
+    cnt[:] = 0
+    for p in range(g0, g1):
+        fx = (xs[p] - ox) * inv
+        fy = (ys[p] - oy) * inv
+        r0, c0, ok = _start(clear, fx, fy)
+        first = (p - g0) * nb
+        if not ok:
+            for b in range(nb):
+                ranges[first + b] = 0.0
+            continue
+        free = np.int64(min(min(_code(clear, r0, c0, 0), _code(clear, r0, c0, 1)),
+                            min(_code(clear, r0, c0, 2), _code(clear, r0, c0, 3)))) - 2
+        if free >= tmax:
+            for b in range(nb):
+                ranges[first + b] = tmax * res
+            continue
+        ax = fx - math.floor(fx)
+        ay = fy - math.floor(fy)
+        on_line = ax <= gd or ax >= 1.0 - gd or ay <= gd or ay >= 1.0 - gd
+        for b in range(nb):
+            i = first + b
+            dx, dy = _ray_dir(ct[p], st[p], cb[b], sb[b])
+            fxs[i] = fx
+            fys[i] = fy
+            dxs[i] = dx
+            dys[i] = dy
+            idxs[i] = _inv(dx)
+            idys[i] = _inv(dy)
+            q = _quadrant(dx, dy)
+            rs[i] = r0
+            cs[i] = c0
+            vs[i] = _code(clear, r0, c0, q)
+            adx = abs(dx)
+            ady = abs(dy)
+            square = on_line or (adx < mc and adx != 0.0) or (ady < mc and ady != 0.0)
+            j = q if square else 4 + 2 * q + (0 if adx >= ady else 1)
+            act[j, cnt[j]] = i
+            cnt[j] += 1
+    nf = 0
+    # octant j = 4 + 2 q + m: quadrant q = (dx < 0) + 2 (dy < 0), m = 1 when |dy| > |dx|
+    nf = _wave_st(clear, ext, 0, 0, 1, 1, act[4], cnt[4], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
+    nf = _wave_st(clear, ext, 0, 1, 1, 1, act[5], cnt[5], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
+    nf = _wave_st(clear, ext, 1, 0, -1, 1, act[6], cnt[6], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
+    nf = _wave_st(clear, ext, 1, 1, -1, 1, act[7], cnt[7], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
+    nf = _wave_st(clear, ext, 2, 0, 1, -1, act[8], cnt[8], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
+    nf = _wave_st(clear, ext, 2, 1, 1, -1, act[9], cnt[9], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
+    nf = _wave_st(clear, ext, 3, 0, -1, -1, act[10], cnt[10], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
+    nf = _wave_st(clear, ext, 3, 1, -1, -1, act[11], cnt[11], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
+    for a in range(nf):  # the risky rays, again from their start with the square traversal
+        i = fb[a]
+        r0, c0, _ = _start(clear, fxs[i], fys[i])
+        q = _quadrant(dxs[i], dys[i])
+        rs[i] = r0
+        cs[i] = c0
+        vs[i] = _code(clear, r0, c0, q)
+        act[q, cnt[q]] = i
+        cnt[q] += 1
+    _wave(clear, 0, 1, 1, act[0], cnt[0], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res)
+    _wave(clear, 1, -1, 1, act[1], cnt[1], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res)
+    _wave(clear, 2, 1, -1, act[2], cnt[2], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res)
+    _wave(clear, 3, -1, -1, act[3], cnt[3], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res)
+
+
 @njit(cache=True)
 def _cast_serial_st(clear, ext, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, p0, p1):
     """:func:`_cast_serial` with the stretched rectangles of :func:`stretch_map`: the same
@@ -524,88 +606,12 @@ def _cast_serial_st(clear, ext, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, out, 
     and rays with a risky jump (:func:`_jump_st`) are cast with the square traversal of
     :func:`_cast_serial` instead, from their start.
     """
-    inv = 1.0 / res
     nb = cb.shape[0]
-    g = _POSES_PER_WAVE_ST
-    nr = g * nb
-    fxs = np.empty(nr)
-    fys = np.empty(nr)
-    dxs = np.empty(nr)
-    dys = np.empty(nr)
-    idxs = np.empty(nr)
-    idys = np.empty(nr)
-    rs = np.empty(nr, np.int64)
-    cs = np.empty(nr, np.int64)
-    vs = np.empty(nr, np.uint8)
-    act = np.empty((12, nr), np.uint64)  # 0-3: square traversal by quadrant; 4 + 2 q + m: stretched
-    cnt = np.zeros(12, np.int64)
-    fb = np.empty(nr, np.uint64)
-    ranges = np.empty(nr)
-    gd = STRETCH_GUARD_CELLS
-    mc = STRETCH_MIN_COMPONENT
-    for g0 in range(p0, p1, g):
-        g1 = min(p1, g0 + g)
-        cnt[:] = 0
-        for p in range(g0, g1):
-            fx = (xs[p] - ox) * inv
-            fy = (ys[p] - oy) * inv
-            r0, c0, ok = _start(clear, fx, fy)
-            first = (p - g0) * nb
-            if not ok:
-                for b in range(nb):
-                    ranges[first + b] = 0.0
-                continue
-            free = np.int64(min(min(_code(clear, r0, c0, 0), _code(clear, r0, c0, 1)),
-                                min(_code(clear, r0, c0, 2), _code(clear, r0, c0, 3)))) - 2
-            if free >= tmax:
-                for b in range(nb):
-                    ranges[first + b] = tmax * res
-                continue
-            ax = fx - math.floor(fx)
-            ay = fy - math.floor(fy)
-            on_line = ax <= gd or ax >= 1.0 - gd or ay <= gd or ay >= 1.0 - gd
-            for b in range(nb):
-                i = first + b
-                dx, dy = _ray_dir(ct[p], st[p], cb[b], sb[b])
-                fxs[i] = fx
-                fys[i] = fy
-                dxs[i] = dx
-                dys[i] = dy
-                idxs[i] = _inv(dx)
-                idys[i] = _inv(dy)
-                q = _quadrant(dx, dy)
-                rs[i] = r0
-                cs[i] = c0
-                vs[i] = _code(clear, r0, c0, q)
-                adx = abs(dx)
-                ady = abs(dy)
-                square = on_line or (adx < mc and adx != 0.0) or (ady < mc and ady != 0.0)
-                j = q if square else 4 + 2 * q + (0 if adx >= ady else 1)
-                act[j, cnt[j]] = i
-                cnt[j] += 1
-        nf = 0
-        # octant j = 4 + 2 q + m: quadrant q = (dx < 0) + 2 (dy < 0), m = 1 when |dy| > |dx|
-        nf = _wave_st(clear, ext, 0, 0, 1, 1, act[4], cnt[4], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
-        nf = _wave_st(clear, ext, 0, 1, 1, 1, act[5], cnt[5], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
-        nf = _wave_st(clear, ext, 1, 0, -1, 1, act[6], cnt[6], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
-        nf = _wave_st(clear, ext, 1, 1, -1, 1, act[7], cnt[7], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
-        nf = _wave_st(clear, ext, 2, 0, 1, -1, act[8], cnt[8], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
-        nf = _wave_st(clear, ext, 2, 1, 1, -1, act[9], cnt[9], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
-        nf = _wave_st(clear, ext, 3, 0, -1, -1, act[10], cnt[10], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
-        nf = _wave_st(clear, ext, 3, 1, -1, -1, act[11], cnt[11], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res, fb, nf)
-        for a in range(nf):  # the risky rays, again from their start with the square traversal
-            i = fb[a]
-            r0, c0, _ = _start(clear, fxs[i], fys[i])
-            q = _quadrant(dxs[i], dys[i])
-            rs[i] = r0
-            cs[i] = c0
-            vs[i] = _code(clear, r0, c0, q)
-            act[q, cnt[q]] = i
-            cnt[q] += 1
-        _wave(clear, 0, 1, 1, act[0], cnt[0], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res)
-        _wave(clear, 1, -1, 1, act[1], cnt[1], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res)
-        _wave(clear, 2, 1, -1, act[2], cnt[2], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res)
-        _wave(clear, 3, -1, -1, act[3], cnt[3], fxs, fys, dxs, dys, idxs, idys, rs, cs, vs, tmax, ranges, res)
+    scratch = _scratch_st(nb)
+    ranges = scratch[-1]
+    for g0 in range(p0, p1, _POSES_PER_WAVE_ST):
+        g1 = min(p1, g0 + _POSES_PER_WAVE_ST)
+        _cast_group_st(clear, ext, ox, oy, res, xs, ys, ct, st, cb, sb, tmax, g0, g1, scratch)
         for p in range(g0, g1):
             first = (p - g0) * nb
             for b in range(nb):
@@ -1200,6 +1206,18 @@ class RayCaster:
         thetas = self.grid.kernel_theta(thetas)
         return _run(self.clearance, ox, oy, self._res, xs, ys, thetas, beams, self.max_range_m, out, bool(parallel),
                     self.stretch)
+
+    def _kernel_inputs(self, xs, ys, thetas) -> tuple:
+        """``(clear, ext, ox, oy, res, xs, ys, cos thetas, sin thetas, tmax)``: what the serial
+        stretched kernels take for poses ``xs, ys, thetas`` (finite float64 (P,), copied when
+        strided), computed as :meth:`cast_xyt` computes them (the same bits). Requires
+        ``stretched=True``."""
+        if self.stretch is None:
+            raise ValueError("_kernel_inputs needs a RayCaster built with stretched=True on an untiled map")
+        xs, ys, ox, oy = self.grid.kernel_frame(np.ascontiguousarray(xs), np.ascontiguousarray(ys))
+        thetas = self.grid.kernel_theta(np.ascontiguousarray(thetas))
+        return (self.clearance, self.stretch, ox, oy, self._res, xs, ys, np.cos(thetas), np.sin(thetas),
+                self.max_range_m / self._res)
 
     def _cast_into(self, xs, ys, thetas, cos_b, sin_b, out: np.ndarray, parallel: bool) -> np.ndarray:
         """:meth:`cast_xyt` into ``out`` (P, B) without input checks, the beams given by their
