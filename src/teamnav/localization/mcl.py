@@ -37,7 +37,8 @@ from numba import njit
 from teamnav.control.protocol import SensorInfo
 from teamnav.geometry.angles import wrap_angle
 from teamnav.localization._checks import SampleSetState, array, generator
-from teamnav.localization.beam_model import BeamModelParams, BeamTable, beam_loglik_kernel, beam_loglik_kernel_serial
+from teamnav.localization.beam_model import (BeamModelParams, BeamTable, beam_loglik_cast_kernel, beam_loglik_kernel,
+                                             beam_loglik_kernel_serial)
 from teamnav.localization.kld import KLDParams, kld_count_kernel
 from teamnav.localization.likelihood_field import (
     LikelihoodFieldParams, build_log_field, lf_loglik_kernel, lf_loglik_kernel_serial,
@@ -393,9 +394,11 @@ class MCL(SampleSetState):
             offsets = np.zeros(1)
         self._k = int(offsets.shape[0])
         self._ray_angles = np.ascontiguousarray((used[:, None] + offsets[None, :]).ravel())
+        self._ray_cs = (np.cos(self._ray_angles), np.sin(self._ray_angles))  # what cast_xyt computes per call
         self._used_angles = used
         blocking = known_map.blocking(self.sees)
-        self._caster = RayCaster(known_map, self.sees, self.max_range_m) if params.sensor_model == "beam" else None
+        self._caster = (RayCaster(known_map, self.sees, self.max_range_m, stretched=True)
+                        if params.sensor_model == "beam" else None)
         self._beam_table = BeamTable(params.beam, self.max_range_m) if params.sensor_model == "beam" else None
         free = known_map.cells == FREE
         if params.init_clearance_m > 0:
@@ -518,14 +521,21 @@ class MCL(SampleSetState):
         exponent = self.params.likelihood_exponent
         if self.params.sensor_model == "beam":
             r = self._ray_angles.shape[0]
-            if self._rays.shape != (n, r):
-                self._rays = np.empty((n, r))
             p = self._particles
             threads = self._threads(n * r)
-            self._caster.cast_xyt(p[:, 0], p[:, 1], p[:, 2], self._ray_angles, out=self._rays, parallel=threads)
+            if not np.isfinite(p).all():
+                raise ValueError("particle poses must be finite")
             self._table = table = self._beam_table(z, out=self._table)  # reuses the last scan's buffer
-            kernel = beam_loglik_kernel if threads else beam_loglik_kernel_serial
-            kernel(self._rays, self._k, table, 1.0 / self._beam_table.step_m, exponent, self._ll)
+            inv_step = 1.0 / self._beam_table.step_m
+            if not threads and self._caster.stretch is not None:  # cast and sum in one pass
+                beam_loglik_cast_kernel(*self._caster._kernel_inputs(p[:, 0], p[:, 1], p[:, 2]), *self._ray_cs,
+                                        self._k, table, inv_step, exponent, self._ll)
+            else:
+                if self._rays.shape != (n, r):
+                    self._rays = np.empty((n, r))
+                self._caster._cast_into(p[:, 0], p[:, 1], p[:, 2], *self._ray_cs, self._rays, threads)
+                kernel = beam_loglik_kernel if threads else beam_loglik_kernel_serial
+                kernel(self._rays, self._k, table, inv_step, exponent, self._ll)
         else:
             keep = z < self.max_range_m - 1e-6
             a = self._used_angles[keep]
