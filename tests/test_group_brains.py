@@ -163,19 +163,20 @@ def test_identity_without_targets():
 
 
 def test_teams_with_helpers_step_in_one_group_brain():
-    """R1 and a helper form one team of the team's group brain: with state sharing (§5's trouble
-    following is not compiled) R1 runs its per-robot brain inside it, beside the compiled helper;
-    without, R1 is compiled too (identity with the reference: tests/test_team_compiled.py and
-    tests/test_goal_sharing_compiled.py)."""
-    ov = {"robots.0.params.navigator": "avoid_past", "robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0}
-    for state_sharing, r1 in ((True, "LosExplorer"), (False, "_R1TeamView")):
-        scn = load_scenario("los-help-simple", overrides={**ov, "robots.0.params.state_sharing": state_sharing},
+    """R1 and a helper form one team of the team's group brain: with VisBug-21 (its temporary
+    goals are not compiled) R1 runs its per-robot brain inside it, beside the compiled helper;
+    with Avoid-Past, R1 is compiled too (identity with the reference: tests/test_team_compiled.py
+    and tests/test_goal_sharing_compiled.py)."""
+    ov = {"robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0}
+    for navigator, r1 in (("visbug21", "LosExplorer"), ("avoid_past", "_R1TeamView")):
+        scn = load_scenario("los-help-simple", overrides={**ov, "robots.0.params.navigator": navigator},
                             duration_s=1.0, seed=0)
         sim = Simulation(build_grid(scn), scn, group_brains=True)
         assert [type(t).__name__ for t, *_ in sim.group_teams] == ["LosTeamGroup"]
         assert sim.group_teams[0][1:3] == (0, 2)
         assert type(sim.brains[0][0]).__name__ == r1
         assert type(sim.brains[1][0]).__name__ == "_HelperView"
+        assert sim.group_teams[0][0].compiled_robots == (1 if navigator == "visbug21" else 2)
 
 
 def test_runs_with_faults_keep_the_reference_brains():

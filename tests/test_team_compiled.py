@@ -26,15 +26,16 @@ from teamnav.sim.engine import Simulation
 STEPS = 1500
 
 
-def _scenario(task: int, paper: bool, navigator: str, steps: int = STEPS, r1: dict | None = None, **params):
-    """R1..R4 on office_simple with one tuning task's targets, every robot on ``navigator``
-    without state sharing (R1's compiled step declines §5's trouble following), ``params``
-    for every robot; ``paper``: the paper column (``paper_rules: true``)."""
+def _scenario(task: int, paper: bool, navigator: str, steps: int = STEPS, r1: dict | None = None,
+              state_sharing: bool = False, **params):
+    """R1..R4 on office_simple with one tuning task's targets, every robot on ``navigator``, with
+    or without state sharing (§5), ``params`` for every robot and ``r1`` for R1 alone; ``paper``:
+    the paper column (``paper_rules: true``)."""
     ov = dict(team_overrides("simple", 3))
     ov["robots.0.params.targets_xy"] = task_targets_xy("simple", task)
     for k in range(4):
         ov[f"robots.{k}.params.navigator"] = navigator
-        ov[f"robots.{k}.params.state_sharing"] = False
+        ov[f"robots.{k}.params.state_sharing"] = state_sharing
         ov[f"robots.{k}.params.paper_rules"] = paper
         for name, value in params.items():
             ov[f"robots.{k}.params.{name}"] = value
@@ -86,17 +87,34 @@ def side_by_side(scn, steps: int):
 
 
 @pytest.mark.parametrize("paper", [False, True], ids=["teamnav", "paper"])
-@pytest.mark.parametrize("task,navigator", [(1001, "potential_field"), (1002, "avoid_past")])
-def test_whole_team_compiled_is_the_reference(task, navigator, paper):
-    """Both columns, two tuning tasks, the potential field and Avoid-Past: R1 follows teammates
-    and ghosts (and, in the teamnav column, takes via points and direct promises)."""
-    refs, _ = side_by_side(_scenario(task, paper, navigator), STEPS)
+@pytest.mark.parametrize("task,navigator,state_sharing", [(1001, "potential_field", True), (1002, "avoid_past", False)],
+                         ids=["potential_field-state_sharing", "avoid_past"])
+def test_whole_team_compiled_is_the_reference(task, navigator, state_sharing, paper):
+    """Both columns, two tuning tasks, Tables 1-2's team cases (the potential field with state
+    sharing, Avoid-Past without): R1 follows teammates and ghosts, and teammates when in trouble
+    (§5 rule 3); in the teamnav column it also takes via points and direct promises."""
+    refs, _ = side_by_side(_scenario(task, paper, navigator, state_sharing=state_sharing), STEPS)
     r1 = refs[0]
-    assert r1.targets_reached >= 3
+    assert r1.targets_reached >= 2
     assert r1.mode_steps.get("follow_teammate", 0) > 0 and r1.mode_steps.get("ghost", 0) > 0
     assert r1.temp_switches > 0 and r1.msgs_received > 100
+    assert (r1.mode_steps.get("trouble_follow", 0) > 0) == state_sharing
     if not paper:
         assert r1.vias_taken > 0 and r1.promised_steps > 0
+
+
+@pytest.mark.parametrize("progress,steps", [("goal", STEPS), ("moved", 800)])
+def test_trouble_following_gap_fills(progress, steps):
+    """§5 rule 3's gap-fills with other values: progress measured towards the own goal or as a
+    step not blocked, close behind the helper counting as progress, and a kept helper position
+    given up after a few steps without closing in (``trouble_drop_stalled_helper``)."""
+    refs, _ = side_by_side(_scenario(1002, False, "avoid_past", steps, state_sharing=True,
+                                     r1={"trouble_progress": progress, "trouble_near_helper_m": 1.0,
+                                         "trouble_drop_after_steps": 15}), steps)
+    r1 = refs[0]
+    assert r1.mode_steps.get("trouble_follow", 0) > 0
+    if progress == "goal":
+        assert r1.trouble_helpers_dropped > 0
 
 
 def test_stalled_points_dropped_and_budget():
@@ -109,11 +127,12 @@ def test_stalled_points_dropped_and_budget():
 
 
 def test_what_is_declined_runs_the_reference_inside():
-    """R1 with state sharing or VisBug-21 among teammates runs its reference brain inside the
+    """R1 with ``trouble_return`` or VisBug-21 among teammates runs its reference brain inside the
     group brain (the helpers stay compiled); ``unsupported`` says why R1's row is not compiled."""
     from teamnav.papers.los_help.brains.explorer import LosExplorer
 
-    for extra, why in (({"state_sharing": True}, "state_sharing"), ({"navigator": "visbug21"}, "visbug21")):
+    for extra, why in (({"state_sharing": True, "trouble_return": True}, "trouble_return"),
+                       ({"navigator": "visbug21"}, "visbug21")):
         scn = _scenario(1001, False, "potential_field", 5, r1=extra)
         sim = Simulation(build_grid(scn), scn, group_brains=True)
         assert [type(t).__name__ for t, *_ in sim.group_teams] == ["LosTeamGroup"]

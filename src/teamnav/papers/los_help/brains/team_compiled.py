@@ -11,8 +11,12 @@ R1's group and the helpers' groups into one team, stepped in one call. Each row 
   reached within ε or ``ghost_tolerance_m``; at the reached point on to the reporter's via point
   (``share_via``, ``via_in_sight``), else the point is kept only to arbitrate (§4.2) and, with
   ``trust_direct_promise``, a promise of the goal itself is followed straight (``promised``); a
-  point R1 does not close in on for Cr steps is dropped (``drop_stalled_ghost``); else algorithm
-  A towards its goal; Pr, Tr, Nt (§5); the broadcast (§4.4);
+  point R1 does not close in on for Cr steps is dropped (``drop_stalled_ghost``); in trouble
+  with nothing else leading it, the nearest teammate in sight that is not
+  (``trouble_follow``, §5 rule 3, :mod:`.trouble_following`, with its gap-fills
+  ``trouble_sighting_at_send``, ``trouble_helper_towards_goal``, ``keep_trouble_helper``,
+  ``trouble_drop_stalled_helper``, ``trouble_progress`` and ``trouble_near_helper_m``); else
+  algorithm A towards its goal; Pr, Tr, Nt (§5); the broadcast (§4.4);
 - **a helper** (:mod:`.helper_compiled`'s rows: the patrol, goal sharing, the broadcast);
 - **a reference row**: a robot whose parameters the compiled step declines runs its own
   per-robot brain inside this group brain, fed the same observation the engine would give it
@@ -23,10 +27,11 @@ When every robot of the simulation is a compiled row, messages travel as packed 
 (:class:`~.packed.PackedLosMsg`, sized as the :class:`~.messages.LosHelpMsg` they stand for);
 else they are the reference's :class:`~.messages.LosHelpMsg`, which per-robot brains read.
 
-What R1's compiled step declines (its row runs the reference instead): state sharing (§5's
-trouble following, :mod:`.trouble_following`), VisBug-21 with teammates (its temporary goals
-and ``start_again`` at a ghost), ``frame_source`` other than ``"bearings"`` and
-``navigate_past_teammates_beyond_m``. R1 alone (no teammate) is :class:`~.compiled.LosExplorerGroup`.
+What R1's compiled step declines (its row runs the reference instead): VisBug-21 with
+teammates (its temporary goals and ``start_again`` at a ghost), the trouble gap-fills
+``trouble_return`` and ``trouble_release_to_helper`` (off in both columns), ``frame_source``
+other than ``"bearings"`` and ``navigate_past_teammates_beyond_m``. R1 alone (no teammate) is
+:class:`~.compiled.LosExplorerGroup`.
 
 Every branch is the reference's, operation for operation, as in :mod:`.compiled`;
 ``tests/test_team_compiled.py`` runs both side by side and demands the same run.
@@ -67,7 +72,29 @@ RP_TRUST = 3  # trust_direct_promise
 RP_DROP_STALLED = 4  # drop_stalled_ghost
 RP_POINT_MARGIN = 5  # goal sharing's point_margin_m (2.5 radii)
 RP_ME = 6  # the row's robot id (its own slot in ``paths``)
-N_RP = 7
+RP_STATE = 7  # state_sharing (§5: trouble following, :mod:`.trouble_following`)
+RP_TOWARDS = 8  # trouble_helper_towards_goal
+RP_HEADING_STEPS = 9  # trouble_heading_steps
+RP_RECEDE = 10  # trouble_recede_m
+RP_AT_SEND = 11  # trouble_sighting_at_send
+RP_KEEP_HELPER = 12  # keep_trouble_helper
+RP_DROP_HELPER = 13  # trouble_drop_stalled_helper
+RP_DROP_AFTER = 14  # trouble_drop_after_steps
+RP_PROGRESS = 15  # trouble_progress: PROGRESS_*
+RP_NEAR_HELPER = 16  # trouble_near_helper_m (NaN: None)
+N_RP = 17
+
+PROGRESS_HELPER = 0
+PROGRESS_MOVED = 1
+PROGRESS_GOAL = 2
+PROGRESS = ("helper", "moved", "goal")
+
+# R1's float state (rfst)
+F_TT_X = 0  # _trouble_target's position (own frame)
+F_TT_Y = 1
+F_TT_BEST = 2  # _tt_best_d
+F_PREV_GOAL_D = 3  # _prev_goal_d
+N_RF = 4
 
 R_ROLE = 0
 R_MODE = 1  # MODE_*
@@ -81,25 +108,31 @@ R_TEMP_DROPPED = 8
 R_VIAS = 9
 R_PROMISED_STEPS = 10
 R_TEMP_SWITCHES = 11
-R_TEMP_KEY = 12  # _temp_key: ("path", source) as the source (-1: None)
-R_STEPS = 13  # mode_steps: R_STEPS + MODE_*
-N_R = R_STEPS + 5
+R_TEMP_KEY = 12  # _temp_key: (kind, id) as R_TEMP_KIND and the id (-1: None)
+R_TEMP_KIND = 13
+R_TT_ID = 14  # _trouble_target's teammate (-1: None)
+R_TT_STALL = 15  # _tt_stall
+R_HELPERS_DROPPED = 16  # trouble_helpers_dropped
+R_STEPS = 17  # mode_steps: R_STEPS + MODE_*
+N_R = R_STEPS + 6
 
 MODE_OWN_GOAL = 0
 MODE_DONE = 1
 MODE_GAVE_UP = 2
 MODE_FOLLOW = 3
 MODE_GHOST = 4
-MODES = ("own_goal", "done", "gave_up", "follow_teammate", "ghost")
+MODE_TROUBLE = 5
+MODES = ("own_goal", "done", "gave_up", "follow_teammate", "ghost", "trouble_follow")
 
 KEY_NONE = 0
 KEY_GOAL = 1  # ("goal", target index)
 KEY_PATH = 2  # ("path", source, step): a temporary point for A
 KEY_PROMISED = 3  # ("promised", target index)
+KEY_HELPER = 4  # ("helper", teammate): §5 rule 3's temporary goal
 
 
 @njit(cache=True)
-def r1_team_advance_row(r, step, odom, epar, eist, rist, targets, target_steps, own_set, own_k, own_xy):
+def r1_team_advance_row(r, step, odom, epar, eist, rist, targets, target_steps, own_set, own_k, own_xy, mg_n):
     """``LosExplorer._advance_task`` of row ``r`` (§2): the target reached within ε, then the
     next; a target not reached within ``max_steps_per_target`` ends the task. ``own_set`` /
     ``own_k`` / ``own_xy``: the ``set_own_goal`` call it makes (-1: None)."""
@@ -131,6 +164,7 @@ def r1_team_advance_row(r, step, odom, epar, eist, rist, targets, target_steps, 
             own_xy[r, 0] = targets[r, i + 1, 0]
             own_xy[r, 1] = targets[r, i + 1, 1]
         rist[r, R_LAST_KIND] = KEY_NONE
+        mg_n[r, :] = 0  # _mate_goal_d = {} (the teammates' distances were to the old goal)
         if epar[r, C.Q_RESET_TR] != 0.0:
             eist[r, C.J_PR] = 0
             eist[r, C.J_NT_TR] = 1
@@ -203,7 +237,7 @@ def _head_to_k(r, tx, ty, kind, ka, kb, stop_within, end_margin, trust, px, py, 
 
 @njit(cache=True)
 def r1_team_decide_row(r, step, odom, ranges, vis, angles, max_range, gap, sight, epar, efst, eist, rist, rpar,
-                       targets, paths, npar, nfst, nist, grid, normals):
+                       targets, paths, npar, nfst, nist, grid, normals, tf):
     """``LosExplorer._decide`` of row ``r`` without state sharing (see the module docstring), with
     the step's move count and mode count; returns the body-frame direction (NaN: none)."""
     px = odom[r, 0]
@@ -219,14 +253,16 @@ def r1_team_decide_row(r, step, odom, ranges, vis, angles, max_range, gap, sight
         rist[r, R_MODE] = MODE_GAVE_UP if eist[r, C.J_GAVE_UP] != 0 else MODE_DONE
     else:
         d, progressing = _r1_decide_task(r, step, px, py, th, c, s, ranges, vis, angles, max_range, gap, sight, epar,
-                                         efst, eist, rist, rpar, targets, paths, npar, nfst, nist, grid, normals)
+                                         efst, eist, rist, rpar, targets, paths, npar, nfst, nist, grid, normals, tf)
         HC.trouble_update(r, progressing, epar, eist)
         mode = rist[r, R_MODE]
-        if mode == MODE_FOLLOW or mode == MODE_GHOST:  # LosExplorer._decide: a new point headed for
-            key = rist[r, R_LAST_A] if rist[r, R_LAST_KIND] == KEY_PATH else -1
-            if key != rist[r, R_TEMP_KEY]:
+        if mode == MODE_FOLLOW or mode == MODE_GHOST or mode == MODE_TROUBLE:  # _decide: a new point headed for
+            kind = rist[r, R_LAST_KIND]  # the key's first two fields: ("path", source) or ("helper", teammate)
+            key = rist[r, R_LAST_A] if (kind == KEY_PATH or kind == KEY_HELPER) else -1
+            if key != rist[r, R_TEMP_KEY] or (key >= 0 and kind != rist[r, R_TEMP_KIND]):
                 rist[r, R_TEMP_SWITCHES] += 1
             rist[r, R_TEMP_KEY] = key
+            rist[r, R_TEMP_KIND] = kind
         else:
             rist[r, R_TEMP_KEY] = -1
     if not math.isnan(d):
@@ -237,9 +273,10 @@ def r1_team_decide_row(r, step, odom, ranges, vis, angles, max_range, gap, sight
 
 @njit(cache=True)
 def _r1_decide_task(r, step, px, py, th, c, s, ranges, vis, angles, max_range, gap, sight, epar, efst, eist, rist,
-                    rpar, targets, paths, npar, nfst, nist, grid, normals):
-    """``LosExplorer._decide_task`` of row ``r`` with ``state_sharing`` off (no trouble helper, no
-    release point): (direction relative to the body or NaN, progressing)."""
+                    rpar, targets, paths, npar, nfst, nist, grid, normals, tf):
+    """``LosExplorer._decide_task`` of row ``r`` (without ``trouble_return`` and
+    ``trouble_release_to_helper``, which are declined): (direction relative to the body or NaN,
+    progressing)."""
     idx = eist[r, C.J_IDX]
     gx = targets[r, idx, 0]
     gy = targets[r, idx, 1]
@@ -316,6 +353,18 @@ def _r1_decide_task(r, step, px, py, th, c, s, ranges, vis, angles, max_range, g
                 rist[r, R_TEMP_STALL] = 0
                 rist[r, R_TEMP_DROPPED] += 1
                 GC.gs_mark_reached(paths, r, me)
+    # _watch_mates(goal)
+    if eist[r, C.J_TR] == 0:
+        rist[r, R_TT_ID] = -1
+    state = rpar[r, RP_STATE] != 0.0
+    rfst, mg_step, mg_d, mg_n, tr, tr_xy, stalled = tf
+    if state and rpar[r, RP_TOWARDS] != 0.0:
+        _track_mates(r, step, gx, gy, px, py, c, s, sight, rpar, mg_step, mg_d, mg_n)
+    goal_d = N.py_hypot(gx - px, gy - py)
+    if not has_action and state and eist[r, C.J_TR] != 0:
+        d, progressing, has_action = _follow_in_trouble(r, step, px, py, th, c, s, gx, gy, goal_d, progressing,
+                                                        ranges, vis, angles, max_range, gap, sight, epar, efst, eist,
+                                                        rist, rpar, npar, nfst, nist, grid, normals, tf)
     if not has_action and rist[r, R_PROMISED] == idx and eist[r, C.J_TR] == 0:
         rist[r, R_MODE] = MODE_OWN_GOAL
         rist[r, R_PROMISED_STEPS] += 1
@@ -328,23 +377,164 @@ def _r1_decide_task(r, step, px, py, th, c, s, ranges, vis, angles, max_range, g
         rist[r, R_LAST_KIND] = KEY_NONE
         d, progressing = _navigate_t(r, gx, gy, False, px, py, th, ranges, angles, max_range, efst, eist, rist, npar,
                                      nfst, nist, grid, normals)
+    rfst[r, F_PREV_GOAL_D] = goal_d
     return d, progressing
 
 
 @njit(cache=True)
-def team_advance(step, odom, role, epar, eist, rist, hist, patrol, targets, target_steps, own_set, own_k, own_xy):
+def _seen_xy(r, o, px, py, c, s, sight):
+    """Where teammate ``o`` is seen now (own frame; the brain's ``_seen_now``), NaN when not seen."""
+    if math.isnan(sight[r, o, 0]):
+        return math.nan, math.nan
+    rg = sight[r, o, 0]
+    b = sight[r, o, 1]
+    bx = rg * math.cos(b)
+    by = rg * math.sin(b)
+    return px + c * bx - s * by, py + s * bx + c * by
+
+
+@njit(cache=True)
+def _track_mates(r, step, gx, gy, px, py, c, s, sight, rpar, mg_step, mg_d, mg_n):
+    """``_TroubleFollowing._track_mates``: each teammate's straight distance to the goal over the
+    last ``trouble_heading_steps`` steps it was seen (oldest first)."""
+    keep = step - int(rpar[r, RP_HEADING_STEPS])
+    m_slots = sight.shape[1]
+    for o in range(m_slots):
+        x, y = _seen_xy(r, o, px, py, c, s, sight)
+        if not math.isnan(x):
+            k = mg_n[r, o]
+            mg_step[r, o, k] = step
+            mg_d[r, o, k] = N.py_hypot(x - gx, y - gy)
+            mg_n[r, o] = k + 1
+    for o in range(m_slots):
+        k = mg_n[r, o]
+        drop = 0
+        while drop < k and mg_step[r, o, drop] < keep:
+            drop += 1
+        if drop > 0:
+            for j in range(k - drop):
+                mg_step[r, o, j] = mg_step[r, o, j + drop]
+                mg_d[r, o, j] = mg_d[r, o, j + drop]
+            mg_n[r, o] = k - drop
+
+
+@njit(cache=True)
+def _mate_recedes(r, o, rpar, mg_d, mg_n):
+    """``_TroubleFollowing._mate_recedes``: teammate ``o`` went farther from the goal over its kept sightings."""
+    k = mg_n[r, o]
+    if k < 2:
+        return False
+    return mg_d[r, o, k - 1] > mg_d[r, o, 0] + 0.1 * rpar[r, RP_RECEDE]
+
+
+@njit(cache=True)
+def _follow_in_trouble(r, step, px, py, th, c, s, gx, gy, goal_d, progressing, ranges, vis, angles, max_range, gap,
+                       sight, epar, efst, eist, rist, rpar, npar, nfst, nist, grid, normals, tf):
+    """``_TroubleFollowing._follow_in_trouble`` (§5 rule 3 and its gap-fills; ``trouble_return``
+    and ``trouble_release_to_helper`` are declined): (direction or NaN, progressing, whether an
+    action was chosen)."""
+    rfst, mg_step, mg_d, mg_n, tr, tr_xy, stalled = tf
+    m_slots = sight.shape[1]
+    step_m = epar[r, C.Q_STEP]
+    near = 2.0 * epar[r, C.Q_RADIUS] + step_m
+    towards_goal = rpar[r, RP_TOWARDS] != 0.0
+    keep_helper = rpar[r, RP_KEEP_HELPER] != 0.0
+    at_send = rpar[r, RP_AT_SEND] != 0.0
+    # seen: seen now, or (trouble_sighting_at_send) seen when it sent the Tr bit that arrived now
+    now_x = np.empty(m_slots)
+    now_y = np.empty(m_slots)
+    seen_x = np.empty(m_slots)
+    seen_y = np.empty(m_slots)
+    for o in range(m_slots):
+        x, y = _seen_xy(r, o, px, py, c, s, sight)
+        now_x[o] = x
+        now_y[o] = y
+        if math.isnan(x) and at_send and not math.isnan(tr_xy[r, o, 0]):
+            x = tr_xy[r, o, 0]
+            y = tr_xy[r, o, 1]
+        seen_x[o] = x
+        seen_y[o] = y
+    tt = rist[r, R_TT_ID]
+    tx = rfst[r, F_TT_X]
+    ty = rfst[r, F_TT_Y]
+    if tt >= 0 and not math.isnan(now_x[tt]) and towards_goal:
+        d_mate = mg_d[r, tt, mg_n[r, tt] - 1]
+        if d_mate < rfst[r, F_TT_BEST]:  # min(best, d_mate)
+            rfst[r, F_TT_BEST] = d_mate
+        if d_mate > rfst[r, F_TT_BEST] + rpar[r, RP_RECEDE]:
+            tt = -1  # it turned away from the goal: let it go
+            rist[r, R_TT_ID] = -1
+    vis_x = now_x if keep_helper else seen_x
+    vis_y = now_y if keep_helper else seen_y
+    if tt >= 0 and not math.isnan(vis_x[tt]):
+        tx = vis_x[tt]
+        ty = vis_y[tt]
+        rfst[r, F_TT_X] = tx
+        rfst[r, F_TT_Y] = ty
+    elif tt < 0 or N.py_hypot(tx - px, ty - py) <= near:
+        # choose_helper: the nearest candidate not in trouble (ties: the lowest id)
+        helper = -1
+        best_d = math.inf
+        for o in range(m_slots):
+            if math.isnan(seen_x[o]) or tr[r, o] != 0.0:  # unknown (-1) or in trouble (1)
+                continue
+            if towards_goal and _mate_recedes(r, o, rpar, mg_d, mg_n):
+                continue
+            dd = N.py_hypot(seen_x[o] - px, seen_y[o] - py)
+            if dd < best_d:
+                helper = o
+                best_d = dd
+        tt = helper
+        rist[r, R_TT_ID] = helper
+        rist[r, R_TT_STALL] = 0
+        if helper >= 0:
+            tx = seen_x[helper]
+            ty = seen_y[helper]
+            rfst[r, F_TT_X] = tx
+            rfst[r, F_TT_Y] = ty
+            if towards_goal:
+                k = mg_n[r, helper]
+                rfst[r, F_TT_BEST] = mg_d[r, helper, k - 1] if k > 0 else N.py_hypot(tx - gx, ty - gy)
+    if tt >= 0 and (not math.isnan(vis_x[tt]) or keep_helper):
+        rist[r, R_MODE] = MODE_TROUBLE
+        d, towards = _head_to_k(r, tx, ty, KEY_HELPER, tt, 0, near, near, False, px, py, th, c, s, ranges, vis, angles,
+                                max_range, gap, epar, efst, eist, rist, npar, nfst, nist, grid, normals)
+        in_now = not math.isnan(now_x[tt])
+        if rpar[r, RP_DROP_HELPER] != 0.0:
+            rist[r, R_TT_STALL] = 0 if (towards or in_now) else rist[r, R_TT_STALL] + 1
+            if rist[r, R_TT_STALL] >= int(rpar[r, RP_DROP_AFTER]):
+                rist[r, R_TT_STALL] = 0
+                rist[r, R_HELPERS_DROPPED] += 1
+                rist[r, R_TT_ID] = -1
+        mode = int(rpar[r, RP_PROGRESS])
+        if mode == PROGRESS_HELPER:
+            progressing = towards  # Fig. 10: progress towards G_icurr = R_j
+        elif mode == PROGRESS_MOVED:
+            progressing = not stalled[r]
+        else:
+            progressing = goal_d < rfst[r, F_PREV_GOAL_D] - epar[r, C.Q_PMF] * step_m
+        near_m = rpar[r, RP_NEAR_HELPER]
+        if not math.isnan(near_m) and in_now and N.py_hypot(tx - px, ty - py) <= near_m:
+            progressing = True
+        return d, progressing, True
+    return math.nan, progressing, False
+
+
+@njit(cache=True)
+def team_advance(step, odom, role, epar, eist, rist, hist, patrol, targets, target_steps, own_set, own_k, own_xy,
+                 mg_n):
     """Each compiled row's task (R1: its targets; a helper: its patrol) and the ``set_own_goal``
     call it makes."""
     for r in range(odom.shape[0]):
         if role[r] == ROLE_R1:
-            r1_team_advance_row(r, step, odom, epar, eist, rist, targets, target_steps, own_set, own_k, own_xy)
+            r1_team_advance_row(r, step, odom, epar, eist, rist, targets, target_steps, own_set, own_k, own_xy, mg_n)
         else:
             HC.helper_advance_row(r, odom, epar, eist, hist, patrol, own_set, own_k, own_xy)
 
 
 @njit(cache=True)
 def team_decide(step, odom, role, ranges, vis, angles, max_range, gap, sight, epar, efst, eist, rist, rpar, hist,
-                patrol, targets, paths, npar, nfst, nist, grid, normals, out_dir, grow, nav):
+                patrol, targets, paths, npar, nfst, nist, grid, normals, out_dir, grow, nav, tf):
     """Each compiled row's decision (``out_dir[r]``: the body-frame direction, NaN: none). Returns,
     changing nothing, 1 (grow Avoid-Past's grid: ``grow`` = row, cell i, cell j) or 2 (refill the
     normals), as :func:`~.compiled.r1_alone_step`; else 0."""
@@ -357,7 +547,7 @@ def team_decide(step, odom, role, ranges, vis, angles, max_range, gap, sight, ep
     for r in range(n):
         if role[r] == ROLE_R1:
             out_dir[r] = r1_team_decide_row(r, step, odom, ranges, vis, angles, max_range, gap, sight, epar, efst,
-                                            eist, rist, rpar, targets, paths, npar, nfst, nist, grid, normals)
+                                            eist, rist, rpar, targets, paths, npar, nfst, nist, grid, normals, tf)
         else:
             out_dir[r] = HC.helper_decide_row(r, odom, ranges, vis, angles, max_range, gap, epar, efst, eist, hist,
                                               patrol, npar, nfst, nist, grid, normals, nav)
@@ -374,8 +564,10 @@ def r1_team_unsupported(p: Any, info: RobotInfo) -> str | None:
     if p.navigator not in ("potential_field", "avoid_past"):
         return (f"navigator {p.navigator!r} with teammates (compiled: potential_field, avoid_past; VisBug-21's "
                 "temporary goals and start_again are not)")
-    if p.state_sharing:
-        return "state_sharing (§5's trouble following is not compiled)"
+    if p.state_sharing and p.trouble_return:
+        return "trouble_return (§5: back to where a teammate was last seen; not compiled)"
+    if p.state_sharing and p.trouble_release_to_helper:
+        return "trouble_release_to_helper (§5: on to a released teammate's last position; not compiled)"
     if p.frame_source != "bearings":
         return f"frame_source {p.frame_source!r}"
     if p.navigate_past_teammates_beyond_m is not None:
@@ -432,7 +624,8 @@ class _R1TeamView:
     vias_taken = property(lambda self: self._q(R_VIAS))
     msgs_received = property(lambda self: int(self._g.gs.gist[self._r, GC.I_MSGS_RECEIVED]))
     target_steps = property(lambda self: [int(v) for v in self._g.target_steps[self._r, :self._i(C.J_REACHED)]])
-    ghosts_unreachable = trouble_helpers_dropped = 0  # VisBug-21 and state sharing are not compiled with teammates
+    trouble_helpers_dropped = property(lambda self: self._q(R_HELPERS_DROPPED))
+    ghosts_unreachable = 0  # VisBug-21 is not compiled with teammates
 
     @property
     def mode_steps(self) -> dict[str, int]:
@@ -468,7 +661,7 @@ class _R1TeamView:
         out.update(target_index=self.target_index, targets_reached=self.targets_reached, finished=self.finished,
                    gave_up=self.gave_up, goal_seen_steps=self.goal_seen_steps, promised_steps=self.promised_steps,
                    temp_dropped=self.temp_dropped, ghosts_unreachable=0, vias_taken=self.vias_taken,
-                   trouble_helpers_dropped=0)
+                   trouble_helpers_dropped=self.trouble_helpers_dropped)
         if self.params.log_layers:
             goal = gs.own_goal(r)
             ghosts = [(float(p[GC.P_PX]), float(p[GC.P_PY])) for _, p in paths if p[GC.P_KIND] != GC.KIND_DIRECT]
@@ -505,6 +698,16 @@ class _Compiled:
         self.hist = np.zeros((n, HC.N_H), dtype=np.int64)
         self.rpar = np.zeros((n, N_RP))
         self.rist = np.zeros((n, N_R), dtype=np.int64)
+        self.rfst = np.zeros((n, N_RF))
+        self.rfst[:, F_TT_BEST] = math.inf
+        self.rfst[:, F_PREV_GOAL_D] = math.inf
+        self.rist[:, R_TT_ID] = -1
+        # the teammates' recent distances to the goal (``_mate_goal_d``): at most
+        # trouble_heading_steps + 1 kept, one more before the old ones are dropped
+        depth = max([int(getattr(p, "trouble_heading_steps", 0)) for p in params] + [0]) + 2
+        self.mg_step = np.zeros((n, m, depth), dtype=np.int64)
+        self.mg_d = np.zeros((n, m, depth))
+        self.mg_n = np.zeros((n, m), dtype=np.int64)
         npar, vpar, vis_r, radius, step = [], [], [], [], []
         for r, (p, info) in enumerate(zip(params, infos)):
             sensor = info.sensors[p.laser]
@@ -545,6 +748,16 @@ class _Compiled:
                 rp[RP_DROP_STALLED] = float(p.drop_stalled_ghost)
                 rp[RP_POINT_MARGIN] = 2.5 * rad
                 rp[RP_ME] = ids[r]
+                rp[RP_STATE] = float(p.state_sharing)
+                rp[RP_TOWARDS] = float(p.trouble_helper_towards_goal)
+                rp[RP_HEADING_STEPS] = p.trouble_heading_steps
+                rp[RP_RECEDE] = p.trouble_recede_m
+                rp[RP_AT_SEND] = float(p.trouble_sighting_at_send)
+                rp[RP_KEEP_HELPER] = float(p.keep_trouble_helper)
+                rp[RP_DROP_HELPER] = float(p.trouble_drop_stalled_helper)
+                rp[RP_DROP_AFTER] = p.trouble_drop_after_steps
+                rp[RP_PROGRESS] = PROGRESS.index(p.trouble_progress)
+                rp[RP_NEAR_HELPER] = math.nan if p.trouble_near_helper_m is None else p.trouble_near_helper_m
             else:
                 e[C.Q_BUDGET] = -1.0
                 if p.patrol_xy:
@@ -612,14 +825,16 @@ class _Compiled:
         GC.team_sightings(self.ids, obs.det_count, obs.det_id, obs.det_range_m, obs.det_bearing_rad, ranges, self.a64,
                           max_range, self.radius, self.see_past, sight, vis)
         team_advance(step, odom, self.role, self.epar, self.eist, self.rist, self.hist, self.patrol, self.targets,
-                     self.target_steps, self.own_set, self.own_k, self.own_xy)
+                     self.target_steps, self.own_set, self.own_k, self.own_xy, self.mg_n)
         self.gs.begin_step(step, odom, sight, self.own_set, self.own_k, self.own_xy, in_rows, senders, start, vis,
                            self.a64)
+        tf = (self.rfst, self.mg_step, self.mg_d, self.mg_n, self.gs.tr, self.gs.tr_xy,
+              np.ascontiguousarray(obs.stalled, dtype=np.bool_))
         while True:
             code = team_decide(step, odom, self.role, ranges, vis, self.a64, max_range, self.gap, sight, self.epar,
                                self.efst, self.eist, self.rist, self.rpar, self.hist, self.patrol, self.targets,
                                self.gs.paths, self.npar, self.nfst, self.nist, self.grid, self.normals, self.dir,
-                               self.grow, self.nav)
+                               self.grow, self.nav, tf)
             if code == 0:
                 break
             if code == 1:
@@ -677,6 +892,8 @@ class LosTeamGroup:
         if why is not None:
             raise ValueError(f"LosTeamGroup cannot run these robots: {why}")
         self._alone = C.LosExplorerGroup(params, rngs, infos) if alone else None
+        #: robots whose step is compiled (the others run their reference brains inside)
+        self.compiled_robots = sum(1 for role in roles if role) if not alone else len(params)
         if alone:
             self.robots = self._alone.robots
             return
