@@ -445,10 +445,10 @@ def _team_steps(base: Path, new: Path, steps: int, repeats: int, base_name: str,
 GROUP_NAVIGATORS = ("potential_field", "avoid_past", "visbug21")
 #: ... and R1..R4 with the helpers R2..R4 compiled (R1, with teammates, on its per-robot brain),
 #: the scenario's VisBug-21 for every robot ("team/<navigator of R1>").
-#: R1..R4: with VisBug-21 R1 runs its reference brain inside the team's group brain (VisBug-21's
-#: temporary goals are not compiled); with Avoid-Past (Table 1's case, no state sharing) the
-#: whole team is compiled
-GROUP_TEAMS = ("team/visbug21", "team/avoid_past")
+#: R1..R4 as in Tables 1-2 (state sharing with the potential field only): with VisBug-21 R1 runs
+#: its reference brain inside the team's group brain (VisBug-21's temporary goals are not
+#: compiled); with the potential field or Avoid-Past the whole team is compiled
+GROUP_TEAMS = ("team/visbug21", "team/potential_field", "team/avoid_past")
 
 
 def _group_overrides(navigator: str, paper: bool, task: int) -> dict:
@@ -457,7 +457,8 @@ def _group_overrides(navigator: str, paper: bool, task: int) -> dict:
     if navigator.startswith("team/"):  # R1..R4; the paper column: every robot with paper_rules
         ov = dict(team_overrides("simple", 3))
         ov["robots.0.params.navigator"] = navigator[len("team/"):]
-        ov["robots.0.params.state_sharing"] = False  # as Table 1's Avoid-Past and VisBug-21 cases
+        # Tables 1-2's cases: state sharing with the potential field, not with the others
+        ov["robots.0.params.state_sharing"] = navigator == "team/potential_field"
         if paper:
             for k in range(4):
                 ov[f"robots.{k}.params.paper_rules"] = True
