@@ -564,7 +564,7 @@ def _group_brains(steps: int, repeats: int, only: list[str] | None = None) -> No
     """CPU per team step, compiled group brains vs the Python reference (see ``--group-brains``)."""
     load0 = os.getloadavg()[0]
     t0 = time.process_time()
-    print(f"R1 alone, and R1..R4 with R2..R4 compiled (team/...), on office_simple, tuning task {TEAM_TASK}, "
+    print(f"R1 alone, and R1..R4 (team/...: the team's group brain), on office_simple, tuning task {TEAM_TASK}, "
           f"{steps} steps per run, {repeats} round(s), medians "
           f"of CPU (time.process_time, one numba thread), this tree ({REPO}), load {load0:.1f}")
     print(f"{'column':8s} {'navigator':16s} {'ref ms/step':>11s} {'(brains)':>9s} {'compiled':>9s} {'(brains)':>9s} "

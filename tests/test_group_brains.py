@@ -427,6 +427,8 @@ def test_packed_messages_round_trip_and_size_as_the_message():
             body = PackedLosMsg(row)
             assert payload_size_bytes(body) == payload_size_bytes(msg)
             assert Message(0, 0.0, body, kind="los_help").size_bytes() == message_size_bytes(msg)
+            sized = PackedLosMsg.sized(row)  # the size computed once, as a compiled team sends it
+            assert sized.size == payload_size_bytes(msg) and payload_size_bytes(sized) == sized.size
     from teamnav.papers.los_help.brains.messages import LosHelpMsg
 
     with pytest.raises(ValueError):

@@ -960,8 +960,8 @@ class LosTeamGroup:
             row = part.gs.out[k].copy()
             view = part.views[k]
             if self._packed:
-                body = PackedLosMsg(row)
-                size = 24 + body.size_bytes()  # message_size_bytes: the 24-byte header and the body
+                body = PackedLosMsg.sized(row)
+                size = 24 + body.size  # message_size_bytes: the 24-byte header and the body
             else:
                 body = unpack(row)
                 sent_rows[id(body)] = (body, row)
