@@ -445,7 +445,10 @@ def _team_steps(base: Path, new: Path, steps: int, repeats: int, base_name: str,
 GROUP_NAVIGATORS = ("potential_field", "avoid_past", "visbug21")
 #: ... and R1..R4 with the helpers R2..R4 compiled (R1, with teammates, on its per-robot brain),
 #: the scenario's VisBug-21 for every robot ("team/<navigator of R1>").
-GROUP_TEAMS = ("team/visbug21",)
+#: R1..R4 as in Tables 1-2 (state sharing with the potential field only): with VisBug-21 R1 runs
+#: its reference brain inside the team's group brain (VisBug-21's temporary goals are not
+#: compiled); with the potential field or Avoid-Past the whole team is compiled
+GROUP_TEAMS = ("team/visbug21", "team/potential_field", "team/avoid_past")
 
 
 def _group_overrides(navigator: str, paper: bool, task: int) -> dict:
@@ -454,6 +457,8 @@ def _group_overrides(navigator: str, paper: bool, task: int) -> dict:
     if navigator.startswith("team/"):  # R1..R4; the paper column: every robot with paper_rules
         ov = dict(team_overrides("simple", 3))
         ov["robots.0.params.navigator"] = navigator[len("team/"):]
+        # Tables 1-2's cases: state sharing with the potential field, not with the others
+        ov["robots.0.params.state_sharing"] = navigator == "team/potential_field"
         if paper:
             for k in range(4):
                 ov[f"robots.{k}.params.paper_rules"] = True
@@ -541,7 +546,10 @@ def _group_worker(navigator: str, paper: bool, compiled: bool, steps: int) -> di
                                     group_brains=compiled)
     if compiled and not res.sim.group_teams:
         raise SystemExit("the group brain did not run R1")
-    return {"cpu_s": total, "brain_s": brain_s, "steps": int(res.sim.step_index), "digest": _digest(res)}
+    # robots whose step is compiled (a team's group brain may run a row on its reference brain)
+    robots = sum(getattr(team, "compiled_robots", stop - start) for team, start, stop, _ in res.sim.group_teams)
+    return {"cpu_s": total, "brain_s": brain_s, "steps": int(res.sim.step_index), "digest": _digest(res),
+            "compiled_robots": robots, "robots": int(res.sim.n_robots)}
 
 
 def _group_measure(navigator: str, paper: bool, compiled: bool, steps: int) -> dict:
@@ -556,12 +564,12 @@ def _group_brains(steps: int, repeats: int, only: list[str] | None = None) -> No
     """CPU per team step, compiled group brains vs the Python reference (see ``--group-brains``)."""
     load0 = os.getloadavg()[0]
     t0 = time.process_time()
-    print(f"R1 alone, and R1..R4 with R2..R4 compiled (team/...), on office_simple, tuning task {TEAM_TASK}, "
+    print(f"R1 alone, and R1..R4 (team/...: the team's group brain), on office_simple, tuning task {TEAM_TASK}, "
           f"{steps} steps per run, {repeats} round(s), medians "
           f"of CPU (time.process_time, one numba thread), this tree ({REPO}), load {load0:.1f}")
     print(f"{'column':8s} {'navigator':16s} {'ref ms/step':>11s} {'(brains)':>9s} {'compiled':>9s} {'(brains)':>9s} "
           f"{'ratio':>6s} {'brains':>7s}  outputs")
-    lines, ratios, team_ratios = [], [], []
+    lines, ratios, team_ratios, whole_ratios = [], [], [], []
     for paper, nav in itertools.product((False, True), GROUP_NAVIGATORS + GROUP_TEAMS):
         col = "paper" if paper else "teamnav"
         if only and not any(o in f"{col}/{nav}" for o in only):
@@ -578,9 +586,12 @@ def _group_brains(steps: int, repeats: int, only: list[str] | None = None) -> No
         ct = statistics.median(1000 * r["cpu_s"] / r["steps"] for r in cmp_)
         cb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in cmp_)
         team = nav.startswith("team/")
-        (team_ratios if team else ratios).append(rt / ct)
+        whole = team and all(r["compiled_robots"] == r["robots"] for r in cmp_)
+        if same:  # a ratio only for identical runs
+            (whole_ratios if whole else team_ratios if team else ratios).append(rt / ct)
         print(f"{col:8s} {nav:16s} {rt:11.4f} {rb:9.4f} {ct:9.4f} {cb:9.4f} {rt / ct:6.2f} {rb / cb:7.2f}  "
-              f"{'identical' if same else 'DIFFER'}", flush=True)
+              f"{'identical' if same else 'DIFFER'}; compiled robots {cmp_[0]['compiled_robots']} of "
+              f"{cmp_[0]['robots']}", flush=True)
         lines.append(f"LOS team step, {4 if team else 1} robots ({col}, {nav}): compiled / reference = {rt / ct:.2f}x")
     print(f"(brains: CPU inside the brains' step and log, or the group brain's step_group and the views' log; "
           f"load {load0:.1f} -> {os.getloadavg()[0]:.1f}; this script's own CPU {time.process_time() - t0:.1f} s, "
@@ -589,9 +600,11 @@ def _group_brains(steps: int, repeats: int, only: list[str] | None = None) -> No
         print(line)
     if ratios:
         print(f"LOS team step, 1 robots: compiled / reference = {statistics.median(ratios):.2f}x")
-    if team_ratios:  # not yet the whole team compiled: named apart from the issue's "4 robots:" line
+    if team_ratios:  # R1 on its reference brain inside the team: named apart from the issue's "4 robots:" line
         print(f"LOS team step, 4 robots (helpers compiled, R1 reference): compiled / reference = "
               f"{statistics.median(team_ratios):.2f}x")
+    if whole_ratios:  # the whole team compiled (the issue's line; last)
+        print(f"LOS team step, 4 robots: compiled / reference = {statistics.median(whole_ratios):.1f}x")
 
 
 if __name__ == "__main__":

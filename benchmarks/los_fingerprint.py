@@ -149,7 +149,9 @@ def run_one(map_key: str, case: str, team: str, err_max: float, steps: int, pape
         h.update(json.dumps(s, sort_keys=True).encode())
     summary["steps"] = int(res.sim.step_index)
     h.update(str(summary["steps"]).encode())
-    summary["compiled_robots"] = sum(stop - start for _, start, stop, _ in res.sim.group_teams)  # not hashed
+    # not hashed; a team's group brain may run a row on its reference brain (``compiled_robots``)
+    summary["compiled_robots"] = sum(getattr(team, "compiled_robots", stop - start)
+                                     for team, start, stop, _ in res.sim.group_teams)
     return h.hexdigest(), summary
 
 

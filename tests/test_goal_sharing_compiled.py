@@ -474,12 +474,12 @@ def _same_log(la: dict, lb: dict, where: str) -> None:
 
 
 def side_by_side(scn, steps: int):
-    """The reference R1..R4 and the same run with the helpers' group brain (R1, with teammates,
-    stays on its per-robot brain), step by step: true poses, odometry, commands, every robot's
+    """The reference R1..R4 and the same run with the team's group brain (R1, with state sharing
+    or VisBug-21, runs its per-robot brain inside it), step by step: true poses, odometry, commands, every robot's
     log and the radio's totals must be equal."""
     ref = Simulation(build_grid(scn), scn)
     grp = Simulation(build_grid(scn), scn, group_brains=True)
-    assert len(grp.group_teams) == 1 and grp.group_teams[0][1:3] == (1, 4), "the helpers' group brain must run R2..R4"
+    assert len(grp.group_teams) == 1 and grp.group_teams[0][1:3] == (0, 4), "the team's group brain must run R1..R4"
     brains_ref = [b for g in ref.brains for b in g]
     brains_grp = [b for g in grp.brains for b in g]
     for k in range(steps):

@@ -162,16 +162,21 @@ def test_identity_without_targets():
     assert r1.finished and r1.mode == "done"
 
 
-def test_teams_with_helpers_keep_the_reference_brains():
-    """R1 with a helper is not compiled yet: its group brain declines and R1 runs its
-    per-robot brain; the helper runs the helpers' group brain (its identity with the
-    reference: tests/test_goal_sharing_compiled.py)."""
-    ov = {"robots.0.params.navigator": "avoid_past", "robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0}
-    scn = load_scenario("los-help-simple", overrides=ov, duration_s=1.0, seed=0)
-    sim = Simulation(build_grid(scn), scn, group_brains=True)
-    assert [type(t).__name__ for t, *_ in sim.group_teams] == ["LosHelperGroup"]
-    assert sim.group_teams[0][1:3] == (1, 2)
-    assert type(sim.brains[0][0]).__name__ == "LosExplorer"
+def test_teams_with_helpers_step_in_one_group_brain():
+    """R1 and a helper form one team of the team's group brain: with VisBug-21 (its temporary
+    goals are not compiled) R1 runs its per-robot brain inside it, beside the compiled helper;
+    with Avoid-Past, R1 is compiled too (identity with the reference: tests/test_team_compiled.py
+    and tests/test_goal_sharing_compiled.py)."""
+    ov = {"robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0}
+    for navigator, r1 in (("visbug21", "LosExplorer"), ("avoid_past", "_R1TeamView")):
+        scn = load_scenario("los-help-simple", overrides={**ov, "robots.0.params.navigator": navigator},
+                            duration_s=1.0, seed=0)
+        sim = Simulation(build_grid(scn), scn, group_brains=True)
+        assert [type(t).__name__ for t, *_ in sim.group_teams] == ["LosTeamGroup"]
+        assert sim.group_teams[0][1:3] == (0, 2)
+        assert type(sim.brains[0][0]).__name__ == r1
+        assert type(sim.brains[1][0]).__name__ == "_HelperView"
+        assert sim.group_teams[0][0].compiled_robots == (1 if navigator == "visbug21" else 2)
 
 
 def test_runs_with_faults_keep_the_reference_brains():
@@ -422,6 +427,8 @@ def test_packed_messages_round_trip_and_size_as_the_message():
             body = PackedLosMsg(row)
             assert payload_size_bytes(body) == payload_size_bytes(msg)
             assert Message(0, 0.0, body, kind="los_help").size_bytes() == message_size_bytes(msg)
+            sized = PackedLosMsg.sized(row)  # the size computed once, as a compiled team sends it
+            assert sized.size == payload_size_bytes(msg) and payload_size_bytes(sized) == sized.size
     from teamnav.papers.los_help.brains.messages import LosHelpMsg
 
     with pytest.raises(ValueError):

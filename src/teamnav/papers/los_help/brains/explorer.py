@@ -51,9 +51,9 @@ class LosExplorer(_TroubleFollowing, _LosBrain):
 
     Params = LosExplorerParams
     #: the compiled form of this brain for a whole group (``Simulation(..., group_brains=True)``;
-    #: :mod:`teamnav.control.group`): R1 alone so far (:mod:`.compiled`); the helpers have their own
-    #: (:mod:`.helper_compiled`)
-    group_brain = "teamnav.papers.los_help.brains.compiled:LosExplorerGroup"
+    #: :mod:`teamnav.control.group`): R1 and the helpers in one team (:mod:`.team_compiled`; R1
+    #: alone: :mod:`.compiled`)
+    group_brain = "teamnav.papers.los_help.brains.team_compiled:LosTeamGroup"
 
     def __init__(self, params: LosExplorerParams, rng: np.random.Generator, info: RobotInfo) -> None:
         super().__init__(params, rng, info)

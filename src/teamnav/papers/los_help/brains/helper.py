@@ -57,9 +57,9 @@ class LosHelper(_LosBrain):
     """
 
     Params = LosHelperParams
-    #: the compiled form of this brain for a whole team of helpers (``Simulation(..., group_brains=True)``;
-    #: ``docs/concepts/group-brains.md``)
-    group_brain = "teamnav.papers.los_help.brains.helper_compiled:LosHelperGroup"
+    #: the compiled form of this brain with its team (``Simulation(..., group_brains=True)``;
+    #: ``docs/concepts/group-brains.md``): R1 and the helpers in one team (:mod:`.team_compiled`)
+    group_brain = "teamnav.papers.los_help.brains.team_compiled:LosTeamGroup"
 
     def __init__(self, params: LosHelperParams, rng: np.random.Generator, info: RobotInfo) -> None:
         super().__init__(params, rng, info)

@@ -70,109 +70,142 @@ MODES = ("patrol", "stay")
 
 
 @njit(cache=True)
-def helpers_advance(odom, epar, eist, hist, patrol, own_set, own_k, own_xy):
-    """``LosHelper._advance_task`` of every row; ``own_set`` / ``own_k`` / ``own_xy``: the
+def helper_advance_row(r, odom, epar, eist, hist, patrol, own_set, own_k, own_xy):
+    """``LosHelper._advance_task`` of row ``r``; ``own_set[r]`` / ``own_k[r]`` / ``own_xy[r]``: the
     ``set_own_goal`` call it makes (for :func:`~.goal_sharing_compiled.gs_begin_step`)."""
+    own_set[r] = 0
+    n = hist[r, H_NP]
+    if n == 0:
+        return
+    wi = hist[r, H_WI]
+    reached = N.py_hypot(patrol[r, wi, 0] - odom[r, 0], patrol[r, wi, 1] - odom[r, 1]) < epar[r, C.Q_TOL]
+    hist[r, H_ON_WP] += 1
+    timeout = hist[r, H_TIMEOUT]
+    timed_out = not reached and timeout > 0 and hist[r, H_ON_WP] > timeout
+    if not (reached or timed_out):
+        return
+    if n == 1:
+        return  # one waypoint: it stays there
+    if hist[r, H_CYCLE] != 0:
+        wi = (wi + 1) % n
+    else:
+        if not (0 <= wi + hist[r, H_DIR] < n):
+            hist[r, H_DIR] = -hist[r, H_DIR]
+        wi += hist[r, H_DIR]
+    hist[r, H_WI] = wi
+    if reached:
+        hist[r, H_REACHED] += 1
+    else:
+        hist[r, H_SKIPPED] += 1
+    hist[r, H_ON_WP] = 0
+    eist[r, C.J_IDX] += 1
+    eist[r, C.J_LAST] = 0  # _last_target = None
+    own_set[r] = 1
+    own_k[r] = eist[r, C.J_IDX]
+    own_xy[r, 0] = patrol[r, wi, 0]
+    own_xy[r, 1] = patrol[r, wi, 1]
+    if epar[r, C.Q_RESET_TR] != 0.0:  # TroubleState.reset
+        eist[r, C.J_PR] = 0
+        eist[r, C.J_NT_TR] = 1
+        eist[r, C.J_TR] = 0
+
+
+@njit(cache=True)
+def helpers_advance(odom, epar, eist, hist, patrol, own_set, own_k, own_xy):
+    """``LosHelper._advance_task`` of every row (:func:`helper_advance_row`)."""
     for r in range(odom.shape[0]):
-        own_set[r] = 0
-        n = hist[r, H_NP]
-        if n == 0:
-            continue
+        helper_advance_row(r, odom, epar, eist, hist, patrol, own_set, own_k, own_xy)
+
+
+@njit(cache=True)
+def nav_needs_room(r, px, py, epar, npar, nist, grid, grow):
+    """Before any row steps: 2 when row ``r``'s potential field / Avoid-Past has fewer than two
+    normals left, 1 (``grow`` = row, cell i, cell j) when its Avoid-Past visit would fall outside
+    its grid; else 0 (VisBug-21 rows: always 0)."""
+    if epar[r, C.Q_VISBUG] != 0.0:
+        return 0
+    if nist[r, N.I_NORMAL] > N.NORMALS - 2:
+        return 2
+    out, ci, cj = N.visit_cell_outside(npar, nist, grid, r, px, py)
+    if out:
+        grow[0] = r
+        grow[1] = ci
+        grow[2] = cj
+        return 1
+    return 0
+
+
+@njit(cache=True)
+def helper_decide_row(r, odom, ranges, vis, angles, max_range, gap, epar, efst, eist, hist, patrol, npar, nfst, nist,
+                      grid, normals, nav):
+    """``LosHelper._decide`` of row ``r``, with the step's move count and mode count; returns the
+    body-frame direction of the next step (NaN: none)."""
+    px = odom[r, 0]
+    py = odom[r, 1]
+    th = odom[r, 2]
+    c = math.cos(th)
+    s = math.sin(th)
+    efst[r, C.X_PX] = px
+    efst[r, C.X_PY] = py
+    efst[r, C.X_TH] = th
+    d = math.nan
+    np_ = hist[r, H_NP]
+    if np_ == 0:
+        hist[r, H_MODE] = MODE_STAY
+    else:
         wi = hist[r, H_WI]
-        reached = N.py_hypot(patrol[r, wi, 0] - odom[r, 0], patrol[r, wi, 1] - odom[r, 1]) < epar[r, C.Q_TOL]
-        hist[r, H_ON_WP] += 1
-        timeout = hist[r, H_TIMEOUT]
-        timed_out = not reached and timeout > 0 and hist[r, H_ON_WP] > timeout
-        if not (reached or timed_out):
-            continue
-        if n == 1:
-            continue  # one waypoint: it stays there
-        if hist[r, H_CYCLE] != 0:
-            wi = (wi + 1) % n
+        wx = patrol[r, wi, 0]
+        wy = patrol[r, wi, 1]
+        if np_ == 1 and N.py_hypot(wx - px, wy - py) < epar[r, C.Q_TOL]:
+            hist[r, H_MODE] = MODE_STAY
         else:
-            if not (0 <= wi + hist[r, H_DIR] < n):
-                hist[r, H_DIR] = -hist[r, H_DIR]
-            wi += hist[r, H_DIR]
-        hist[r, H_WI] = wi
-        if reached:
-            hist[r, H_REACHED] += 1
-        else:
-            hist[r, H_SKIPPED] += 1
-        hist[r, H_ON_WP] = 0
-        eist[r, C.J_IDX] += 1
-        eist[r, C.J_LAST] = 0  # _last_target = None
-        own_set[r] = 1
-        own_k[r] = eist[r, C.J_IDX]
-        own_xy[r, 0] = patrol[r, wi, 0]
-        own_xy[r, 1] = patrol[r, wi, 1]
-        if epar[r, C.Q_RESET_TR] != 0.0:  # TroubleState.reset
-            eist[r, C.J_PR] = 0
-            eist[r, C.J_NT_TR] = 1
-            eist[r, C.J_TR] = 0
+            hist[r, H_MODE] = MODE_PATROL
+            if C._sees(r, wx, wy, 0.0, px, py, c, s, vis, angles, gap, epar[r, C.Q_VIS_R]):
+                d, progressing = C._head_to(r, wx, wy, 0.5 * epar[r, C.Q_TOL], px, py, th, c, s, ranges, angles,
+                                            max_range, gap, epar, efst, eist, npar, nfst, nist, grid, normals, nav,
+                                            vis)
+            else:  # _drive: A towards the waypoint
+                eist[r, C.J_LAST] = 0
+                d, progressing = C._navigate(r, wx, wy, px, py, th, ranges, angles, max_range, epar, efst, eist,
+                                             npar, nfst, nist, grid, normals, nav)
+            trouble_update(r, progressing, epar, eist)
+    if not math.isnan(d):
+        eist[r, C.J_MOVES] += 1
+    hist[r, H_STEPS + hist[r, H_MODE]] += 1
+    return d
+
+
+@njit(cache=True)
+def trouble_update(r, progressing, epar, eist):
+    """§5: ``TroubleState.update(progressing)`` of row ``r``."""
+    bound = eist[r, C.J_NT_TR] * int(epar[r, C.Q_CR])
+    if progressing:
+        eist[r, C.J_PR] = max(eist[r, C.J_PR] - 1, 0)
+    else:
+        eist[r, C.J_PR] = min(eist[r, C.J_PR] + eist[r, C.J_NT_TR], bound)
+    if eist[r, C.J_TR] == 0 and eist[r, C.J_PR] >= bound:
+        eist[r, C.J_TR] = 1
+    elif eist[r, C.J_TR] == 1 and eist[r, C.J_PR] == 0:
+        eist[r, C.J_TR] = 0
+        eist[r, C.J_NT_TR] += 1
 
 
 @njit(cache=True)
 def helpers_decide(odom, ranges, vis, angles, max_range, gap, epar, efst, eist, hist, patrol, npar, nfst, nist, grid,
                    normals, out_dir, grow, nav):
-    """``LosHelper._decide`` of every row, with the step's move count and mode count;
-    ``out_dir[r]``: the body-frame direction of the next step (NaN: none). Returns, changing
-    nothing, 1 (grow Avoid-Past's grid: ``grow`` = row, cell i, cell j) or 2 (refill the
-    normals), as :func:`~.compiled.r1_alone_step`; else 0."""
+    """``LosHelper._decide`` of every row (:func:`helper_decide_row`); ``out_dir[r]``: the
+    body-frame direction of the next step (NaN: none). Returns, changing nothing, 1 (grow
+    Avoid-Past's grid: ``grow`` = row, cell i, cell j) or 2 (refill the normals), as
+    :func:`~.compiled.r1_alone_step`; else 0."""
     n = odom.shape[0]
     for r in range(n):
-        if hist[r, H_NP] > 0 and epar[r, C.Q_VISBUG] == 0.0:
-            if nist[r, N.I_NORMAL] > N.NORMALS - 2:
-                return 2
-            out, ci, cj = N.visit_cell_outside(npar, nist, grid, r, odom[r, 0], odom[r, 1])
-            if out:
-                grow[0] = r
-                grow[1] = ci
-                grow[2] = cj
-                return 1
+        if hist[r, H_NP] > 0:
+            code = nav_needs_room(r, odom[r, 0], odom[r, 1], epar, npar, nist, grid, grow)
+            if code != 0:
+                return code
     for r in range(n):
-        px = odom[r, 0]
-        py = odom[r, 1]
-        th = odom[r, 2]
-        c = math.cos(th)
-        s = math.sin(th)
-        efst[r, C.X_PX] = px
-        efst[r, C.X_PY] = py
-        efst[r, C.X_TH] = th
-        d = math.nan
-        np_ = hist[r, H_NP]
-        if np_ == 0:
-            hist[r, H_MODE] = MODE_STAY
-        else:
-            wi = hist[r, H_WI]
-            wx = patrol[r, wi, 0]
-            wy = patrol[r, wi, 1]
-            if np_ == 1 and N.py_hypot(wx - px, wy - py) < epar[r, C.Q_TOL]:
-                hist[r, H_MODE] = MODE_STAY
-            else:
-                hist[r, H_MODE] = MODE_PATROL
-                if C._sees(r, wx, wy, 0.0, px, py, c, s, vis, angles, gap, epar[r, C.Q_VIS_R]):
-                    d, progressing = C._head_to(r, wx, wy, 0.5 * epar[r, C.Q_TOL], px, py, th, c, s, ranges, angles,
-                                                max_range, gap, epar, efst, eist, npar, nfst, nist, grid, normals, nav,
-                                                vis)
-                else:  # _drive: A towards the waypoint
-                    eist[r, C.J_LAST] = 0
-                    d, progressing = C._navigate(r, wx, wy, px, py, th, ranges, angles, max_range, epar, efst, eist,
-                                                 npar, nfst, nist, grid, normals, nav)
-                # §5: TroubleState.update(progressing)
-                bound = eist[r, C.J_NT_TR] * int(epar[r, C.Q_CR])
-                if progressing:
-                    eist[r, C.J_PR] = max(eist[r, C.J_PR] - 1, 0)
-                else:
-                    eist[r, C.J_PR] = min(eist[r, C.J_PR] + eist[r, C.J_NT_TR], bound)
-                if eist[r, C.J_TR] == 0 and eist[r, C.J_PR] >= bound:
-                    eist[r, C.J_TR] = 1
-                elif eist[r, C.J_TR] == 1 and eist[r, C.J_PR] == 0:
-                    eist[r, C.J_TR] = 0
-                    eist[r, C.J_NT_TR] += 1
-        if not math.isnan(d):
-            eist[r, C.J_MOVES] += 1
-        hist[r, H_STEPS + hist[r, H_MODE]] += 1
-        out_dir[r] = d
+        out_dir[r] = helper_decide_row(r, odom, ranges, vis, angles, max_range, gap, epar, efst, eist, hist, patrol,
+                                       npar, nfst, nist, grid, normals, nav)
     return 0
 
 

@@ -63,14 +63,25 @@ def row_width(m: int) -> int:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class PackedLosMsg:
-    """A message body that is one packed row (read-only); sized as its :class:`LosHelpMsg`."""
+    """A message body that is one packed row (read-only); sized as its :class:`LosHelpMsg`.
+
+    ``size``: :meth:`size_bytes` computed once by the sender (-1: computed on each call; the
+    radio sizes a message each time it sends or delivers it)."""
 
     row: np.ndarray
+    size: int = -1
+
+    @classmethod
+    def sized(cls, row: np.ndarray) -> "PackedLosMsg":
+        """A body for ``row`` that carries its size (:meth:`size_bytes`, computed once)."""
+        return cls(row, cls(row).size_bytes())
 
     def size_bytes(self) -> int:
         """``payload_size_bytes`` of the :class:`LosHelpMsg` this row packs (its sizer's formula:
         8 for the step, 24 per sighting, 32 per goal, 24 per report and 8 per via field sent,
         1 for a Tr bit)."""
+        if self.size >= 0:
+            return self.size
         r = self.row
         m = (r.shape[0] - N_HEADER) // (SIGHT_W + GOAL_W + REPORT_W)
         n_r = int(r[H_N_REPORT])
