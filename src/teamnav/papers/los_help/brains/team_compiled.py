@@ -633,46 +633,13 @@ class _R1TeamView:
 
     def log(self) -> dict[str, Any]:
         """:meth:`~.explorer.LosExplorer.log`, the same keys in the same order."""
-        g, r = self._g, self._r
-        gs = g.gs
-        paths = gs.path_rows(r)
-        me_x, me_y = float(g.efst[r, C.X_PX]), float(g.efst[r, C.X_PY])
-        own_d = -1.0
-        for o, p in paths:
-            if o == self.me:
-                own_d = float(math.hypot(float(p[GC.P_PX]) - me_x, float(p[GC.P_PY]) - me_y) + float(p[GC.P_D]))
-        out = {
-            "mode": self.mode,
-            "moves": self.moves,
-            "tr": bool(self._i(C.J_TR)),
-            "pr": self._i(C.J_PR),
-            "nt": self._i(C.J_NT_TR),
-            "msgs_sent": int(self.msgs_sent),
-            "bytes_sent": int(self.bytes_sent),
-            "msgs_received": self.msgs_received,
-            "nav_restarts": self.nav_restarts,
-            "known_goals": int(gs.gist[r, GC.I_N_KNOWN]),
-            "ghosts": sum(1 for _, p in paths if p[GC.P_KIND] != GC.KIND_DIRECT),
-            "own_d_m": own_d,
-            **{f"steps_{m}": int(k) for m, k in sorted(self.mode_steps.items())},
-            "slide_steps": self.slide_steps,
-            "temp_switches": self.temp_switches,
-        }
+        out = HC.common_log(self, self.temp_switches)
         out.update(target_index=self.target_index, targets_reached=self.targets_reached, finished=self.finished,
                    gave_up=self.gave_up, goal_seen_steps=self.goal_seen_steps, promised_steps=self.promised_steps,
                    temp_dropped=self.temp_dropped, ghosts_unreachable=0, vias_taken=self.vias_taken,
                    trouble_helpers_dropped=self.trouble_helpers_dropped)
         if self.params.log_layers:
-            goal = gs.own_goal(r)
-            ghosts = [(float(p[GC.P_PX]), float(p[GC.P_PY])) for _, p in paths if p[GC.P_KIND] != GC.KIND_DIRECT]
-            out["layers"] = {
-                "los_goal": {"kind": "markers", "frame": "odom", "hold": True,
-                             "data": np.array([goal[1:]], dtype=np.float64) if goal is not None else np.zeros((0, 2)),
-                             "description": "Sgorbissa & Arkin: the robot's current goal (target or patrol waypoint)"},
-                "los_ghosts": {"kind": "markers", "frame": "odom", "hold": True,
-                               "data": np.array(ghosts, dtype=np.float64).reshape(-1, 2),
-                               "description": "Sgorbissa & Arkin §4: ghost robots and own past viewpoints kept for goals"},
-            }
+            out["layers"] = HC.log_layers(self)
         return out
 
 
@@ -863,7 +830,7 @@ class LosTeamGroup:
         if all(type(p) is LosExplorerParams and int(info.team_size) == 1 for p, info in zip(params, infos)):
             return True, [], C.LosExplorerGroup.unsupported(params, infos)
         helpers = [(p, info) for p, info in zip(params, infos) if type(p) is LosHelperParams]
-        helpers_why = (HC.LosHelperGroup.unsupported([p for p, _ in helpers], [i for _, i in helpers])
+        helpers_why = (HC.helpers_unsupported([p for p, _ in helpers], [i for _, i in helpers])
                        if helpers else "no helpers")
         roles = []
         for p, info in zip(params, infos):
