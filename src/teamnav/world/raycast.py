@@ -997,11 +997,9 @@ def _clearance_of(blocking: np.ndarray):
     return clearance_tiles(blocking) if blocking.size >= TILED_CLEARANCE_CELLS else clearance_map(blocking)
 
 
-_CLEAR_CACHE: dict[int, tuple[weakref.ref, np.ndarray]] = {}
-
-
-def _cached_clearance(blocking: np.ndarray) -> np.ndarray:
-    """Clearance maps of ``blocking``, cached while a read-only mask is alive.
+def _cached_per_mask(cache: dict, blocking: np.ndarray, make) -> np.ndarray:
+    """``make()``, computed once per read-only mask ``blocking`` and kept in ``cache`` while the
+    mask is alive.
 
     Only masks that nobody can write through are cached: read-only arrays whose bases are
     read-only too (a read-only view of a writeable array may still change underneath).
@@ -1009,19 +1007,28 @@ def _cached_clearance(blocking: np.ndarray) -> np.ndarray:
     base = blocking
     while isinstance(base, np.ndarray):
         if base.flags.writeable:
-            return _clearance_of(blocking)
+            return make()
         base = base.base
     key = id(blocking)
-    hit = _CLEAR_CACHE.get(key)
+    hit = cache.get(key)
     if hit is not None and hit[0]() is blocking:
         return hit[1]
-    clear = _clearance_of(blocking)
+    value = make()
     try:
-        ref = weakref.ref(blocking, lambda _r, key=key: _CLEAR_CACHE.pop(key, None))
+        ref = weakref.ref(blocking, lambda _r, key=key: cache.pop(key, None))
     except TypeError:  # pragma: no cover - every ndarray supports weak references
-        return clear
-    _CLEAR_CACHE[key] = (ref, clear)
-    return clear
+        return value
+    cache[key] = (ref, value)
+    return value
+
+
+_CLEAR_CACHE: dict[int, tuple[weakref.ref, np.ndarray]] = {}
+
+
+def _cached_clearance(blocking: np.ndarray) -> np.ndarray:
+    """Clearance maps of ``blocking``, cached while a read-only mask is alive
+    (:func:`_cached_per_mask`)."""
+    return _cached_per_mask(_CLEAR_CACHE, blocking, lambda: _clearance_of(blocking))
 
 
 _STRETCH_CACHE: dict[int, tuple[weakref.ref, np.ndarray]] = {}
@@ -1029,24 +1036,9 @@ _STRETCH_CACHE: dict[int, tuple[weakref.ref, np.ndarray]] = {}
 
 def _cached_stretch(blocking: np.ndarray, clear: np.ndarray) -> np.ndarray:
     """:func:`stretch_map` of ``clear = clearance_map(blocking)``, cached while a read-only mask
-    is alive (as :func:`_cached_clearance`): every filter on one map shares it (~75 ms and
-    16 bytes a cell for the MIT basement)."""
-    base = blocking
-    while isinstance(base, np.ndarray):
-        if base.flags.writeable:
-            return stretch_map(clear)
-        base = base.base
-    key = id(blocking)
-    hit = _STRETCH_CACHE.get(key)
-    if hit is not None and hit[0]() is blocking:
-        return hit[1]
-    ext = stretch_map(clear)
-    try:
-        ref = weakref.ref(blocking, lambda _r, key=key: _STRETCH_CACHE.pop(key, None))
-    except TypeError:  # pragma: no cover - every ndarray supports weak references
-        return ext
-    _STRETCH_CACHE[key] = (ref, ext)
-    return ext
+    is alive (:func:`_cached_per_mask`): every filter on one map shares it (~75 ms and 16 bytes
+    a cell for the MIT basement)."""
+    return _cached_per_mask(_STRETCH_CACHE, blocking, lambda: stretch_map(clear))
 
 
 def _run(clear, ox, oy, res, xs, ys, thetas, beams, max_range_m, out, parallel, ext=None):
