@@ -6,8 +6,10 @@ The engine steps the reference team and the same scenario with ``group_brains=Tr
 side and requires, at every step, equal true poses, odometry, commands and every robot's log,
 with R1 compiled with its teammates (its goal-sharing choices: the own goal in sight, a
 teammate, a ghost, the via point, a direct promise, a stalled point dropped) and the messages
-on the radio as packed rows. Where R1's compiled step declines (state sharing, VisBug-21 with
-teammates), R1 runs its reference brain inside the group brain:
+on the radio as packed rows; with VisBug-21 (since 2026-11-29) also its temporary goals,
+``start_again`` at a reached ghost and the resumed task goal. Where R1's compiled step declines
+(``trouble_return``, VisBug-21's ``turn="random"``), R1 runs its reference brain inside the group
+brain:
 ``tests/test_goal_sharing_compiled.py`` covers that with the scenario's defaults.
 """
 
@@ -103,6 +105,51 @@ def test_whole_team_compiled_is_the_reference(task, navigator, state_sharing, pa
         assert r1.vias_taken > 0 and r1.promised_steps > 0
 
 
+class _VisBugCalls:
+    """Counts the reference VisBug-21's temporary goals, ``start_again`` calls (and those made
+    while a task goal is suspended) and resumed task goals (the compiled rows never call them)."""
+
+    def __init__(self, monkeypatch):
+        from teamnav.control.nav.local.visbug21 import VisBug21
+
+        self.temporary = self.start_again = self.start_again_suspended = self.resumed = 0
+        set_goal, start_again, resume = VisBug21.set_goal, VisBug21.start_again, VisBug21._resume
+
+        def counted_set_goal(nav, goal_xy, temporary=False):
+            self.temporary += bool(temporary)
+            return set_goal(nav, goal_xy, temporary)
+
+        def counted_start_again(nav, reverse_walk_factor=None):
+            self.start_again += 1
+            self.start_again_suspended += nav.suspended_goal_xy is not None
+            return start_again(nav, reverse_walk_factor)
+
+        def counted_resume(nav, xy):
+            self.resumed += 1
+            return resume(nav, xy)
+
+        monkeypatch.setattr(VisBug21, "set_goal", counted_set_goal)
+        monkeypatch.setattr(VisBug21, "start_again", counted_start_again)
+        monkeypatch.setattr(VisBug21, "_resume", counted_resume)
+
+
+@pytest.mark.parametrize("paper", [False, True], ids=["teamnav", "paper"])
+@pytest.mark.parametrize("task", [1001, 1002])
+def test_visbug_team_compiled_is_the_reference(task, paper, monkeypatch):
+    """Tables 1-2's VisBug-21 team (every robot on VisBug-21, no state sharing), both columns, two
+    tuning tasks: R1 compiled with its teammates goes to teammates and ghosts as temporary goals
+    (the task goal's M-line and hit point suspended, then resumed) and starts VisBug again at a
+    reached ghost (``restart_navigator_at_ghost``, with ``visbug_reverse_walk_factor``)."""
+    calls = _VisBugCalls(monkeypatch)
+    refs, _ = side_by_side(_scenario(task, paper, "visbug21"), STEPS)
+    r1 = refs[0]
+    assert r1.targets_reached >= 1 and r1.msgs_received > 100
+    assert r1.mode_steps.get("follow_teammate", 0) > 0 and r1.mode_steps.get("ghost", 0) > 0
+    assert calls.temporary > 0 and calls.start_again > 0, vars(calls)
+    if (task, paper) == (1001, True):  # the case with start_again during a temporary goal
+        assert calls.start_again_suspended > 0 and calls.resumed > 0, vars(calls)
+
+
 @pytest.mark.parametrize("progress,steps", [("goal", STEPS), ("moved", 800)])
 def test_trouble_following_gap_fills(progress, steps):
     """§5 rule 3's gap-fills with other values: progress measured towards the own goal or as a
@@ -127,12 +174,13 @@ def test_stalled_points_dropped_and_budget():
 
 
 def test_what_is_declined_runs_the_reference_inside():
-    """R1 with ``trouble_return`` or VisBug-21 among teammates runs its reference brain inside the
-    group brain (the helpers stay compiled); ``unsupported`` says why R1's row is not compiled."""
+    """R1 with ``trouble_return`` or VisBug-21's ``turn="random"`` among teammates runs its
+    reference brain inside the group brain (the helpers stay compiled); ``unsupported`` says why
+    R1's row is not compiled."""
     from teamnav.papers.los_help.brains.explorer import LosExplorer
 
     for extra, why in (({"state_sharing": True, "trouble_return": True}, "trouble_return"),
-                       ({"navigator": "visbug21"}, "visbug21")):
+                       ({"navigator": "visbug21", "navigator_params": {"turn": "random"}}, "turn 'random'")):
         scn = _scenario(1001, False, "potential_field", 5, r1=extra)
         sim = Simulation(build_grid(scn), scn, group_brains=True)
         assert [type(t).__name__ for t, *_ in sim.group_teams] == ["LosTeamGroup"]
