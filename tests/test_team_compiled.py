@@ -57,14 +57,15 @@ def _same_log(la: dict, lb: dict, where: str) -> None:
             assert a.shape == b.shape and a.tobytes() == b.tobytes(), (name, where)
 
 
-def side_by_side(scn, steps: int):
-    """The reference team and the compiled one, step by step (see the module docstring)."""
+def side_by_side(scn, steps: int, r1_view: str = "_R1TeamView"):
+    """The reference team and the compiled one, step by step (see the module docstring);
+    ``r1_view``: R1's class in the group brain (``LosExplorer``: a reference row)."""
     ref = Simulation(build_grid(scn), scn)
     grp = Simulation(build_grid(scn), scn, group_brains=True)
     assert [(type(t).__name__, a, b) for t, a, b, _ in grp.group_teams] == [("LosTeamGroup", 0, 4)]
     brains_ref = [b for g in ref.brains for b in g]
     brains_grp = [b for g in grp.brains for b in g]
-    assert [type(b).__name__ for b in brains_grp] == ["_R1TeamView"] + ["_HelperView"] * 3, "the whole team compiled"
+    assert [type(b).__name__ for b in brains_grp] == [r1_view] + ["_HelperView"] * 3, "the team as expected"
     packed = 0
     orig = grp.radio.send
 
@@ -83,7 +84,10 @@ def side_by_side(scn, steps: int):
         assert np.array_equal(ref._dir_cmd, grp._dir_cmd, equal_nan=True), f"commands differ at {where}"
         for i, (a, b) in enumerate(zip(brains_ref, brains_grp)):
             _same_log(a.log(), b.log(), f"{where}, R{i + 1}")
-    assert packed > 100, "the compiled team's messages travel as packed rows"
+    if r1_view == "_R1TeamView":
+        assert packed > 100, "the compiled team's messages travel as packed rows"
+    else:  # a reference row reads only LosHelpMsg: the compiled rows send those
+        assert packed == 0
     assert brains_ref[0].target_steps == brains_grp[0].target_steps
     return brains_ref, brains_grp
 
@@ -171,6 +175,15 @@ def test_stalled_points_dropped_and_budget():
                                         trouble_cr=8), 1200)
     assert refs[0].temp_dropped > 0, refs[0].log()
     assert refs[0].gave_up and refs[0].mode == "gave_up"
+
+
+def test_a_reference_row_inside_the_team_is_the_reference():
+    """R1 on VisBug-21 with ``turn="random"`` (declined: a draw of its Generator per task goal) runs
+    its per-robot brain as a reference row inside the group brain, fed the observation the engine
+    would give it, beside the compiled helpers: the same run, step by step."""
+    scn = _scenario(1001, False, "visbug21", 800, r1={"navigator_params": {"turn": "random"}})
+    refs, _ = side_by_side(scn, 800, r1_view="LosExplorer")
+    assert refs[0].msgs_received > 100 and refs[0].mode_steps.get("ghost", 0) > 0
 
 
 def test_what_is_declined_runs_the_reference_inside():
