@@ -154,6 +154,15 @@ def test_visbug_team_compiled_is_the_reference(task, paper, monkeypatch):
         assert calls.start_again_suspended > 0 and calls.resumed > 0, vars(calls)
 
 
+def test_visbug_team_gives_up_and_restarts_as_the_reference():
+    """VisBug-21's Bug2 test fires among teammates (``return_tol_m`` 3.0, the paper column, tuning
+    task 1002, 2500 steps): R1 gives up on its task goal and starts a fresh navigator
+    (``restart_navigator_on_give_up``), as the reference."""
+    nav = {"return_tol_m": 3.0, "turn": "right", "boundary_shortcut": True}
+    refs, _ = side_by_side(_scenario(1002, True, "visbug21", 2500, navigator_params=nav), 2500)
+    assert refs[0].nav_restarts > 0, refs[0].log()
+
+
 @pytest.mark.parametrize("progress,steps", [("goal", STEPS), ("moved", 800)])
 def test_trouble_following_gap_fills(progress, steps):
     """§5 rule 3's gap-fills with other values: progress measured towards the own goal or as a

@@ -16,7 +16,12 @@ R1's group and the helpers' groups into one team, stepped in one call. Each row 
   (``trouble_follow``, §5 rule 3, :mod:`.trouble_following`, with its gap-fills
   ``trouble_sighting_at_send``, ``trouble_helper_towards_goal``, ``keep_trouble_helper``,
   ``trouble_drop_stalled_helper``, ``trouble_progress`` and ``trouble_near_helper_m``); else
-  algorithm A towards its goal; Pr, Tr, Nt (§5); the broadcast (§4.4);
+  algorithm A towards its goal; Pr, Tr, Nt (§5); the broadcast (§4.4). Algorithm A is the
+  potential field, Avoid-Past or VisBug-21; with VisBug-21 a teammate, a ghost or a trouble
+  helper is a temporary goal (the task goal's Bug2 memory suspended and resumed), VisBug starts
+  again at a reached ghost (``restart_navigator_at_ghost``, ``visbug_reverse_walk_factor``), a
+  point it finds unreachable is dropped (``drop_unreachable_ghost``), and it is started afresh
+  when it gives up on the task goal (``restart_navigator_on_give_up``);
 - **a helper** (:mod:`.helper_compiled`'s rows: the patrol, goal sharing, the broadcast);
 - **a reference row**: a robot whose parameters the compiled step declines runs its own
   per-robot brain inside this group brain, fed the same observation the engine would give it
@@ -27,8 +32,8 @@ When every robot of the simulation is a compiled row, messages travel as packed 
 (:class:`~.packed.PackedLosMsg`, sized as the :class:`~.messages.LosHelpMsg` they stand for);
 else they are the reference's :class:`~.messages.LosHelpMsg`, which per-robot brains read.
 
-What R1's compiled step declines (its row runs the reference instead): VisBug-21 with
-teammates (its temporary goals and ``start_again`` at a ghost), the trouble gap-fills
+What R1's compiled step declines (its row runs the reference instead): VisBug-21's
+``turn="random"`` (a draw of the Generator per task goal), the trouble gap-fills
 ``trouble_return`` and ``trouble_release_to_helper`` (off in both columns), ``frame_source``
 other than ``"bearings"`` and ``navigate_past_teammates_beyond_m``. R1 alone (no teammate) is
 :class:`~.compiled.LosExplorerGroup`.
@@ -280,7 +285,8 @@ def r1_team_decide_row(r, step, odom, ranges, vis, angles, max_range, gap, sight
         rist[r, R_MODE] = MODE_GAVE_UP if eist[r, C.J_GAVE_UP] != 0 else MODE_DONE
     else:
         d, progressing = _r1_decide_task(r, step, px, py, th, c, s, ranges, vis, angles, max_range, gap, sight, epar,
-                                         efst, eist, rist, rpar, targets, paths, npar, nfst, nist, grid, normals, nav, tf)
+                                         efst, eist, rist, rpar, targets, paths, npar, nfst, nist, grid, normals, nav,
+                                         tf)
         HC.trouble_update(r, progressing, epar, eist)
         mode = rist[r, R_MODE]
         if mode == MODE_FOLLOW or mode == MODE_GHOST or mode == MODE_TROUBLE:  # _decide: a new point headed for
