@@ -36,15 +36,16 @@ It prints, last, one line per configuration and one for their median, in the for
 group_brains=True)``, ``docs/concepts/group-brains.md``) against the Python reference brains, in
 this tree, for every team the group brains compile so far: R1 alone (Tables 1-2's first row)
 on office_simple, tuning task 1001, each column (teamnav, paper as written) and navigator
-(potential field, Avoid-Past, VisBug-21), and R1..R4 with the helpers compiled and R1 on its
-per-robot brain (``team/visbug21``; ``--only paper/visbug21`` keeps the configurations
-whose ``COLUMN/NAVIGATOR`` holds one of the strings). Reference and compiled alternate ``--repeats`` rounds, each run
+(potential field, Avoid-Past, VisBug-21), and R1..R4 as in Tables 1-2, the whole team compiled
+(``team/visbug21``, ``team/potential_field``, ``team/avoid_past``; ``--only paper/visbug21`` keeps
+the configurations whose ``COLUMN/NAVIGATOR`` holds one of the strings). Reference and compiled alternate ``--repeats`` rounds, each run
 in a fresh process after an untimed warm-up; each run's outputs are hashed as ``--team-step``
 does, and a configuration whose runs differ says DIFFER. It prints, last, one line per
 configuration and then one per team size, in the form
 ``LOS team step, 1 robots: compiled / reference = 1.4x`` (reference CPU over compiled CPU,
-median of the configurations); the team's line says ``4 robots (helpers compiled, R1
-reference)``, not the issue's ``4 robots:``, until R1 with teammates is compiled too. ``--quick`` ends with these lines too (1000 steps, one round).
+median of the configurations); a team in which a robot ran its reference brain inside the
+group brain gets a line ``4 robots (helpers compiled, R1 reference)``, not the issue's
+``4 robots:``. ``--quick`` ends with these lines too (1000 steps, one round).
 ``--group-brains --group-tasks 1001,1002``: whole tasks instead (200 targets, the scenario's
 own budget per target, ``stop_when_finished``), reference then compiled in one process per
 task, saying whether every output, the run's metrics and the steps per target are the same
@@ -443,11 +444,9 @@ def _team_steps(base: Path, new: Path, steps: int, repeats: int, base_name: str,
 # ---------------------------------------------------------------------------- group brains
 #: The teams the group brains compile so far: R1 alone (team size 1), per navigator of R1.
 GROUP_NAVIGATORS = ("potential_field", "avoid_past", "visbug21")
-#: ... and R1..R4 with the helpers R2..R4 compiled (R1, with teammates, on its per-robot brain),
-#: the scenario's VisBug-21 for every robot ("team/<navigator of R1>").
-#: R1..R4 as in Tables 1-2 (state sharing with the potential field only): with VisBug-21 R1 runs
-#: its reference brain inside the team's group brain (VisBug-21's temporary goals are not
-#: compiled); with the potential field or Avoid-Past the whole team is compiled
+#: ... and R1..R4 as in Tables 1-2 ("team/<navigator of R1>"; state sharing with the potential
+#: field only), the whole team compiled (with VisBug-21 since 2026-11-29: its temporary goals
+#: and start_again)
 GROUP_TEAMS = ("team/visbug21", "team/potential_field", "team/avoid_past")
 
 

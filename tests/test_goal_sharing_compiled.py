@@ -505,9 +505,10 @@ _SHARING = {
     (True, 1002, "potential_field", None), (False, 1003, None, "state-only"), (True, 1003, None, "reflected")],
     ids=["teamnav", "paper", "teamnav-avoid_past", "paper-potential_field", "teamnav-state-only", "paper-reflected"])
 def test_helpers_group_brain_runs_the_reference_team(paper, task, navigator, sharing):
-    """R2..R4 compiled (their patrol, goal sharing, the broadcast) beside R1's per-robot brain,
-    which reads their messages: the same run, step by step, with the scenario's VisBug-21 or
-    another algorithm A for every robot, and with other sharing rules."""
+    """R1..R4 in the team's group brain (R1 compiled with its teammates since 2026-11-29, VisBug-21
+    included; the helpers' patrol, goal sharing, the broadcast): the same run, step by step,
+    with the scenario's VisBug-21 or another algorithm A for every robot, and with other sharing
+    rules (state sharing alone, reflected visibility with state sharing)."""
     extra = {} if navigator is None else {f"robots.{k}.params.navigator": navigator for k in range(4)}
     for field, value in (_SHARING[sharing] if sharing else {}).items():
         extra.update({f"robots.{k}.params.{field}": value for k in range(4)})

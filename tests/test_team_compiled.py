@@ -6,8 +6,10 @@ The engine steps the reference team and the same scenario with ``group_brains=Tr
 side and requires, at every step, equal true poses, odometry, commands and every robot's log,
 with R1 compiled with its teammates (its goal-sharing choices: the own goal in sight, a
 teammate, a ghost, the via point, a direct promise, a stalled point dropped) and the messages
-on the radio as packed rows. Where R1's compiled step declines (state sharing, VisBug-21 with
-teammates), R1 runs its reference brain inside the group brain:
+on the radio as packed rows; with VisBug-21 (since 2026-11-29) also its temporary goals,
+``start_again`` at a reached ghost and the resumed task goal. Where R1's compiled step declines
+(``trouble_return``, VisBug-21's ``turn="random"``), R1 runs its reference brain inside the group
+brain:
 ``tests/test_goal_sharing_compiled.py`` covers that with the scenario's defaults.
 """
 
@@ -55,14 +57,15 @@ def _same_log(la: dict, lb: dict, where: str) -> None:
             assert a.shape == b.shape and a.tobytes() == b.tobytes(), (name, where)
 
 
-def side_by_side(scn, steps: int):
-    """The reference team and the compiled one, step by step (see the module docstring)."""
+def side_by_side(scn, steps: int, r1_view: str = "_R1TeamView"):
+    """The reference team and the compiled one, step by step (see the module docstring);
+    ``r1_view``: R1's class in the group brain (``LosExplorer``: a reference row)."""
     ref = Simulation(build_grid(scn), scn)
     grp = Simulation(build_grid(scn), scn, group_brains=True)
     assert [(type(t).__name__, a, b) for t, a, b, _ in grp.group_teams] == [("LosTeamGroup", 0, 4)]
     brains_ref = [b for g in ref.brains for b in g]
     brains_grp = [b for g in grp.brains for b in g]
-    assert [type(b).__name__ for b in brains_grp] == ["_R1TeamView"] + ["_HelperView"] * 3, "the whole team compiled"
+    assert [type(b).__name__ for b in brains_grp] == [r1_view] + ["_HelperView"] * 3, "the team as expected"
     packed = 0
     orig = grp.radio.send
 
@@ -81,7 +84,10 @@ def side_by_side(scn, steps: int):
         assert np.array_equal(ref._dir_cmd, grp._dir_cmd, equal_nan=True), f"commands differ at {where}"
         for i, (a, b) in enumerate(zip(brains_ref, brains_grp)):
             _same_log(a.log(), b.log(), f"{where}, R{i + 1}")
-    assert packed > 100, "the compiled team's messages travel as packed rows"
+    if r1_view == "_R1TeamView":
+        assert packed > 100, "the compiled team's messages travel as packed rows"
+    else:  # a reference row reads only LosHelpMsg: the compiled rows send those
+        assert packed == 0
     assert brains_ref[0].target_steps == brains_grp[0].target_steps
     return brains_ref, brains_grp
 
@@ -101,6 +107,60 @@ def test_whole_team_compiled_is_the_reference(task, navigator, state_sharing, pa
     assert (r1.mode_steps.get("trouble_follow", 0) > 0) == state_sharing
     if not paper:
         assert r1.vias_taken > 0 and r1.promised_steps > 0
+
+
+class _VisBugCalls:
+    """Counts the reference VisBug-21's temporary goals, ``start_again`` calls (and those made
+    while a task goal is suspended) and resumed task goals (the compiled rows never call them)."""
+
+    def __init__(self, monkeypatch):
+        from teamnav.control.nav.local.visbug21 import VisBug21
+
+        self.temporary = self.start_again = self.start_again_suspended = self.resumed = 0
+        set_goal, start_again, resume = VisBug21.set_goal, VisBug21.start_again, VisBug21._resume
+
+        def counted_set_goal(nav, goal_xy, temporary=False):
+            self.temporary += bool(temporary)
+            return set_goal(nav, goal_xy, temporary)
+
+        def counted_start_again(nav, reverse_walk_factor=None):
+            self.start_again += 1
+            self.start_again_suspended += nav.suspended_goal_xy is not None
+            return start_again(nav, reverse_walk_factor)
+
+        def counted_resume(nav, xy):
+            self.resumed += 1
+            return resume(nav, xy)
+
+        monkeypatch.setattr(VisBug21, "set_goal", counted_set_goal)
+        monkeypatch.setattr(VisBug21, "start_again", counted_start_again)
+        monkeypatch.setattr(VisBug21, "_resume", counted_resume)
+
+
+@pytest.mark.parametrize("paper", [False, True], ids=["teamnav", "paper"])
+@pytest.mark.parametrize("task", [1001, 1002])
+def test_visbug_team_compiled_is_the_reference(task, paper, monkeypatch):
+    """Tables 1-2's VisBug-21 team (every robot on VisBug-21, no state sharing), both columns, two
+    tuning tasks: R1 compiled with its teammates goes to teammates and ghosts as temporary goals
+    (the task goal's M-line and hit point suspended, then resumed) and starts VisBug again at a
+    reached ghost (``restart_navigator_at_ghost``, with ``visbug_reverse_walk_factor``)."""
+    calls = _VisBugCalls(monkeypatch)
+    refs, _ = side_by_side(_scenario(task, paper, "visbug21"), STEPS)
+    r1 = refs[0]
+    assert r1.targets_reached >= 1 and r1.msgs_received > 100
+    assert r1.mode_steps.get("follow_teammate", 0) > 0 and r1.mode_steps.get("ghost", 0) > 0
+    assert calls.temporary > 0 and calls.start_again > 0, vars(calls)
+    if (task, paper) == (1001, True):  # the case with start_again during a temporary goal
+        assert calls.start_again_suspended > 0 and calls.resumed > 0, vars(calls)
+
+
+def test_visbug_team_gives_up_and_restarts_as_the_reference():
+    """VisBug-21's Bug2 test fires among teammates (``return_tol_m`` 3.0, the paper column, tuning
+    task 1002, 2500 steps): R1 gives up on its task goal and starts a fresh navigator
+    (``restart_navigator_on_give_up``), as the reference."""
+    nav = {"return_tol_m": 3.0, "turn": "right", "boundary_shortcut": True}
+    refs, _ = side_by_side(_scenario(1002, True, "visbug21", 2500, navigator_params=nav), 2500)
+    assert refs[0].nav_restarts > 0, refs[0].log()
 
 
 @pytest.mark.parametrize("progress,steps", [("goal", STEPS), ("moved", 800)])
@@ -126,13 +186,23 @@ def test_stalled_points_dropped_and_budget():
     assert refs[0].gave_up and refs[0].mode == "gave_up"
 
 
+def test_a_reference_row_inside_the_team_is_the_reference():
+    """R1 on VisBug-21 with ``turn="random"`` (declined: a draw of its Generator per task goal) runs
+    its per-robot brain as a reference row inside the group brain, fed the observation the engine
+    would give it, beside the compiled helpers: the same run, step by step."""
+    scn = _scenario(1001, False, "visbug21", 800, r1={"navigator_params": {"turn": "random"}})
+    refs, _ = side_by_side(scn, 800, r1_view="LosExplorer")
+    assert refs[0].msgs_received > 100 and refs[0].mode_steps.get("ghost", 0) > 0
+
+
 def test_what_is_declined_runs_the_reference_inside():
-    """R1 with ``trouble_return`` or VisBug-21 among teammates runs its reference brain inside the
-    group brain (the helpers stay compiled); ``unsupported`` says why R1's row is not compiled."""
+    """R1 with ``trouble_return`` or VisBug-21's ``turn="random"`` among teammates runs its
+    reference brain inside the group brain (the helpers stay compiled); ``unsupported`` says why
+    R1's row is not compiled."""
     from teamnav.papers.los_help.brains.explorer import LosExplorer
 
     for extra, why in (({"state_sharing": True, "trouble_return": True}, "trouble_return"),
-                       ({"navigator": "visbug21"}, "visbug21")):
+                       ({"navigator": "visbug21", "navigator_params": {"turn": "random"}}, "turn 'random'")):
         scn = _scenario(1001, False, "potential_field", 5, r1=extra)
         sim = Simulation(build_grid(scn), scn, group_brains=True)
         assert [type(t).__name__ for t, *_ in sim.group_teams] == ["LosTeamGroup"]

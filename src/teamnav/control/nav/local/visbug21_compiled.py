@@ -27,9 +27,12 @@ it is a candidate: no libm-only rule gives numpy's answer there. The two calls c
 2500 steps) the bearings run at 0.86 calls per step in the paper column (``boundary_shortcut``)
 and the seen-free test at about 0.01 per step in either column.
 
-What R1 alone never reaches is declined by the group brain (``LosExplorerGroup.unsupported``):
-temporary goals (a teammate, a ghost or a helper as the goal: ``set_goal(temporary=True)``,
-``start_again``, ``_resume``) and ``turn="random"`` (a draw of the robot's Generator per goal).
+Temporary goals (a teammate, a ghost or a helper as the goal, which R1 with teammates sets:
+``set_goal(temporary=True)``, :func:`vb_set_goal_t`), ``start_again`` (:func:`vb_start_again`,
+with its ``reverse_walk_factor``) and ``_resume`` are compiled as the reference does them (since
+2026-11-29): the suspended task memory is a copy of the state columns ``VF_GX..VF_REV_REACH`` and
+``VI_HAS_GOAL..VI_RETURNS``. ``turn="random"`` (a draw of the robot's Generator per goal) is
+declined by the group brains.
 
 State layout: float parameters ``VP_*`` of ``vpar`` (n, NV_P); float state ``VF_*`` of ``vfst``
 (n, NV_F); integer state ``VI_*`` of ``vist`` (n, NV_I). Flags ``VI_HAS_*`` say whether an
@@ -51,6 +54,7 @@ from teamnav.control.nav.local.visbug21 import (
     MODE_TO_GOAL,
     MODE_UNREACHABLE,
     NEARER_END_TIE_M,
+    RESUME_FOLLOW_M,
     VisBug21,
 )
 from teamnav.control.nav.local.visbug21_geometry import (
@@ -64,7 +68,7 @@ from teamnav.control.nav.local.visbug21_geometry import (
 from teamnav.control.types import RangeScan
 
 __all__ = ["TURNS", "beam_order", "vb_direction", "vb_new_navigator", "vb_params", "vb_progressing", "vb_set_goal",
-           "vb_state"]
+           "vb_set_goal_t", "vb_start_again", "vb_state"]
 
 #: ``VisBugParams.turn`` as a number (``VP_TURN``); "random" is not compiled
 TURNS = {"left": 0, "right": 1, "nearer_end": 2}
@@ -118,7 +122,16 @@ VF_BX = 24  # _blocked_xy
 VF_BY = 25
 VF_MON_REF = 26  # ProgressMonitor.ref_m
 VF_SLACK = 27  # _slack
-NV_F = 28
+#: the task's Bug2 memory suspended by a temporary goal (``VisBug21._suspended``, its
+#: ``_TASK_STATE``): columns VF_GX..VF_REV_REACH copied to VF_SUS + the same column
+VF_SUS = 28
+N_SUS_F = VF_REV_REACH + 1
+VF_SUS_AT_X = VF_SUS + N_SUS_F  # _suspended_at
+VF_SUS_AT_Y = VF_SUS_AT_X + 1
+VF_RF_X = VF_SUS_AT_Y + 1  # _reverse_for: (task goal, reverse_walk_factor), set by start_again
+VF_RF_Y = VF_RF_X + 1
+VF_RF_F = VF_RF_Y + 1
+NV_F = VF_RF_F + 1
 
 # ----------------------------------------------------------------- integer state
 VI_HAS_GOAL = 0
@@ -136,7 +149,15 @@ VI_HAS_ENDS = 11
 VI_HAS_BLOCKED = 12
 VI_MON_STEPS = 13  # ProgressMonitor.steps
 VI_MON_LAST_GAIN = 14  # ProgressMonitor.last_gain_step
-NV_I = 15
+#: the suspended task's integer memory: columns VI_HAS_GOAL..VI_RETURNS copied to VI_SUS + the same
+VI_SUS = 15
+N_SUS_I = VI_RETURNS + 1
+VI_TEMP = VI_SUS + N_SUS_I  # temporary
+VI_HAS_SUS = VI_TEMP + 1  # _suspended is not None
+VI_RESUMED = VI_HAS_SUS + 1  # _resumed
+VI_HAS_SUS_AT = VI_RESUMED + 1  # _suspended_at is not None
+VI_HAS_RF = VI_HAS_SUS_AT + 1  # _reverse_for is not None
+NV_I = VI_HAS_RF + 1
 
 _T_GOAL = 1.0 - 1e-12
 _TWO_PI = 2.0 * math.pi
@@ -145,6 +166,7 @@ _TIE_M = NEARER_END_TIE_M
 _GUARD_N = int(round(math.pi / GUARD_STEP_RAD))
 _GUARD_RAD = GUARD_STEP_RAD
 _SAME_M = GOAL_SAME_TOL_M
+_RESUME_M = RESUME_FOLLOW_M
 
 
 # ----------------------------------------------------------------- construction (Python)
@@ -230,13 +252,19 @@ def _restart(vfst, vist, r):
     vfst[r, VF_MON_REF] = math.inf
     vist[r, VI_MON_STEPS] = 0
     vist[r, VI_MON_LAST_GAIN] = 0
+    vist[r, VI_RESUMED] = 0
 
 
 @njit(cache=True)
 def vb_new_navigator(vpar, vfst, vist, r):
-    """Row ``r`` as a newly built ``VisBug21`` (no goal; side +1 for ``turn="left"``, else -1)."""
+    """Row ``r`` as a newly built ``VisBug21`` (no goal; side +1 for ``turn="left"``, else -1;
+    not temporary, nothing suspended, no ``_reverse_for``)."""
     vist[r, VI_HAS_GOAL] = 0
     vist[r, VI_SIDE] = 1 if vpar[r, VP_TURN] == 0.0 else -1
+    vist[r, VI_TEMP] = 0
+    vist[r, VI_HAS_SUS] = 0
+    vist[r, VI_HAS_SUS_AT] = 0
+    vist[r, VI_HAS_RF] = 0
     _restart(vfst, vist, r)
 
 
@@ -244,12 +272,95 @@ def vb_new_navigator(vpar, vfst, vist, r):
 def vb_set_goal(vpar, vfst, vist, r, gx, gy):
     """``VisBug21.set_goal(g)`` of a task goal (not temporary): a goal more than 1 µm from the
     current one restarts VisBug (new M-line, no hit point)."""
-    if vist[r, VI_HAS_GOAL] == 1 and N.py_hypot(gx - vfst[r, VF_GX], gy - vfst[r, VF_GY]) <= _SAME_M:
+    vb_set_goal_t(vpar, vfst, vist, r, gx, gy, False)
+
+
+@njit(cache=True)
+def vb_set_goal_t(vpar, vfst, vist, r, gx, gy, temporary):
+    """``VisBug21.set_goal(g, temporary)``: a temporary goal suspends the task goal's Bug2 memory
+    (M-line, H, ``d_H``, mode, side, laps, the alternating walk) and runs a fresh VisBug; the
+    suspended task goal set again (within 1 µm) resumes it; any other task goal drops it. As the
+    reference, ``turn="random"`` is not compiled (its draw per task goal)."""
+    same = vist[r, VI_HAS_GOAL] == 1 and N.py_hypot(gx - vfst[r, VF_GX], gy - vfst[r, VF_GY]) <= _SAME_M
+    if temporary:
+        if same and vist[r, VI_TEMP] == 1:
+            return
+        if vist[r, VI_HAS_SUS] == 0 and vist[r, VI_HAS_GOAL] == 1 and vist[r, VI_TEMP] == 0:
+            vist[r, VI_HAS_SUS] = 1
+            for k in range(N_SUS_F):
+                vfst[r, VF_SUS + k] = vfst[r, k]
+            for k in range(N_SUS_I):
+                vist[r, VI_SUS + k] = vist[r, k]
+            if vist[r, VI_HAS_LAST] == 1:
+                vist[r, VI_HAS_SUS_AT] = 1
+                vfst[r, VF_SUS_AT_X] = vfst[r, VF_LX]
+                vfst[r, VF_SUS_AT_Y] = vfst[r, VF_LY]
+            else:
+                vist[r, VI_HAS_SUS_AT] = 0
+        vist[r, VI_TEMP] = 1
+        vfst[r, VF_GX] = gx
+        vfst[r, VF_GY] = gy
+        vist[r, VI_HAS_GOAL] = 1
+        _restart(vfst, vist, r)
+        return
+    if same and vist[r, VI_TEMP] == 0:
+        return
+    task = vist[r, VI_HAS_SUS] == 1
+    vist[r, VI_HAS_SUS] = 0
+    vist[r, VI_TEMP] = 0
+    if task and N.py_hypot(gx - vfst[r, VF_SUS + VF_GX], gy - vfst[r, VF_SUS + VF_GY]) <= _SAME_M:
+        _restart(vfst, vist, r)
+        for k in range(N_SUS_F):
+            vfst[r, k] = vfst[r, VF_SUS + k]
+        for k in range(N_SUS_I):
+            vist[r, k] = vist[r, VI_SUS + k]
+        vist[r, VI_RESUMED] = 1
         return
     vfst[r, VF_GX] = gx
     vfst[r, VF_GY] = gy
     vist[r, VI_HAS_GOAL] = 1
     _restart(vfst, vist, r)
+    if vist[r, VI_HAS_RF] == 1 and N.py_hypot(gx - vfst[r, VF_RF_X], gy - vfst[r, VF_RF_Y]) > _SAME_M:
+        vist[r, VI_HAS_RF] = 0
+
+
+@njit(cache=True)
+def vb_start_again(vpar, vfst, vist, r, reverse_walk_factor):
+    """``VisBug21.start_again(reverse_walk_factor)`` (NaN: None): forget the task goal's M-line,
+    hit point and mode (during a temporary goal: drop the suspended task memory instead); with a
+    factor, the boundary walks towards the task goal alternate until the goal changes."""
+    has_task = True
+    if vist[r, VI_HAS_SUS] == 1:
+        tx = vfst[r, VF_SUS + VF_GX]
+        ty = vfst[r, VF_SUS + VF_GY]
+    elif vist[r, VI_TEMP] == 1 or vist[r, VI_HAS_GOAL] == 0:
+        has_task = False
+        tx = 0.0
+        ty = 0.0
+    else:
+        tx = vfst[r, VF_GX]
+        ty = vfst[r, VF_GY]
+    if reverse_walk_factor == reverse_walk_factor and has_task:
+        vist[r, VI_HAS_RF] = 1
+        vfst[r, VF_RF_X] = tx
+        vfst[r, VF_RF_Y] = ty
+        vfst[r, VF_RF_F] = reverse_walk_factor
+    if vist[r, VI_HAS_SUS] == 1 or vist[r, VI_TEMP] == 1:
+        vist[r, VI_HAS_SUS] = 0
+    elif vist[r, VI_HAS_GOAL] == 1:
+        _restart(vfst, vist, r)
+
+
+@njit(cache=True)
+def _resume(vpar, vfst, vist, r, px, py):
+    """``VisBug21._resume``: the first step back on the task goal after a temporary one."""
+    vist[r, VI_RESUMED] = 0
+    if (vist[r, VI_HAS_HIT] == 1 and N.py_hypot(vfst[r, VF_GX] - px, vfst[r, VF_GY] - py)
+            < vfst[r, VF_HIT_D] - vpar[r, VP_LEAVE_MARGIN]):
+        _restart(vfst, vist, r)
+    elif (vist[r, VI_MODE] == MODE_FOLLOW and vist[r, VI_HAS_SUS_AT] == 1
+          and N.py_hypot(px - vfst[r, VF_SUS_AT_X], py - vfst[r, VF_SUS_AT_Y]) > _RESUME_M):
+        vist[r, VI_MODE] = MODE_TO_GOAL
 
 
 @njit(cache=True)
@@ -469,6 +580,9 @@ def _hit(vpar, vfst, vist, r, x, y):
     vist[r, VI_HAS_FREF] = 0
     vfst[r, VF_DIR_WALKED] = 0.0
     f = vpar[r, VP_REVERSE]
+    if vist[r, VI_HAS_RF] == 1 and N.py_hypot(vfst[r, VF_GX] - vfst[r, VF_RF_X],
+                                              vfst[r, VF_GY] - vfst[r, VF_RF_Y]) <= _SAME_M:
+        f = vfst[r, VF_RF_F]  # set by start_again for this goal
     if f != f:
         lim = math.inf
     else:
@@ -487,6 +601,8 @@ def vb_direction(vpar, vfst, vist, r, px, py, th, ranges, angles, order, a_sorte
         return math.nan
     gx = vfst[r, VF_GX]
     gy = vfst[r, VF_GY]
+    if vist[r, VI_RESUMED] == 1:
+        _resume(vpar, vfst, vist, r, px, py)
     if vist[r, VI_HAS_MLINE] == 0:
         vist[r, VI_HAS_MLINE] = 1
         vfst[r, VF_SX] = px

@@ -16,7 +16,12 @@ R1's group and the helpers' groups into one team, stepped in one call. Each row 
   (``trouble_follow``, §5 rule 3, :mod:`.trouble_following`, with its gap-fills
   ``trouble_sighting_at_send``, ``trouble_helper_towards_goal``, ``keep_trouble_helper``,
   ``trouble_drop_stalled_helper``, ``trouble_progress`` and ``trouble_near_helper_m``); else
-  algorithm A towards its goal; Pr, Tr, Nt (§5); the broadcast (§4.4);
+  algorithm A towards its goal; Pr, Tr, Nt (§5); the broadcast (§4.4). Algorithm A is the
+  potential field, Avoid-Past or VisBug-21; with VisBug-21 a teammate, a ghost or a trouble
+  helper is a temporary goal (the task goal's Bug2 memory suspended and resumed), VisBug starts
+  again at a reached ghost (``restart_navigator_at_ghost``, ``visbug_reverse_walk_factor``), a
+  point it finds unreachable is dropped (``drop_unreachable_ghost``), and it is started afresh
+  when it gives up on the task goal (``restart_navigator_on_give_up``);
 - **a helper** (:mod:`.helper_compiled`'s rows: the patrol, goal sharing, the broadcast);
 - **a reference row**: a robot whose parameters the compiled step declines runs its own
   per-robot brain inside this group brain, fed the same observation the engine would give it
@@ -27,8 +32,8 @@ When every robot of the simulation is a compiled row, messages travel as packed 
 (:class:`~.packed.PackedLosMsg`, sized as the :class:`~.messages.LosHelpMsg` they stand for);
 else they are the reference's :class:`~.messages.LosHelpMsg`, which per-robot brains read.
 
-What R1's compiled step declines (its row runs the reference instead): VisBug-21 with
-teammates (its temporary goals and ``start_again`` at a ghost), the trouble gap-fills
+What R1's compiled step declines (its row runs the reference instead): VisBug-21's
+``turn="random"`` (a draw of the Generator per task goal), the trouble gap-fills
 ``trouble_return`` and ``trouble_release_to_helper`` (off in both columns), ``frame_source``
 other than ``"bearings"`` and ``navigate_past_teammates_beyond_m``. R1 alone (no teammate) is
 :class:`~.compiled.LosExplorerGroup`.
@@ -82,7 +87,10 @@ RP_DROP_HELPER = 13  # trouble_drop_stalled_helper
 RP_DROP_AFTER = 14  # trouble_drop_after_steps
 RP_PROGRESS = 15  # trouble_progress: PROGRESS_*
 RP_NEAR_HELPER = 16  # trouble_near_helper_m (NaN: None)
-N_RP = 17
+RP_RESTART_AT_GHOST = 17  # restart_navigator_at_ghost (VisBug-21's start_again)
+RP_REVERSE = 18  # visbug_reverse_walk_factor (NaN: None)
+RP_DROP_UNREACH = 19  # drop_unreachable_ghost
+N_RP = 20
 
 PROGRESS_HELPER = 0
 PROGRESS_MOVED = 1
@@ -113,7 +121,9 @@ R_TEMP_KIND = 13
 R_TT_ID = 14  # _trouble_target's teammate (-1: None)
 R_TT_STALL = 15  # _tt_stall
 R_HELPERS_DROPPED = 16  # trouble_helpers_dropped
-R_STEPS = 17  # mode_steps: R_STEPS + MODE_*
+R_GHOSTS_UNREACH = 17  # ghosts_unreachable
+R_TEMP_UNREACH = 18  # _temp_unreachable: A found this step's temporary point unreachable
+R_STEPS = 19  # mode_steps: R_STEPS + MODE_*
 N_R = R_STEPS + 6
 
 MODE_OWN_GOAL = 0
@@ -172,26 +182,48 @@ def r1_team_advance_row(r, step, odom, epar, eist, rist, targets, target_steps, 
 
 
 @njit(cache=True)
-def _navigate_t(r, gx, gy, temporary, px, py, th, ranges, angles, max_range, efst, eist, rist, npar, nfst, nist, grid,
-                normals):
-    """``_Driving._navigate`` with the potential field or Avoid-Past (which always give a heading
-    once a goal is set): (heading relative to the body, progressing); ``temporary``: an excursion
-    to a teammate or a ghost (A keeps its task goal's memory, ``set_goal(temporary=True)``)."""
+def _navigate_t(r, gx, gy, temporary, px, py, th, ranges, angles, max_range, epar, efst, eist, rist, npar, nfst, nist,
+                grid, normals, nav):
+    """``_Driving._navigate``: (heading relative to the body or NaN for none, progressing);
+    ``temporary``: an excursion to a teammate, a ghost or a trouble helper (A keeps its task
+    goal's memory, ``set_goal(temporary=True)``). The potential field and Avoid-Past always give a
+    heading once a goal is set. VisBug-21 gives none once it finds its goal unreachable: for a
+    temporary point, no move and ``R_TEMP_UNREACH`` set (the explorer's
+    ``drop_unreachable_ghost`` reads it); for the task goal, with ``restart_navigator_on_give_up``,
+    a fresh navigator next step."""
     tmp = 1 if temporary else 0
+    visbug = epar[r, C.Q_VISBUG] != 0.0
     if (eist[r, C.J_NAV_SET] == 0 or efst[r, C.X_NAV_GX] != gx or efst[r, C.X_NAV_GY] != gy
             or rist[r, R_NAV_TEMP] != tmp):
-        N.set_goal(npar, nfst, nist, grid, r, gx, gy, temporary)
+        if visbug:
+            V.vb_set_goal_t(nav[0], nav[1], nav[2], r, gx, gy, temporary)
+        else:
+            N.set_goal(npar, nfst, nist, grid, r, gx, gy, temporary)
         eist[r, C.J_NAV_SET] = 1
         efst[r, C.X_NAV_GX] = gx
         efst[r, C.X_NAV_GY] = gy
         rist[r, R_NAV_TEMP] = tmp
-    h = N.direction(npar, nfst, nist, grid, normals, r, px, py, th, ranges[r], angles, max_range)
-    return N.py_wrap(h - th), N.progressing(npar, nist, r)
+    if not visbug:
+        h = N.direction(npar, nfst, nist, grid, normals, r, px, py, th, ranges[r], angles, max_range)
+        return N.py_wrap(h - th), N.progressing(npar, nist, r)
+    vpar, vfst, vist, order, a_sorted = nav
+    h = V.vb_direction(vpar, vfst, vist, r, px, py, th, ranges[r], angles, order, a_sorted, max_range)
+    progressing = V.vb_progressing(vpar, vfst, vist, r)
+    rist[r, R_TEMP_UNREACH] = 0
+    if h != h:
+        if temporary:
+            rist[r, R_TEMP_UNREACH] = 1  # A keeps the point (and the suspended task memory)
+        elif epar[r, C.Q_RESTART] != 0.0:  # A gave up: a fresh navigator next step (``self._nav = None``)
+            V.vb_new_navigator(vpar, vfst, vist, r)
+            eist[r, C.J_NAV_SET] = 0
+            eist[r, C.J_NAV_RESTARTS] += 1
+        return math.nan, progressing
+    return N.py_wrap(h - th), progressing
 
 
 @njit(cache=True)
 def _head_to_k(r, tx, ty, kind, ka, kb, stop_within, end_margin, trust, px, py, th, c, s, ranges, vis, angles,
-               max_range, gap, epar, efst, eist, rist, npar, nfst, nist, grid, normals):
+               max_range, gap, epar, efst, eist, rist, npar, nfst, nist, grid, normals, nav):
     """``_Driving._head_to`` with the key ``(kind, ka, kb)``: (heading relative to the body or NaN
     for none, progressing)."""
     step_m = epar[r, C.Q_STEP]
@@ -230,14 +262,14 @@ def _head_to_k(r, tx, ty, kind, ka, kb, stop_within, end_margin, trust, px, py, 
                         eist[r, C.J_SLIDES] += 1
                         return N.py_wrap(h - th), progressing
     temporary = not (kind == KEY_GOAL or kind == KEY_PROMISED)
-    d, _ = _navigate_t(r, tx, ty, temporary, px, py, th, ranges, angles, max_range, efst, eist, rist, npar, nfst,
-                       nist, grid, normals)
+    d, _ = _navigate_t(r, tx, ty, temporary, px, py, th, ranges, angles, max_range, epar, efst, eist, rist, npar, nfst,
+                       nist, grid, normals, nav)
     return d, progressing
 
 
 @njit(cache=True)
 def r1_team_decide_row(r, step, odom, ranges, vis, angles, max_range, gap, sight, epar, efst, eist, rist, rpar,
-                       targets, paths, npar, nfst, nist, grid, normals, tf):
+                       targets, paths, npar, nfst, nist, grid, normals, nav, tf):
     """``LosExplorer._decide`` of row ``r`` without state sharing (see the module docstring), with
     the step's move count and mode count; returns the body-frame direction (NaN: none)."""
     px = odom[r, 0]
@@ -253,7 +285,8 @@ def r1_team_decide_row(r, step, odom, ranges, vis, angles, max_range, gap, sight
         rist[r, R_MODE] = MODE_GAVE_UP if eist[r, C.J_GAVE_UP] != 0 else MODE_DONE
     else:
         d, progressing = _r1_decide_task(r, step, px, py, th, c, s, ranges, vis, angles, max_range, gap, sight, epar,
-                                         efst, eist, rist, rpar, targets, paths, npar, nfst, nist, grid, normals, tf)
+                                         efst, eist, rist, rpar, targets, paths, npar, nfst, nist, grid, normals, nav,
+                                         tf)
         HC.trouble_update(r, progressing, epar, eist)
         mode = rist[r, R_MODE]
         if mode == MODE_FOLLOW or mode == MODE_GHOST or mode == MODE_TROUBLE:  # _decide: a new point headed for
@@ -273,7 +306,7 @@ def r1_team_decide_row(r, step, odom, ranges, vis, angles, max_range, gap, sight
 
 @njit(cache=True)
 def _r1_decide_task(r, step, px, py, th, c, s, ranges, vis, angles, max_range, gap, sight, epar, efst, eist, rist,
-                    rpar, targets, paths, npar, nfst, nist, grid, normals, tf):
+                    rpar, targets, paths, npar, nfst, nist, grid, normals, nav, tf):
     """``LosExplorer._decide_task`` of row ``r`` (without ``trouble_return`` and
     ``trouble_release_to_helper``, which are declined): (direction relative to the body or NaN,
     progressing)."""
@@ -295,7 +328,7 @@ def _r1_decide_task(r, step, px, py, th, c, s, ranges, vis, angles, max_range, g
         eist[r, C.J_GOAL_SEEN] += 1
         d, progressing = _head_to_k(r, gx, gy, KEY_GOAL, idx, 0, 0.0, 0.5 * tol, False, px, py, th, c, s, ranges,
                                     vis, angles, max_range, gap, epar, efst, eist, rist, npar, nfst, nist, grid,
-                                    normals)
+                                    normals, nav)
         has_action = True
     elif (kind == GC.KIND_GHOST or kind == GC.KIND_SELF) and paths[r, me, GC.P_REACHED] == 0.0:
         qx = paths[r, me, GC.P_PX]
@@ -331,25 +364,39 @@ def _r1_decide_task(r, step, px, py, th, c, s, ranges, vis, angles, max_range, g
             d, progressing = _head_to_k(r, paths[r, me, GC.P_PX], paths[r, me, GC.P_PY], KEY_PATH,
                                         int(paths[r, me, GC.P_SOURCE]), int(paths[r, me, GC.P_STEP]), 0.0,
                                         rpar[r, RP_GHOST_TOL], False, px, py, th, c, s, ranges, vis, angles,
-                                        max_range, gap, epar, efst, eist, rist, npar, nfst, nist, grid, normals)
+                                        max_range, gap, epar, efst, eist, rist, npar, nfst, nist, grid, normals, nav)
             has_action = True
         elif dq < reach:
             # §4.2: at the ghost without seeing the goal: A again, the promise kept to arbitrate
             GC.gs_mark_reached(paths, r, me)
-            # restart_navigator_at_ghost: the potential field and Avoid-Past have no start_again
+            if rpar[r, RP_RESTART_AT_GHOST] != 0.0 and epar[r, C.Q_VISBUG] != 0.0:
+                # restart_navigator_at_ghost: VisBug-21's start_again (the potential field and
+                # Avoid-Past have none); on a navigator not yet built (after a give-up), whose
+                # compiled row is fresh, it changes nothing, as the reference skips it
+                V.vb_start_again(nav[0], nav[1], nav[2], r, rpar[r, RP_REVERSE])
             if (rpar[r, RP_TRUST] != 0.0
                     and paths[r, me, GC.P_D] <= N.py_hypot(gx - qx, gy - qy) + step_m):
                 rist[r, R_PROMISED] = idx
         else:
             rist[r, R_MODE] = MODE_FOLLOW if live else MODE_GHOST
+            rist[r, R_TEMP_UNREACH] = 0
             d, progressing = _head_to_k(r, qx, qy, KEY_PATH, source, int(paths[r, me, GC.P_STEP]), 0.0, reach, False,
                                         px, py, th, c, s, ranges, vis, angles, max_range, gap, epar, efst, eist, rist,
-                                        npar, nfst, nist, grid, normals)
+                                        npar, nfst, nist, grid, normals, nav)
             has_action = True
-            # drop_unreachable_ghost: A never finds a point unreachable here (no VisBug-21)
+            if rist[r, R_TEMP_UNREACH] != 0 and rpar[r, RP_DROP_UNREACH] != 0.0:
+                # drop_unreachable_ghost: A (VisBug-21) declared the point unreachable; dropped
+                # as a reached one, A starts again on R1's own goal (no action this branch)
+                rist[r, R_GHOSTS_UNREACH] += 1
+                rist[r, R_TEMP_STALL] = 0
+                GC.gs_mark_reached(paths, r, me)
+                rist[r, R_LAST_KIND] = KEY_NONE
+                d = math.nan
+                progressing = False
+                has_action = False
             # a point R1 makes no progress towards for Cr steps is given up like a reached one
-            rist[r, R_TEMP_STALL] = 0 if progressing else rist[r, R_TEMP_STALL] + 1
-            if rpar[r, RP_DROP_STALLED] != 0.0 and rist[r, R_TEMP_STALL] >= int(epar[r, C.Q_CR]):
+            rist[r, R_TEMP_STALL] = 0 if (progressing or not has_action) else rist[r, R_TEMP_STALL] + 1
+            if has_action and rpar[r, RP_DROP_STALLED] != 0.0 and rist[r, R_TEMP_STALL] >= int(epar[r, C.Q_CR]):
                 rist[r, R_TEMP_STALL] = 0
                 rist[r, R_TEMP_DROPPED] += 1
                 GC.gs_mark_reached(paths, r, me)
@@ -364,19 +411,19 @@ def _r1_decide_task(r, step, px, py, th, c, s, ranges, vis, angles, max_range, g
     if not has_action and state and eist[r, C.J_TR] != 0:
         d, progressing, has_action = _follow_in_trouble(r, step, px, py, th, c, s, gx, gy, goal_d, progressing,
                                                         ranges, vis, angles, max_range, gap, sight, epar, efst, eist,
-                                                        rist, rpar, npar, nfst, nist, grid, normals, tf)
+                                                        rist, rpar, npar, nfst, nist, grid, normals, nav, tf)
     if not has_action and rist[r, R_PROMISED] == idx and eist[r, C.J_TR] == 0:
         rist[r, R_MODE] = MODE_OWN_GOAL
         rist[r, R_PROMISED_STEPS] += 1
         d, progressing = _head_to_k(r, gx, gy, KEY_PROMISED, idx, 0, 0.0, 0.5 * tol, True, px, py, th, c, s, ranges,
                                     vis, angles, max_range, gap, epar, efst, eist, rist, npar, nfst, nist, grid,
-                                    normals)
+                                    normals, nav)
         has_action = True
     if not has_action:  # _unseen_goal -> _drive: A towards the goal
         rist[r, R_MODE] = MODE_OWN_GOAL
         rist[r, R_LAST_KIND] = KEY_NONE
-        d, progressing = _navigate_t(r, gx, gy, False, px, py, th, ranges, angles, max_range, efst, eist, rist, npar,
-                                     nfst, nist, grid, normals)
+        d, progressing = _navigate_t(r, gx, gy, False, px, py, th, ranges, angles, max_range, epar, efst, eist, rist,
+                                     npar, nfst, nist, grid, normals, nav)
     rfst[r, F_PREV_GOAL_D] = goal_d
     return d, progressing
 
@@ -429,7 +476,7 @@ def _mate_recedes(r, o, rpar, mg_d, mg_n):
 
 @njit(cache=True)
 def _follow_in_trouble(r, step, px, py, th, c, s, gx, gy, goal_d, progressing, ranges, vis, angles, max_range, gap,
-                       sight, epar, efst, eist, rist, rpar, npar, nfst, nist, grid, normals, tf):
+                       sight, epar, efst, eist, rist, rpar, npar, nfst, nist, grid, normals, nav, tf):
     """``_TroubleFollowing._follow_in_trouble`` (§5 rule 3 and its gap-fills; ``trouble_return``
     and ``trouble_release_to_helper`` are declined): (direction or NaN, progressing, whether an
     action was chosen)."""
@@ -498,7 +545,7 @@ def _follow_in_trouble(r, step, px, py, th, c, s, gx, gy, goal_d, progressing, r
     if tt >= 0 and (not math.isnan(vis_x[tt]) or keep_helper):
         rist[r, R_MODE] = MODE_TROUBLE
         d, towards = _head_to_k(r, tx, ty, KEY_HELPER, tt, 0, near, near, False, px, py, th, c, s, ranges, vis, angles,
-                                max_range, gap, epar, efst, eist, rist, npar, nfst, nist, grid, normals)
+                                max_range, gap, epar, efst, eist, rist, npar, nfst, nist, grid, normals, nav)
         in_now = not math.isnan(now_x[tt])
         if rpar[r, RP_DROP_HELPER] != 0.0:
             rist[r, R_TT_STALL] = 0 if (towards or in_now) else rist[r, R_TT_STALL] + 1
@@ -547,7 +594,7 @@ def team_decide(step, odom, role, ranges, vis, angles, max_range, gap, sight, ep
     for r in range(n):
         if role[r] == ROLE_R1:
             out_dir[r] = r1_team_decide_row(r, step, odom, ranges, vis, angles, max_range, gap, sight, epar, efst,
-                                            eist, rist, rpar, targets, paths, npar, nfst, nist, grid, normals, tf)
+                                            eist, rist, rpar, targets, paths, npar, nfst, nist, grid, normals, nav, tf)
         else:
             out_dir[r] = HC.helper_decide_row(r, odom, ranges, vis, angles, max_range, gap, epar, efst, eist, hist,
                                               patrol, npar, nfst, nist, grid, normals, nav)
@@ -561,9 +608,12 @@ def r1_team_unsupported(p: Any, info: RobotInfo) -> str | None:
 
     if type(p) is not LosExplorerParams:
         return f"params of type {type(p).__name__}"
-    if p.navigator not in ("potential_field", "avoid_past"):
-        return (f"navigator {p.navigator!r} with teammates (compiled: potential_field, avoid_past; VisBug-21's "
-                "temporary goals and start_again are not)")
+    if p.navigator not in ("potential_field", "avoid_past", "visbug21"):
+        return f"navigator {p.navigator!r} with teammates (compiled: potential_field, avoid_past, visbug21)"
+    if p.navigator == "visbug21":
+        turn = NAVIGATORS["visbug21"].Params(**dict(p.navigator_params)).turn
+        if turn not in V.TURNS:
+            return f"VisBug-21 turn {turn!r} (a draw per goal; compiled: {', '.join(V.TURNS)})"
     if p.state_sharing and p.trouble_return:
         return "trouble_return (§5: back to where a teammate was last seen; not compiled)"
     if p.state_sharing and p.trouble_release_to_helper:
@@ -625,7 +675,7 @@ class _R1TeamView:
     msgs_received = property(lambda self: int(self._g.gs.gist[self._r, GC.I_MSGS_RECEIVED]))
     target_steps = property(lambda self: [int(v) for v in self._g.target_steps[self._r, :self._i(C.J_REACHED)]])
     trouble_helpers_dropped = property(lambda self: self._q(R_HELPERS_DROPPED))
-    ghosts_unreachable = 0  # VisBug-21 is not compiled with teammates
+    ghosts_unreachable = property(lambda self: self._q(R_GHOSTS_UNREACH))
 
     @property
     def mode_steps(self) -> dict[str, int]:
@@ -636,8 +686,8 @@ class _R1TeamView:
         out = HC.common_log(self, self.temp_switches)
         out.update(target_index=self.target_index, targets_reached=self.targets_reached, finished=self.finished,
                    gave_up=self.gave_up, goal_seen_steps=self.goal_seen_steps, promised_steps=self.promised_steps,
-                   temp_dropped=self.temp_dropped, ghosts_unreachable=0, vias_taken=self.vias_taken,
-                   trouble_helpers_dropped=self.trouble_helpers_dropped)
+                   temp_dropped=self.temp_dropped, ghosts_unreachable=self.ghosts_unreachable,
+                   vias_taken=self.vias_taken, trouble_helpers_dropped=self.trouble_helpers_dropped)
         if self.params.log_layers:
             out["layers"] = HC.log_layers(self)
         return out
@@ -725,6 +775,11 @@ class _Compiled:
                 rp[RP_DROP_AFTER] = p.trouble_drop_after_steps
                 rp[RP_PROGRESS] = PROGRESS.index(p.trouble_progress)
                 rp[RP_NEAR_HELPER] = math.nan if p.trouble_near_helper_m is None else p.trouble_near_helper_m
+                rp[RP_RESTART_AT_GHOST] = float(p.restart_navigator_at_ghost)
+                # LosExplorer: the factor only with VisBug-21 (else start_again() without one)
+                rp[RP_REVERSE] = (math.nan if p.navigator != "visbug21" or p.visbug_reverse_walk_factor is None
+                                  else float(p.visbug_reverse_walk_factor))
+                rp[RP_DROP_UNREACH] = float(p.drop_unreachable_ghost)
             else:
                 e[C.Q_BUDGET] = -1.0
                 if p.patrol_xy:
