@@ -163,20 +163,23 @@ def test_identity_without_targets():
 
 
 def test_teams_with_helpers_step_in_one_group_brain():
-    """R1 and a helper form one team of the team's group brain: with VisBug-21 (its temporary
-    goals are not compiled) R1 runs its per-robot brain inside it, beside the compiled helper;
-    with Avoid-Past, R1 is compiled too (identity with the reference: tests/test_team_compiled.py
-    and tests/test_goal_sharing_compiled.py)."""
+    """R1 and a helper form one team of the team's group brain: with VisBug-21 or Avoid-Past R1
+    is compiled too (identity with the reference: tests/test_team_compiled.py and
+    tests/test_goal_sharing_compiled.py); with VisBug-21's ``turn="random"`` (a draw per task goal,
+    declined) R1 runs its per-robot brain inside the group, beside the compiled helper."""
     ov = {"robots.1.count": 1, "robots.2.count": 0, "robots.3.count": 0}
-    for navigator, r1 in (("visbug21", "LosExplorer"), ("avoid_past", "_R1TeamView")):
-        scn = load_scenario("los-help-simple", overrides={**ov, "robots.0.params.navigator": navigator},
-                            duration_s=1.0, seed=0)
+    cases = (({"robots.0.params.navigator": "visbug21",
+               "robots.0.params.navigator_params": {"turn": "random"}}, "LosExplorer", 1),
+             ({"robots.0.params.navigator": "visbug21"}, "_R1TeamView", 2),
+             ({"robots.0.params.navigator": "avoid_past"}, "_R1TeamView", 2))
+    for r1_over, r1, compiled in cases:
+        scn = load_scenario("los-help-simple", overrides={**ov, **r1_over}, duration_s=1.0, seed=0)
         sim = Simulation(build_grid(scn), scn, group_brains=True)
         assert [type(t).__name__ for t, *_ in sim.group_teams] == ["LosTeamGroup"]
         assert sim.group_teams[0][1:3] == (0, 2)
         assert type(sim.brains[0][0]).__name__ == r1
         assert type(sim.brains[1][0]).__name__ == "_HelperView"
-        assert sim.group_teams[0][0].compiled_robots == (1 if navigator == "visbug21" else 2)
+        assert sim.group_teams[0][0].compiled_robots == compiled
 
 
 def test_runs_with_faults_keep_the_reference_brains():
