@@ -114,7 +114,7 @@ def test_the_report_owns_the_option_and_run_and_report_pass_it(monkeypatch, tmp_
     seen = {}
 
     class _Stop(Exception):
-        pass
+        """Ends the probe trial once the engine's brains are seen."""
 
     def fake_run(scn, **kw):
         seen["run"] = kw.get("group_brains")

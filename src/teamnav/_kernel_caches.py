@@ -217,6 +217,6 @@ def renew(root: Path = PACKAGE_ROOT, *, force: bool = False) -> list[Path]:
         tmp = record_path.with_name(f"{RECORD_NAME}.{os.getpid()}.tmp")
         tmp.write_text(json.dumps({"modules": sorted(str(m.relative_to(root)) for m in deps), "stats": stats}))
         os.replace(tmp, record_path)
-    except OSError:
-        pass
+    except OSError:  # a cache folder that cannot be written: renewed again next time, never an error
+        return renewed
     return renewed
