@@ -100,3 +100,27 @@ def test_the_start_is_the_papers_one_at_a_time_in_both_columns_with_its_interval
     assert math.hypot(sc.launch.spot[0] - home.x_m, sc.launch.spot[1] - home.y_m) < 1e-9
 
 
+
+
+@pytest.mark.parametrize("build, section", [(L.blazing_ledger, "blazing-a-trail"),
+                                            (L.try_ledger, "try-to-see-it-my-way")])
+def test_the_180_degree_rules_threshold_is_a_fill_row_with_the_value_both_columns_drive_with(build, section):
+    """"Approximately opposite" (Blazing §4.2) has no angle in either paper: the value the columns'
+    Navigate uses must be a ledger row marked fill that says it was not chosen on runs."""
+    from teamnav.control.nav.navigate import NavigateParams
+    from teamnav.experiments.spec import load_scenario
+    from teamnav.papers.trails.brains.blazing_trail import navigate_params
+
+    rows = [r for r in build().rows if r.name == "navigate.reverse_threshold_deg"]
+    assert {r.column for r in rows} == {"paper", "teamnav"} and all(r.source == "fill" for r in rows)
+    assert all("approximately the opposite direction" in r.ref and "not re-chosen" in r.ref for r in rows)
+    scen = load_scenario(section).robots[0].params
+    used = navigate_params(dict(scen.get("navigate", {})), 0.25).reverse_threshold_deg
+    paper_rules = NavigateParams.PAPER_RULES.get("reverse_threshold_deg", used)
+    assert {r.value for r in rows} == {used} == {paper_rules}
+
+
+@pytest.mark.skipif(not PAPERS.is_dir(), reason="the papers' texts are not beside this checkout")
+def test_the_threshold_rows_quote_is_verbatim():
+    quote = L.REVERSE_THRESHOLD_REF.split('"')[1]
+    assert quote in _paper_text("blazing-a-trail")

@@ -53,6 +53,12 @@ BOX_REACH_REF = ("the papers give no size (Blazing §4.2: \"A virtual box a litt
                  "Lane share 0.842, 0.959, 0.966, 0.946, 0.958: 1.6 m is 0.007 ± 0.002 below 2.0 m, so 2.0 m "
                  "(an inner point of the grid; 40 runs, 317 CPU s). It had first been chosen on report seeds 0-7 "
                  "by efficiency; the rule keeps it. Both columns")
+#: Navigate's "approximately opposite" (the 180° rule's threshold): a silence filled by a library default, not tuned
+REVERSE_THRESHOLD_REF = ("Blazing §4.2: \"If the robot is heading in approximately the opposite direction to the "
+                         "trail it makes a sharp 180° right turn.\" No angle is given (Try §3.3 reuses Navigate). "
+                         "150° is Navigate's library default (reverse_threshold_deg), chosen by neither rule nor "
+                         "runs, on no seeds: not re-chosen yet. With the crumb radius it sets how often the 180° rule "
+                         "fires (Blazing's cause paragraph). Both columns")
 #: (gap [m], where, quote) per section, for the rule of ``launch.clear_m``
 LAUNCH_GAP = {"blazing-a-trail": (0.40, "Blazing §4.2", BLAZING_GAP_QUOTE),
               "try-to-see-it-my-way": (0.20, "Try §3.3", TRY_GAP_QUOTE)}
@@ -151,6 +157,7 @@ _SHARED_BLAZING = (
      "Blazing §5.1: \"When the robot detects an opening it turns into the opening if the average heading of the "
      "crumbs points to the side where the opening is detected.\""),
     ("navigate.box_reach_m", 2.0, "fill", BOX_REACH_REF),
+    ("navigate.reverse_threshold_deg", 150.0, "fill", REVERSE_THRESHOLD_REF),
     ("crumb_interval_s, radius_m", "1 s, 2 m", "fill",
      "the 2000 paper gives neither (\"at regular time intervals\", \"a threshold radius\"); the library defaults: "
      "2 m is about a corridor's width (1.8 m), chosen by that arithmetic, not on runs. Both columns"),
@@ -229,6 +236,7 @@ def try_ledger() -> Ledger:
          "+0.037 ± 0.037, a tie; 3 m +0.069 ± 0.026): 4 m, an inner point (20 runs, 162 CPU s). 3 m until "
          "2026-11-29, chosen on report seeds 0-11 by efficiency. Both columns"),
         ("navigate.box_reach_m", 2.0, "fill", BOX_REACH_REF),
+        ("navigate.reverse_threshold_deg", 150.0, "fill", REVERSE_THRESHOLD_REF),
         *_start_rows("try-to-see-it-my-way"),
         ("heading drift per robot", T.DRIFT_TEXT, "fill",
          "Try §3.6 states Tanis 0.35 and Fly 2 deg/min and the directions (\"Bug's coordinate system rotated "
