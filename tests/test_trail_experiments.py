@@ -769,3 +769,30 @@ def test_the_paper_columns_failures_name_breakdowns_without_drift_as_not_the_pap
     assert "never broke down (5 runs of 60 min)" in ok and "the mechanism the paper reports" in ok
     assert failure_cause_text(fails, k1, 3600.0).endswith("is not known here.")
     assert failure_cause_text({"first-trail": (True, ""), "team-vs-one-robot": (None, "")}, k0, 3600.0) == ""
+
+
+def test_the_2002_paper_columns_failures_name_wandering_the_papers_table_1_rules_out():
+    """FIDELITY §1: the 2002 paper's Table 1 gives 31.3 m a trip (8211 m / 262), the route's length.
+    When the paper column drives much more than that a trip, the section says its failures are not
+    shown to be the paper's and names the fills behind the 180° rule; when it drives about the
+    paper's distance, it says its losses are not from wandering. Never when every claim holds."""
+    from teamnav.papers.trails.report.try_to_see_it_my_way import PAPER_M_PER_TRIP, failure_cause_text
+
+    assert PAPER_M_PER_TRIP == pytest.approx(8211 / 262)
+
+    def runs(m_per_trip):
+        return [{"place_speed_mps": 0.2, "distance_m_lifetime_total": m_per_trip * 100, "trips_total": 100,
+                 "lifetime_min_total": 600.0} for _ in range(5)]
+    fails = {"hours-efficiency": (False, ""), "memory-flat": (True, ""), "hours-at-breaking-drift": (None, "")}
+    k0 = [{"breakdown_censored": 1} for _ in range(4)]
+    study = [{"part": "reversals", "config": c, "seed": s, "duration_s": 1800.0, "reversals": n}
+             for s in (1000, 1001) for c, n in (("paper", 200), ("teamnav", 40))]
+    text = failure_cause_text(fails, runs(60.0), k0, 3600.0, study)
+    assert text.startswith("Why the paper column fails hours-efficiency:") and "memory-flat" not in text
+    assert "drive 60.0 m a trip" in text and "1.9x" in text and "not shown to be the paper's" in text
+    assert "never broke down" in text and "400 times per team hour, against 80" in text
+    assert "reverse_threshold_deg, 150°" in text
+    near = failure_cause_text(fails, runs(33.0), [dict(r, breakdown_censored=0) for r in k0], 3600.0, study)
+    assert "do not come from wandering" in near and "broke down in 4" in near and "not shown" not in near
+    assert failure_cause_text(fails, [], k0, 3600.0, study).endswith("is not known here.")
+    assert failure_cause_text({"memory-flat": (True, ""), "x": (None, "")}, runs(60.0), k0, 3600.0, study) == ""

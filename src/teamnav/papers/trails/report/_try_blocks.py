@@ -99,8 +99,9 @@ def odometry_table(scale_s: list, scale_b: list, slip_s: list, slip_b: list, d_s
     return blocks
 
 
-def table1_block(share: list) -> Table:
-    """Table 1 of the paper: trips, distance and lifetime per robot, ours beside the paper's."""
+def table1_block(share: list, column: str = "") -> Table:
+    """Table 1 of the paper: trips, distance and lifetime per robot, ours (one column's runs, named
+    by ``column``) beside the paper's."""
     trips = T.values(share, "trips_total")
     rows = []
     for i, name in enumerate(OUR_ROBOTS):
@@ -111,7 +112,7 @@ def table1_block(share: list) -> Table:
     p = PAPER_TABLE1["Total"]
     rows.append(["Total", p[0], T.msd(trips, "{:.0f}"), p[1], T.msd(T.values(share, "distance_m_total"), "{:.0f}"),
                  p[2], T.msd(T.values(share, "lifetime_min_total"), "{:.1f}")])
-    return Table("Table 1: trips, distance and lifetime per robot",
+    return Table("Table 1: trips, distance and lifetime per robot" + (f" ({column})" if column else ""),
                         ["Robot", "Trips (paper)", "Trips (ours)", "Distance m (paper)", "Distance m (ours)",
                          "Lifetime min (paper)", "Lifetime min (ours)"], rows,
                         note="lifetime = time of the robot's last place visit; the paper's Total row (262 trips, "
