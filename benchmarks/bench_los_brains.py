@@ -51,8 +51,9 @@ The scaling row (last in ``--group-brains`` and ``--quick``, alone with ``--scal
 ``--sizes``): R1 and n - 1 helpers, n = 4, 8, 16, 32, 64, on ``office_simple_grid`` (21 wings, each
 Fig. 11's office; helpers three per wing on R2..R4's routes; ``teamnav.papers.los_help.scaling``), R1
 on VisBug-21 on tuning task 1001, reference and compiled brains alternating, each run in a fresh
-process after a 4-robot warm-up, hashed as above. CPU is counted inside ``Simulation.run`` (the
-team steps; the set-up of 64 start regions is not a team step). The teamnav column (``--quick``:
+process, timed after 100 untimed steps of the same run (the set-up of 64 start regions is not a
+team step, and numba compiles VisBug-21's object-mode call in each process on first use); the end
+states (poses, logs, radio totals) are hashed, and a row whose runs differ says DIFFER. The teamnav column (``--quick``:
 300 steps, one round, about 35 CPU-s) or both columns (otherwise). Its lines come after the
 4-robot line, one per team size, ``LOS team step, 8 robots: compiled / reference = 2.2x`` (whole
 step; the table gives the brains' share too); its own 4-robot size is named ``4 robots
@@ -646,39 +647,60 @@ SCALE_SIZES = (4, 8, 16, 32, 64)
 #: Steps per timed run of the scaling row with ``--quick`` (a few hundred: about 1.5 CPU-min
 #: for the five sizes, reference and compiled, processes and warm-ups included).
 SCALE_QUICK_STEPS = 300
+#: Untimed steps before the timed ones, in the same run.
+SCALE_WARM_STEPS = 100
 
 
-def _scale_worker(n: int, paper: bool, compiled: bool, steps: int) -> dict:
+def _scale_worker(n: int, paper: bool, compiled: bool, steps: int, warm: int = SCALE_WARM_STEPS) -> dict:
     """(in the measuring process) CPU of ``steps`` team steps of R1 and ``n - 1`` helpers on the
-    larger office (R1 on VisBug-21, tuning task TEAM_TASK), reference or compiled brains: the
-    stepping only (``Simulation.run``; the set-up of 64 start regions is not a team step), the
-    part inside the brains, and the run's digest."""
+    larger office (R1 on VisBug-21, tuning task TEAM_TASK), reference or compiled brains, after
+    ``warm`` untimed steps of the same run (kernels loaded, and compiled where numba cannot cache
+    them: VisBug-21's object-mode call in the paper column is compiled in each process on first
+    use); the part inside the brains; numba compilations during the timed steps (should be 0);
+    and a digest of the end state (true and odometry poses, every brain's log, radio totals)."""
+    import hashlib
+
+    import numpy as np
+    from numba.core import event
+
+    from los_fingerprint import _default
+    from teamnav.experiments.spec import build_grid
     from teamnav.papers.los_help import scaling
-    from teamnav.experiments.runner import run
-    from teamnav.sim import engine
+    from teamnav.sim.engine import Simulation
 
-    run(scaling.load(4, task=TEAM_TASK, paper=paper, duration_s=3.0), progress=False,
-        group_brains=compiled)  # warm-up: kernels loaded (the same kernels at every size)
-    scn = scaling.load(n, task=TEAM_TASK, paper=paper, duration_s=steps * 0.1)
-    loop_s = [0.0]
-    orig_run = engine.Simulation.run
-
-    def timed(self, *args, **kwargs):
-        t = time.process_time()
-        try:
-            return orig_run(self, *args, **kwargs)
-        finally:
-            loop_s[0] += time.process_time() - t
-
-    engine.Simulation.run = timed
-    try:
-        total, brain_s, res = timed_run(scn, group_brains=compiled)
-    finally:
-        engine.Simulation.run = orig_run
-    if compiled and sum(getattr(t, "compiled_robots", 0) for t, *_ in res.sim.group_teams) != n:
+    scn = scaling.load(n, task=TEAM_TASK, paper=paper, duration_s=(warm + steps) * 0.1)
+    sim = Simulation(build_grid(scn), scn, group_brains=compiled)
+    if compiled and sum(getattr(t, "compiled_robots", 0) for t, *_ in sim.group_teams) != n:
         raise SystemExit(f"the group brain did not compile all {n} robots")
-    return {"cpu_s": loop_s[0], "run_s": total, "brain_s": brain_s, "steps": int(res.sim.step_index),
-            "digest": _digest(res), "robots": int(res.sim.n_robots)}
+    brain_s = [0.0]
+    clock = time.process_time
+    teams = [team for team, *_ in sim.group_teams]
+    for brain in [b for g in sim.brains for b in (g if isinstance(g, list) else [g])] + teams:
+        for meth in ("step", "log", "step_group"):  # as benchmarks/_common.py's timed_run
+            f = getattr(brain, meth, None)
+            if callable(f):
+                def timed(*args, f=f):
+                    t = clock()
+                    out = f(*args)
+                    brain_s[0] += clock() - t
+                    return out
+
+                setattr(brain, meth, timed)
+    sim.run(warm)
+    brain_s[0] = 0.0
+    with event.install_recorder("numba:compile") as rec:
+        t0 = clock()
+        sim.run(steps)
+        loop_s = clock() - t0
+    brains = [b for g in sim.brains for b in (g if isinstance(g, list) else [g])]
+    h = hashlib.sha256()
+    for a in (sim.state.poses(), sim.odometry.pose):
+        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    r = sim.radio
+    h.update(json.dumps([b.log() for b in brains] + [list(map(int, r._sent_messages)), list(map(int, r._sent_bytes))],
+                        sort_keys=True, default=_default).encode())
+    return {"cpu_s": loop_s, "brain_s": brain_s[0], "steps": int(sim.step_index) - warm, "digest": h.hexdigest(),
+            "robots": int(sim.n_robots), "compiles": sum(1 for e in rec.buffer if e[1].is_start)}
 
 
 def _scale_measure(n: int, paper: bool, compiled: bool, steps: int) -> dict:
@@ -699,7 +721,7 @@ def _scaling(sizes: tuple[int, ...], steps: int, repeats: int, papers: tuple[boo
     t0 = time.process_time()
     print(f"scaling row: R1 (VisBug-21, tuning task {TEAM_TASK}) and n-1 helpers (three per wing, R2..R4's routes) "
           f"on office_simple_grid, {steps} steps per run, {repeats} round(s), medians of CPU in Simulation.run "
-          f"(time.process_time, one numba thread), load {load0:.1f}")
+          f"after {SCALE_WARM_STEPS} untimed steps (time.process_time, one numba thread), load {load0:.1f}")
     print(f"{'column':8s} {'robots':>6s} {'ref ms/step':>11s} {'(brains)':>9s} {'compiled':>9s} {'(brains)':>9s} "
           f"{'ratio':>6s} {'brains':>7s}  outputs")
     ratios: dict[int, list[float]] = {n: [] for n in sizes}
@@ -713,10 +735,12 @@ def _scaling(sizes: tuple[int, ...], steps: int, repeats: int, papers: tuple[boo
         rb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in ref)
         ct = statistics.median(1000 * r["cpu_s"] / r["steps"] for r in cmp_)
         cb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in cmp_)
+        compiles = sum(r["compiles"] for r in ref + cmp_)
         if same:  # a ratio only for identical runs
             ratios[n].append(rt / ct)
         print(f"{'paper' if paper else 'teamnav':8s} {n:6d} {rt:11.3f} {rb:9.3f} {ct:9.3f} {cb:9.3f} {rt / ct:6.2f} "
-              f"{rb / cb:7.2f}  {'identical' if same else 'DIFFER'}", flush=True)
+              f"{rb / cb:7.2f}  {'identical' if same else 'DIFFER'}"
+              f"{f'; {compiles} numba compilations while timed' if compiles else ''}", flush=True)
     print(f"(brains: CPU inside the brains' step and log, or the group brain's step_group and the views' log; "
           f"load {load0:.1f} -> {os.getloadavg()[0]:.1f}; this script's own CPU {time.process_time() - t0:.1f} s, "
           f"the runs' in their processes)")

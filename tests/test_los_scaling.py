@@ -146,3 +146,25 @@ def test_compiled_team_is_the_reference_at_n(n, navigator, paper):
     heard = [b.msgs_received for b in brains_ref]
     assert sum(h > 0 for h in heard) >= n // 2, f"too few robots heard a teammate: {heard}"
     assert brains_ref[0].target_steps == brains_grp[0].target_steps
+
+
+@pytest.mark.parametrize("m", [1, 4, 64])
+def test_row_sizes_is_size_bytes(m):
+    """The compiled team sizes its sent rows in one kernel call (``packed.row_sizes``): the same
+    integers as :meth:`PackedLosMsg.size_bytes` and as the :class:`LosHelpMsg` each row packs
+    (random messages with up to ``m`` sightings, goals and reports, via fields sent or not, Tr
+    bit or none), for any choice of rows."""
+    from teamnav.control.types import payload_size_bytes
+    from teamnav.papers.los_help.brains.packed import PackedLosMsg, pack, row_sizes
+
+    from test_group_brains import _random_msgs
+
+    rng = np.random.default_rng(11)
+    msgs = list(_random_msgs(rng, m, 120))
+    rows = np.stack([pack(msg, m) for msg in msgs])
+    idx = np.sort(rng.choice(len(msgs), size=50, replace=False)).astype(np.int64)
+    got = row_sizes(rows, idx)
+    assert got.dtype == np.int64
+    assert got.tolist() == [PackedLosMsg(rows[i]).size_bytes() for i in idx]
+    assert got.tolist() == [payload_size_bytes(msgs[i]) for i in idx]
+    assert row_sizes(rows, np.zeros(0, dtype=np.int64)).shape == (0,)
