@@ -54,7 +54,8 @@ on VisBug-21 on tuning task 1001, reference and compiled brains alternating, eac
 process, timed after 100 untimed steps of the same run (the set-up of 64 start regions is not a
 team step, and numba compiles VisBug-21's object-mode call in each process on first use); the end
 states (poses, logs, radio totals) are hashed, and a row whose runs differ says DIFFER. The teamnav column (``--quick``:
-300 steps, one round, about 35 CPU-s) or both columns (otherwise). Its lines come after the
+300 steps, one round, about 35 CPU-s) or both columns (otherwise: ``--steps``, ``--repeats``; 1000
+steps x 3 rounds cost about 5 CPU-min). Its lines come after the
 4-robot line, one per team size, ``LOS team step, 8 robots: compiled / reference = 2.2x`` (whole
 step; the table gives the brains' share too); its own 4-robot size is named ``4 robots
 (office_simple_grid)``, so that the issue's 4-robot line stays the Tables' team on office_simple.
