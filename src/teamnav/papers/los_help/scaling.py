@@ -103,7 +103,7 @@ def scenario_data(n_robots: int, *, task: int = 1001, n_targets: int = 20, navig
     """
     if not 2 <= n_robots <= MAX_ROBOTS:
         raise ValueError(f"n_robots must be in [2, {MAX_ROBOTS}] (R1 and 1-{MAX_ROBOTS - 1} helpers), got {n_robots}")
-    base = T.scenario_data("simple", task=1, n_targets=1, navigator=navigator, helpers=1)
+    base = T.scenario_data("simple", task=task, n_targets=1, navigator=navigator, helpers=1)  # bodies, sensing, radio
     r1, helper = base["robots"][0], base["robots"][1]
     r1 = copy.deepcopy(r1)
     r1["params"]["targets_xy"] = targets_xy(task, n_targets)
