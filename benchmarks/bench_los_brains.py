@@ -22,6 +22,7 @@ Usage::
     python benchmarks/bench_los_brains.py --paper-rules --only visbug21   # the paper-as-written column
     python benchmarks/bench_los_brains.py --team-step --base-commit 37d70e6   # 4-robot team steps, both columns
     python benchmarks/bench_los_brains.py --group-brains             # compiled group brains vs the reference
+    python benchmarks/bench_los_brains.py --scaling --quick          # only the scaling row, teams of 4-64
 
 ``--team-step``: CPU seconds per 1000 team steps of R1..R4 on office_simple (R1 on tuning task
 1001, Table 1's helpers' routes), for each column (teamnav, paper as written) and navigator
@@ -46,6 +47,18 @@ configuration and then one per team size, in the form
 median of the configurations); a team in which a robot ran its reference brain inside the
 group brain gets a line ``4 robots (helpers compiled, R1 reference)``, not the issue's
 ``4 robots:``. ``--quick`` ends with these lines too (1000 steps, one round).
+The scaling row (last in ``--group-brains`` and ``--quick``, alone with ``--scaling``; sizes with
+``--sizes``): R1 and n - 1 helpers, n = 4, 8, 16, 32, 64, on ``office_simple_grid`` (21 wings, each
+Fig. 11's office; helpers three per wing on R2..R4's routes; ``teamnav.papers.los_help.scaling``), R1
+on VisBug-21 on tuning task 1001, reference and compiled brains alternating, each run in a fresh
+process, timed after 100 untimed steps of the same run (the set-up of 64 start regions is not a
+team step, and numba compiles VisBug-21's object-mode call in each process on first use); the end
+states (poses, logs, radio totals) are hashed, and a row whose runs differ says DIFFER. The teamnav column (``--quick``:
+300 steps, one round, about 35 CPU-s) or both columns (otherwise: ``--steps``, ``--repeats``; 1000
+steps x 3 rounds cost about 5 CPU-min). Its lines come after the
+4-robot line, one per team size, ``LOS team step, 8 robots: compiled / reference = 2.2x`` (whole
+step; the table gives the brains' share too); its own 4-robot size is named ``4 robots
+(office_simple_grid)``, so that the issue's 4-robot line stays the Tables' team on office_simple.
 ``--group-brains --group-tasks 1001,1002``: whole tasks instead (200 targets, the scenario's
 own budget per target, ``stop_when_finished``), reference then compiled in one process per
 task, saying whether every output, the run's metrics and the steps per target are the same
@@ -147,6 +160,11 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--group-tasks", help="with --group-brains: whole tuning tasks (comma-separated), identity "
                                           "of outputs and metrics, reference vs compiled")
     ap.add_argument("--group-task-worker", nargs=3, metavar=("NAV", "PAPER", "TASK"), help=argparse.SUPPRESS)
+    ap.add_argument("--scale-worker", nargs=4, metavar=("N", "PAPER", "COMPILED", "STEPS"), help=argparse.SUPPRESS)
+    ap.add_argument("--scaling", action="store_true",
+                    help="only the scaling row: teams of 4-64 on office_simple_grid, compiled vs reference")
+    ap.add_argument("--sizes", default=",".join(str(n) for n in SCALE_SIZES),
+                    help="team sizes of the scaling row (comma-separated; default %(default)s)")
     ap.add_argument("--team-step", action="store_true",
                     help="CPU per 1000 team steps at 4 robots, both columns x 3 navigators, base vs this tree")
     ap.add_argument("--targets", type=int, default=0, help="time whole tasks of the first N targets of task 1")
@@ -178,6 +196,16 @@ def main(argv: list[str] | None = None) -> None:
     if args.kernels:
         _kernels()
         return
+    if args.scale_worker:
+        n, paper, compiled, k = args.scale_worker
+        print(json.dumps(_scale_worker(int(n), paper == "1", compiled == "1", int(k))))
+        return
+    sizes = tuple(int(v) for v in args.sizes.split(","))
+    if args.scaling:
+        lines = _scaling(sizes, SCALE_QUICK_STEPS if args.quick else args.steps,
+                         1 if args.quick else max(1, args.repeats), (False,) if args.quick else (False, True))
+        print("\n".join(lines))
+        return
     if args.group_task_worker:
         nav, paper, task = args.group_task_worker
         print(json.dumps(_group_task_worker(nav, paper == "1", int(task))))
@@ -186,7 +214,7 @@ def main(argv: list[str] | None = None) -> None:
         return _group_tasks([int(t) for t in args.group_tasks.split(",")], args.only)
     if args.group_brains:
         return _group_brains(1000 if args.quick else args.steps, 1 if args.quick else max(1, args.repeats),
-                             args.only)
+                             args.only, sizes, args.quick)
     steps = 600 if args.quick else args.steps
     repeats = 1 if args.quick else max(1, args.repeats)
     base = Path(args.base_src) if args.base_src else _base_src(args.base_commit)
@@ -221,7 +249,7 @@ def main(argv: list[str] | None = None) -> None:
         print(f"ratio base/new per step: min {min(ratios):.2f}, median {statistics.median(ratios):.2f}, "
               f"max {max(ratios):.2f} (CPU time.process_time, one numba thread)")
     if args.quick and not args.only:
-        _group_brains(1000, 1)  # last: the compiled group brains' lines per team size
+        _group_brains(1000, 1, None, sizes, True)  # last: the compiled group brains' lines per team size
 
 
 def _kernels() -> None:
@@ -559,7 +587,8 @@ def _group_measure(navigator: str, paper: bool, compiled: bool, steps: int) -> d
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def _group_brains(steps: int, repeats: int, only: list[str] | None = None) -> None:
+def _group_brains(steps: int, repeats: int, only: list[str] | None = None, sizes: tuple[int, ...] = (),
+                  quick: bool = False) -> None:
     """CPU per team step, compiled group brains vs the Python reference (see ``--group-brains``)."""
     load0 = os.getloadavg()[0]
     t0 = time.process_time()
@@ -602,8 +631,122 @@ def _group_brains(steps: int, repeats: int, only: list[str] | None = None) -> No
     if team_ratios:  # R1 on its reference brain inside the team: named apart from the issue's "4 robots:" line
         print(f"LOS team step, 4 robots (helpers compiled, R1 reference): compiled / reference = "
               f"{statistics.median(team_ratios):.2f}x")
-    if whole_ratios:  # the whole team compiled (the issue's line; last)
+    scale_lines = []
+    if sizes and not only:  # the scaling row: its table here, its lines after the 4-robot line
+        scale_lines = _scaling(sizes, SCALE_QUICK_STEPS if quick else steps, repeats,
+                               (False,) if quick else (False, True))
+    if whole_ratios:  # the whole team compiled (the issue's line)
         print(f"LOS team step, 4 robots: compiled / reference = {statistics.median(whole_ratios):.1f}x")
+    for line in scale_lines:  # last: one line per larger team size
+        print(line)
+
+
+# ---------------------------------------------------------------------------- scaling row
+#: Team sizes of the scaling row (R1 and n - 1 helpers on office_simple_grid,
+#: ``teamnav.papers.los_help.scaling``).
+SCALE_SIZES = (4, 8, 16, 32, 64)
+#: Steps per timed run of the scaling row with ``--quick`` (a few hundred: about 1.5 CPU-min
+#: for the five sizes, reference and compiled, processes and warm-ups included).
+SCALE_QUICK_STEPS = 300
+#: Untimed steps before the timed ones, in the same run.
+SCALE_WARM_STEPS = 100
+
+
+def _scale_worker(n: int, paper: bool, compiled: bool, steps: int, warm: int = SCALE_WARM_STEPS) -> dict:
+    """(in the measuring process) CPU of ``steps`` team steps of R1 and ``n - 1`` helpers on the
+    larger office (R1 on VisBug-21, tuning task TEAM_TASK), reference or compiled brains, after
+    ``warm`` untimed steps of the same run (kernels loaded, and compiled where numba cannot cache
+    them: VisBug-21's object-mode call in the paper column is compiled in each process on first
+    use); the part inside the brains; numba compilations during the timed steps (should be 0);
+    and a digest of the end state (true and odometry poses, every brain's log, radio totals)."""
+    import hashlib
+
+    import numpy as np
+    from numba.core import event
+
+    from los_fingerprint import _default
+    from teamnav.experiments.spec import build_grid
+    from teamnav.papers.los_help import scaling
+    from teamnav.sim.engine import Simulation
+
+    scn = scaling.load(n, task=TEAM_TASK, paper=paper, duration_s=(warm + steps) * 0.1)
+    sim = Simulation(build_grid(scn), scn, group_brains=compiled)
+    if compiled and sum(getattr(t, "compiled_robots", 0) for t, *_ in sim.group_teams) != n:
+        raise SystemExit(f"the group brain did not compile all {n} robots")
+    brain_s = [0.0]
+    clock = time.process_time
+    teams = [team for team, *_ in sim.group_teams]
+    for brain in [b for g in sim.brains for b in (g if isinstance(g, list) else [g])] + teams:
+        for meth in ("step", "log", "step_group"):  # as benchmarks/_common.py's timed_run
+            f = getattr(brain, meth, None)
+            if callable(f):
+                def timed(*args, f=f):
+                    t = clock()
+                    out = f(*args)
+                    brain_s[0] += clock() - t
+                    return out
+
+                setattr(brain, meth, timed)
+    sim.run(warm)
+    brain_s[0] = 0.0
+    with event.install_recorder("numba:compile") as rec:
+        t0 = clock()
+        sim.run(steps)
+        loop_s = clock() - t0
+    brains = [b for g in sim.brains for b in (g if isinstance(g, list) else [g])]
+    h = hashlib.sha256()
+    for a in (sim.state.poses(), sim.odometry.pose):
+        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    r = sim.radio
+    h.update(json.dumps([b.log() for b in brains] + [list(map(int, r._sent_messages)), list(map(int, r._sent_bytes))],
+                        sort_keys=True, default=_default).encode())
+    return {"cpu_s": loop_s, "brain_s": brain_s[0], "steps": int(sim.step_index) - warm, "digest": h.hexdigest(),
+            "robots": int(sim.n_robots), "compiles": sum(1 for e in rec.buffer if e[1].is_start)}
+
+
+def _scale_measure(n: int, paper: bool, compiled: bool, steps: int) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(REPO / "src"), NUMBA_NUM_THREADS="1")
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--scale-worker", str(n),
+                          "1" if paper else "0", "1" if compiled else "0", str(steps)],
+                         env=env, check=True, capture_output=True, text=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _scaling(sizes: tuple[int, ...], steps: int, repeats: int, papers: tuple[bool, ...] = (False,)) -> list[str]:
+    """The scaling row: CPU per team step of R1 and n - 1 helpers on office_simple_grid, compiled
+    against reference, per team size (and column); prints its table and returns its last lines,
+    ``LOS team step, N robots: compiled / reference = X.Xx`` (the whole step, median over the
+    columns) for every size but 4, whose line is named ``4 robots (office_simple_grid)`` (the
+    issue's 4-robot line is the Tables' team on office_simple, printed by ``--group-brains``)."""
+    load0 = os.getloadavg()[0]
+    t0 = time.process_time()
+    print(f"scaling row: R1 (VisBug-21, tuning task {TEAM_TASK}) and n-1 helpers (three per wing, R2..R4's routes) "
+          f"on office_simple_grid, {steps} steps per run, {repeats} round(s), medians of CPU in Simulation.run "
+          f"after {SCALE_WARM_STEPS} untimed steps (time.process_time, one numba thread), load {load0:.1f}")
+    print(f"{'column':8s} {'robots':>6s} {'ref ms/step':>11s} {'(brains)':>9s} {'compiled':>9s} {'(brains)':>9s} "
+          f"{'ratio':>6s} {'brains':>7s}  outputs")
+    ratios: dict[int, list[float]] = {n: [] for n in sizes}
+    for paper, n in itertools.product(papers, sizes):
+        ref, cmp_ = [], []
+        for _ in range(repeats):  # alternate: both see the same load
+            ref.append(_scale_measure(n, paper, False, steps))
+            cmp_.append(_scale_measure(n, paper, True, steps))
+        same = len({r["digest"] for r in ref + cmp_}) == 1
+        rt = statistics.median(1000 * r["cpu_s"] / r["steps"] for r in ref)
+        rb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in ref)
+        ct = statistics.median(1000 * r["cpu_s"] / r["steps"] for r in cmp_)
+        cb = statistics.median(1000 * r["brain_s"] / r["steps"] for r in cmp_)
+        compiles = sum(r["compiles"] for r in ref + cmp_)
+        if same:  # a ratio only for identical runs
+            ratios[n].append(rt / ct)
+        print(f"{'paper' if paper else 'teamnav':8s} {n:6d} {rt:11.3f} {rb:9.3f} {ct:9.3f} {cb:9.3f} {rt / ct:6.2f} "
+              f"{rb / cb:7.2f}  {'identical' if same else 'DIFFER'}"
+              f"{f'; {compiles} numba compilations while timed' if compiles else ''}", flush=True)
+    print(f"(brains: CPU inside the brains' step and log, or the group brain's step_group and the views' log; "
+          f"load {load0:.1f} -> {os.getloadavg()[0]:.1f}; this script's own CPU {time.process_time() - t0:.1f} s, "
+          f"the runs' in their processes)")
+    return [f"LOS team step, {n} robots{' (office_simple_grid)' if n == 4 else ''}: compiled / reference = "
+            f"{statistics.median(r):.1f}x" for n, r in ratios.items() if r]
 
 
 if __name__ == "__main__":

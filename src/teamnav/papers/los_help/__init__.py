@@ -17,6 +17,7 @@ PAPER = Paper(
         "office_simple": "teamnav.papers.los_help.maps:office_simple",
         "office_complex": "teamnav.papers.los_help.maps:office_complex",
         "office_complex_closed": ("teamnav.papers.los_help.maps:office_complex", {"alleys": False}),
+        "office_simple_grid": "teamnav.papers.los_help.maps:office_simple_grid",
     },
     metric_sets={"los_help": "teamnav.papers.los_help.metrics"},
     sections=(

@@ -2,7 +2,9 @@
 
 - :func:`office_simple`: the simple office of §6, Fig. 11 (and the scenario of Fig. 1);
 - :func:`office_complex`: the complex office of §6, Fig. 13, built to trap local methods
-  (``alleys=False`` is the builtin ``office_complex_closed``).
+  (``alleys=False`` is the builtin ``office_complex_closed``);
+- :func:`office_simple_grid`: not the paper's, a larger office of 21 copies of Fig. 11's for
+  teams of up to 64 robots (the benchmarks' scaling row).
 
 The paper gives both only as figures: what each map keeps from the text and figures, and
 what is ours, is written in each function's docstring and in :attr:`EnvironmentMap.notes`.
@@ -13,7 +15,7 @@ from __future__ import annotations
 
 from teamnav.world.map_builder import EnvironmentMap, MapBuilder, _res
 
-__all__ = ["office_simple", "office_complex"]
+__all__ = ["office_simple", "office_simple_grid", "office_complex", "wing_origin"]
 
 
 def office_simple(resolution_m: float = 0.1) -> EnvironmentMap:
@@ -33,19 +35,8 @@ def office_simple(resolution_m: float = 0.1) -> EnvironmentMap:
     """
     res = _res(resolution_m)
     b = MapBuilder(30.0, 14.0, res).fill("wall")
-    b.clear_rect(0.2, 5.8, 29.8, 8.2)  # corridor
     places: dict[str, tuple[float, float]] = {}
-    xs = [(0.2, 5.8), (6.0, 11.8), (12.0, 17.8), (18.0, 23.8), (24.0, 29.8)]
-    for k, (x0, x1) in enumerate(xs, start=1):
-        b.clear_rect(x0, 0.2, x1, 5.6)  # south room
-        b.clear_rect(x0 + 0.6, 5.6, x0 + 1.8, 5.8)  # door near its west wall
-        b.clear_rect(x0, 8.4, x1, 13.8)  # north room
-        b.clear_rect(x1 - 1.8, 8.2, x1 - 0.6, 8.4)  # door near its east wall
-        places[f"room_S{k}"] = (round((x0 + x1) / 2, 3), 2.9)
-        places[f"room_N{k}"] = (round((x0 + x1) / 2, 3), 11.1)
-    places["base"] = (1.0, 7.0)
-    for k, x in enumerate((3.0, 9.0, 15.0, 21.0, 27.0), start=1):
-        places[f"patrol_{k}"] = (x, 7.0)
+    _simple_wing(b, 0.0, 0.0, places, "")
     notes = (
         "Sgorbissa & Arkin §6 Fig. 11 (simple office): 30x14 m, corridor y in [5.8, 8.2] m, "
         "5 rooms each side (5.8x5.4 m) with 1.2 m doors near one end; targets at room centres; "
@@ -53,6 +44,89 @@ def office_simple(resolution_m: float = 0.1) -> EnvironmentMap:
     )
     regions = {"corridor": (0.2, 5.8, 29.8, 8.2)}
     return EnvironmentMap(b.build("builtin:office_simple"), places, notes, regions)
+
+
+#: Width and height [m] of one wing of :func:`office_simple_grid`: the simple office itself.
+WING_W_M, WING_H_M = 30.0, 14.0
+#: Width [m] of the north-south corridor between two columns of wings (the simple office's own
+#: corridor width, 2.4 m).
+CONNECTOR_W_M = 2.4
+
+
+def _simple_wing(b: "MapBuilder", x0: float, y0: float, places: dict[str, tuple[float, float]], tag: str) -> None:
+    """Carve the simple office of Fig. 11 (:func:`office_simple`) into a filled builder, its
+    lower-left corner at (``x0``, ``y0``); its places are named with ``tag`` after the prefix
+    (``room_S1`` with tag "" is office_simple's own name, ``room_w03_S1`` with tag "w03_")."""
+    b.clear_rect(x0 + 0.2, y0 + 5.8, x0 + 29.8, y0 + 8.2)  # corridor
+    xs = [(0.2, 5.8), (6.0, 11.8), (12.0, 17.8), (18.0, 23.8), (24.0, 29.8)]
+    for k, (xa, xb) in enumerate(xs, start=1):
+        xa, xb = x0 + xa, x0 + xb
+        b.clear_rect(xa, y0 + 0.2, xb, y0 + 5.6)  # south room
+        b.clear_rect(xa + 0.6, y0 + 5.6, xa + 1.8, y0 + 5.8)  # door near its west wall
+        b.clear_rect(xa, y0 + 8.4, xb, y0 + 13.8)  # north room
+        b.clear_rect(xb - 1.8, y0 + 8.2, xb - 0.6, y0 + 8.4)  # door near its east wall
+        places[f"room_{tag}S{k}"] = (round((xa + xb) / 2, 3), round(y0 + 2.9, 3))
+        places[f"room_{tag}N{k}"] = (round((xa + xb) / 2, 3), round(y0 + 11.1, 3))
+    places[f"base{'_' + tag.rstrip('_') if tag else ''}"] = (round(x0 + 1.0, 3), round(y0 + 7.0, 3))
+    for k, x in enumerate((3.0, 9.0, 15.0, 21.0, 27.0), start=1):
+        places[f"patrol_{tag}{k}"] = (round(x0 + x, 3), round(y0 + 7.0, 3))
+
+
+def wing_origin(wing: int, cols: int = 3) -> tuple[float, float]:
+    """Lower-left corner [m] of wing ``wing`` (row-major from the south-west, ``cols`` per row)
+    of :func:`office_simple_grid`."""
+    if wing < 0:
+        raise ValueError(f"wing must be >= 0, got {wing}")
+    c, r = wing % cols, wing // cols
+    return c * (WING_W_M + CONNECTOR_W_M), r * WING_H_M
+
+
+def office_simple_grid(resolution_m: float = 0.1, cols: int = 3, rows: int = 7) -> EnvironmentMap:
+    """A larger office for team sizes beyond the paper's: ``cols`` x ``rows`` copies ("wings") of
+    the simple office of Fig. 11 (:func:`office_simple`), joined by their corridors.
+
+    Not a map of the paper: §6 runs four robots on Fig. 11. This building is for scaling the
+    team to 64 robots (the benchmarks' scaling row) while keeping what each robot meets what
+    R1..R4 meet on Fig. 11: every wing is the simple office cell for cell (rooms of 5.8 x 5.4 m,
+    1.2 m doors near one end, a 2.4 m corridor, 0.2 m walls; the same traps for a potential
+    field), so a robot's laser, sightings and navigation see the paper's geometry. The default
+    3 x 7 = 21 wings hold 63 helpers at three per wing, the paper's R2..R4 per office, so a
+    64-robot team is as dense as the paper's team of four. Our choices: the wings sit in rows
+    (row-major from the south-west, :func:`wing_origin`); between two columns runs a 2.4 m
+    north-south corridor the height of the building, into which the east-west corridors of the
+    wings beside it open (their end walls removed over the corridor's width); the north wall
+    of one row's north rooms and the south wall of the next row's south rooms are back to back
+    (0.4 m). The building is (30 cols + 2.4 (cols - 1)) m x 14 rows m: 94.8 m x 98 m by default.
+
+    Places: per wing ``k`` (two digits), ``room_wKK_S1``..``room_wKK_N5``, ``base_wKK`` and
+    ``patrol_wKK_1``..5, as office_simple's names; ``base`` is wing 0's base (R1's start).
+    """
+    res = _res(resolution_m)
+    if int(cols) != cols or int(rows) != rows or cols < 1 or rows < 1:
+        raise ValueError(f"cols and rows must be integers >= 1, got {cols!r} x {rows!r}")
+    cols, rows = int(cols), int(rows)
+    width, height = cols * WING_W_M + (cols - 1) * CONNECTOR_W_M, rows * WING_H_M
+    b = MapBuilder(width, height, res).fill("wall")
+    places: dict[str, tuple[float, float]] = {}
+    regions: dict[str, tuple[float, float, float, float]] = {}
+    for w in range(cols * rows):
+        x0, y0 = wing_origin(w, cols)
+        _simple_wing(b, x0, y0, places, f"w{w:02d}_")
+        regions[f"corridor_w{w:02d}"] = (x0 + 0.2, y0 + 5.8, x0 + 29.8, y0 + 8.2)
+    for c in range(cols - 1):  # north-south corridors between columns, the wings' corridors opening into them
+        xa = (c + 1) * WING_W_M + c * CONNECTOR_W_M
+        b.clear_rect(xa, 0.2, xa + CONNECTOR_W_M, height - 0.2)
+        regions[f"connector_{c + 1}"] = (xa, 0.2, xa + CONNECTOR_W_M, height - 0.2)
+        for r in range(rows):
+            y0 = r * WING_H_M
+            b.clear_rect(xa - 0.2, y0 + 5.8, xa + CONNECTOR_W_M + 0.2, y0 + 8.2)
+    places["base"] = places["base_w00"]
+    notes = (
+        f"Beyond the paper (scaling): {cols}x{rows} wings, each Sgorbissa & Arkin §6 Fig. 11's simple office "
+        f"(30x14 m), joined by {CONNECTOR_W_M} m north-south corridors between the columns into which the wings' "
+        f"corridors open; {width:g}x{height:g} m; targets at room centres."
+    )
+    return EnvironmentMap(b.build("builtin:office_simple_grid" if (cols, rows) == (3, 7) else f"builtin:office_simple_grid_{cols}x{rows}"), places, notes, regions)
 
 
 def _u_obstacle(b: "MapBuilder", xmin: float, ymin: float, xmax: float, ymax: float, opens: str,

@@ -27,11 +27,12 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from teamnav.control.types import register_payload_sizer
 from teamnav.papers.los_help.brains.messages import GoalShare, LosHelpMsg, Sighting, VisReport
 
-__all__ = ["PackedLosMsg", "pack", "row_width", "unpack"]
+__all__ = ["PackedLosMsg", "pack", "row_sizes", "row_width", "unpack"]
 
 H_STEP = 0
 H_TROUBLE = 1
@@ -97,6 +98,29 @@ class PackedLosMsg:
 
 
 register_payload_sizer(PackedLosMsg, PackedLosMsg.size_bytes)
+
+
+@njit(cache=True)
+def row_sizes(rows: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """:meth:`PackedLosMsg.size_bytes` of the rows ``rows[idx[i]]`` (a team's outgoing rows), in
+    one call: the same formula, so the same integers (a test compares them). A team of 64 sends
+    about 50 messages a step, each with up to 64 reports: sizing them one by one in Python was
+    an O(robots²) loop of the compiled team step."""
+    m = (rows.shape[1] - N_HEADER) // (SIGHT_W + GOAL_W + REPORT_W)
+    at = N_HEADER + (SIGHT_W + GOAL_W) * m
+    out = np.empty(idx.shape[0], dtype=np.int64)
+    for i in range(idx.shape[0]):
+        r = rows[idx[i]]
+        n_r = int(r[H_N_REPORT])
+        n = 8 + 24 * int(r[H_N_SIGHT]) + 32 * int(r[H_N_GOAL]) + 24 * n_r
+        for k in range(n_r):
+            for j in range(3, 6):
+                if not math.isnan(r[at + REPORT_W * k + j]):
+                    n += 8
+        if r[H_TROUBLE] >= 0:
+            n += 1
+        out[i] = n
+    return out
 
 
 def pack(msg: LosHelpMsg, m: int) -> np.ndarray:

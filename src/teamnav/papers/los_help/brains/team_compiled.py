@@ -62,7 +62,7 @@ from teamnav.papers.los_help.brains import goal_sharing_compiled as GC
 from teamnav.papers.los_help.brains import helper_compiled as HC
 from teamnav.papers.los_help.brains.goal_sharing import max_beam_gap
 from teamnav.papers.los_help.brains.messages import MESSAGE_KIND, LosHelpMsg, message_size_bytes
-from teamnav.papers.los_help.brains.packed import PackedLosMsg, pack, unpack
+from teamnav.papers.los_help.brains.packed import PackedLosMsg, pack, row_sizes, unpack
 
 __all__ = ["LosTeamGroup", "r1_team_unsupported", "row_observation"]
 
@@ -978,19 +978,24 @@ class LosTeamGroup:
         if not self._packed and len(sent_rows) > 8 * n:  # keep a few steps' bodies (delivered at the next step)
             for key in list(sent_rows)[:len(sent_rows) - 4 * n]:
                 del sent_rows[key]
-        for k in np.flatnonzero(sent):
-            row = part.gs.out[k].copy()
-            view = part.views[k]
-            if self._packed:
-                body = PackedLosMsg.sized(row)
-                size = 24 + body.size  # message_size_bytes: the 24-byte header and the body
-            else:
-                body = unpack(row)
-                sent_rows[id(body)] = (body, row)
-                size = message_size_bytes(body)
-            outbox.append((view.me, Message(view.me, t, body, kind=MESSAGE_KIND)))
-            view.msgs_sent += 1
-            view.bytes_sent += size
+        sent_idx = np.flatnonzero(sent)
+        if len(sent_idx):
+            out_rows = part.gs.out[sent_idx]  # one fresh copy of this step's rows (each body keeps its own row)
+            sizes = row_sizes(part.gs.out, sent_idx).tolist() if self._packed else None
+            views = part.views
+            for i, k in enumerate(sent_idx.tolist()):
+                row = out_rows[i]
+                view = views[k]
+                if sizes is not None:
+                    body = PackedLosMsg(row, sizes[i])  # sized once, as PackedLosMsg.sized
+                    size = 24 + sizes[i]  # message_size_bytes: the 24-byte header and the body
+                else:
+                    body = unpack(row)
+                    sent_rows[id(body)] = (body, row)
+                    size = message_size_bytes(body)
+                outbox.append((view.me, Message(view.me, t, body, kind=MESSAGE_KIND)))
+                view.msgs_sent += 1
+                view.bytes_sent += size
         for r, brain in self._ref.items():  # the reference rows, on their own brains
             # the class's own step: not an attribute set on the instance (a benchmark's timer
             # wraps the brains it finds in Simulation.brains; this call is inside step_group)
