@@ -1,0 +1,113 @@
+"""The trail brains under ``group_brains`` (``papers/trails/brains/trail_compiled.py``: the
+reference brains over a compiled Navigate) run as the reference does, bit for bit.
+
+Vaughan et al. 2000 §4.1-4.2 (``blazing-a-trail``, ``blazing-trail-v1``) and 2002 §3
+(``try-to-see-it-my-way``, ``trail-share-v1``), each in both report columns (teamnav and the
+paper as written, ``paper_rules: true``), with the scenarios' heading drift and their launch
+(robots started one at a time): the engine steps the reference and the compiled team side by
+side and requires, at every step, the same true poses, odometry, commands and logs.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from teamnav import load_scenario
+from teamnav.control import registry
+from teamnav.control.nav.navigate import NavigateParams
+from teamnav.control.nav.navigate_compiled import py_remainder, unsupported
+from teamnav.experiments.spec import build_grid
+from teamnav.sim.engine import Simulation
+
+STEPS = 1200
+
+
+def _scenario(name: str, paper: bool, steps: int = STEPS, seed: int = 1000, navigate: dict | None = None):
+    """``name`` for ``steps`` steps; ``paper``: every robot with ``paper_rules: true`` (the
+    params those rules set dropped, as the reports' paper column does)."""
+    base = load_scenario(name)
+    ov: dict = {}
+    for k, g in enumerate(base.robots):
+        params = dict(g.params)
+        if paper:
+            rules = registry.lookup(g.controller).Params.PAPER_RULES
+            params = {**{a: b for a, b in params.items() if a not in rules}, "paper_rules": True}
+        if navigate is not None:
+            params["navigate"] = dict(navigate)
+        ov[f"robots.{k}.params"] = params
+    return load_scenario(name, overrides=ov, duration_s=steps * 0.1, seed=seed)
+
+
+def _log_equal(a, b) -> bool:
+    if isinstance(a, dict):
+        return isinstance(b, dict) and list(a) == list(b) and all(_log_equal(a[k], b[k]) for k in a)
+    if isinstance(a, np.ndarray):
+        return isinstance(b, np.ndarray) and a.shape == b.shape and a.tobytes() == b.tobytes()
+    return type(a) is type(b) and a == b
+
+
+def side_by_side(scn, steps: int) -> tuple[Simulation, Simulation]:
+    """Step the reference and the group-brain simulation together; assert equal at every step."""
+    ref = Simulation(build_grid(scn), scn)
+    cmp_ = Simulation(build_grid(scn), scn, group_brains=True)
+    assert not ref.group_teams and len(cmp_.group_teams) == 1
+    for step in range(steps):
+        ref.step()
+        cmp_.step()
+        where = f"step {step + 1}"
+        for name in ("x_m", "y_m", "theta_rad"):
+            a, b = getattr(ref.state, name), getattr(cmp_.state, name)
+            assert a.tobytes() == b.tobytes(), f"{where}: true {name} {a} vs {b}"
+        assert ref.odometry.pose.tobytes() == cmp_.odometry.pose.tobytes(), where
+        assert ref._v_cmd.tobytes() == cmp_._v_cmd.tobytes() and ref._w_cmd.tobytes() == cmp_._w_cmd.tobytes(), where
+        if step % 10 == 0 or step == steps - 1:
+            for ga, gb in zip(ref.brains, cmp_.brains):
+                for ba, bb in zip(ga, gb):
+                    la, lb = ba.log(), bb.log()
+                    assert _log_equal(la, lb), f"{where}: logs differ {la} vs {lb}"
+    return ref, cmp_
+
+
+@pytest.mark.parametrize("paper", [False, True], ids=["teamnav", "paper"])
+@pytest.mark.parametrize("name", ["blazing-a-trail", "try-to-see-it-my-way"])
+def test_compiled_trail_team_runs_as_the_reference(name, paper):
+    scn = _scenario(name, paper)
+    ref, cmp_ = side_by_side(scn, STEPS)
+    team = cmp_.group_teams[0][0]
+    assert team.compiled_robots == 4  # every robot's Navigate compiled
+    modes = {b.nav.mode for g in cmp_.brains for b in g}
+    assert modes <= {"navigate", "advance", "turn", "panic"}
+    # the launch started every robot, and the radio carried the same crumbs or trails
+    assert not (ref.waiting is not None and ref.waiting.any())
+    assert ref.radio.sent_messages.sum() > 0
+    assert ref.radio.sent_messages.tolist() == cmp_.radio.sent_messages.tolist()
+    assert ref.radio.sent_bytes.tolist() == cmp_.radio.sent_bytes.tolist()
+
+
+def test_declined_navigate_flags_keep_the_reference_navigate_and_the_same_run():
+    """A give-way (not compiled) leaves those robots on the reference Navigate inside the group:
+    the team still runs (nothing compiles here), and per robot, as the reference does."""
+    scn = _scenario("blazing-a-trail", False, steps=300, navigate={"give_way_s": 3.0})
+    sim = Simulation(build_grid(scn), scn, group_brains=True)
+    assert sim.group_teams == []  # no robot compiles: the group brain declines the team
+    assert "give_way_s" in unsupported(NavigateParams(give_way_s=3.0))
+    assert unsupported(NavigateParams(paper_rules=True)) is None
+
+
+@given(st.floats(min_value=-1e6, max_value=1e6, allow_nan=False))
+def test_py_remainder_is_pythons_math_remainder(x):
+    for y in (2.0 * math.pi, 1.0, 0.3):
+        assert py_remainder(x, y) == math.remainder(x, y) and math.copysign(1.0, py_remainder(x, y)) == \
+            math.copysign(1.0, math.remainder(x, y)), (x, y)
+
+
+def test_py_remainder_at_the_half_way_points():
+    two_pi = 2.0 * math.pi
+    for k in range(-7, 8):
+        for x in (k * math.pi, k * two_pi, np.nextafter(k * math.pi, math.inf), np.nextafter(k * math.pi, -math.inf)):
+            assert py_remainder(float(x), two_pi) == math.remainder(float(x), two_pi), x
