@@ -111,3 +111,25 @@ def test_py_remainder_at_the_half_way_points():
     for k in range(-7, 8):
         for x in (k * math.pi, k * two_pi, np.nextafter(k * math.pi, math.inf), np.nextafter(k * math.pi, -math.inf)):
             assert py_remainder(float(x), two_pi) == math.remainder(float(x), two_pi), x
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from(["left", "right"]), st.floats(0.3, 3.0), st.booleans())
+def test_sparse_box_scan_answers_as_the_sliding_box(seed, side, reach, walls):
+    """Each box's crossing beams, the followed side's first (``box_beams``), give the first free
+    slide position and "ahead blocked" of the reference kernel, on random scans."""
+    from teamnav.control.nav.navigate_compiled import box_beams, first_free_box_sparse
+    from teamnav.control.nav.wall_follow import SlidingBox, first_free_box
+
+    rng = np.random.default_rng(seed)
+    angles = np.linspace(-np.pi / 2, np.pi / 2, 361)
+    box = SlidingBox(angles, 0.8, 1.0, 0.1, max(0.05, reach - 0.4), 0.05, 0.4, 1.5, 1.0, 0.3, side)
+    r = rng.uniform(0.05, 8.0, 361)
+    if walls:  # a wall beside the robot at a random distance, and clutter ahead
+        lateral = rng.uniform(0.2, 2.5)
+        s = np.abs(np.sin(angles))
+        wall = np.where(s > 1e-6, lateral / np.maximum(s, 1e-6), 8.0)
+        on_side = angles > 0 if side == "left" else angles < 0
+        r = np.where(on_side, np.minimum(wall, 8.0), np.maximum(r, rng.uniform(0.5, 8.0)))
+    idx, cnt = box_beams(box.exit_m, box.sign)
+    assert first_free_box_sparse(r, box._cos, box.box_near_m, box.exit_m, idx, cnt) == \
+        first_free_box(r, box._cos, box.box_near_m, box.exit_m)

@@ -36,9 +36,8 @@ from numba import njit
 from teamnav.control.nav.local.compiled import py_hypot
 from teamnav.control.nav.navigate import Navigate, NavigateParams
 from teamnav.control.nav.openings import NEAR_WALL_MIN_M, any_near_edge
-from teamnav.control.nav.wall_follow import first_free_box
 
-__all__ = ["CompiledNavigate", "nav_step", "py_remainder", "unsupported"]
+__all__ = ["CompiledNavigate", "box_beams", "first_free_box_sparse", "nav_step", "nav_step_rng", "py_remainder", "unsupported"]
 
 _TWO_PI = 2.0 * math.pi
 _MODES = ("navigate", "advance", "turn", "panic")
@@ -261,10 +260,58 @@ def _panic_step(fst, ist, par, r, front, free_exit):
     return 0.0, 0.0
 
 
+def box_beams(exit_m: np.ndarray, side_sign: float) -> tuple[np.ndarray, np.ndarray]:
+    """For each box (row of ``exit_m``), the beams that cross it (``exit > -inf``), the followed
+    side's first, padded: ``(idx (K+1, M) int64, count (K+1,) int64)``. A beam that does not cross
+    a box can never block it (``range < -inf`` never holds), and whether a box is blocked does not
+    depend on the order its beams are looked at, so :func:`first_free_box_sparse` over these gives
+    :func:`~teamnav.control.nav.wall_follow.first_free_box`'s answer, looking at fewer beams (the
+    wall, on the followed side, blocks a box at its first beams)."""
+    rows = []
+    for k in range(exit_m.shape[0]):
+        b = np.flatnonzero(exit_m[k] > -np.inf)
+        rows.append(b[::-1] if side_sign > 0 else b)  # beams run right to left: left side first = last first
+    m = max((len(b) for b in rows), default=0)
+    idx = np.zeros((exit_m.shape[0], max(m, 1)), dtype=np.int64)
+    cnt = np.zeros(exit_m.shape[0], dtype=np.int64)
+    for k, b in enumerate(rows):
+        idx[k, : len(b)] = b
+        cnt[k] = len(b)
+    return idx, cnt
+
+
 @njit(cache=True)
-def _box_command(fst, ist, par, r, cos_a, sin_a, exit_m, offsets):
+def first_free_box_sparse(r, cos_a, near_m, exit_m, idx, cnt):
+    """:func:`~teamnav.control.nav.wall_follow.first_free_box` over each box's crossing beams
+    (:func:`box_beams`): the same (first free slide position or -1, straight ahead blocked)."""
+    n_rows = exit_m.shape[0]
+    first = -1
+    for k in range(n_rows - 1):
+        free = True
+        for j in range(cnt[k]):
+            b = idx[k, j]
+            rb = r[b]
+            if rb * cos_a[b] >= near_m and rb < exit_m[k, b]:
+                free = False
+                break
+        if free:
+            first = k
+            break
+    ahead = False
+    k = n_rows - 1
+    for j in range(cnt[k]):
+        b = idx[k, j]
+        rb = r[b]
+        if rb * cos_a[b] >= near_m and rb < exit_m[k, b]:
+            ahead = True
+            break
+    return first, ahead
+
+
+@njit(cache=True)
+def _box_command(fst, ist, par, r, cos_a, sin_a, exit_m, offsets, box_idx, box_cnt):
     """SlidingBox.command: (v, w, offset, state); keeps the on-the-spot turn direction."""
-    first, ahead_blocked = first_free_box(r, cos_a, par[P_BOX_NEAR], exit_m)
+    first, ahead_blocked = first_free_box_sparse(r, cos_a, par[P_BOX_NEAR], exit_m, box_idx, box_cnt)
     if first == 0 and not (ahead_blocked and par[P_BOX_AHEAD] != 0.0):
         fst[F_AWAY] = 0.0
         return par[P_CRUISE], 0.0, offsets[0], B_OPEN
@@ -345,6 +392,17 @@ def _detect_side(r, side, order, cos_s, sin_s, n_ext, near_m, jump_m, min_width,
 
 
 @njit(cache=True)
+def _finite_scan(r_in, max_range):
+    """The scan with no-returns (non-finite) at max range: ``r_in`` itself when all are finite.
+    (A function of its own: an array variable reassigned inside the step made numba's step ~3x
+    slower even where the reassignment never ran.)"""
+    for b in range(r_in.shape[0]):
+        if not math.isfinite(r_in[b]):
+            return np.where(np.isfinite(r_in), r_in, max_range)
+    return r_in
+
+
+@njit(cache=True)
 def _straight_ok(r, angles, along, half, clear):
     best = -math.inf
     anyb = False
@@ -357,9 +415,9 @@ def _straight_ok(r, angles, along, half, clear):
 
 
 @njit(cache=True)
-def nav_step(fst, ist, par, rev_at, r_in, x, y, th, t, stalled, has_pref, pref, allow_reverse, ignore_memory, rng,
-             angles, cos_a, sin_a, exit_m, offsets, order_l, cos_l, sin_l, order_r, cos_r, sin_r, head, front,
-             free_exit):
+def _nav_core(fst, ist, par, rev_at, r_in, x, y, th, t, stalled, has_pref, pref, allow_reverse, ignore_memory, rng,
+              angles, cos_a, sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r,
+             head, front, free_exit):
     """One :meth:`Navigate.step <teamnav.control.nav.navigate.Navigate.step>` of one robot (module
     docstring): the command ``(v, w)``, state updated in place.
 
@@ -375,12 +433,7 @@ def nav_step(fst, ist, par, rev_at, r_in, x, y, th, t, stalled, has_pref, pref, 
     if rng is None:  # no Generator (a fast call): a step that must draw is undone and returns NaN
         f0 = fst.copy()
         i0 = ist.copy()
-    # the scan, no-returns at max range
-    r = r_in
-    for b in range(r_in.shape[0]):
-        if not math.isfinite(r_in[b]):
-            r = np.where(np.isfinite(r_in), r_in, par[P_MAX_RANGE])
-            break
+    r = _finite_scan(r_in, par[P_MAX_RANGE])
     if ist[I_HAS_LAST] != 0:
         fst[F_ODO] += py_hypot(x - fst[F_LX], y - fst[F_LY])
         fst[F_TURNED] += _wrap(th - fst[F_LTH])
@@ -425,7 +478,7 @@ def nav_step(fst, ist, par, rev_at, r_in, x, y, th, t, stalled, has_pref, pref, 
                 return _clip(par, v, w)
             ist[I_MODE] = M_NAV
         else:
-            v, w, off, st = _box_command(fst, ist, par, r, cos_a, sin_a, exit_m, offsets)
+            v, w, off, st = _box_command(fst, ist, par, r, cos_a, sin_a, exit_m, offsets, box_idx, box_cnt)
             ist[I_BOX_STATE] = st
             fst[F_BOX_OFFSET] = off
             if par[P_HOLD] != 0.0 and st != B_BLOCKED:
@@ -466,7 +519,7 @@ def nav_step(fst, ist, par, rev_at, r_in, x, y, th, t, stalled, has_pref, pref, 
                 return _clip(par, v, w)
             ist[I_MODE] = M_NAV
 
-    bv, bw, boff, bst = _box_command(fst, ist, par, r, cos_a, sin_a, exit_m, offsets)
+    bv, bw, boff, bst = _box_command(fst, ist, par, r, cos_a, sin_a, exit_m, offsets, box_idx, box_cnt)
     ist[I_BOX_STATE] = bst
     fst[F_BOX_OFFSET] = boff
     # 4. Openings.
@@ -548,6 +601,29 @@ def nav_step(fst, ist, par, rev_at, r_in, x, y, th, t, stalled, has_pref, pref, 
     return _clip(par, bv, bw)
 
 
+@njit(cache=True)
+def nav_step(fst, ist, par, rev_at, r_in, x, y, th, t, stalled, has_pref, pref, allow_reverse, ignore_memory,
+             angles, cos_a, sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r,
+             head, front, free_exit):
+    """One :meth:`Navigate.step <teamnav.control.nav.navigate.Navigate.step>` of one robot, without
+    its Generator (:func:`_nav_core` with ``rng=None``): ``(nan, nan)`` and the state untouched when
+    a draw is due; then :func:`nav_step_rng`. Two entry points, one signature each: a dispatcher
+    with two signatures resolves every call in Python (~15 µs)."""
+    return _nav_core(fst, ist, par, rev_at, r_in, x, y, th, t, stalled, has_pref, pref, allow_reverse, ignore_memory,
+                     None, angles, cos_a, sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r,
+                     cos_r, sin_r, head, front, free_exit)
+
+
+@njit(cache=True)
+def nav_step_rng(fst, ist, par, rev_at, r_in, x, y, th, t, stalled, has_pref, pref, allow_reverse, ignore_memory, rng,
+                 angles, cos_a, sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r,
+                 head, front, free_exit):
+    """:func:`nav_step` with the robot's Generator (a step that draws)."""
+    return _nav_core(fst, ist, par, rev_at, r_in, x, y, th, t, stalled, has_pref, pref, allow_reverse, ignore_memory,
+                     rng, angles, cos_a, sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r,
+                     cos_r, sin_r, head, front, free_exit)
+
+
 class CompiledNavigate:
     """One robot's :class:`~teamnav.control.nav.navigate.Navigate` with its step compiled
     (:func:`nav_step`); the same constructor, public methods and attributes the trail brains use.
@@ -618,8 +694,9 @@ class CompiledNavigate:
         head = det._head if det._quick else np.zeros((2, 1), dtype=np.int64)
         i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
         f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
+        box_idx, box_cnt = box_beams(box.exit_m, ref.side_sign)
         self._geo = (f64(ref.angles_rad), f64(box._cos), f64(box._sin), f64(box.exit_m), f64(box.offsets_m),
-                     i64(order_l), f64(cos_l), f64(sin_l), i64(order_r), f64(cos_r), f64(sin_r), i64(head),
+                     box_idx, box_cnt, i64(order_l), f64(cos_l), f64(sin_l), i64(order_r), f64(cos_r), f64(sin_r), i64(head),
                      i64(pan._front), f64(pan._free_exit))
         self.fst = np.zeros(N_F)
         self.ist = np.zeros(N_I, dtype=np.int64)
@@ -700,7 +777,23 @@ class CompiledNavigate:
         has = preferred_heading_rad is not None
         args = (self.fst, self.ist, self._par, self.rev_at, r, x, y, th, float(obs.time_s), bool(obs.stalled),
                 has, float(preferred_heading_rad) if has else 0.0, bool(allow_reverse), bool(reverse_ignore_memory))
-        v, w = nav_step(*args, None, *self._geo)
+        v, w = nav_step(*args, *self._geo)
         if v != v:  # a draw was due: the step again, with the robot's Generator
-            v, w = nav_step(*args, self.rng, *self._geo)
+            v, w = nav_step_rng(*args, self.rng, *self._geo)
         return v, w
+
+
+def warm_up() -> None:
+    """Load (or compile) both forms of :func:`nav_step`, the fast one and the one with a
+    Generator, so that neither is loaded inside a timed run (a benchmark's warm-up calls this:
+    the form with a Generator is first needed only when a robot first panics or explores)."""
+    from teamnav.control.protocol import RobotInfo, SensorInfo
+    from teamnav.control.types import Observation, RangeScan
+
+    angles = np.linspace(-np.pi / 2, np.pi / 2, 181)
+    info = RobotInfo(0, 1, 0.25, "unicycle", 0.5, 2.0, 0.1, 0.1,
+                     sensors={"laser": SensorInfo("laser", "laser", angles, 8.0)})
+    nav = CompiledNavigate(NavigateParams(), np.random.default_rng(0), info)
+    for r in (8.0, 0.3):  # open space (no draw), then an obstacle critically close (Panic draws)
+        scan = RangeScan(np.full(181, r), angles, 8.0)
+        nav.step(Observation(0, 0, 0.0, np.zeros(3), np.zeros(3), scans={"laser": scan}))
