@@ -133,3 +133,33 @@ def test_sparse_box_scan_answers_as_the_sliding_box(seed, side, reach, walls):
     idx, cnt = box_beams(box.exit_m, box.sign)
     assert first_free_box_sparse(r, box._cos, box.box_near_m, box.exit_m, idx, cnt) == \
         first_free_box(r, box._cos, box.box_near_m, box.exit_m)
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0, 1, 7, 8, 9, 127, 128, 129, 300, 1000, 8192, 8193, 20000]))
+def test_pairwise_sum_is_numpys_sum(seed, n):
+    from teamnav.papers.trails.brains.trail_compiled import pairwise_sum
+
+    a = np.sin(np.random.default_rng(seed).uniform(-4.0, 4.0, n))
+    assert 0.0 + pairwise_sum(a, 0, n) == float(a.sum())
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 400), st.floats(0.1, 5.0))
+def test_compiled_crumb_mean_is_the_reference_mean(seed, n, radius):
+    """The crumbs' mean heading around a point (Blazing §4.1), compiled and reference, bit for bit,
+    on random crumb lists (headings from -pi to pi, cancelling ones included)."""
+    from teamnav.papers.trails.brains.crumbs import average_heading
+    from teamnav.papers.trails.brains.trail_compiled import average_heading_kernel
+
+    rng = np.random.default_rng(seed)
+    buf = np.zeros((n + 1, 4))
+    buf[:n, :2] = rng.uniform(-3.0, 3.0, (n, 2))
+    buf[:n, 2] = rng.uniform(-np.pi, np.pi, n)
+    if n >= 2 and seed % 3 == 0:  # two crumbs that cancel
+        buf[1, :2] = buf[0, :2]
+        buf[1, 2] = buf[0, 2] - np.pi if buf[0, 2] > 0 else buf[0, 2] + np.pi
+    x, y = rng.uniform(-3.0, 3.0, 2)
+    ref = average_heading(buf[:n, :2], buf[:n, 2], float(x), float(y), radius)
+    found, mean = average_heading_kernel(buf, n, float(x), float(y), radius)
+    assert (ref is not None) == found
+    if found:
+        assert mean == ref

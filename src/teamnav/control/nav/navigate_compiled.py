@@ -797,3 +797,22 @@ def warm_up() -> None:
     for r in (8.0, 0.3):  # open space (no draw), then an obstacle critically close (Panic draws)
         scan = RangeScan(np.full(181, r), angles, 8.0)
         nav.step(Observation(0, 0, 0.0, np.zeros(3), np.zeros(3), scans={"laser": scan}))
+
+
+def _renew_caches() -> None:
+    """This module's kernels call the reference's kernels (the openings' quick test) and CPython's
+    hypot (``local/compiled.py``): renew their numba caches when one of those changes
+    (:func:`~teamnav.control.group.renew_stale_caches`)."""
+    import sys
+
+    from teamnav.control.group import renew_stale_caches
+    from teamnav.control.nav import openings
+    from teamnav.control.nav.local import compiled as local_compiled
+
+    here = sys.modules[__name__]
+    kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
+               and f.py_func.__module__ == __name__]
+    renew_stale_caches(kernels, [m.__file__ for m in (openings, local_compiled)])
+
+
+_renew_caches()

@@ -27,13 +27,237 @@ import math
 from typing import Any, Sequence
 
 import numpy as np
+from numba import njit
 
 from teamnav.control.group import GroupAction, GroupObservation
 from teamnav.control.nav import navigate_compiled as NC
+from teamnav.control.nav.local.compiled import py_hypot
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Observation, RangeScan
 
-__all__ = ["BlazingTrailGroup", "TrailShareGroup"]
+__all__ = ["BlazingTrailGroup", "TrailShareGroup", "average_heading_kernel", "blazing_row_step", "pairwise_sum"]
+
+_TWO_PI = 2.0 * math.pi
+
+# blazing-trail-v1's parameter columns (B_*)
+B_MIN_MOVE = 0  # crumb_min_move_m
+B_INTERVAL = 1  # crumb_interval_s
+B_REV_CARRIED = 2  # reverse_carried_crumbs
+B_PRUNE = 3  # prune_loops
+B_PRUNE_R = 4  # prune_radius_m
+B_PRUNE_LOOP = 5  # prune_min_loop_m
+B_LOOK = 6  # lookahead_m
+B_RADIUS = 7  # radius_m
+B_REV_MIN = 8  # reverse_min_crumbs
+B_RECOVER = 9  # recover_radius_m
+N_B = 10
+
+
+# ----------------------------------------------------------------- numpy's arithmetic, written out
+@njit(cache=True)
+def _pairwise_block(a, lo, n):
+    """numpy's ``pairwise_sum`` for ``n <= 128``: a plain sum below 8, else eight accumulators."""
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[lo + i]
+        return res
+    r0 = a[lo]
+    r1 = a[lo + 1]
+    r2 = a[lo + 2]
+    r3 = a[lo + 3]
+    r4 = a[lo + 4]
+    r5 = a[lo + 5]
+    r6 = a[lo + 6]
+    r7 = a[lo + 7]
+    i = 8
+    m = n - (n % 8)
+    while i < m:
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True)
+def pairwise_sum(a, lo, n):
+    """numpy's ``pairwise_sum`` for float64 (``loops_utils.h.src``) over ``a[lo:lo + n]``: up to 128
+    :func:`_pairwise_block`, above that the two halves (the first rounded down to a multiple of 8)
+    summed. ``0.0 + pairwise_sum(a, 0, a.size)`` is ``a.sum()`` bit for bit (its identity, then the
+    loop). The recursion is unrolled onto a stack: numba's cache reloads a recursive function
+    wrongly (a process that loaded it crashed)."""
+    if n <= 128:
+        return _pairwise_block(a, lo, n)
+    f_lo = np.empty(192, dtype=np.int64)  # frames: (lo, n, combine?) ; depth <= log2(n) < 64
+    f_n = np.empty(192, dtype=np.int64)
+    f_comb = np.empty(192, dtype=np.bool_)
+    vals = np.empty(128)
+    top = 0
+    nv = 0
+    f_lo[0] = lo
+    f_n[0] = n
+    f_comb[0] = False
+    top = 1
+    while top > 0:
+        top -= 1
+        flo = f_lo[top]
+        fn = f_n[top]
+        if f_comb[top]:  # both halves done: left + right
+            right = vals[nv - 1]
+            left = vals[nv - 2]
+            nv -= 2
+            vals[nv] = left + right
+            nv += 1
+        elif fn <= 128:
+            vals[nv] = _pairwise_block(a, flo, fn)
+            nv += 1
+        else:
+            n2 = fn // 2
+            n2 -= n2 % 8
+            f_lo[top] = flo  # then: combine
+            f_n[top] = fn
+            f_comb[top] = True
+            f_lo[top + 1] = flo + n2  # the right half, done second
+            f_n[top + 1] = fn - n2
+            f_comb[top + 1] = False
+            f_lo[top + 2] = flo  # the left half, done first
+            f_n[top + 2] = n2
+            f_comb[top + 2] = False
+            top += 3
+    return vals[0]
+
+
+@njit(cache=True, inline="always")
+def _wrap_scalar(a):
+    """:func:`teamnav.papers.trails.brains.crumbs._wrap_scalar`: (-pi, pi]."""
+    w = NC.py_remainder(a, _TWO_PI)
+    return math.pi if w == -math.pi else w
+
+
+@njit(cache=True)
+def average_heading_kernel(buf, n, x, y, radius):
+    """:func:`teamnav.papers.trails.brains.crumbs.average_heading` over ``buf[:n]`` (x, y, heading,
+    path): ``(found, mean)``. ``np.sin``/``np.cos`` of numpy are libm's on the machines the tests
+    run on (checked there), and the sums are numpy's pairwise sums."""
+    if n == 0:
+        return False, 0.0
+    r2 = radius * radius
+    sins = np.empty(n)
+    coss = np.empty(n)
+    k = 0
+    for i in range(n):
+        dx = buf[i, 0] - x
+        dy = buf[i, 1] - y
+        if dx * dx + dy * dy <= r2:
+            h = buf[i, 2]
+            sins[k] = math.sin(h)
+            coss[k] = math.cos(h)
+            k += 1
+    if k == 0:
+        return False, 0.0
+    s = 0.0 + pairwise_sum(sins, 0, k)
+    c = 0.0 + pairwise_sum(coss, 0, k)
+    if py_hypot(s, c) <= 1e-9 * k:
+        return False, 0.0
+    return True, _wrap_scalar(math.atan2(s, c))
+
+
+@njit(cache=True)
+def blazing_row_step(path_m, has_last, lx, ly, has_crumb, cx, cy, next_crumb_s, carrying, priv, priv_n, glob, glob_n,
+                     bpar, fst, ist, par, rev_at, r, x, y, th, t, stalled, angles, cos_a, sin_a, exit_m, offsets,
+                     box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r, head, front, free_exit):
+    """One ``blazing-trail-v1`` step of one robot on a step without events or messages
+    (:meth:`BlazingTrail.step <teamnav.papers.trails.brains.blazing_trail.BlazingTrail.step>`:
+    the path, crumb dropping with or without loop pruning, the crumbs' mean heading around the
+    point ahead, the 180° rule's crumb count, the recovery towards the nearest crumb, then Navigate
+    without its Generator). ``priv`` must have room for one more crumb.
+
+    Returns ``(v, w, path_m, has_crumb, cx, cy, next_crumb_s, priv_n, cut, following, recovering,
+    has_pref, pref, allow)``; ``v`` NaN: Navigate must draw (its state untouched; the caller steps
+    it with the Generator, the brain's part being done).
+    """
+    if has_last:
+        path_m += py_hypot(x - lx, y - ly)
+    moved = (not has_crumb) or py_hypot(x - cx, y - cy) >= bpar[B_MIN_MOVE]
+    cut = False
+    if t >= next_crumb_s and moved:
+        cx = x
+        cy = y
+        has_crumb = True
+        outbound = not (carrying and bpar[B_REV_CARRIED] != 0.0)
+        drop = True
+        if bpar[B_PRUNE] != 0.0 and priv_n > 0:
+            rr = bpar[B_PRUNE_R] * bpar[B_PRUNE_R]
+            lim = path_m - bpar[B_PRUNE_LOOP]
+            for i in range(priv_n):
+                dx = priv[i, 0] - x
+                dy = priv[i, 1] - y
+                if dx * dx + dy * dy <= rr and priv[i, 3] <= lim:
+                    priv_n = i + 1
+                    cut = True
+                    drop = False
+                    break
+        if drop:
+            h = th if outbound else th + math.pi
+            priv[priv_n, 0] = x
+            priv[priv_n, 1] = y
+            priv[priv_n, 2] = _wrap_scalar(h)
+            priv[priv_n, 3] = path_m
+            priv_n += 1
+        next_crumb_s = t + bpar[B_INTERVAL] - 1e-9
+    look = bpar[B_LOOK]
+    qx = x + look * math.cos(th)
+    qy = y + look * math.sin(th)
+    found, mean = average_heading_kernel(glob, glob_n, qx, qy, bpar[B_RADIUS])
+    pref = 0.0
+    if found:
+        pref = _wrap_scalar(mean + math.pi) if carrying else _wrap_scalar(mean)
+    following = found
+    allow = found
+    if found and bpar[B_REV_MIN] > 1.0:
+        rr = bpar[B_RADIUS] * bpar[B_RADIUS]
+        cnt = 0
+        for i in range(glob_n):
+            dx = glob[i, 0] - qx
+            dy = glob[i, 1] - qy
+            if dx * dx + dy * dy <= rr:
+                cnt += 1
+        allow = cnt >= bpar[B_REV_MIN]
+    recovering = False
+    if not found and bpar[B_RECOVER] > 0.0 and not (fst[NC.F_ODO] < fst[NC.F_LEAVE]) and glob_n > 0:
+        best = -1
+        bd = math.inf
+        for i in range(glob_n):
+            dx = glob[i, 0] - x
+            dy = glob[i, 1] - y
+            d2 = dx * dx + dy * dy
+            if d2 < bd:
+                bd = d2
+                best = i
+        if not (bd > bpar[B_RECOVER] * bpar[B_RECOVER]):
+            nx = glob[best, 0]
+            ny = glob[best, 1]
+            ex = nx - x
+            ey = ny - y
+            if ex * ex + ey * ey > 1e-12:
+                pref = math.atan2(ny - y, nx - x)
+                found = True
+                allow = True
+                recovering = True
+    v, w = NC.nav_step(fst, ist, par, rev_at, r, x, y, th, t, stalled, found, pref, allow, False, angles, cos_a,
+                       sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r, head,
+                       front, free_exit)
+    return (v, w, path_m, has_crumb, cx, cy, next_crumb_s, priv_n, cut, following, recovering, found, pref, allow)
 
 
 def _row_observation(obs: GroupObservation, r: int) -> Observation:
@@ -119,9 +343,86 @@ class _TrailGroup:
 
 
 class BlazingTrailGroup(_TrailGroup):
-    """``blazing-trail-v1`` teams (module docstring)."""
+    """``blazing-trail-v1`` teams (module docstring). A robot's step without task events or
+    messages (nearly all of them) is one compiled call (:func:`blazing_row_step`: crumbs, the
+    trail's hint and Navigate); a step with either, and every step of a robot whose global
+    crumbs expire (``global_crumb_ttl_s``) or whose Navigate is the reference's, runs the
+    reference brain's own step."""
 
     controller = "teamnav.papers.trails.brains.blazing_trail:BlazingTrail"
+
+    def __init__(self, params, rngs, infos) -> None:
+        super().__init__(params, rngs, infos)
+        self._bpar = []
+        self._fast = []
+        for brain in self.robots:
+            p = brain.params
+            b = np.zeros(N_B)
+            b[B_MIN_MOVE] = p.crumb_min_move_m
+            b[B_INTERVAL] = p.crumb_interval_s
+            b[B_REV_CARRIED] = 1.0 if p.reverse_carried_crumbs else 0.0
+            b[B_PRUNE] = 1.0 if p.prune_loops else 0.0
+            b[B_PRUNE_R] = p.prune_radius_m
+            b[B_PRUNE_LOOP] = p.prune_min_loop_m
+            b[B_LOOK] = p.lookahead_m
+            b[B_RADIUS] = p.radius_m
+            b[B_REV_MIN] = p.reverse_min_crumbs
+            b[B_RECOVER] = p.recover_radius_m
+            self._bpar.append(b)
+            self._fast.append(isinstance(brain.nav, NC.CompiledNavigate) and p.global_crumb_ttl_s is None)
+
+    def step_group(self, obs: GroupObservation) -> GroupAction:
+        """Every robot's step (module docstring); a waiting robot's brain is off."""
+        n = self._n
+        v = np.zeros(n)
+        w = np.zeros(n)
+        d = np.full(n, math.nan)
+        outbox: list = []
+        waiting = obs.waiting
+        events = obs.events
+        inbox = obs.inbox
+        poses = obs.odom_pose.tolist()
+        stalled = obs.stalled.tolist()
+        t = float(obs.time_s)
+        step = int(obs.step)
+        for r, brain in enumerate(self.robots):
+            if waiting is not None and waiting[r]:
+                continue
+            if not self._fast[r] or inbox[r] or (events is not None and events[r]):
+                action, msgs = brain.step(_row_observation(obs, r))
+                v[r] = action.v_mps
+                w[r] = action.omega_radps
+                if msgs:
+                    rid = int(obs.robot_ids[r])
+                    outbox.extend((rid, m) for m in msgs)
+                continue
+            x, y, th = poses[r][:3]
+            nav = brain.nav
+            priv = brain.private
+            priv._reserve(1)
+            glob = brain.global_crumbs
+            last = brain._last_xy
+            crumb = brain._crumb_xy
+            ranges = obs.ranges_m[brain.params.sensor][r]
+            out = blazing_row_step(
+                brain._path_m, last is not None, last[0] if last is not None else 0.0,
+                last[1] if last is not None else 0.0, crumb is not None, crumb[0] if crumb is not None else 0.0,
+                crumb[1] if crumb is not None else 0.0, brain._next_crumb_s, brain.carrying, priv._buf, priv._n,
+                glob._buf, glob._n, self._bpar[r], nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t,
+                stalled[r], *nav._geo)
+            (vr, wr, brain._path_m, has_crumb, cx, cy, brain._next_crumb_s, priv._n, cut, brain._following,
+             brain._recovering, has_pref, pref, allow) = out
+            brain._step = step
+            brain._last_xy = (x, y)
+            if has_crumb:
+                brain._crumb_xy = (cx, cy)
+            brain.loops_cut += cut
+            if vr != vr:  # Navigate must draw: its step again, with the robot's Generator
+                vr, wr = NC.nav_step_rng(nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t, stalled[r],
+                                         has_pref, pref, allow, False, nav.rng, *nav._geo)
+            v[r] = vr
+            w[r] = wr
+        return GroupAction(v, w, d, outbox)
 
     @classmethod
     def _probe_params(cls, params: Any):
@@ -141,3 +442,23 @@ class TrailShareGroup(_TrailGroup):
         from teamnav.papers.trails.brains.trail_share import TRAIL_SHARE_NAVIGATE
 
         return navigate_params({**TRAIL_SHARE_NAVIGATE, **params.navigate}, params.cruise_speed_mps)
+
+
+def _renew_caches() -> None:
+    """This module's kernels inline Navigate's compiled step (``navigate_compiled``) and what it
+    calls: renew their numba caches when one of those changes (a cached kernel of this module
+    went on calling an old form of the step, and crashed, 2026-11-29;
+    :func:`~teamnav.control.group.renew_stale_caches`)."""
+    import sys
+
+    from teamnav.control.group import renew_stale_caches
+    from teamnav.control.nav import openings
+    from teamnav.control.nav.local import compiled as local_compiled
+
+    here = sys.modules[__name__]
+    kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
+               and f.py_func.__module__ == __name__]
+    renew_stale_caches(kernels, [m.__file__ for m in (NC, openings, local_compiled)])
+
+
+_renew_caches()
