@@ -270,6 +270,109 @@ def _row_observation(obs: GroupObservation, r: int) -> Observation:
                        obs.events[r] if obs.events is not None else ())
 
 
+# trail-share-v1's parameter columns (S_*)
+S_DESCEND = 0  # descend_only
+S_REACH = 1  # reach_m
+S_LOOK = 2  # lookahead_m
+S_RADIUS = 3  # radius_m
+S_RECOVER = 4  # recover_radius_m
+S_RECOVER_REV = 5  # recover_reverse
+N_S = 6
+
+
+@njit(cache=True)
+def _best_crumb(xys, codes, n, code, x, y, radius, below):
+    """:meth:`Trail.best_crumb <teamnav.papers.trails.brains.trails.Trail.best_crumb>`: (index or
+    -1, time-to-place); ties to the earliest."""
+    r2 = radius * radius
+    best = -1
+    bs = math.inf
+    for i in range(n):
+        if codes[i] != code:
+            continue
+        dx = xys[i, 0] - x
+        dy = xys[i, 1] - y
+        if not (dx * dx + dy * dy <= r2):
+            continue
+        si = xys[i, 2]
+        if below != math.inf and not (si < below):
+            continue
+        if best < 0 or si < bs:
+            best = i
+            bs = si
+    return best, bs
+
+
+@njit(cache=True)
+def share_row_step(bound_s, bound_t, code, xys, codes, n, spar, fst, ist, par, rev_at, r, x, y, th, t, stalled,
+                   angles, cos_a, sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r,
+                   sin_r, head, front, free_exit):
+    """The trail-using part of one ``trail-share-v1`` step (:meth:`TrailShare.step
+    <teamnav.papers.trails.brains.trail_share.TrailShare.step>` after the events, messages,
+    expiry and broadcast, which the caller has run or ruled out): the ``descend_only`` bound, the
+    lowest time-to-place crumb around the point ahead (§2.3 step 1), the recovery towards the
+    nearest crumb, then Navigate without its Generator. ``code``: the goal Place's code in the
+    Trail (-1: none).
+
+    Returns ``(v, w, bound_s, bound_t, following, recovering, has_pref, pref, ignore_memory)``;
+    ``v`` NaN: Navigate must draw (the caller steps it with the Generator).
+    """
+    has_code = code >= 0 and n > 0
+    below = math.inf
+    if spar[S_DESCEND] != 0.0:
+        bound = bound_s + (t - bound_t)
+        if has_code:
+            i, si = _best_crumb(xys, codes, n, code, x, y, spar[S_REACH], math.inf)
+            if i >= 0 and si < bound:
+                bound_s = si
+                bound_t = t
+                bound = si
+        below = bound
+    look = spar[S_LOOK]
+    qx = x + look * math.cos(th)
+    qy = y + look * math.sin(th)
+    found = False
+    pref = 0.0
+    if has_code:
+        i, _ = _best_crumb(xys, codes, n, code, qx, qy, spar[S_RADIUS], below)
+        if i >= 0:
+            dx = xys[i, 0] - x
+            dy = xys[i, 1] - y
+            if not (dx * dx + dy * dy < 1e-12):
+                found = True
+                pref = math.atan2(dy, dx)
+    following = found
+    recovering = False
+    if not found and spar[S_RECOVER] > 0.0 and not (fst[NC.F_ODO] < fst[NC.F_LEAVE]) and has_code:
+        best = -1
+        bd = math.inf
+        for j in range(n):
+            d2 = math.inf
+            if codes[j] == code:
+                ex = xys[j, 0] - x
+                ey = xys[j, 1] - y
+                d2 = ex * ex + ey * ey
+            if below != math.inf and not (xys[j, 2] < below):
+                d2 = math.inf
+            if best < 0 or d2 < bd:
+                best = j
+                bd = d2
+        if bd <= spar[S_RECOVER] * spar[S_RECOVER]:
+            nx = xys[best, 0]
+            ny = xys[best, 1]
+            ex = nx - x
+            ey = ny - y
+            if ex * ex + ey * ey > 1e-12:
+                pref = math.atan2(ny - y, nx - x)
+                found = True
+                recovering = True
+    ignore = recovering and spar[S_RECOVER_REV] != 0.0
+    v, w = NC.nav_step(fst, ist, par, rev_at, r, x, y, th, t, stalled, found, pref, True, ignore, angles, cos_a,
+                       sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r, head,
+                       front, free_exit)
+    return v, w, bound_s, bound_t, following, recovering, found, pref, ignore
+
+
 class _TrailGroup:
     """A team of one trail brain class: each robot its reference brain over a compiled Navigate."""
 
@@ -432,9 +535,72 @@ class BlazingTrailGroup(_TrailGroup):
 
 
 class TrailShareGroup(_TrailGroup):
-    """``trail-share-v1`` teams (module docstring)."""
+    """``trail-share-v1`` teams (module docstring). A robot's step without task events, messages
+    or a broadcast due (nearly all of them: one broadcast per ``broadcast_interval_s``) runs the
+    reference's Trail expiry, then one compiled call (:func:`share_row_step`: the trail-using
+    rule, the recovery, Navigate); any other step runs the reference brain's own step."""
 
     controller = "teamnav.papers.trails.brains.trail_share:TrailShare"
+
+    def __init__(self, params, rngs, infos) -> None:
+        super().__init__(params, rngs, infos)
+        self._spar = []
+        self._fast = []
+        for brain in self.robots:
+            p = brain.params
+            sp = np.zeros(N_S)
+            sp[S_DESCEND] = 1.0 if p.descend_only else 0.0
+            sp[S_REACH] = p.reach_m
+            sp[S_LOOK] = p.lookahead_m
+            sp[S_RADIUS] = p.radius_m
+            sp[S_RECOVER] = p.recover_radius_m
+            sp[S_RECOVER_REV] = 1.0 if p.recover_reverse else 0.0
+            self._spar.append(sp)
+            self._fast.append(isinstance(brain.nav, NC.CompiledNavigate) and not brain._tell_bold)
+
+    def step_group(self, obs: GroupObservation) -> GroupAction:
+        """Every robot's step (class docstring); a waiting robot's brain is off."""
+        n = self._n
+        v = np.zeros(n)
+        w = np.zeros(n)
+        d = np.full(n, math.nan)
+        outbox: list = []
+        waiting = obs.waiting
+        events = obs.events
+        inbox = obs.inbox
+        poses = obs.odom_pose.tolist()
+        stalled = obs.stalled.tolist()
+        t = float(obs.time_s)
+        step = int(obs.step)
+        for r, brain in enumerate(self.robots):
+            if waiting is not None and waiting[r]:
+                continue
+            if (not self._fast[r] or not brain._started or t >= brain._next_broadcast_s or inbox[r]
+                    or (events is not None and events[r])):
+                action, msgs = brain.step(_row_observation(obs, r))
+                v[r] = action.v_mps
+                w[r] = action.omega_radps
+                if msgs:
+                    rid = int(obs.robot_ids[r])
+                    outbox.extend((rid, m) for m in msgs)
+                continue
+            x, y, th = poses[r][:3]
+            brain._step = step
+            trail = brain.trail
+            trail.expire(t, brain.params.crumb_max_age_s)  # §2.3 step 2 (the reference's own)
+            code = trail._codes.get(brain.round.goal)
+            nav = brain.nav
+            ranges = obs.ranges_m[brain.params.sensor][r]
+            vr, wr, brain._bound_s, brain._bound_t, brain._following, brain._recovering, has_pref, pref, ignore = \
+                share_row_step(brain._bound_s, brain._bound_t, -1 if code is None else code, trail._xys, trail._p,
+                               trail._n, self._spar[r], nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t,
+                               stalled[r], *nav._geo)
+            if vr != vr:  # Navigate must draw: its step again, with the robot's Generator
+                vr, wr = NC.nav_step_rng(nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t, stalled[r],
+                                         has_pref, pref, True, ignore, nav.rng, *nav._geo)
+            v[r] = vr
+            w[r] = wr
+        return GroupAction(v, w, d, outbox)
 
     @classmethod
     def _probe_params(cls, params: Any):
