@@ -34,6 +34,8 @@ from teamnav.control.nav import navigate_compiled as NC
 from teamnav.control.nav.local.compiled import py_hypot
 from teamnav.control.protocol import RobotInfo
 from teamnav.control.types import Observation, RangeScan
+from teamnav.papers.trails.brains.crumbs import CrumbBatch
+from teamnav.papers.trails.brains.trails import TrailMessage
 
 __all__ = ["BlazingTrailGroup", "TrailShareGroup", "average_heading_kernel", "blazing_row_step", "pairwise_sum"]
 
@@ -446,11 +448,12 @@ class _TrailGroup:
 
 
 class BlazingTrailGroup(_TrailGroup):
-    """``blazing-trail-v1`` teams (module docstring). A robot's step without task events or
-    messages (nearly all of them) is one compiled call (:func:`blazing_row_step`: crumbs, the
-    trail's hint and Navigate); a step with either, and every step of a robot whose global
-    crumbs expire (``global_crumb_ttl_s``) or whose Navigate is the reference's, runs the
-    reference brain's own step."""
+    """``blazing-trail-v1`` teams (module docstring). A robot's step without task events (nearly
+    all of them) is the reference's inbox rule (received crumbs appended to the global list; the
+    crumb dropping that precedes it in the reference touches only the private list) and one
+    compiled call (:func:`blazing_row_step`: crumbs, the trail's hint and Navigate); a step with
+    events, and every step of a robot whose global crumbs expire (``global_crumb_ttl_s``) or
+    whose Navigate is the reference's, runs the reference brain's own step."""
 
     controller = "teamnav.papers.trails.brains.blazing_trail:BlazingTrail"
 
@@ -491,7 +494,7 @@ class BlazingTrailGroup(_TrailGroup):
         for r, brain in enumerate(self.robots):
             if waiting is not None and waiting[r]:
                 continue
-            if not self._fast[r] or inbox[r] or (events is not None and events[r]):
+            if not self._fast[r] or (events is not None and events[r]):
                 action, msgs = brain.step(_row_observation(obs, r))
                 v[r] = action.v_mps
                 w[r] = action.omega_radps
@@ -499,6 +502,13 @@ class BlazingTrailGroup(_TrailGroup):
                     rid = int(obs.robot_ids[r])
                     outbox.extend((rid, m) for m in msgs)
                 continue
+            if inbox[r] and brain.params.communicate:
+                # the reference's inbox rule (BlazingTrail.step); it touches only the global list, and
+                # the crumb dropping before it in the reference only the private one
+                me = brain.info.robot_id
+                for msg in inbox[r]:
+                    if msg.kind == "crumbs" and isinstance(msg.body, CrumbBatch) and msg.sender != me:
+                        brain._add_global(msg.body, t)
             x, y, th = poses[r][:3]
             nav = brain.nav
             priv = brain.private
@@ -535,10 +545,11 @@ class BlazingTrailGroup(_TrailGroup):
 
 
 class TrailShareGroup(_TrailGroup):
-    """``trail-share-v1`` teams (module docstring). A robot's step without task events, messages
-    or a broadcast due (nearly all of them: one broadcast per ``broadcast_interval_s``) runs the
-    reference's Trail expiry, then one compiled call (:func:`share_row_step`: the trail-using
-    rule, the recovery, Navigate); any other step runs the reference brain's own step."""
+    """``trail-share-v1`` teams (module docstring). A robot's step without task events or a
+    broadcast due (nearly all of them: one broadcast per ``broadcast_interval_s``) runs the
+    reference's inbox rule (§2.2 step 3, trails combined) and Trail expiry, then one compiled
+    call (:func:`share_row_step`: the trail-using rule, the recovery, Navigate); any other step
+    runs the reference brain's own step."""
 
     controller = "teamnav.papers.trails.brains.trail_share:TrailShare"
 
@@ -575,7 +586,7 @@ class TrailShareGroup(_TrailGroup):
         for r, brain in enumerate(self.robots):
             if waiting is not None and waiting[r]:
                 continue
-            if (not self._fast[r] or not brain._started or t >= brain._next_broadcast_s or inbox[r]
+            if (not self._fast[r] or not brain._started or t >= brain._next_broadcast_s
                     or (events is not None and events[r])):
                 action, msgs = brain.step(_row_observation(obs, r))
                 v[r] = action.v_mps
@@ -587,6 +598,15 @@ class TrailShareGroup(_TrailGroup):
             x, y, th = poses[r][:3]
             brain._step = step
             trail = brain.trail
+            p = brain.params
+            if inbox[r] and p.communicate:  # §2.2 step 3, the reference's rule (TrailShare.step)
+                me = brain.info.robot_id
+                for msg in inbox[r]:
+                    if msg.kind == "trail" and isinstance(msg.body, TrailMessage) and msg.sender != me:
+                        if trail.combine(msg.body, p.policy, use_transforms=p.use_place_transforms) is None:
+                            brain.refused += 1
+                        else:
+                            brain.combined += 1
             trail.expire(t, brain.params.crumb_max_age_s)  # §2.3 step 2 (the reference's own)
             code = trail._codes.get(brain.round.goal)
             nav = brain.nav
