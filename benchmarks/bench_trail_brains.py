@@ -18,11 +18,12 @@ this tree. Configurations:
 
 Each run is a fresh process (one numba thread) after an untimed warm-up of the same
 configuration (numba's cache loaded); reference and compiled alternate ``--repeats`` rounds, so
-both see the same load. CPU is ``time.process_time`` of the run (not the process start); the
-brains' share is the CPU inside the brains' ``step``/``log`` or the group brain's
-``step_group`` (``_common.timed_run``). Each run's outputs (true and odometry poses, stalls,
-logs, events, radio totals) are hashed; a configuration whose runs differ says DIFFER and gets
-no ratio.
+both see the same load. CPU is ``time.process_time`` of the team steps alone (the simulation and
+its brains are built before the clock starts: building 100 robots' Navigates costs about as much
+as 50 of their steps); the brains' share is the CPU inside the brains' ``step``/``log`` or the
+group brain's ``step_group`` and the robots' ``log``. Each run's outputs (true and odometry
+poses, stalls, every robot's log, the places' events, radio totals) are hashed; a configuration
+whose runs differ says DIFFER and gets no ratio.
 
 It prints, last, one line per team size, reference CPU over compiled CPU per team step (median
 of the configurations), in the form ``Trail team step, 4 robots: compiled / reference = 1.4x``.
@@ -48,7 +49,6 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 sys.path.insert(0, str(HERE))
-from _common import timed_run  # noqa: E402  (benchmarks/_common.py)
 
 SEED = 1000  # a tuning seed (FIDELITY.md: seeds >= 1000); nothing is judged here
 
@@ -84,7 +84,9 @@ def _overrides(name: str) -> dict:
     return ov
 
 
-def _digest(res) -> str:
+def _digest(sim) -> str:
+    """SHA-256 of a run's outputs: true and odometry poses and stall flags at the end, every
+    robot's log, the places' event log and the radio's totals."""
     import hashlib
 
     import numpy as np
@@ -92,20 +94,24 @@ def _digest(res) -> str:
     def default(o):
         return o.tolist() if hasattr(o, "tolist") else str(o)
 
-    d = res.data
     h = hashlib.sha256()
-    for a in (d.true_pose, d.odom_pose):
+    st = sim.state
+    for a in (st.x_m, st.y_m, st.theta_rad, sim.odometry.pose):
         h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
-    h.update(np.ascontiguousarray(d.stalled).astype(np.uint8).tobytes())
-    h.update(json.dumps([d.logs, d.event_log, d.messages_sent, d.bytes_sent, d.messages_delivered],
-                        sort_keys=True, default=default).encode())
+    h.update(np.ascontiguousarray(st.stalled).astype(np.uint8).tobytes())
+    logs = [b.log() for g in sim.brains for b in g]
+    radio = [sim.radio.sent_messages.tolist(), sim.radio.sent_bytes.tolist()] if sim.radio is not None else None
+    h.update(json.dumps([logs, sim.places.log, radio], sort_keys=True, default=default).encode())
     return h.hexdigest()
 
 
 def _worker(name: str, compiled: bool, steps: int) -> dict:
-    """(in the measuring process) one warm run of ``steps`` steps."""
+    """(in the measuring process) one warm run of ``steps`` team steps: CPU of the steps alone
+    (the simulation and its brains are built before the clock starts), and inside the brains."""
     from teamnav import load_scenario
     from teamnav.experiments.runner import run
+    from teamnav.experiments.spec import build_grid
+    from teamnav.sim.engine import Simulation
 
     scenario = CONFIGS[name][0]
     ov = _overrides(name)
@@ -115,15 +121,41 @@ def _worker(name: str, compiled: bool, steps: int) -> dict:
         from teamnav.control.nav.navigate_compiled import warm_up
 
         warm_up()  # the kernel's form with a Generator too (first needed at a robot's first Panic)
-    # the group brain's per-robot views are its robots' reference brains: time its step_group only
-    total, brain_s, res = timed_run(load_scenario(scenario, overrides=ov, duration_s=steps * 0.1, seed=SEED),
-                                    ("log",) if compiled else ("step", "log"), group_brains=compiled)
-    teams = res.sim.group_teams
+    scn = load_scenario(scenario, overrides=ov, duration_s=steps * 0.1, seed=SEED)
+    sim = Simulation(build_grid(scn), scn, group_brains=compiled)
+    clock = time.process_time
+    brain_s = [0.0]
+    # the brains' step and log, or the group brain's step_group (its per-robot views are its
+    # robots' reference brains, whose step it may call: not counted twice) and the views' log
+    teams = [team for team, *_ in sim.group_teams]
+    targets = [(team, "step_group") for team in teams]
+    for group in sim.brains:
+        for brain in group:
+            targets += [(brain, "log")] + ([] if compiled and teams else [(brain, "step")])
+    for obj, meth in targets:
+        f = getattr(obj, meth, None)
+        if not callable(f):
+            continue
+
+        def timed(*args, f=f):
+            t = clock()
+            out = f(*args)
+            brain_s[0] += clock() - t
+            return out
+
+        setattr(obj, meth, timed)
+    t0 = clock()
+    for _ in range(steps):
+        sim.step()
+    total = clock() - t0
     if compiled and not teams:
         raise SystemExit(f"{name}: the group brain did not run the team")
-    robots = sum(getattr(team, "compiled_robots", stop - start) for team, start, stop, _ in teams)
-    return {"cpu_s": total, "brain_s": brain_s, "steps": int(res.sim.step_index), "digest": _digest(res),
-            "compiled_robots": robots, "robots": int(res.sim.n_robots)}
+    robots = sum(getattr(team, "compiled_robots", stop - start) for team, start, stop, _ in sim.group_teams)
+    for obj, meth in targets:  # the views' own methods again, for the digest's logs
+        if meth in vars(obj):
+            delattr(obj, meth)
+    return {"cpu_s": total, "brain_s": brain_s[0], "steps": steps, "digest": _digest(sim),
+            "compiled_robots": robots, "robots": int(sim.n_robots)}
 
 
 def _measure(name: str, compiled: bool, steps: int) -> dict:

@@ -633,11 +633,31 @@ class CompiledNavigate:
     :func:`unsupported` names.
     """
 
-    def __init__(self, params: NavigateParams, rng: np.random.Generator, info: Any, laser: str = "laser") -> None:
+    def __init__(self, params: NavigateParams, rng: np.random.Generator, info: Any, laser: str = "laser", *,
+                 reference: Navigate | None = None, shared: dict | None = None) -> None:
         why = unsupported(params)
         if why is not None:
             raise ValueError(f"CompiledNavigate: {why}")
-        ref = Navigate(params, rng, info, laser=laser)
+        # ``reference``: a Navigate already built from the same inputs (its geometry is read, not
+        # built again); ``shared``: a dict in which robots of one team with the same parameters,
+        # limits and sensor share their parameter row and geometry (read-only in the kernel)
+        ref = reference if reference is not None else Navigate(params, rng, info, laser=laser)
+        key = None
+        if shared is not None:
+            sensor = info.sensors[laser]
+            key = (params, float(info.radius_m), float(info.max_v_mps), float(info.max_omega_radps),
+                   float(info.dt_s), laser, np.asarray(sensor.angles_rad, dtype=np.float64).tobytes(),
+                   float(sensor.max_range_m))
+            hit = shared.get(key)
+            if hit is not None:
+                self.params, self.info, self.rng, self.laser = params, info, rng, laser
+                self.angles_rad = ref.angles_rad
+                self._par, self._geo = hit
+                self.fst = np.zeros(N_F)
+                self.ist = np.zeros(N_I, dtype=np.int64)
+                self.rev_at = np.zeros((REV_AT, 2))
+                self.reset()
+                return
         self.params = params
         self.info = info
         self.rng = rng
@@ -698,6 +718,8 @@ class CompiledNavigate:
         self._geo = (f64(ref.angles_rad), f64(box._cos), f64(box._sin), f64(box.exit_m), f64(box.offsets_m),
                      box_idx, box_cnt, i64(order_l), f64(cos_l), f64(sin_l), i64(order_r), f64(cos_r), f64(sin_r), i64(head),
                      i64(pan._front), f64(pan._free_exit))
+        if key is not None:
+            shared[key] = (self._par, self._geo)
         self.fst = np.zeros(N_F)
         self.ist = np.zeros(N_I, dtype=np.int64)
         self.rev_at = np.zeros((REV_AT, 2))

@@ -416,11 +416,12 @@ class _TrailGroup:
         self.robots: list[Any] = []
         #: robots whose Navigate is compiled (the others keep the reference's)
         self.compiled_robots = 0
+        shared: dict = {}  # robots with the same Navigate inputs share its parameter row and geometry
         for p, rng, info in zip(params, rngs, infos):
             brain = ctl(p, rng, info)
             nav = brain.nav
             if NC.unsupported(nav.params) is None:
-                brain.nav = NC.CompiledNavigate(nav.params, rng, info, laser=nav.laser)
+                brain.nav = NC.CompiledNavigate(nav.params, rng, info, laser=nav.laser, reference=nav, shared=shared)
                 self.compiled_robots += 1
             self.robots.append(brain)
         self._n = len(self.robots)
