@@ -80,6 +80,8 @@ def test_compiled_trail_team_runs_as_the_reference(name, paper):
     ref, cmp_ = side_by_side(scn, STEPS)
     team = cmp_.group_teams[0][0]
     assert team.compiled_robots == 4  # every robot's Navigate compiled
+    if name == "blazing-a-trail":  # one geometry for the four: the team steps in one call
+        assert team._team
     modes = {b.nav.mode for g in cmp_.brains for b in g}
     assert modes <= {"navigate", "advance", "turn", "panic"}
     # the launch started every robot, and the radio carried the same crumbs or trails
@@ -163,3 +165,15 @@ def test_compiled_crumb_mean_is_the_reference_mean(seed, n, radius):
     assert (ref is not None) == found
     if found:
         assert mean == ref
+
+
+def test_blazing_team_with_two_navigate_settings_steps_robot_by_robot_as_the_reference():
+    """Robots whose Navigate parameters differ do not share a geometry: the group brain steps
+    them one call per robot (not the team call), and the run is still the reference's."""
+    scn = _scenario("blazing-a-trail", False, steps=600)
+    scn = scn.model_copy(update={"robots": [
+        g.model_copy(update={"params": {**g.params, "navigate": {"p_take_opening": 0.6}}}) if k == 1 else g
+        for k, g in enumerate(scn.robots)]})
+    ref, cmp_ = side_by_side(scn, 600)
+    team = cmp_.group_teams[0][0]
+    assert team.compiled_robots == 4 and not team._team

@@ -54,6 +54,20 @@ B_REV_MIN = 8  # reverse_min_crumbs
 B_RECOVER = 9  # recover_radius_m
 N_B = 10
 
+# blazing-trail-v1's scalar state in a team's array (BS_*)
+BS_PATH = 0  # _path_m
+BS_HAS_LAST = 1  # _last_xy is not None
+BS_LX = 2
+BS_LY = 3
+BS_HAS_CRUMB = 4  # _crumb_xy is not None
+BS_CX = 5
+BS_CY = 6
+BS_NEXT = 7  # _next_crumb_s
+BS_CUT = 8  # loops_cut
+BS_FOLLOW = 9  # _following
+BS_RECOVER = 10  # _recovering
+N_BS = 11
+
 
 # ----------------------------------------------------------------- numpy's arithmetic, written out
 @njit(cache=True)
@@ -272,6 +286,46 @@ def _row_observation(obs: GroupObservation, r: int) -> Observation:
                        obs.events[r] if obs.events is not None else ())
 
 
+@njit(cache=True)
+def blazing_team_step(rows, bs, pn, privs, gn, globs, bpar, carry, nf, ni, par, nrev, ranges, poses, t, stalled, angles,
+                      cos_a, sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r,
+                      head, front, free_exit, out_v, out_w, out_pref):
+    """:func:`blazing_row_step` for the robots ``rows`` of a team in one call (their Navigate
+    parameters and geometry shared), state in the team's arrays: ``bs`` (n, N_BS) the brains'
+    scalars (``BS_*``), ``pn``/``gn`` the private and global crumb counts, ``privs``/``globs``
+    their buffers, ``nf``/``ni``/``nrev`` Navigate's states. Commands into ``out_v``/``out_w``;
+    a robot whose Navigate must draw gets ``out_v`` NaN and its hint in ``out_pref`` (has_pref,
+    pref, allow) for the caller's :func:`~teamnav.control.nav.navigate_compiled.nav_step_rng`."""
+    for k in range(rows.shape[0]):
+        r = rows[k]
+        b = bs[r]
+        pose = poses[r]
+        out = blazing_row_step(b[BS_PATH], b[BS_HAS_LAST] != 0.0, b[BS_LX], b[BS_LY], b[BS_HAS_CRUMB] != 0.0,
+                               b[BS_CX], b[BS_CY], b[BS_NEXT], carry[r], privs[r], pn[r], globs[r], gn[r], bpar[r],
+                               nf[r], ni[r], par, nrev[r], ranges[r], pose[0], pose[1], pose[2], t, stalled[r], angles,
+                               cos_a, sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r,
+                               sin_r, head, front, free_exit)
+        b[BS_PATH] = out[2]
+        b[BS_HAS_LAST] = 1.0
+        b[BS_LX] = pose[0]
+        b[BS_LY] = pose[1]
+        if out[3]:
+            b[BS_HAS_CRUMB] = 1.0
+            b[BS_CX] = out[4]
+            b[BS_CY] = out[5]
+        b[BS_NEXT] = out[6]
+        pn[r] = out[7]
+        if out[8]:
+            b[BS_CUT] += 1.0
+        b[BS_FOLLOW] = 1.0 if out[9] else 0.0
+        b[BS_RECOVER] = 1.0 if out[10] else 0.0
+        out_v[r] = out[0]
+        out_w[r] = out[1]
+        out_pref[r, 0] = 1.0 if out[11] else 0.0
+        out_pref[r, 1] = out[12]
+        out_pref[r, 2] = 1.0 if out[13] else 0.0
+
+
 # trail-share-v1's parameter columns (S_*)
 S_DESCEND = 0  # descend_only
 S_REACH = 1  # reach_m
@@ -448,6 +502,26 @@ class _TrailGroup:
         return GroupAction(v, w, d, outbox)
 
 
+class _BlazingView:
+    """Robot r's face in a :class:`BlazingTrailGroup` that steps the team in one call: its
+    reference brain, brought up to date from the team's arrays before anything is read."""
+
+    def __init__(self, group: "BlazingTrailGroup", r: int) -> None:
+        self._g = group
+        self._r = r
+
+    def log(self) -> dict:
+        self._g._to_brain(self._r)
+        return self._g._brains[self._r].log()
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__") or name in ("_g", "_r"):
+            raise AttributeError(name)
+        g = self._g
+        g._to_brain(self._r)
+        return getattr(g._brains[self._r], name)
+
+
 class BlazingTrailGroup(_TrailGroup):
     """``blazing-trail-v1`` teams (module docstring). A robot's step without task events (nearly
     all of them) is the reference's inbox rule (received crumbs appended to the global list; the
@@ -477,9 +551,164 @@ class BlazingTrailGroup(_TrailGroup):
             b[B_RECOVER] = p.recover_radius_m
             self._bpar.append(b)
             self._fast.append(isinstance(brain.nav, NC.CompiledNavigate) and p.global_crumb_ttl_s is None)
+        navs = [brain.nav for brain in self.robots]
+        self._team = bool(navs) and all(self._fast) and all(
+            nav._par is navs[0]._par and nav.laser == navs[0].laser for nav in navs)
+        if self._team:
+            self._init_team()
+
+    # ------------------------------------------------------------------ the team in one call
+    def _init_team(self) -> None:
+        """Every robot's Navigate shares one geometry: the team steps in one call
+        (:func:`blazing_team_step`), its state in arrays; each robot's reference brain is brought
+        up to date from them whenever it is read (:class:`_BlazingView`) or steps itself."""
+        from numba.typed import List
+
+        n = self._n
+        self._brains = list(self.robots)
+        self._nf = np.zeros((n, NC.N_F))
+        self._ni = np.zeros((n, NC.N_I), dtype=np.int64)
+        self._nrev = np.zeros((n, NC.REV_AT, 2))
+        for r, brain in enumerate(self._brains):
+            nav = brain.nav
+            self._nf[r] = nav.fst
+            self._ni[r] = nav.ist
+            self._nrev[r] = nav.rev_at
+            nav.fst, nav.ist, nav.rev_at = self._nf[r], self._ni[r], self._nrev[r]  # views: one state
+        self._npar = self._brains[0].nav._par
+        self._ngeo = self._brains[0].nav._geo
+        self._laser = self._brains[0].nav.laser
+        self._bs = np.zeros((n, N_BS))
+        self._pn = np.zeros(n, dtype=np.int64)
+        self._gn = np.zeros(n, dtype=np.int64)
+        self._cap = np.zeros(n, dtype=np.int64)
+        self._carry = np.zeros(n, dtype=np.bool_)
+        self._last_step = np.zeros(n, dtype=np.int64)
+        self._bpar_all = np.ascontiguousarray(np.stack(self._bpar))
+        self._priv_obj = [b.private._buf for b in self._brains]
+        self._glob_obj = [b.global_crumbs._buf for b in self._brains]
+        self._privs = List(self._priv_obj)
+        self._globs = List(self._glob_obj)
+        self._out_pref = np.zeros((n, 3))
+        for r in range(n):
+            self._from_brain(r)
+        self.robots = [_BlazingView(self, r) for r in range(n)]
+
+    def _from_brain(self, r: int) -> None:
+        """Robot r's state, from its reference brain into the team's arrays."""
+        b = self._brains[r]
+        row = self._bs[r]
+        row[BS_PATH] = b._path_m
+        last, crumb = b._last_xy, b._crumb_xy
+        row[BS_HAS_LAST] = 0.0 if last is None else 1.0
+        row[BS_LX], row[BS_LY] = (0.0, 0.0) if last is None else last
+        row[BS_HAS_CRUMB] = 0.0 if crumb is None else 1.0
+        row[BS_CX], row[BS_CY] = (0.0, 0.0) if crumb is None else crumb
+        row[BS_NEXT] = b._next_crumb_s
+        row[BS_CUT] = b.loops_cut
+        row[BS_FOLLOW] = 1.0 if b._following else 0.0
+        row[BS_RECOVER] = 1.0 if b._recovering else 0.0
+        self._pn[r] = b.private._n
+        self._sync_buffers(r)
+        self._carry[r] = b.carrying
+        self._last_step[r] = b._step
+
+    def _sync_buffers(self, r: int) -> None:
+        """Robot r's crumb buffers and counts (a list that grew has a new buffer: the typed lists
+        are built again, not assigned into, since a typed list's ``__setitem__`` compiles on first
+        use, in whichever step needs it)."""
+        from numba.typed import List
+
+        b = self._brains[r]
+        if b.private._buf is not self._priv_obj[r]:
+            self._priv_obj[r] = b.private._buf
+            self._privs = List(self._priv_obj)
+        self._cap[r] = b.private._buf.shape[0]
+        g = b.global_crumbs
+        if g._buf is not self._glob_obj[r]:
+            self._glob_obj[r] = g._buf
+            self._globs = List(self._glob_obj)
+        self._gn[r] = g._n
+
+    def _to_brain(self, r: int) -> None:
+        """Robot r's state, from the team's arrays into its reference brain."""
+        b = self._brains[r]
+        row = self._bs[r].tolist()
+        b._path_m = row[BS_PATH]
+        b._last_xy = (row[BS_LX], row[BS_LY]) if row[BS_HAS_LAST] else None
+        b._crumb_xy = (row[BS_CX], row[BS_CY]) if row[BS_HAS_CRUMB] else None
+        b._next_crumb_s = row[BS_NEXT]
+        b.loops_cut = int(row[BS_CUT])
+        b._following = bool(row[BS_FOLLOW])
+        b._recovering = bool(row[BS_RECOVER])
+        b.private._n = int(self._pn[r])
+        b._step = int(self._last_step[r])
+
+    def _step_team(self, obs: GroupObservation) -> GroupAction:
+        n = self._n
+        outbox: list = []
+        waiting = obs.waiting
+        events = obs.events
+        inbox = obs.inbox
+        t = float(obs.time_s)
+        step = int(obs.step)
+        v = np.zeros(n)
+        w = np.zeros(n)
+        active = np.ones(n, dtype=np.bool_) if waiting is None else ~waiting
+        if events is not None:  # a step with task events: the reference brain's own (in robot order)
+            for r, ev in enumerate(events):
+                if ev and active[r]:
+                    active[r] = False
+                    self._to_brain(r)
+                    action, msgs = self._brains[r].step(_row_observation(obs, r))
+                    self._from_brain(r)
+                    self._last_step[r] = step
+                    v[r] = action.v_mps
+                    w[r] = action.omega_radps
+                    if msgs:
+                        rid = int(obs.robot_ids[r])
+                        outbox.extend((rid, m) for m in msgs)
+        for r, box in enumerate(inbox):
+            if box and active[r]:
+                b = self._brains[r]
+                if b.params.communicate:  # the reference's inbox rule (only the global list)
+                    me = b.info.robot_id
+                    for msg in box:
+                        if msg.kind == "crumbs" and isinstance(msg.body, CrumbBatch) and msg.sender != me:
+                            b._add_global(msg.body, t)
+                    self._sync_buffers(r)
+        rows = np.flatnonzero(active)
+        if rows.size:
+            full = rows[self._pn[rows] + 1 > self._cap[rows]]
+            for r in full.tolist():  # room for one more private crumb
+                priv = self._brains[r].private
+                priv._n = int(self._pn[r])
+                priv._reserve(1)
+                self._sync_buffers(r)
+            ranges = np.ascontiguousarray(obs.ranges_m[self._laser])
+            poses = np.ascontiguousarray(obs.odom_pose)
+            stalled = np.ascontiguousarray(obs.stalled, dtype=np.bool_)
+            out_v = np.zeros(n)
+            out_w = np.zeros(n)
+            pref = self._out_pref
+            blazing_team_step(rows, self._bs, self._pn, self._privs, self._gn, self._globs, self._bpar_all,
+                              self._carry, self._nf, self._ni, self._npar, self._nrev, ranges, poses, t, stalled,
+                              *self._ngeo, out_v, out_w, pref)
+            self._last_step[rows] = step
+            for r in rows[np.isnan(out_v[rows])].tolist():  # Navigate must draw: with the Generator
+                x, y, th = poses[r, :3].tolist()
+                nav = self._brains[r].nav
+                out_v[r], out_w[r] = NC.nav_step_rng(
+                    nav.fst, nav.ist, nav._par, nav.rev_at, ranges[r], x, y, th, t, bool(stalled[r]),
+                    bool(pref[r, 0]), float(pref[r, 1]), bool(pref[r, 2]), False, nav.rng, *nav._geo)
+            v[rows] = out_v[rows]
+            w[rows] = out_w[rows]
+        return GroupAction(v, w, np.full(n, math.nan), outbox)
 
     def step_group(self, obs: GroupObservation) -> GroupAction:
         """Every robot's step (module docstring); a waiting robot's brain is off."""
+        if self._team:
+            return self._step_team(obs)
         n = self._n
         v = np.zeros(n)
         w = np.zeros(n)
