@@ -73,15 +73,21 @@ def side_by_side(scn, steps: int) -> tuple[Simulation, Simulation]:
     return ref, cmp_
 
 
+@pytest.mark.parametrize("team_call", [False, True], ids=["per-robot", "team-call"])
 @pytest.mark.parametrize("paper", [False, True], ids=["teamnav", "paper"])
 @pytest.mark.parametrize("name", ["blazing-a-trail", "try-to-see-it-my-way"])
-def test_compiled_trail_team_runs_as_the_reference(name, paper):
+def test_compiled_trail_team_runs_as_the_reference(name, paper, team_call, monkeypatch):
+    """Both forms of the group brain: one call per robot (four robots, the default) and the team
+    in one call (the default from TEAM_MIN robots on, forced here for four)."""
+    from teamnav.papers.trails.brains import trail_compiled
+
+    if team_call:
+        monkeypatch.setattr(trail_compiled._TrailGroup, "TEAM_MIN", 1)
     scn = _scenario(name, paper)
     ref, cmp_ = side_by_side(scn, STEPS)
     team = cmp_.group_teams[0][0]
     assert team.compiled_robots == 4  # every robot's Navigate compiled
-    if name == "blazing-a-trail":  # one geometry for the four: the team steps in one call
-        assert team._team
+    assert team._team == team_call
     modes = {b.nav.mode for g in cmp_.brains for b in g}
     assert modes <= {"navigate", "advance", "turn", "panic"}
     # the launch started every robot, and the radio carried the same crumbs or trails
@@ -167,13 +173,31 @@ def test_compiled_crumb_mean_is_the_reference_mean(seed, n, radius):
         assert mean == ref
 
 
-def test_blazing_team_with_two_navigate_settings_steps_robot_by_robot_as_the_reference():
+def test_blazing_team_with_two_navigate_settings_steps_robot_by_robot_as_the_reference(monkeypatch):
     """Robots whose Navigate parameters differ do not share a geometry: the group brain steps
     them one call per robot (not the team call), and the run is still the reference's."""
     scn = _scenario("blazing-a-trail", False, steps=600)
     scn = scn.model_copy(update={"robots": [
         g.model_copy(update={"params": {**g.params, "navigate": {"p_take_opening": 0.6}}}) if k == 1 else g
         for k, g in enumerate(scn.robots)]})
+    from teamnav.papers.trails.brains import trail_compiled
+
+    monkeypatch.setattr(trail_compiled._TrailGroup, "TEAM_MIN", 1)  # would step as a team if it could
     ref, cmp_ = side_by_side(scn, 600)
     team = cmp_.group_teams[0][0]
     assert team.compiled_robots == 4 and not team._team
+
+
+@pytest.mark.parametrize("controller", ["blazing-trail-v1", "trail-share-v1"])
+def test_ten_robots_step_as_a_team_in_one_call_as_the_reference(controller):
+    """Ten robots of ``trail-team`` (one group, one geometry) on the open building, started at
+    random spots (no launch): the default team call, side by side with the reference."""
+    ov = {"robots.0.count": 10, "map": {"builtin": "trail_office"}, "launch": None,
+          "robots.0.start": {"theta_deg": None}, "robots.0.controller": controller}
+    if controller == "trail-share-v1":
+        ov["robots.0.params"] = {"cruise_speed_mps": 0.4, "communicate": True, "layer_every_steps": 6000}
+    scn = load_scenario("trail-team", overrides=ov, duration_s=60.0, seed=1001)
+    ref, cmp_ = side_by_side(scn, 600)
+    team = cmp_.group_teams[0][0]
+    assert team._team and team.compiled_robots == 10
+    assert ref.radio.sent_messages.tolist() == cmp_.radio.sent_messages.tolist()
