@@ -1,24 +1,29 @@
-"""The trail brains as group brains: a team stepped in one call, Navigate compiled.
+"""The trail brains as group brains: Navigate and the trail rules compiled, a team in one call.
 
 ``blazing-trail-v1`` (:class:`~teamnav.papers.trails.brains.blazing_trail.BlazingTrail`, Blazing
 §4.1-4.2) and ``trail-share-v1`` (:class:`~teamnav.papers.trails.brains.trail_share.TrailShare`,
-Try §3) under ``group_brains`` (``docs/concepts/group-brains.md``). What is compiled so far is
-Navigate (§4.2's wall following, openings, 180° rule and Panic), the larger part of a trail
-robot's step: each robot's brain is its reference brain with its Navigate replaced by
-:class:`~teamnav.control.nav.navigate_compiled.CompiledNavigate` (the same rules, state as
-arrays, one numba call per robot). The crumb lists, the Trails, the waggle dance and the task
-round run as the reference's own code, so they are the reference by construction; the runs are
-the same bit for bit (``tests/test_trail_compiled.py``, both columns, both sections, with drift).
-
-Not compiled yet (the plan in ``docs/concepts/group-brains.md``): the crumb queries (the
-circular mean needs numpy's own ``sin`` and pairwise sum to give the same bits), the Trails'
-transforms, and one kernel call for the whole team instead of one per robot.
+Try §3) under ``group_brains`` (``docs/concepts/group-brains.md``, "The trail brains"). Each
+robot keeps its reference brain, with its Navigate replaced by
+:class:`~teamnav.control.nav.navigate_compiled.CompiledNavigate` (§4.2's wall following,
+openings, 180° rule and Panic; the same rules, state as arrays). On a step without task events
+the hot part of the brain is compiled too: for blazing-trail-v1 the path, crumb dropping and
+loop pruning, the crumbs' mean heading, the 180° rule's count, the recovery, then Navigate
+(:func:`blazing_row_step`); for trail-share-v1 the descend-only bound, the lowest
+time-to-place crumb, the recovery, then Navigate (:func:`share_row_step`). From
+``TEAM_MIN`` robots sharing one Navigate geometry on, the team steps in one call
+(:func:`blazing_team_step`, :func:`share_team_step`), its state in arrays; below, one call per
+robot. What stays the reference's own code, run as the reference runs it: steps with task
+events (the waggle dance, Places set), the inbox rules (crumbs appended, Trails combined through
+the Places), the Trails' expiry and trail-share's broadcast steps. The runs are the same bit for
+bit (``tests/test_trail_compiled.py``: both columns, both sections, with drift and launch, both
+forms of the call).
 
 A robot whose Navigate parameters the kernel declines
 (:func:`~teamnav.control.nav.navigate_compiled.unsupported`: the meeting flags) keeps the
-reference Navigate inside the group, so a run is never inexact. Robots started one at a time
-(a scenario's ``launch``) are skipped while they wait (``GroupObservation.waiting``), as the
-per-robot path skips them.
+reference Navigate and its reference step inside the group, so a run is never inexact; so does a
+blazing-trail-v1 robot whose global crumbs expire (``global_crumb_ttl_s``). Robots started one at
+a time (a scenario's ``launch``) are skipped while they wait (``GroupObservation.waiting``), as
+the per-robot path skips them.
 """
 
 from __future__ import annotations
