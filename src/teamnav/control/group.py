@@ -66,6 +66,11 @@ class GroupObservation:
         Messages delivered this step to each robot.
     events : tuple of n tuples, or None
         Task events of each robot (None: no place fired this step).
+    waiting : ndarray (n,) bool, or None
+        Robots not started yet (a scenario's ``launch``: one at a time from one spot): their
+        brains are off this step, as the per-robot path does not call them, and their commands
+        are ignored (zeroed by the engine). None: every robot runs. Only a group brain class with
+        ``handles_waiting = True`` is given a run with a launch.
     """
 
     robot_ids: np.ndarray
@@ -83,6 +88,7 @@ class GroupObservation:
     det_bearing_rad: np.ndarray
     inbox: tuple
     events: tuple | None
+    waiting: np.ndarray | None = None
 
 
 @_fast_frozen_init

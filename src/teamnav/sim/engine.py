@@ -331,10 +331,14 @@ class Simulation:
                 raise ValueError(f"{label}: controller {g.controller!r}: batched controllers command (v, omega) and "
                                  f"need kinematics 'unicycle', got {g.kinematics!r}")
             group_cls = None
-            if (group_brains and not batched and g.count and launch is None
+            if (group_brains and not batched and g.count
                     and (config.faults is None or config.faults.empty)
                     and "group_brain" in vars(cls)):
                 group_cls = _group_brain_class()(cls)
+                # robots started one at a time: only a group brain that skips waiting rows
+                # (GroupObservation.waiting) runs them
+                if launch is not None and not getattr(group_cls, "handles_waiting", False):
+                    group_cls = None
             if group_cls is not None:
                 brain = None  # built with its team below (or per robot, where the group brain declines)
                 pending.append((gi, cls, group_cls, params, rngs, infos))
@@ -935,6 +939,7 @@ class Simulation:
             ranges, angles, max_range, count, ids, rng, brg,
             tuple(inboxes[sl]) if inboxes is not None else ((),) * n,
             tuple(events[sl]) if events is not None else None,
+            self.waiting[sl].copy() if self.waiting is not None else None,
         )
         timer = self._brain_timer
         self.calling = (first.index, None, step, _now())

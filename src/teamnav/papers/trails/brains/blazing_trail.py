@@ -294,6 +294,9 @@ class BlazingTrail:
     info : RobotInfo
     """
 
+    #: the compiled form under ``group_brains`` (Navigate compiled; ``trail_compiled``)
+    group_brain = "teamnav.papers.trails.brains.trail_compiled:BlazingTrailGroup"
+
     Params = BlazingTrailParams
 
     def __init__(self, params: BlazingTrailParams, rng: np.random.Generator, info: RobotInfo) -> None:

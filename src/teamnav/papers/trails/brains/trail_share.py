@@ -337,6 +337,9 @@ class TrailShare:
     info : RobotInfo
     """
 
+    #: the compiled form under ``group_brains`` (Navigate compiled; ``trail_compiled``)
+    group_brain = "teamnav.papers.trails.brains.trail_compiled:TrailShareGroup"
+
     Params = TrailShareParams
 
     def __init__(self, params: TrailShareParams, rng: np.random.Generator, info: RobotInfo) -> None:
