@@ -223,3 +223,17 @@ def test_stored_probe_runs_are_the_docs_jsonl():
 
     assert sorted(GF.probe_runs(), key=key) == sorted(lines, key=key)
     assert all(1000 <= r["seed"] < 2000 for r in lines)
+
+
+def test_the_decompositions_seeds_are_its_own_not_those_of_the_turn_count():
+    """The 'each gap-fill alone' text names the decomposition's paired seeds; the turn-count table
+    (tuning seeds) names its own."""
+    def run(part, seed):
+        return {"part": part, "case": "", "config": "paper", "seed": seed, "duration_s": 1800.0, "units": 3,
+                "units_second_half": 1, "breakdown_s": 1800.0, "breakdown_censored": True, "cpu_s": 1.0,
+                "reversals": 10}
+
+    out = GF.blocks([run("gapfills", s) for s in (100, 101)] + [run("reversals", s) for s in (1000, 1001)],
+                    system="try")
+    assert "paired seeds 100-101," in out[0].text
+    assert any("seeds 1000-1001" in getattr(b, "title", "") for b in out[1:])

@@ -171,7 +171,8 @@ def blocks(runs=None, system: str = "blazing") -> list:
     out: list = [Text(
         f"Why the two columns of {brain} differ, taken apart (scripts/trail_gap_fill_study.py "
         f"--system {system}, paired seeds "
-        f"{_seeds(runs)}, which are neither the report's nor used to choose anything; measured once and shown "
+        f"{_seeds([r for r in runs if r['part'] in ('gapfills', 'drift')] or runs)}, which are neither the report's "
+        "nor used to choose anything; measured once and shown "
         "as measured, not re-run here). 'paper+G': the paper's rules with gap-fill G alone at teamnav's value "
         "(what G buys on its own); 'teamnav-G': ours with G alone at the paper's value (what G is worth among "
         "the others); 'teamnav@0.25': every gap-fill of ours at the paper's cruise speed.")]
