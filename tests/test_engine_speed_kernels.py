@@ -254,20 +254,78 @@ def test_every_kernel_is_cached(mod):
 
 @pytest.mark.parametrize("heading", [0.0, 0.3, math.pi / 2, -2.5, math.pi])
 @pytest.mark.parametrize("gap", [2e-9, 1e-7, 1e-3, 0.2])
-def test_disc_just_beyond_the_near_ring_on_a_lone_long_ray(heading, gap):
-    """A disc met after the cast (just beyond ``_NEAR_M``) on the only ray that runs far: the
-    box of long rays must hold it, however thin (one beam, small radii)."""
-    grid = OccupancyGrid.empty(40.0, 40.0, 0.05, origin_xy_m=(-20.0, -20.0))
+@pytest.mark.parametrize("open_space", [True, False])
+def test_disc_just_beyond_the_near_ring_on_a_lone_long_ray(heading, gap, open_space):
+    """A disc met after the cast (just beyond the near reach: ``_OPEN_NEAR_M`` in open space,
+    ``_NEAR_M`` with a wall within 4 m) on the only ray that runs far: the box of that ray's
+    segment must hold it, however thin (one beam, small radii)."""
+    cells = np.zeros((800, 800), np.uint8)
+    if not open_space:  # a wall 3 m behind the pose: less than _NEAR_M of free map around it
+        cells[:, 340] = WALL
+    grid = OccupancyGrid(cells, 0.05, (-20.0, -20.0))
     sensor = build_range_sensor(LaserConfig(n_beams=1, fov_deg=1.0, max_range_m=10.0, noise_std_m=0.0,
                                             sees_robots=True), grid)
+    if not open_space:
+        heading = math.copysign(min(abs(heading), 1.0), heading) if heading else 0.0  # away from the wall
     r = 0.02
-    t = rs_mod._NEAR_M + gap
+    near = rs_mod._OPEN_NEAR_M if open_space else rs_mod._NEAR_M
+    t = near + gap
     cx, cy = (t + r) * math.cos(heading), (t + r) * math.sin(heading)
     bodies = (np.array([0.0, cx, 9.0]), np.array([0.0, cy, 9.0]), np.array([0.01, r, 0.01]), np.array([0]))
     xs, ys, th = np.zeros(1), np.zeros(1), np.array([heading])
     got = sensor._pass(xs, ys, th, bodies, None)
     np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, None))
     assert got[0, 0] < t + 1e-6
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([1, 3, 45, 181]))
+def test_far_discs_grazing_the_segments_of_long_rays(seed, open_space, n_beams):
+    """Each ray still longer than the near reach after the cast tests the discs of its own
+    segment's box (``_ray_hits_in_box``): discs beyond the near reach that graze a long ray
+    (centred up to a radius off it, within a few ulps of tangent), that sit just past the
+    segment's start or with their front just before its end, and larger discs than the rest
+    (the box's margin is the largest radius): the former path's ranges bit for bit."""
+    rng = np.random.default_rng(seed)
+    cells = np.zeros((800, 800), np.uint8)
+    if not open_space:
+        cells[:, 340] = WALL  # 3 m behind the pose
+    grid = OccupancyGrid(cells, 0.05, (-20.0, -20.0))
+    fov = float(rng.choice([20.0, 90.0, 180.0]))
+    sensor = build_range_sensor(LaserConfig(n_beams=n_beams, fov_deg=fov, max_range_m=10.0, noise_std_m=0.0,
+                                            sees_robots=True), grid)
+    heading = float(rng.uniform(-1.0, 1.0)) if not open_space else float(rng.uniform(-4.0, 4.0))
+    near = rs_mod._OPEN_NEAR_M if open_space else rs_mod._NEAR_M
+    angles = heading + sensor.ray_angles_rad
+    bx, by, br = [0.0], [0.0], [0.2]
+    for _ in range(int(rng.integers(1, 12))):
+        a = float(angles[int(rng.integers(0, angles.shape[0]))])
+        dx, dy = math.cos(a), math.sin(a)
+        r = float(rng.choice([0.01, 0.2, 0.45]))
+        kind = int(rng.integers(0, 3))
+        if kind == 0:  # grazing: centred up to a radius off the ray, beyond the near reach
+            t = near + float(rng.uniform(0.0, 10.0 - near))
+            off = (r + float(rng.choice([0.0, 1e-15, -1e-15, 1e-12, -1e-12]))) * float(rng.choice([1.0, rng.uniform(0, 1)]))
+            side = 1.0 if rng.random() < 0.5 else -1.0
+            cx, cy = t * dx - side * off * dy, t * dy + side * off * dx
+        elif kind == 1:  # front just past the near reach
+            t = near + float(rng.choice([2e-9, 1e-7, 1e-3, 0.3]))
+            cx, cy = (t + r) * dx, (t + r) * dy
+        else:  # front just before the range's end
+            t = 10.0 - float(rng.choice([1e-9, 1e-6, 0.05]))
+            cx, cy = (t + r) * dx, (t + r) * dy
+        bx.append(cx)
+        by.append(cy)
+        br.append(r)
+    bodies = (np.array(bx), np.array(by), np.array(br), np.array([0]))
+    xs, ys, th = np.zeros(1), np.zeros(1), np.array([heading])
+    old = rs_mod.PARALLEL_MIN_RAYS
+    try:
+        rs_mod.PARALLEL_MIN_RAYS = 10**12
+        got = sensor._pass(xs, ys, th, bodies, None)
+    finally:
+        rs_mod.PARALLEL_MIN_RAYS = old
+    np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, None))
 
 
 @settings(max_examples=80, deadline=None)
