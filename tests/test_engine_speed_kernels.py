@@ -216,6 +216,90 @@ def test_two_reaches_test_every_disc_once(seed, inner, reach):
             np.testing.assert_array_equal(one, ref[0])
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(2.0, 9.0), st.sampled_from([0.5, 0.7, 1.5]), st.booleans())
+def test_clipped_columns_keep_discs_at_the_reach_and_behind_the_fan(seed, reach, cell, half_turn):
+    """A wide window reads in each hash column only the rows that can hold a disc the culls
+    keep: discs whose front is just inside the reach (any direction, the largest radius) and
+    discs centred behind a half-turn fan's half-plane that still cross its edge rays are
+    met, as when every ray is tested against every disc."""
+    rng = np.random.default_rng(seed)
+    px, py = rng.uniform(-3.0, 3.0, 2)
+    th = float(rng.uniform(-7.0, 7.0))
+    width = math.pi if half_turn else float(rng.uniform(0.5, 3.0))
+    angles = np.linspace(-width / 2, width / 2, int(rng.choice([31, 181])))
+    plan = beam_plan(angles)
+    rmax = 0.45
+    xs, ys, rs = [px], [py], [0.2]
+    for _ in range(60):
+        kind = int(rng.integers(0, 3))
+        r = float(rng.choice([rmax, rmax, 0.2, 0.01]))
+        delta = float(rng.choice([0.0, 1e-12, 1e-9, 1e-6, 1e-3, 0.1]))
+        if kind == 0:  # front just inside the reach, often straight along an axis (the circle's extremes)
+            a = th + float(rng.uniform(-width / 2, width / 2))
+            axis = float(rng.choice([0.0, 0.5, 1.0, -0.5])) * math.pi
+            if rng.random() < 0.5 and abs(math.remainder(axis - th, 2 * math.pi)) < width / 2:
+                a = axis
+            d = reach + r - delta
+            xs.append(px + d * math.cos(a))
+            ys.append(py + d * math.sin(a))
+        elif kind == 1:  # centred behind the half-plane, crossing an edge ray
+            a = th + (width / 2 if rng.random() < 0.5 else -width / 2)
+            t = float(rng.uniform(0.0, reach))
+            back = th + math.pi  # the fan's middle turned round
+            off = r - delta
+            xs.append(px + t * math.cos(a) + off * math.cos(back))
+            ys.append(py + t * math.sin(a) + off * math.sin(back))
+        else:
+            xs.append(px + float(rng.uniform(-reach - 1, reach + 1)))
+            ys.append(py + float(rng.uniform(-reach - 1, reach + 1)))
+        rs.append(r)
+    all_x, all_y, all_r = np.array(xs), np.array(ys), np.array(rs)
+    hsh = rh_mod._prepare(all_x, all_y, all_r, 10.0, cell)
+    nb = angles.shape[0]
+    got = np.full(nb, reach)
+    rh_mod._robot_hits_row(px, py, math.cos(th), math.sin(th), 0, 0.0, reach, plan.beams, plan.even, hsh, got,
+                           np.empty(nb), np.empty(nb), True, rh_mod._ALL)
+    want = np.full((1, nb), reach)
+    robot_hits_reference(np.array([px]), np.array([py]), np.array([th]), angles, (all_x, all_y, all_r, np.array([0])),
+                         want)
+    np.testing.assert_array_equal(got, want[0])
+
+
+@pytest.mark.parametrize("axis", [0, 1, 2, 3])
+@pytest.mark.parametrize("cell", [0.7, 1.5])
+def test_clipped_rows_keep_a_disc_just_past_a_row_boundary_at_the_reach(axis, cell):
+    """The row clipping's circle, on its tight side: a disc of the largest radius straight
+    ahead along an axis, its front 0.1 mm inside the reach and its centre 1 mm past a hash row
+    (column) boundary, the boundary the clipped range must not stop short of."""
+    c, s_ = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][axis]
+    rmax, delta, eps = 0.45, 1e-4, 1e-3
+    lo_corner = -8.0  # an anchor disc there sets the hash's origin: boundaries at lo_corner + k cell
+    if c + s_ > 0:  # ahead along +x or +y: the centre just past the first boundary beyond 5.5 m
+        target = lo_corner + math.ceil((5.5 - lo_corner) / cell) * cell + eps
+    else:  # along -x or -y: just before (below) the last boundary under -5.5 m
+        target = lo_corner + math.floor((-5.5 - lo_corner) / cell) * cell - eps
+    dist = abs(target)
+    reach = dist - rmax + delta
+    # 250 small discs out of reach at the far corner: enough discs for the hash to keep `cell`
+    xs = [0.0, lo_corner, abs(c) * target] + [12.0] * 250
+    ys = [0.0, lo_corner, abs(s_) * target] + [12.0] * 250
+    rs = [0.2, 0.01, rmax] + [0.01] * 250
+    all_x, all_y, all_r = np.array(xs), np.array(ys), np.array(rs)
+    th = math.atan2(s_, c)
+    angles = np.linspace(-math.pi / 2, math.pi / 2, 181)
+    plan = beam_plan(angles)
+    hsh = rh_mod._prepare(all_x, all_y, all_r, 10.0, cell)
+    assert (hsh[5], hsh[6], hsh[7]) == (lo_corner, lo_corner, cell)
+    got = np.full(181, reach)
+    rh_mod._robot_hits_row(0.0, 0.0, math.cos(th), math.sin(th), 0, 0.0, reach, plan.beams, plan.even, hsh, got,
+                           np.empty(181), np.empty(181), True, rh_mod._ALL)
+    want = np.full((1, 181), reach)
+    robot_hits_reference(np.zeros(1), np.zeros(1), np.array([th]), angles, (all_x, all_y, all_r, np.array([0])), want)
+    assert want[0, 90] < reach - 0.5 * delta  # the middle ray meets the disc
+    np.testing.assert_array_equal(got, want[0])
+
+
 def test_basement_team_matches_former_path():
     """1000 robots on the MIT basement map, as bench_engine's laser case: bit for bit, serial and parallel."""
     import sys
