@@ -365,9 +365,9 @@ def test_disc_just_beyond_the_near_ring_on_a_lone_long_ray(heading, gap, open_sp
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([1, 3, 45, 181]))
 def test_far_discs_grazing_the_segments_of_long_rays(seed, open_space, n_beams):
-    """Each ray still longer than the near reach after the cast tests the discs of its own
-    segment's box (``_ray_hits_in_box``): discs beyond the near reach that graze a long ray
-    (centred up to a radius off it, within a few ulps of tangent), that sit just past the
+    """Runs of rays still longer than the near reach after the cast test the discs of the box
+    around their segments (up to ``_FAR_RUN`` rays a box): discs beyond the near reach that
+    graze a long ray (centred up to a radius off it, within a few ulps of tangent), that sit just past the
     segment's start or with their front just before its end, and larger discs than the rest
     (the box's margin is the largest radius): the former path's ranges bit for bit."""
     rng = np.random.default_rng(seed)

@@ -420,34 +420,6 @@ def _robot_hits_row(px, py, cti, sti, me, inner, reach, beams, even, hsh, row, r
                     row[b] = min(row[b], t)
 
 
-@njit(cache=True, inline="always")
-def _ray_hits_in_box(px, py, me, dx, dy, t, bx0, bx1, by0, by1, hsh):
-    """``min(t, first hit of the ray from (px, py) along unit (dx, dy) on any disc other than
-    ``me`` centred in the box [bx0, bx1] x [by0, by1] [m])``: every disc of the hash cells
-    the box overlaps is tested with :func:`_disc_hit`, the arithmetic of
-    :func:`robot_hits_reference`. No angular window and no reach test: a disc the ray misses
-    gives ``inf``, and one tested again (already met by another pass) changes nothing
-    (``min`` is idempotent), so any box holding every disc that could shorten the ray gives
-    the reference's answer bit for bit. For a few long rays a robot (the far pass of
-    :func:`~teamnav.sim.sensors.range_sensors._sense_rows`), cheaper than one box around all
-    of them with a window per disc."""
-    sx, sy, sr, sid, start, x0, y0, cell, nkx, nky, rmax = hsh
-    kx0 = max(0, int(math.floor((bx0 - x0) / cell)))
-    kx1 = min(nkx - 1, int(math.floor((bx1 - x0) / cell)))
-    ky0 = max(0, int(math.floor((by0 - y0) / cell)))
-    ky1 = min(nky - 1, int(math.floor((by1 - y0) / cell)))
-    if ky0 > ky1:  # the box misses the hash grid: start[kx * nky + ky0] could lie past its end
-        return t
-    for kx in range(kx0, kx1 + 1):
-        # cells (kx, ky0..ky1) are contiguous
-        for s in range(start[kx * nky + ky0], start[kx * nky + ky1 + 1]):
-            if sid[s] == me:
-                continue
-            r = sr[s]
-            t = min(t, _disc_hit(px - sx[s], py - sy[s], dx, dy, r * r))
-    return t
-
-
 @njit(cache=True)
 def _prepare(all_x, all_y, all_r, max_range_m, cell_m):
     """:func:`_build_hash` (cell side :func:`default_cell_m` when ``cell_m <= 0``) plus the
