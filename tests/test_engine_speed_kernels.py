@@ -389,7 +389,8 @@ def test_far_discs_grazing_the_segments_of_long_rays(seed, open_space, n_beams):
         kind = int(rng.integers(0, 3))
         if kind == 0:  # grazing: centred up to a radius off the ray, beyond the near reach
             t = near + float(rng.uniform(0.0, 10.0 - near))
-            off = (r + float(rng.choice([0.0, 1e-15, -1e-15, 1e-12, -1e-12]))) * float(rng.choice([1.0, rng.uniform(0, 1)]))
+            tangent = r + float(rng.choice([0.0, 1e-15, -1e-15, 1e-12, -1e-12]))
+            off = tangent * float(rng.choice([1.0, rng.uniform(0, 1)]))
             side = 1.0 if rng.random() < 0.5 else -1.0
             cx, cy = t * dx - side * off * dy, t * dy + side * off * dx
         elif kind == 1:  # front just past the near reach

@@ -367,8 +367,8 @@ def _sense_rows(i0, i1, clear, cast, hits, beams, even, hsh, noise, out):
     the map cast of the pose, each ray traversed only up to its cap
     (:func:`~teamnav.world.raycast._cast_pose_capped`: ``min(map range, disc hit)`` bit for
     bit), then runs of up to ``_FAR_RUN`` consecutive rays still longer than the near reach
-    against the discs of the box around their segments, the nearest ray of each beam, then the beam's keyed noise (row ``i``'s streams of
-    :func:`_counter_noise_rows`)."""
+    against the discs of the box around their segments, the nearest ray of each beam, then
+    the beam's keyed noise (row ``i``'s streams of :func:`_counter_noise_rows`)."""
     ox, oy, res, kxs, kys, kct, kst, cb, sb, tmax, rpb = cast
     use_hits, xs, ys, ct, st, self_idx, reach = hits
     use_noise, key, sigma, p_max, p_short, max_range = noise
