@@ -20,7 +20,8 @@ thread count is set before numba starts):
   the MIT basement map, which cannot hold 10 000 such robots: its start gives up near 2 000).
 
 Printed per cell: robot-steps per second (wall clock) and per CPU-second, the real-time factor
-(simulated seconds per wall second at the scenario's 0.1-s step), and the peak resident memory
+(simulated seconds per wall second at the scenario's 0.1-s step; also per CPU-second of the
+process, all its threads, which a loaded machine distorts less), and the peak resident memory
 of the whole process (``ru_maxrss``: interpreter, numba, map, state, as ``/usr/bin/time`` shows
 it; ARGoS's the same way). Then the goals as ratios: teamnav / ARGoS speed, teamnav memory /
 ARGoS memory, 2 threads / 1 thread. The last lines, for scripts, are ``key: value`` pairs.
@@ -80,7 +81,7 @@ def child(case: str, n: int, steps: int) -> dict:
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     return {"case": case, "robots": n, "steps": steps, "threads": numba.get_num_threads(), "seconds": wall,
             "robot_steps_per_s": n * steps / wall, "robot_steps_per_cpu_s": n * steps / cpu,
-            "realtime": steps * DT_S / wall, "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
+            "realtime": steps * DT_S / wall, "realtime_cpu": steps * DT_S / cpu, "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
 
 
 def run_child(case: str, n: int, steps: int, threads: int) -> dict:
@@ -156,7 +157,8 @@ def main(argv: list[str] | None = None) -> int:
                 peer = run_argos(a.argos_build, n, steps, t) if case == "swarm" and have_argos else None
                 rows.append((case, n, t, res, peer))
                 print(f"  {case:5s} N={n:6d} threads={t}: teamnav {res['robot_steps_per_s']:>12,.0f} robot-steps/s "
-                      f"({res['realtime']:.2f}x real time, {res['peak_rss_mb']:.0f} MB)"
+                      f"({res['realtime']:.2f}x real time, {res['realtime_cpu']:.2f}x by CPU time, "
+                      f"{res['peak_rss_mb']:.0f} MB)"
                       + (f"; ARGoS {peer['robot_steps_per_s']:>10,.0f} ({peer['realtime']:.2f}x, "
                          f"{peer['peak_rss_mb']:.0f} MB, start-up {peer['startup_s']:.1f} s)" if peer else ""),
                       flush=True)
@@ -175,6 +177,7 @@ def main(argv: list[str] | None = None) -> int:
     print()
     for (c, n, t), (r, p) in sorted(by.items()):
         print(f"{c}_{n}_{t}t_realtime: {r['realtime']:.3f}")
+        print(f"{c}_{n}_{t}t_realtime_cpu: {r['realtime_cpu']:.3f}")
         print(f"{c}_{n}_{t}t_peak_mb: {r['peak_rss_mb']:.0f}")
         if p:
             print(f"{c}_{n}_{t}t_speed_vs_argos: {r['robot_steps_per_s'] / p['robot_steps_per_s']:.2f}")

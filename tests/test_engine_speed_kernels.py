@@ -216,6 +216,90 @@ def test_two_reaches_test_every_disc_once(seed, inner, reach):
             np.testing.assert_array_equal(one, ref[0])
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(2.0, 9.0), st.sampled_from([0.5, 0.7, 1.5]), st.booleans())
+def test_clipped_columns_keep_discs_at_the_reach_and_behind_the_fan(seed, reach, cell, half_turn):
+    """A wide window reads in each hash column only the rows that can hold a disc the culls
+    keep: discs whose front is just inside the reach (any direction, the largest radius) and
+    discs centred behind a half-turn fan's half-plane that still cross its edge rays are
+    met, as when every ray is tested against every disc."""
+    rng = np.random.default_rng(seed)
+    px, py = rng.uniform(-3.0, 3.0, 2)
+    th = float(rng.uniform(-7.0, 7.0))
+    width = math.pi if half_turn else float(rng.uniform(0.5, 3.0))
+    angles = np.linspace(-width / 2, width / 2, int(rng.choice([31, 181])))
+    plan = beam_plan(angles)
+    rmax = 0.45
+    xs, ys, rs = [px], [py], [0.2]
+    for _ in range(60):
+        kind = int(rng.integers(0, 3))
+        r = float(rng.choice([rmax, rmax, 0.2, 0.01]))
+        delta = float(rng.choice([0.0, 1e-12, 1e-9, 1e-6, 1e-3, 0.1]))
+        if kind == 0:  # front just inside the reach, often straight along an axis (the circle's extremes)
+            a = th + float(rng.uniform(-width / 2, width / 2))
+            axis = float(rng.choice([0.0, 0.5, 1.0, -0.5])) * math.pi
+            if rng.random() < 0.5 and abs(math.remainder(axis - th, 2 * math.pi)) < width / 2:
+                a = axis
+            d = reach + r - delta
+            xs.append(px + d * math.cos(a))
+            ys.append(py + d * math.sin(a))
+        elif kind == 1:  # centred behind the half-plane, crossing an edge ray
+            a = th + (width / 2 if rng.random() < 0.5 else -width / 2)
+            t = float(rng.uniform(0.0, reach))
+            back = th + math.pi  # the fan's middle turned round
+            off = r - delta
+            xs.append(px + t * math.cos(a) + off * math.cos(back))
+            ys.append(py + t * math.sin(a) + off * math.sin(back))
+        else:
+            xs.append(px + float(rng.uniform(-reach - 1, reach + 1)))
+            ys.append(py + float(rng.uniform(-reach - 1, reach + 1)))
+        rs.append(r)
+    all_x, all_y, all_r = np.array(xs), np.array(ys), np.array(rs)
+    hsh = rh_mod._prepare(all_x, all_y, all_r, 10.0, cell)
+    nb = angles.shape[0]
+    got = np.full(nb, reach)
+    rh_mod._robot_hits_row(px, py, math.cos(th), math.sin(th), 0, 0.0, reach, plan.beams, plan.even, hsh, got,
+                           np.empty(nb), np.empty(nb), True, rh_mod._ALL)
+    want = np.full((1, nb), reach)
+    robot_hits_reference(np.array([px]), np.array([py]), np.array([th]), angles, (all_x, all_y, all_r, np.array([0])),
+                         want)
+    np.testing.assert_array_equal(got, want[0])
+
+
+@pytest.mark.parametrize("axis", [0, 1, 2, 3])
+@pytest.mark.parametrize("cell", [0.7, 1.5])
+def test_clipped_rows_keep_a_disc_just_past_a_row_boundary_at_the_reach(axis, cell):
+    """The row clipping's circle, on its tight side: a disc of the largest radius straight
+    ahead along an axis, its front 0.1 mm inside the reach and its centre 1 mm past a hash row
+    (column) boundary, the boundary the clipped range must not stop short of."""
+    c, s_ = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][axis]
+    rmax, delta, eps = 0.45, 1e-4, 1e-3
+    lo_corner = -8.0  # an anchor disc there sets the hash's origin: boundaries at lo_corner + k cell
+    if c + s_ > 0:  # ahead along +x or +y: the centre just past the first boundary beyond 5.5 m
+        target = lo_corner + math.ceil((5.5 - lo_corner) / cell) * cell + eps
+    else:  # along -x or -y: just before (below) the last boundary under -5.5 m
+        target = lo_corner + math.floor((-5.5 - lo_corner) / cell) * cell - eps
+    dist = abs(target)
+    reach = dist - rmax + delta
+    # 250 small discs out of reach at the far corner: enough discs for the hash to keep `cell`
+    xs = [0.0, lo_corner, abs(c) * target] + [12.0] * 250
+    ys = [0.0, lo_corner, abs(s_) * target] + [12.0] * 250
+    rs = [0.2, 0.01, rmax] + [0.01] * 250
+    all_x, all_y, all_r = np.array(xs), np.array(ys), np.array(rs)
+    th = math.atan2(s_, c)
+    angles = np.linspace(-math.pi / 2, math.pi / 2, 181)
+    plan = beam_plan(angles)
+    hsh = rh_mod._prepare(all_x, all_y, all_r, 10.0, cell)
+    assert (hsh[5], hsh[6], hsh[7]) == (lo_corner, lo_corner, cell)
+    got = np.full(181, reach)
+    rh_mod._robot_hits_row(0.0, 0.0, math.cos(th), math.sin(th), 0, 0.0, reach, plan.beams, plan.even, hsh, got,
+                           np.empty(181), np.empty(181), True, rh_mod._ALL)
+    want = np.full((1, 181), reach)
+    robot_hits_reference(np.zeros(1), np.zeros(1), np.array([th]), angles, (all_x, all_y, all_r, np.array([0])), want)
+    assert want[0, 90] < reach - 0.5 * delta  # the middle ray meets the disc
+    np.testing.assert_array_equal(got, want[0])
+
+
 def test_basement_team_matches_former_path():
     """1000 robots on the MIT basement map, as bench_engine's laser case: bit for bit, serial and parallel."""
     import sys
@@ -254,20 +338,79 @@ def test_every_kernel_is_cached(mod):
 
 @pytest.mark.parametrize("heading", [0.0, 0.3, math.pi / 2, -2.5, math.pi])
 @pytest.mark.parametrize("gap", [2e-9, 1e-7, 1e-3, 0.2])
-def test_disc_just_beyond_the_near_ring_on_a_lone_long_ray(heading, gap):
-    """A disc met after the cast (just beyond ``_NEAR_M``) on the only ray that runs far: the
-    box of long rays must hold it, however thin (one beam, small radii)."""
-    grid = OccupancyGrid.empty(40.0, 40.0, 0.05, origin_xy_m=(-20.0, -20.0))
+@pytest.mark.parametrize("open_space", [True, False])
+def test_disc_just_beyond_the_near_ring_on_a_lone_long_ray(heading, gap, open_space):
+    """A disc met after the cast (just beyond the near reach: ``_OPEN_NEAR_M`` in open space,
+    ``_NEAR_M`` with a wall within 4 m) on the only ray that runs far: the box of that ray's
+    segment must hold it, however thin (one beam, small radii)."""
+    cells = np.zeros((800, 800), np.uint8)
+    if not open_space:  # a wall 3 m behind the pose: less than _NEAR_M of free map around it
+        cells[:, 340] = WALL
+    grid = OccupancyGrid(cells, 0.05, (-20.0, -20.0))
     sensor = build_range_sensor(LaserConfig(n_beams=1, fov_deg=1.0, max_range_m=10.0, noise_std_m=0.0,
                                             sees_robots=True), grid)
+    if not open_space:
+        heading = math.copysign(min(abs(heading), 1.0), heading) if heading else 0.0  # away from the wall
     r = 0.02
-    t = rs_mod._NEAR_M + gap
+    near = rs_mod._OPEN_NEAR_M if open_space else rs_mod._NEAR_M
+    t = near + gap
     cx, cy = (t + r) * math.cos(heading), (t + r) * math.sin(heading)
     bodies = (np.array([0.0, cx, 9.0]), np.array([0.0, cy, 9.0]), np.array([0.01, r, 0.01]), np.array([0]))
     xs, ys, th = np.zeros(1), np.zeros(1), np.array([heading])
     got = sensor._pass(xs, ys, th, bodies, None)
     np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, None))
     assert got[0, 0] < t + 1e-6
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([1, 3, 45, 181]))
+def test_far_discs_grazing_the_segments_of_long_rays(seed, open_space, n_beams):
+    """Runs of rays still longer than the near reach after the cast test the discs of the box
+    around their segments (up to ``_FAR_RUN`` rays a box): discs beyond the near reach that
+    graze a long ray (centred up to a radius off it, within a few ulps of tangent), that sit just past the
+    segment's start or with their front just before its end, and larger discs than the rest
+    (the box's margin is the largest radius): the former path's ranges bit for bit."""
+    rng = np.random.default_rng(seed)
+    cells = np.zeros((800, 800), np.uint8)
+    if not open_space:
+        cells[:, 340] = WALL  # 3 m behind the pose
+    grid = OccupancyGrid(cells, 0.05, (-20.0, -20.0))
+    fov = float(rng.choice([20.0, 90.0, 180.0]))
+    sensor = build_range_sensor(LaserConfig(n_beams=n_beams, fov_deg=fov, max_range_m=10.0, noise_std_m=0.0,
+                                            sees_robots=True), grid)
+    heading = float(rng.uniform(-1.0, 1.0)) if not open_space else float(rng.uniform(-4.0, 4.0))
+    near = rs_mod._OPEN_NEAR_M if open_space else rs_mod._NEAR_M
+    angles = heading + sensor.ray_angles_rad
+    bx, by, br = [0.0], [0.0], [0.2]
+    for _ in range(int(rng.integers(1, 12))):
+        a = float(angles[int(rng.integers(0, angles.shape[0]))])
+        dx, dy = math.cos(a), math.sin(a)
+        r = float(rng.choice([0.01, 0.2, 0.45]))
+        kind = int(rng.integers(0, 3))
+        if kind == 0:  # grazing: centred up to a radius off the ray, beyond the near reach
+            t = near + float(rng.uniform(0.0, 10.0 - near))
+            tangent = r + float(rng.choice([0.0, 1e-15, -1e-15, 1e-12, -1e-12]))
+            off = tangent * float(rng.choice([1.0, rng.uniform(0, 1)]))
+            side = 1.0 if rng.random() < 0.5 else -1.0
+            cx, cy = t * dx - side * off * dy, t * dy + side * off * dx
+        elif kind == 1:  # front just past the near reach
+            t = near + float(rng.choice([2e-9, 1e-7, 1e-3, 0.3]))
+            cx, cy = (t + r) * dx, (t + r) * dy
+        else:  # front just before the range's end
+            t = 10.0 - float(rng.choice([1e-9, 1e-6, 0.05]))
+            cx, cy = (t + r) * dx, (t + r) * dy
+        bx.append(cx)
+        by.append(cy)
+        br.append(r)
+    bodies = (np.array(bx), np.array(by), np.array(br), np.array([0]))
+    xs, ys, th = np.zeros(1), np.zeros(1), np.array([heading])
+    old = rs_mod.PARALLEL_MIN_RAYS
+    try:
+        rs_mod.PARALLEL_MIN_RAYS = 10**12
+        got = sensor._pass(xs, ys, th, bodies, None)
+    finally:
+        rs_mod.PARALLEL_MIN_RAYS = old
+    np.testing.assert_array_equal(got, former(sensor, xs, ys, th, bodies, None))
 
 
 @settings(max_examples=80, deadline=None)

@@ -32,7 +32,8 @@ beam is short).
 One pass per robot. The engine's sensing (:meth:`RangeSensor._pass`) runs one numba loop over
 the robots that, for each, intersects the other robots' discs within ``_NEAR_M`` first, casts
 the map only up to those hits (:func:`~teamnav.world.raycast._cast_pose_capped`), tests the
-farther discs that could still shorten a ray, takes each beam's nearest ray and adds its keyed
+farther discs that could still shorten a ray (runs of rays still longer than the near reach
+against the discs of the box around their segments), takes each beam's nearest ray and adds its keyed
 noise: the ranges of cast -> robot bodies -> noise, bit for bit, for a third of the work at
 1000 laser robots (``benchmarks/README.md``, 2026-11-27). Sensors of fewer than
 ``ONE_PASS_MIN_RAYS`` rays a robot run those three passes as such.
@@ -312,20 +313,28 @@ def _counter_noise_blocks(true, keys, starts, sigma, p_max, p_short, max_range, 
 #: of the beams end within 3 m, and 9 of the ~86 discs ahead of a robot shorten a ray).
 _NEAR_M: float = 4.0
 #: The near reach [m] of a pose with at least ``_NEAR_M`` of free map all around it (its
-#: quadrants' free squares): in open space the rays that pass ``_NEAR_M`` point every way, and
-#: the box of the far discs grows to most of the half-disc of the range, so taking the
-#: discs up to ``_OPEN_NEAR_M`` first costs less (measured 2026-11-29, one thread, the two
-#: forms in their own processes alternating: 10 000 laser robots in the open swarm arena,
-#: sensing pass 116-117 ms with 4 m everywhere, 110 ms with this; on the MIT basement map,
-#: 1000 robots, 8 m everywhere would cost 9.6 ms against 8.0). Which discs go first changes
-#: no range (two reaches test every disc once).
-_OPEN_NEAR_M: float = 8.0
+#: quadrants' free squares): in open space many rays pass ``_NEAR_M``, and each of them
+#: then tests the discs of a box around its segment beyond the near reach, so taking the
+#: discs up to ``_OPEN_NEAR_M`` first costs less. Measured 2026-11-29 on 10 000 laser robots
+#: in the open swarm arena (bench_scale's laser cell), one thread, sensing pass CPU ms, one
+#: process each, the same minutes, one box a ray: 4 m 104.6 (4.5 m), 5 m 96-98, 5.5 m 96.1,
+#: 6 m 95.7, 6.5 m 96.1, 8 m 106-108; later, with the clipped columns of the near pass:
+#: 5.5 m 93.5-93.7, 6 m 92.2-92.7, 7 m 97.5-98.3 (with one box around all the long rays,
+#: 2026-11-29 earlier: 8 m 110 against 116 with 4 m). On the MIT basement map the walls end 99 % of the rays within
+#: 4 m and few poses have 4 m free. Which discs go first changes no range (two reaches
+#: test every disc at least once, and a disc met twice changes nothing).
+_OPEN_NEAR_M: float = 6.0
 #: Fewest rays a robot for :meth:`RangeSensor._pass` to sense robot by robot in one kernel
 #: (below, e.g. 7 proximity rays, three passes over all robots are faster: 0.55 against
 #: 0.68 ms a step for 1000 swarm robots).
 ONE_PASS_MIN_RAYS: int = 24
 #: Largest side [m] of the hash cells of the one-pass sensing (its windows are a few metres).
 _HASH_CELL_M: float = 1.5
+#: Most consecutive rays longer than the near reach that test the discs of one box around
+#: their segments (beyond the near reach) together: 10 000 laser robots in bench_scale's open
+#: arena, one thread, 2026-11-29, sensing pass CPU ms: 90.6 one ray a box, 83.9 up to 4,
+#: 84.8 up to 8, 85.2 up to 16 (a long run's box grows with its angle).
+_FAR_RUN: int = 8
 
 
 @njit(cache=True)
@@ -357,11 +366,13 @@ def _sense_rows(i0, i1, clear, cast, hits, beams, even, hsh, noise, out):
     (:func:`~teamnav.sim.sensors.robot_hits._robot_hits_row`, into the rays' caps), then
     the map cast of the pose, each ray traversed only up to its cap
     (:func:`~teamnav.world.raycast._cast_pose_capped`: ``min(map range, disc hit)`` bit for
-    bit), the nearest ray of each beam, then the beam's keyed noise (row ``i``'s streams of
-    :func:`_counter_noise_rows`)."""
+    bit), then runs of up to ``_FAR_RUN`` consecutive rays still longer than the near reach
+    against the discs of the box around their segments, the nearest ray of each beam, then
+    the beam's keyed noise (row ``i``'s streams of :func:`_counter_noise_rows`)."""
     ox, oy, res, kxs, kys, kct, kst, cb, sb, tmax, rpb = cast
     use_hits, xs, ys, ct, st, self_idx, reach = hits
     use_noise, key, sigma, p_max, p_short, max_range = noise
+    hsx, hsy, hsr, hsid, hstart, hx0, hy0, hcell, hnkx, hnky, hrmax = hsh
     nr = cb.shape[0]
     nb = out.shape[1]
     inv = 1.0 / res
@@ -393,33 +404,61 @@ def _sense_rows(i0, i1, clear, cast, hits, beams, even, hsh, noise, out):
         _cast_pose_capped(clear, (kxs[i] - ox) * inv, (kys[i] - oy) * inv, res, kct[i], kst[i], cb, sb, tmax, cap,
                           use_hits, rr, dxs, dys, idxs, idys, rs, cs, vs, qs, act)
         if use_hits:
-            # the discs beyond `near` that could still shorten a ray: nearer than the longest
-            # one, and centred within rmax of the part beyond `near` of a ray longer than that
-            # (a hit at t >= near on ray b lies on [near, rr[b]] of it): their bounding box
-            far = 0.0
+            # the discs beyond `near` that could still shorten a ray longer than `near`: a hit
+            # at t >= near on ray b lies on [near, rr[b]] of it, so the disc's centre lies
+            # within rmax of that segment. Runs of consecutive such rays test the discs of the
+            # box around their segments, each disc against every ray of the run with
+            # robot_hits_reference's arithmetic (a disc met twice, or missed, changes nothing)
             px = xs[i]
             py = ys[i]
-            bx0 = np.inf
-            bx1 = -np.inf
-            by0 = np.inf
-            by1 = -np.inf
+            me = self_idx[i]
+            m = hrmax + 1e-6  # largest radius, and rounding
             t0 = near - 1e-6  # a hit beyond `near` (to within rounding)
-            for b in range(nr):
-                t1 = rr[b]
-                if t1 > near:
-                    far = max(far, t1)
-                    ax = px + t0 * rdx[b]
-                    bx = px + t1 * rdx[b]
-                    ay = py + t0 * rdy[b]
-                    by = py + t1 * rdy[b]
+            b = 0
+            while b < nr:
+                if not rr[b] > near:
+                    b += 1
+                    continue
+                # a run of up to _FAR_RUN consecutive long rays: one box around their segments
+                e = b
+                bx0 = np.inf
+                bx1 = -np.inf
+                by0 = np.inf
+                by1 = -np.inf
+                while e < nr and e - b < _FAR_RUN and rr[e] > near:
+                    t1 = rr[e]
+                    ax = px + t0 * rdx[e]
+                    bx = px + t1 * rdx[e]
+                    ay = py + t0 * rdy[e]
+                    by = py + t1 * rdy[e]
                     bx0 = min(bx0, min(ax, bx))
                     bx1 = max(bx1, max(ax, bx))
                     by0 = min(by0, min(ay, by))
                     by1 = max(by1, max(ay, by))
-            if far > near:
-                m = hsh[10] + 1e-6  # largest radius, and rounding
-                _robot_hits_row(px, py, ct[i], st[i], self_idx[i], near, far, beams, even, hsh, rr, rdx, rdy, False,
-                                (bx0 - m, bx1 + m, by0 - m, by1 + m))
+                    e += 1
+                kx0 = max(0, int(math.floor((bx0 - m - hx0) / hcell)))
+                kx1 = min(hnkx - 1, int(math.floor((bx1 + m - hx0) / hcell)))
+                ky0 = max(0, int(math.floor((by0 - m - hy0) / hcell)))
+                ky1 = min(hnky - 1, int(math.floor((by1 + m - hy0) / hcell)))
+                if ky0 <= ky1:  # else the box misses the hash grid (hstart[...] could lie past its end)
+                    for kx in range(kx0, kx1 + 1):
+                        for s in range(hstart[kx * hnky + ky0], hstart[kx * hnky + ky1 + 1]):
+                            if hsid[s] == me:
+                                continue
+                            fx = px - hsx[s]
+                            fy = py - hsy[s]
+                            r = hsr[s]
+                            cc = fx * fx + fy * fy - r * r
+                            for k in range(b, e):
+                                # _disc_hit's arithmetic, selects for its branches
+                                bb = fx * rdx[k] + fy * rdy[k]
+                                disc = bb * bb - cc
+                                h = -bb - math.sqrt(disc if disc > 0.0 else 0.0)
+                                h = h if (bb < 0.0) & (disc >= 0.0) else np.inf
+                                h = 0.0 if cc <= 0.0 else h
+                                o = rr[k]
+                                rr[k] = h if h < o else o
+                b = e
         row = out[i]
         if rpb == 1:
             for b in range(nb):

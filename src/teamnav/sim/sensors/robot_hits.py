@@ -78,6 +78,13 @@ _ALL = (-np.inf, np.inf, -np.inf, np.inf)
 _CELLS_PER_ROBOT: int = 4
 #: Sensing robots per chunk of :func:`_robot_hits_parallel` (one pair of scratch arrays each).
 _HITS_CHUNK: int = 64
+#: :func:`_robot_hits_row` reads, in each hash column of a window wider than this many
+#: columns, only the rows that can hold a disc its culls keep (narrower windows: the
+#: arithmetic costs about what it saves). Measured 2026-11-29, the near pass (6 m) of
+#: 10 000 laser robots in bench_scale's open arena, one thread: 49.5 -> 47 ms.
+_CLIP_MIN_COLUMNS: int = 3
+#: Rounding margin [m] of those rows (far above the rounding of metre-scale coordinates).
+_CLIP_SLACK_M: float = 1e-6
 
 
 # ---------------------------------------------------------------------------- kernels
@@ -294,10 +301,42 @@ def _robot_hits_row(px, py, cti, sti, me, inner, reach, beams, even, hsh, row, r
     ky1 = min(nky - 1, int(math.floor((min(py + half, by1) - y0) / cell)))
     if ky0 > ky1:  # the window misses the hash grid (a far box beyond every disc): nothing to test,
         return     # and start[kx * nky + ky0] could lie past the end of `start` (read out of bounds)
+    # a window of _CLIP_MIN_COLUMNS + 1 columns or more reads in each column only the rows
+    # that can hold a centre the culls below would keep: within `half` of the sensor, and
+    # (a fan no wider than a half-turn) not wholly behind its half-plane, for any radius up to
+    # rmax; 1e-6 m more for rounding (the culls decide, exactly as before, for every disc read)
+    clip = kx1 - kx0 >= _CLIP_MIN_COLUMNS
+    hcut = -(rmax + _REACH_SLACK_M) - _CLIP_SLACK_M  # gx hx + gy hy below this: culled, whatever r
     for kx in range(kx0, kx1 + 1):
-        # cells (kx, ky0..ky1) are contiguous
-        s0 = start[kx * nky + ky0]
-        s1 = start[kx * nky + ky1 + 1]
+        kya = ky0
+        kyb = ky1
+        if clip:
+            ua = x0 + kx * cell - _CLIP_SLACK_M - px  # the column's x offsets from the sensor
+            ub = x0 + (kx + 1) * cell + _CLIP_SLACK_M - px
+            un = ua if ua > 0.0 else (ub if ub < 0.0 else 0.0)  # the nearest
+            w2 = half * half - un * un
+            if w2 < 0.0:
+                continue
+            wy = math.sqrt(w2) + _CLIP_SLACK_M
+            lo = -wy  # the rows' y offsets from the sensor
+            hi = wy
+            if front:
+                gxh = max(ua * hx, ub * hx)  # the column's largest gx hx
+                if abs(hy) > 0.25:
+                    lim_y = (hcut - gxh) / hy  # kept: gy hy >= hcut - gx hx
+                    if hy > 0.0:
+                        lo = max(lo, lim_y - _CLIP_SLACK_M)
+                    else:
+                        hi = min(hi, lim_y + _CLIP_SLACK_M)
+                if gxh + max(lo * hy, hi * hy) < hcut:  # the whole column behind
+                    continue
+            kya = max(ky0, int(math.floor((py + lo - y0) / cell)))
+            kyb = min(ky1, int(math.floor((py + hi - y0) / cell)))
+            if kya > kyb:
+                continue
+        # cells (kx, kya..kyb) are contiguous
+        s0 = start[kx * nky + kya]
+        s1 = start[kx * nky + kyb + 1]
         for s in range(s0, s1):
             gx = sx[s] - px  # sensor -> centre
             gy = sy[s] - py
