@@ -165,6 +165,18 @@ def _wrap_scalar(a):
     return math.pi if w == -math.pi else w
 
 
+@njit(cache=True, inline="always")
+def _toward(cx, cy, x, y):
+    """The recovery's hint (both brains' ``recover_radius_m``, a gap-fill: the heading from the
+    robot at (x, y) to the nearest crumb (cx, cy)): ``(ok, heading)``, not ok when the crumb is
+    where the robot is, as the reference's ``> 1e-12`` test."""
+    ex = cx - x
+    ey = cy - y
+    if ex * ex + ey * ey > 1e-12:
+        return True, math.atan2(cy - y, cx - x)
+    return False, 0.0
+
+
 @njit(cache=True)
 def average_heading_kernel(buf, n, x, y, radius):
     """:func:`teamnav.papers.trails.brains.crumbs.average_heading` over ``buf[:n]`` (x, y, heading,
@@ -266,15 +278,10 @@ def blazing_row_step(path_m, has_last, lx, ly, has_crumb, cx, cy, next_crumb_s, 
                 bd = d2
                 best = i
         if not (bd > bpar[B_RECOVER] * bpar[B_RECOVER]):
-            nx = glob[best, 0]
-            ny = glob[best, 1]
-            ex = nx - x
-            ey = ny - y
-            if ex * ex + ey * ey > 1e-12:
-                pref = math.atan2(ny - y, nx - x)
-                found = True
-                allow = True
-                recovering = True
+            recovering, h = _toward(glob[best, 0], glob[best, 1], x, y)
+            if recovering:
+                pref = h
+                found = allow = True
     v, w = NC.nav_step(fst, ist, par, rev_at, r, x, y, th, t, stalled, found, pref, allow, False, angles, cos_a,
                        sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r, head,
                        front, free_exit)
@@ -421,14 +428,10 @@ def share_row_step(bound_s, bound_t, code, xys, codes, n, spar, fst, ist, par, r
                 best = j
                 bd = d2
         if bd <= spar[S_RECOVER] * spar[S_RECOVER]:
-            nx = xys[best, 0]
-            ny = xys[best, 1]
-            ex = nx - x
-            ey = ny - y
-            if ex * ex + ey * ey > 1e-12:
-                pref = math.atan2(ny - y, nx - x)
+            recovering, h = _toward(xys[best, 0], xys[best, 1], x, y)
+            if recovering:
+                pref = h
                 found = True
-                recovering = True
     ignore = recovering and spar[S_RECOVER_REV] != 0.0
     v, w = NC.nav_step(fst, ist, par, rev_at, r, x, y, th, t, stalled, found, pref, True, ignore, angles, cos_a,
                        sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r, head,
@@ -473,6 +476,27 @@ def share_team_step(rows, ss, code, xyss, ps, tn, spar, nf, ni, par, nrev, range
         hint[r, 1] = out[7]
         hint[r, 2] = 1.0
         hint[r, 3] = 1.0 if out[8] else 0.0
+
+
+class _Buffers:
+    """The team's per-robot numpy buffers (the reference brains' own) as the numba typed list a
+    team kernel takes. A robot's buffer that grew is a new object: the typed list is built again,
+    not assigned into, since a typed list's ``__setitem__`` compiles on first use, in whichever
+    step needs it."""
+
+    def __init__(self, bufs: Sequence[np.ndarray]) -> None:
+        from numba.typed import List
+
+        self._obj = list(bufs)
+        self.typed = List(self._obj)
+
+    def sync(self, r: int, buf: np.ndarray) -> None:
+        """Robot r's buffer is ``buf``."""
+        if buf is not self._obj[r]:
+            from numba.typed import List
+
+            self._obj[r] = buf
+            self.typed = List(self._obj)
 
 
 class _TeamView:
@@ -822,18 +846,14 @@ class BlazingTrailGroup(_TrailGroup):
         """The brains' scalars (``BS_*``), crumb counts, the private lists' capacities, what
         they carry; the crumb buffers (the reference's own) as typed lists
         (:func:`blazing_team_step`)."""
-        from numba.typed import List
-
         n = self._n
         self._bs = np.zeros((n, N_BS))
         self._pn = np.zeros(n, dtype=np.int64)
         self._gn = np.zeros(n, dtype=np.int64)
         self._cap = np.zeros(n, dtype=np.int64)
         self._carry = np.zeros(n, dtype=np.bool_)
-        self._priv_obj = [b.private._buf for b in self._brains]
-        self._glob_obj = [b.global_crumbs._buf for b in self._brains]
-        self._privs = List(self._priv_obj)
-        self._globs = List(self._glob_obj)
+        self._privs = _Buffers([b.private._buf for b in self._brains])
+        self._globs = _Buffers([b.global_crumbs._buf for b in self._brains])
 
     def _from_brain(self, r: int) -> None:
         b = self._brains[r]
@@ -854,20 +874,12 @@ class BlazingTrailGroup(_TrailGroup):
         self._last_step[r] = b._step
 
     def _sync_buffers(self, r: int) -> None:
-        """Robot r's crumb buffers and counts (a list that grew has a new buffer: the typed lists
-        are built again, not assigned into, since a typed list's ``__setitem__`` compiles on first
-        use, in whichever step needs it)."""
-        from numba.typed import List
-
+        """Robot r's crumb buffers, the private list's capacity and the global list's count."""
         b = self._brains[r]
-        if b.private._buf is not self._priv_obj[r]:
-            self._priv_obj[r] = b.private._buf
-            self._privs = List(self._priv_obj)
+        self._privs.sync(r, b.private._buf)
         self._cap[r] = b.private._buf.shape[0]
         g = b.global_crumbs
-        if g._buf is not self._glob_obj[r]:
-            self._glob_obj[r] = g._buf
-            self._globs = List(self._glob_obj)
+        self._globs.sync(r, g._buf)
         self._gn[r] = g._n
 
     def _to_brain(self, r: int) -> None:
@@ -896,9 +908,9 @@ class BlazingTrailGroup(_TrailGroup):
             self._sync_buffers(r)
 
     def _team_kernel(self, rows, ranges, poses, t, stalled, out_v, out_w, hint) -> None:
-        blazing_team_step(rows, self._bs, self._pn, self._privs, self._gn, self._globs, self._par_all, self._carry,
-                          self._nf, self._ni, self._npar, self._nrev, ranges, poses, t, stalled, *self._ngeo, out_v,
-                          out_w, hint)
+        blazing_team_step(rows, self._bs, self._pn, self._privs.typed, self._gn, self._globs.typed, self._par_all,
+                          self._carry, self._nf, self._ni, self._npar, self._nrev, ranges, poses, t, stalled,
+                          *self._ngeo, out_v, out_w, hint)
 
     @classmethod
     def _probe_params(cls, params: Any):
@@ -972,18 +984,14 @@ class TrailShareGroup(_TrailGroup):
     def _init_state(self) -> None:
         """The brains' scalars (``SS_*``), goal codes, Trail counts, broadcast times; the Trails'
         buffers (the reference's own) as typed lists (:func:`share_team_step`)."""
-        from numba.typed import List
-
         n = self._n
         self._ss = np.zeros((n, N_SS))
         self._code = np.full(n, -1, dtype=np.int64)
         self._tn = np.zeros(n, dtype=np.int64)
         self._started = np.zeros(n, dtype=np.bool_)
         self._next_b = np.zeros(n)
-        self._xys_obj = [b.trail._xys for b in self._brains]
-        self._p_obj = [b.trail._p for b in self._brains]
-        self._xyss = List(self._xys_obj)
-        self._ps = List(self._p_obj)
+        self._xyss = _Buffers([b.trail._xys for b in self._brains])
+        self._ps = _Buffers([b.trail._p for b in self._brains])
 
     def _from_brain(self, r: int) -> None:
         b = self._brains[r]
@@ -998,17 +1006,11 @@ class TrailShareGroup(_TrailGroup):
         self._sync_trail(r)
 
     def _sync_trail(self, r: int) -> None:
-        """Robot r's Trail buffers, count and goal code (a Trail that grew has new buffers: the
-        typed lists are built again, as in :meth:`BlazingTrailGroup._sync_buffers`)."""
-        from numba.typed import List
-
+        """Robot r's Trail buffers, count and goal code."""
         b = self._brains[r]
         tr = b.trail
-        if tr._xys is not self._xys_obj[r] or tr._p is not self._p_obj[r]:
-            self._xys_obj[r] = tr._xys
-            self._p_obj[r] = tr._p
-            self._xyss = List(self._xys_obj)
-            self._ps = List(self._p_obj)
+        self._xyss.sync(r, tr._xys)
+        self._ps.sync(r, tr._p)
         self._tn[r] = tr._n
         code = tr._codes.get(b.round.goal)
         self._code[r] = -1 if code is None else code
@@ -1039,8 +1041,9 @@ class TrailShareGroup(_TrailGroup):
                 self._tn[r] = tr._n
 
     def _team_kernel(self, rows, ranges, poses, t, stalled, out_v, out_w, hint) -> None:
-        share_team_step(rows, self._ss, self._code, self._xyss, self._ps, self._tn, self._par_all, self._nf, self._ni,
-                        self._npar, self._nrev, ranges, poses, t, stalled, *self._ngeo, out_v, out_w, hint)
+        share_team_step(rows, self._ss, self._code, self._xyss.typed, self._ps.typed, self._tn, self._par_all,
+                        self._nf, self._ni, self._npar, self._nrev, ranges, poses, t, stalled, *self._ngeo, out_v,
+                        out_w, hint)
 
     @classmethod
     def _probe_params(cls, params: Any):
