@@ -50,6 +50,8 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 sys.path.insert(0, str(HERE))
 
+from _common import clock_brains, unclock_brains  # benchmarks/_common.py
+
 SEED = 1000  # a tuning seed (FIDELITY.md: seeds >= 1000); nothing is judged here
 
 #: name -> (scenario, paper column, robots)
@@ -123,27 +125,11 @@ def _worker(name: str, compiled: bool, steps: int) -> dict:
         warm_up()  # the kernel's form with a Generator too (first needed at a robot's first Panic)
     scn = load_scenario(scenario, overrides=ov, duration_s=steps * 0.1, seed=SEED)
     sim = Simulation(build_grid(scn), scn, group_brains=compiled)
+    # the brains' step and log, or the group brain's step_group and the views' log (its robots'
+    # reference brains, whose step it may call, not counted twice: _common.clock_brains)
+    brain_s, clocked = clock_brains(sim, ("step", "log"))
     clock = time.process_time
-    brain_s = [0.0]
-    # the brains' step and log, or the group brain's step_group (its per-robot views are its
-    # robots' reference brains, whose step it may call: not counted twice) and the views' log
     teams = [team for team, *_ in sim.group_teams]
-    targets = [(team, "step_group") for team in teams]
-    for group in sim.brains:
-        for brain in group:
-            targets += [(brain, "log")] + ([] if compiled and teams else [(brain, "step")])
-    for obj, meth in targets:
-        f = getattr(obj, meth, None)
-        if not callable(f):
-            continue
-
-        def timed(*args, f=f):
-            t = clock()
-            out = f(*args)
-            brain_s[0] += clock() - t
-            return out
-
-        setattr(obj, meth, timed)
     t0 = clock()
     for _ in range(steps):
         sim.step()
@@ -151,9 +137,7 @@ def _worker(name: str, compiled: bool, steps: int) -> dict:
     if compiled and not teams:
         raise SystemExit(f"{name}: the group brain did not run the team")
     robots = sum(getattr(team, "compiled_robots", stop - start) for team, start, stop, _ in sim.group_teams)
-    for obj, meth in targets:  # the views' own methods again, for the digest's logs
-        if meth in vars(obj):
-            delattr(obj, meth)
+    unclock_brains(clocked)  # the views' own methods again, for the digest's logs
     return {"cpu_s": total, "brain_s": brain_s[0], "steps": steps, "digest": _digest(sim),
             "compiled_robots": robots, "robots": int(sim.n_robots)}
 

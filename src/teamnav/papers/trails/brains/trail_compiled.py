@@ -165,6 +165,18 @@ def _wrap_scalar(a):
     return math.pi if w == -math.pi else w
 
 
+@njit(cache=True, inline="always")
+def _toward(cx, cy, x, y):
+    """The recovery's hint (both brains' ``recover_radius_m``, a gap-fill: the heading from the
+    robot at (x, y) to the nearest crumb (cx, cy)): ``(ok, heading)``, not ok when the crumb is
+    where the robot is, as the reference's ``> 1e-12`` test."""
+    ex = cx - x
+    ey = cy - y
+    if ex * ex + ey * ey > 1e-12:
+        return True, math.atan2(cy - y, cx - x)
+    return False, 0.0
+
+
 @njit(cache=True)
 def average_heading_kernel(buf, n, x, y, radius):
     """:func:`teamnav.papers.trails.brains.crumbs.average_heading` over ``buf[:n]`` (x, y, heading,
@@ -266,15 +278,10 @@ def blazing_row_step(path_m, has_last, lx, ly, has_crumb, cx, cy, next_crumb_s, 
                 bd = d2
                 best = i
         if not (bd > bpar[B_RECOVER] * bpar[B_RECOVER]):
-            nx = glob[best, 0]
-            ny = glob[best, 1]
-            ex = nx - x
-            ey = ny - y
-            if ex * ex + ey * ey > 1e-12:
-                pref = math.atan2(ny - y, nx - x)
-                found = True
-                allow = True
-                recovering = True
+            recovering, h = _toward(glob[best, 0], glob[best, 1], x, y)
+            if recovering:
+                pref = h
+                found = allow = True
     v, w = NC.nav_step(fst, ist, par, rev_at, r, x, y, th, t, stalled, found, pref, allow, False, angles, cos_a,
                        sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r, head,
                        front, free_exit)
@@ -294,13 +301,14 @@ def _row_observation(obs: GroupObservation, r: int) -> Observation:
 @njit(cache=True)
 def blazing_team_step(rows, bs, pn, privs, gn, globs, bpar, carry, nf, ni, par, nrev, ranges, poses, t, stalled, angles,
                       cos_a, sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r,
-                      head, front, free_exit, out_v, out_w, out_pref):
+                      head, front, free_exit, out_v, out_w, hint):
     """:func:`blazing_row_step` for the robots ``rows`` of a team in one call (their Navigate
     parameters and geometry shared), state in the team's arrays: ``bs`` (n, N_BS) the brains'
     scalars (``BS_*``), ``pn``/``gn`` the private and global crumb counts, ``privs``/``globs``
     their buffers, ``nf``/``ni``/``nrev`` Navigate's states. Commands into ``out_v``/``out_w``;
-    a robot whose Navigate must draw gets ``out_v`` NaN and its hint in ``out_pref`` (has_pref,
-    pref, allow) for the caller's :func:`~teamnav.control.nav.navigate_compiled.nav_step_rng`."""
+    a robot whose Navigate must draw gets ``out_v`` NaN and its hint in ``hint`` (has_pref,
+    pref, allow_reverse, ignore_memory: the last always 0) for the caller's
+    :func:`~teamnav.control.nav.navigate_compiled.nav_step_rng`."""
     for k in range(rows.shape[0]):
         r = rows[k]
         b = bs[r]
@@ -326,9 +334,10 @@ def blazing_team_step(rows, bs, pn, privs, gn, globs, bpar, carry, nf, ni, par, 
         b[BS_RECOVER] = 1.0 if out[10] else 0.0
         out_v[r] = out[0]
         out_w[r] = out[1]
-        out_pref[r, 0] = 1.0 if out[11] else 0.0
-        out_pref[r, 1] = out[12]
-        out_pref[r, 2] = 1.0 if out[13] else 0.0
+        hint[r, 0] = 1.0 if out[11] else 0.0
+        hint[r, 1] = out[12]
+        hint[r, 2] = 1.0 if out[13] else 0.0
+        hint[r, 3] = 0.0
 
 
 # trail-share-v1's parameter columns (S_*)
@@ -419,14 +428,10 @@ def share_row_step(bound_s, bound_t, code, xys, codes, n, spar, fst, ist, par, r
                 best = j
                 bd = d2
         if bd <= spar[S_RECOVER] * spar[S_RECOVER]:
-            nx = xys[best, 0]
-            ny = xys[best, 1]
-            ex = nx - x
-            ey = ny - y
-            if ex * ex + ey * ey > 1e-12:
-                pref = math.atan2(ny - y, nx - x)
+            recovering, h = _toward(xys[best, 0], xys[best, 1], x, y)
+            if recovering:
+                pref = h
                 found = True
-                recovering = True
     ignore = recovering and spar[S_RECOVER_REV] != 0.0
     v, w = NC.nav_step(fst, ist, par, rev_at, r, x, y, th, t, stalled, found, pref, True, ignore, angles, cos_a,
                        sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r, head,
@@ -445,13 +450,13 @@ N_SS = 4
 @njit(cache=True)
 def share_team_step(rows, ss, code, xyss, ps, tn, spar, nf, ni, par, nrev, ranges, poses, t, stalled, angles, cos_a,
                     sin_a, exit_m, offsets, box_idx, box_cnt, order_l, cos_l, sin_l, order_r, cos_r, sin_r, head,
-                    front, free_exit, out_v, out_w, out_pref):
+                    front, free_exit, out_v, out_w, hint):
     """:func:`share_row_step` for the robots ``rows`` of a team in one call (their Navigate
     parameters and geometry shared): ``ss`` (n, N_SS) the brains' scalars, ``code`` each robot's
     goal Place code (-1: none), ``xyss``/``ps``/``tn`` their Trails' crumbs, codes and counts (the
     reference's own buffers), ``nf``/``ni``/``nrev`` Navigate's states. Commands into ``out_v``/
-    ``out_w``; a robot whose Navigate must draw gets ``out_v`` NaN and (has_pref, pref, ignore
-    memory) in ``out_pref`` for the caller's
+    ``out_w``; a robot whose Navigate must draw gets ``out_v`` NaN and (has_pref, pref,
+    allow_reverse, ignore_memory: the third always 1) in ``hint`` for the caller's
     :func:`~teamnav.control.nav.navigate_compiled.nav_step_rng`."""
     for k in range(rows.shape[0]):
         r = rows[k]
@@ -467,16 +472,38 @@ def share_team_step(rows, ss, code, xyss, ps, tn, spar, nf, ni, par, nrev, range
         b[SS_BOUND_T] = out[3]
         b[SS_FOLLOW] = 1.0 if out[4] else 0.0
         b[SS_RECOVER] = 1.0 if out[5] else 0.0
-        out_pref[r, 0] = 1.0 if out[6] else 0.0
-        out_pref[r, 1] = out[7]
-        out_pref[r, 2] = 1.0 if out[8] else 0.0
+        hint[r, 0] = 1.0 if out[6] else 0.0
+        hint[r, 1] = out[7]
+        hint[r, 2] = 1.0
+        hint[r, 3] = 1.0 if out[8] else 0.0
 
 
-class _ShareView:
-    """Robot r's face in a :class:`TrailShareGroup` that steps the team in one call (as
-    :class:`_BlazingView`)."""
+class _Buffers:
+    """The team's per-robot numpy buffers (the reference brains' own) as the numba typed list a
+    team kernel takes. A robot's buffer that grew is a new object: the typed list is built again,
+    not assigned into, since a typed list's ``__setitem__`` compiles on first use, in whichever
+    step needs it."""
 
-    def __init__(self, group: "TrailShareGroup", r: int) -> None:
+    def __init__(self, bufs: Sequence[np.ndarray]) -> None:
+        from numba.typed import List
+
+        self._obj = list(bufs)
+        self.typed = List(self._obj)
+
+    def sync(self, r: int, buf: np.ndarray) -> None:
+        """Robot r's buffer is ``buf``."""
+        if buf is not self._obj[r]:
+            from numba.typed import List
+
+            self._obj[r] = buf
+            self.typed = List(self._obj)
+
+
+class _TeamView:
+    """Robot r's face in a trail group that steps the team in one call: its reference brain,
+    brought up to date from the team's arrays before anything is read."""
+
+    def __init__(self, group: _TrailGroup, r: int) -> None:
         self._g = group
         self._r = r
 
@@ -493,7 +520,19 @@ class _ShareView:
 
 
 class _TrailGroup:
-    """A team of one trail brain class: each robot its reference brain over a compiled Navigate."""
+    """A team of one trail brain class: each robot its reference brain over a compiled Navigate.
+
+    The part both trail brains share: building the brains, the two forms of the step (one
+    compiled call per robot; from ``TEAM_MIN`` robots sharing one Navigate geometry, the team in
+    one call, its state in arrays, each robot's reference brain brought up to date from them
+    whenever it is read (:class:`_TeamView`) or steps itself), the reference brain's own step
+    where the compiled one does not apply, and Navigate's step with the robot's Generator where
+    the compiled one must draw. What differs, each brain's class says: its parameter row
+    (:meth:`_param_row`), when a robot may take the compiled step (:meth:`_fast_brain`,
+    :meth:`_due`, :meth:`_team_due`), that step (:meth:`_row_step`, :meth:`_before_team`,
+    :meth:`_team_kernel`) and its state in the team's arrays (:meth:`_init_state`,
+    :meth:`_from_brain`, :meth:`_to_brain`).
+    """
 
     #: the team steps in one call (its state in arrays) from this many robots on; below, one
     #: call per robot. Measured 2026-11-29 (step_group, ms per step, 2000 and 200 steps, tuning
@@ -550,231 +589,91 @@ class _TrailGroup:
                 self.compiled_robots += 1
             self.robots.append(brain)
         self._n = len(self.robots)
-
-    def step_group(self, obs: GroupObservation) -> GroupAction:
-        """Every robot's step (a waiting robot's brain is off: command 0, no messages)."""
-        n = self._n
-        v = np.zeros(n)
-        w = np.zeros(n)
-        d = np.full(n, math.nan)
-        outbox: list = []
-        waiting = obs.waiting
-        for r, brain in enumerate(self.robots):
-            if waiting is not None and waiting[r]:
-                continue
-            action, msgs = brain.step(_row_observation(obs, r))
-            v[r] = action.v_mps
-            w[r] = action.omega_radps
-            if action.direction_rad is not None:
-                d[r] = action.direction_rad
-            if msgs:
-                rid = int(obs.robot_ids[r])
-                outbox.extend((rid, m) for m in msgs)
-        return GroupAction(v, w, d, outbox)
-
-
-class _BlazingView:
-    """Robot r's face in a :class:`BlazingTrailGroup` that steps the team in one call: its
-    reference brain, brought up to date from the team's arrays before anything is read."""
-
-    def __init__(self, group: "BlazingTrailGroup", r: int) -> None:
-        self._g = group
-        self._r = r
-
-    def log(self) -> dict:
-        self._g._to_brain(self._r)
-        return self._g._brains[self._r].log()
-
-    def __getattr__(self, name: str) -> Any:
-        if name.startswith("__") or name in ("_g", "_r"):
-            raise AttributeError(name)
-        g = self._g
-        g._to_brain(self._r)
-        return getattr(g._brains[self._r], name)
-
-
-class BlazingTrailGroup(_TrailGroup):
-    """``blazing-trail-v1`` teams (module docstring). A robot's step without task events (nearly
-    all of them) is the reference's inbox rule (received crumbs appended to the global list; the
-    crumb dropping that precedes it in the reference touches only the private list) and one
-    compiled call (:func:`blazing_row_step`: crumbs, the trail's hint and Navigate); a step with
-    events, and every step of a robot whose global crumbs expire (``global_crumb_ttl_s``) or
-    whose Navigate is the reference's, runs the reference brain's own step."""
-
-    controller = "teamnav.papers.trails.brains.blazing_trail:BlazingTrail"
-
-    def __init__(self, params, rngs, infos) -> None:
-        super().__init__(params, rngs, infos)
-        self._bpar = []
-        self._fast = []
-        for brain in self.robots:
-            p = brain.params
-            b = np.zeros(N_B)
-            b[B_MIN_MOVE] = p.crumb_min_move_m
-            b[B_INTERVAL] = p.crumb_interval_s
-            b[B_REV_CARRIED] = 1.0 if p.reverse_carried_crumbs else 0.0
-            b[B_PRUNE] = 1.0 if p.prune_loops else 0.0
-            b[B_PRUNE_R] = p.prune_radius_m
-            b[B_PRUNE_LOOP] = p.prune_min_loop_m
-            b[B_LOOK] = p.lookahead_m
-            b[B_RADIUS] = p.radius_m
-            b[B_REV_MIN] = p.reverse_min_crumbs
-            b[B_RECOVER] = p.recover_radius_m
-            self._bpar.append(b)
-            self._fast.append(isinstance(brain.nav, NC.CompiledNavigate) and p.global_crumb_ttl_s is None)
+        #: each robot's brain parameters as its kernel reads them
+        self._par = [self._param_row(brain.params) for brain in self.robots]
+        #: robots that take the compiled step on a step without task events
+        self._fast = [isinstance(brain.nav, NC.CompiledNavigate) and self._fast_brain(brain) for brain in self.robots]
         navs = [brain.nav for brain in self.robots]
         self._team = len(navs) >= self.TEAM_MIN and all(self._fast) and all(
             nav._par is navs[0]._par and nav.laser == navs[0].laser for nav in navs)
         if self._team:
             self._init_team()
 
-    # ------------------------------------------------------------------ the team in one call
-    def _init_team(self) -> None:
-        """Every robot's Navigate shares one geometry: the team steps in one call
-        (:func:`blazing_team_step`), its state in arrays; each robot's reference brain is brought
-        up to date from them whenever it is read (:class:`_BlazingView`) or steps itself."""
-        from numba.typed import List
+    # ------------------------------------------------------------------ what each brain says
+    @staticmethod
+    def _param_row(p: Any) -> np.ndarray:
+        """The brain's parameters ``p`` as its kernels' parameter row."""
+        raise NotImplementedError
 
-        n = self._n
-        self._brains = list(self.robots)
-        self._nf = np.zeros((n, NC.N_F))
-        self._ni = np.zeros((n, NC.N_I), dtype=np.int64)
-        self._nrev = np.zeros((n, NC.REV_AT, 2))
-        for r, brain in enumerate(self._brains):
-            nav = brain.nav
-            self._nf[r] = nav.fst
-            self._ni[r] = nav.ist
-            self._nrev[r] = nav.rev_at
-            nav.fst, nav.ist, nav.rev_at = self._nf[r], self._ni[r], self._nrev[r]  # views: one state
-        self._npar = self._brains[0].nav._par
-        self._ngeo = self._brains[0].nav._geo
-        self._laser = self._brains[0].nav.laser
-        self._bs = np.zeros((n, N_BS))
-        self._pn = np.zeros(n, dtype=np.int64)
-        self._gn = np.zeros(n, dtype=np.int64)
-        self._cap = np.zeros(n, dtype=np.int64)
-        self._carry = np.zeros(n, dtype=np.bool_)
-        self._last_step = np.zeros(n, dtype=np.int64)
-        self._bpar_all = np.ascontiguousarray(np.stack(self._bpar))
-        self._priv_obj = [b.private._buf for b in self._brains]
-        self._glob_obj = [b.global_crumbs._buf for b in self._brains]
-        self._privs = List(self._priv_obj)
-        self._globs = List(self._glob_obj)
-        self._out_pref = np.zeros((n, 3))
-        for r in range(n):
-            self._from_brain(r)
-        self.robots = [_BlazingView(self, r) for r in range(n)]
+    @staticmethod
+    def _fast_brain(brain: Any) -> bool:
+        """Whether a robot with a compiled Navigate takes the compiled step (on steps without task
+        events)."""
+        raise NotImplementedError
+
+    @staticmethod
+    def _due(brain: Any, t: float) -> bool:
+        """One call per robot: whether this step is the reference brain's own even without task
+        events."""
+        return False
+
+    def _row_step(self, brain: Any, r: int, box: Sequence[Any], ranges: np.ndarray, x: float, y: float, th: float,
+                  t: float, stalled: bool, step: int) -> tuple:
+        """One call per robot: robot r's compiled step (inbox included), its brain's state
+        written back; ``(v, w, has_pref, pref, allow_reverse, ignore_memory)``, ``v`` NaN where
+        Navigate must draw (:meth:`_draw`)."""
+        raise NotImplementedError
+
+    def _init_state(self) -> None:
+        """The team in one call: the brains' own state in the team's arrays (allocated here,
+        filled by :meth:`_from_brain`)."""
+        raise NotImplementedError
 
     def _from_brain(self, r: int) -> None:
         """Robot r's state, from its reference brain into the team's arrays."""
-        b = self._brains[r]
-        row = self._bs[r]
-        row[BS_PATH] = b._path_m
-        last, crumb = b._last_xy, b._crumb_xy
-        row[BS_HAS_LAST] = 0.0 if last is None else 1.0
-        row[BS_LX], row[BS_LY] = (0.0, 0.0) if last is None else last
-        row[BS_HAS_CRUMB] = 0.0 if crumb is None else 1.0
-        row[BS_CX], row[BS_CY] = (0.0, 0.0) if crumb is None else crumb
-        row[BS_NEXT] = b._next_crumb_s
-        row[BS_CUT] = b.loops_cut
-        row[BS_FOLLOW] = 1.0 if b._following else 0.0
-        row[BS_RECOVER] = 1.0 if b._recovering else 0.0
-        self._pn[r] = b.private._n
-        self._sync_buffers(r)
-        self._carry[r] = b.carrying
-        self._last_step[r] = b._step
-
-    def _sync_buffers(self, r: int) -> None:
-        """Robot r's crumb buffers and counts (a list that grew has a new buffer: the typed lists
-        are built again, not assigned into, since a typed list's ``__setitem__`` compiles on first
-        use, in whichever step needs it)."""
-        from numba.typed import List
-
-        b = self._brains[r]
-        if b.private._buf is not self._priv_obj[r]:
-            self._priv_obj[r] = b.private._buf
-            self._privs = List(self._priv_obj)
-        self._cap[r] = b.private._buf.shape[0]
-        g = b.global_crumbs
-        if g._buf is not self._glob_obj[r]:
-            self._glob_obj[r] = g._buf
-            self._globs = List(self._glob_obj)
-        self._gn[r] = g._n
+        raise NotImplementedError
 
     def _to_brain(self, r: int) -> None:
         """Robot r's state, from the team's arrays into its reference brain."""
-        b = self._brains[r]
-        row = self._bs[r].tolist()
-        b._path_m = row[BS_PATH]
-        b._last_xy = (row[BS_LX], row[BS_LY]) if row[BS_HAS_LAST] else None
-        b._crumb_xy = (row[BS_CX], row[BS_CY]) if row[BS_HAS_CRUMB] else None
-        b._next_crumb_s = row[BS_NEXT]
-        b.loops_cut = int(row[BS_CUT])
-        b._following = bool(row[BS_FOLLOW])
-        b._recovering = bool(row[BS_RECOVER])
-        b.private._n = int(self._pn[r])
-        b._step = int(self._last_step[r])
+        raise NotImplementedError
 
-    def _step_team(self, obs: GroupObservation) -> GroupAction:
-        n = self._n
-        outbox: list = []
-        waiting = obs.waiting
-        events = obs.events
-        inbox = obs.inbox
-        t = float(obs.time_s)
-        step = int(obs.step)
-        v = np.zeros(n)
-        w = np.zeros(n)
-        active = np.ones(n, dtype=np.bool_) if waiting is None else ~waiting
-        if events is not None:  # a step with task events: the reference brain's own (in robot order)
-            for r, ev in enumerate(events):
-                if ev and active[r]:
-                    active[r] = False
-                    self._to_brain(r)
-                    action, msgs = self._brains[r].step(_row_observation(obs, r))
-                    self._from_brain(r)
-                    self._last_step[r] = step
-                    v[r] = action.v_mps
-                    w[r] = action.omega_radps
-                    if msgs:
-                        rid = int(obs.robot_ids[r])
-                        outbox.extend((rid, m) for m in msgs)
-        for r, box in enumerate(inbox):
-            if box and active[r]:
-                b = self._brains[r]
-                if b.params.communicate:  # the reference's inbox rule (only the global list)
-                    me = b.info.robot_id
-                    for msg in box:
-                        if msg.kind == "crumbs" and isinstance(msg.body, CrumbBatch) and msg.sender != me:
-                            b._add_global(msg.body, t)
-                    self._sync_buffers(r)
-        rows = np.flatnonzero(active)
-        if rows.size:
-            full = rows[self._pn[rows] + 1 > self._cap[rows]]
-            for r in full.tolist():  # room for one more private crumb
-                priv = self._brains[r].private
-                priv._n = int(self._pn[r])
-                priv._reserve(1)
-                self._sync_buffers(r)
-            ranges = np.ascontiguousarray(obs.ranges_m[self._laser])
-            poses = np.ascontiguousarray(obs.odom_pose)
-            stalled = np.ascontiguousarray(obs.stalled, dtype=np.bool_)
-            out_v = np.zeros(n)
-            out_w = np.zeros(n)
-            pref = self._out_pref
-            blazing_team_step(rows, self._bs, self._pn, self._privs, self._gn, self._globs, self._bpar_all,
-                              self._carry, self._nf, self._ni, self._npar, self._nrev, ranges, poses, t, stalled,
-                              *self._ngeo, out_v, out_w, pref)
-            self._last_step[rows] = step
-            for r in rows[np.isnan(out_v[rows])].tolist():  # Navigate must draw: with the Generator
-                x, y, th = poses[r, :3].tolist()
-                nav = self._brains[r].nav
-                out_v[r], out_w[r] = NC.nav_step_rng(
-                    nav.fst, nav.ist, nav._par, nav.rev_at, ranges[r], x, y, th, t, bool(stalled[r]),
-                    bool(pref[r, 0]), float(pref[r, 1]), bool(pref[r, 2]), False, nav.rng, *nav._geo)
-            v[rows] = out_v[rows]
-            w[rows] = out_w[rows]
-        return GroupAction(v, w, np.full(n, math.nan), outbox)
+    def _team_due(self, active: np.ndarray, t: float) -> np.ndarray:
+        """The team in one call: the robots whose step is the reference brain's own even without
+        task events (a new array)."""
+        return np.zeros(self._n, dtype=np.bool_)
+
+    def _before_team(self, obs: GroupObservation, rows: np.ndarray, t: float) -> None:
+        """The team in one call: the reference's rules the kernel does not run (the inbox), for
+        the robots ``rows``, before it."""
+        raise NotImplementedError
+
+    def _team_kernel(self, rows: np.ndarray, ranges: np.ndarray, poses: np.ndarray, t: float, stalled: np.ndarray,
+                     out_v: np.ndarray, out_w: np.ndarray, hint: np.ndarray) -> None:
+        """The team in one call: the brain's team kernel over ``rows``; a robot whose Navigate
+        must draw gets ``out_v`` NaN and (has_pref, pref, allow_reverse, ignore_memory) in
+        ``hint``."""
+        raise NotImplementedError
+
+    # ------------------------------------------------------------------ the shared machinery
+    @staticmethod
+    def _reference_step(brain: Any, obs: GroupObservation, r: int, v: np.ndarray, w: np.ndarray,
+                        outbox: list) -> None:
+        """Robot r's step as its reference brain's own: its command into ``v``/``w``, its
+        messages onto ``outbox``."""
+        action, msgs = brain.step(_row_observation(obs, r))
+        v[r] = action.v_mps
+        w[r] = action.omega_radps
+        if msgs:
+            rid = int(obs.robot_ids[r])
+            outbox.extend((rid, m) for m in msgs)
+
+    @staticmethod
+    def _draw(nav: Any, ranges: np.ndarray, x: float, y: float, th: float, t: float, stalled: bool, has_pref: bool,
+              pref: float, allow: bool, ignore: bool) -> tuple[float, float]:
+        """Navigate must draw: its step again, with the robot's Generator (the brain's part is
+        done; the compiled step left Navigate's state untouched)."""
+        return NC.nav_step_rng(nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t, stalled, has_pref, pref,
+                               allow, ignore, nav.rng, *nav._geo)
 
     def step_group(self, obs: GroupObservation) -> GroupAction:
         """Every robot's step (module docstring); a waiting robot's brain is off."""
@@ -795,48 +694,223 @@ class BlazingTrailGroup(_TrailGroup):
         for r, brain in enumerate(self.robots):
             if waiting is not None and waiting[r]:
                 continue
-            if not self._fast[r] or (events is not None and events[r]):
-                action, msgs = brain.step(_row_observation(obs, r))
-                v[r] = action.v_mps
-                w[r] = action.omega_radps
-                if msgs:
-                    rid = int(obs.robot_ids[r])
-                    outbox.extend((rid, m) for m in msgs)
+            if not self._fast[r] or (events is not None and events[r]) or self._due(brain, t):
+                self._reference_step(brain, obs, r, v, w, outbox)
                 continue
-            if inbox[r] and brain.params.communicate:
-                # the reference's inbox rule (BlazingTrail.step); it touches only the global list, and
-                # the crumb dropping before it in the reference only the private one
-                me = brain.info.robot_id
-                for msg in inbox[r]:
-                    if msg.kind == "crumbs" and isinstance(msg.body, CrumbBatch) and msg.sender != me:
-                        brain._add_global(msg.body, t)
             x, y, th = poses[r][:3]
-            nav = brain.nav
-            priv = brain.private
-            priv._reserve(1)
-            glob = brain.global_crumbs
-            last = brain._last_xy
-            crumb = brain._crumb_xy
             ranges = obs.ranges_m[brain.params.sensor][r]
-            out = blazing_row_step(
-                brain._path_m, last is not None, last[0] if last is not None else 0.0,
-                last[1] if last is not None else 0.0, crumb is not None, crumb[0] if crumb is not None else 0.0,
-                crumb[1] if crumb is not None else 0.0, brain._next_crumb_s, brain.carrying, priv._buf, priv._n,
-                glob._buf, glob._n, self._bpar[r], nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t,
-                stalled[r], *nav._geo)
-            (vr, wr, brain._path_m, has_crumb, cx, cy, brain._next_crumb_s, priv._n, cut, brain._following,
-             brain._recovering, has_pref, pref, allow) = out
-            brain._step = step
-            brain._last_xy = (x, y)
-            if has_crumb:
-                brain._crumb_xy = (cx, cy)
-            brain.loops_cut += cut
-            if vr != vr:  # Navigate must draw: its step again, with the robot's Generator
-                vr, wr = NC.nav_step_rng(nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t, stalled[r],
-                                         has_pref, pref, allow, False, nav.rng, *nav._geo)
+            vr, wr, has_pref, pref, allow, ignore = self._row_step(brain, r, inbox[r], ranges, x, y, th, t,
+                                                                   stalled[r], step)
+            if math.isnan(vr):  # Navigate must draw
+                vr, wr = self._draw(brain.nav, ranges, x, y, th, t, stalled[r], has_pref, pref, allow, ignore)
             v[r] = vr
             w[r] = wr
         return GroupAction(v, w, d, outbox)
+
+    # ------------------------------------------------------------------ the team in one call
+    def _init_team(self) -> None:
+        """Every robot's Navigate shares one geometry: the team steps in one call, Navigate's
+        states and the brains' own in arrays (the reference Navigate's state arrays become views
+        of the team's: one state)."""
+        n = self._n
+        self._brains = list(self.robots)
+        self._nf = np.zeros((n, NC.N_F))
+        self._ni = np.zeros((n, NC.N_I), dtype=np.int64)
+        self._nrev = np.zeros((n, NC.REV_AT, 2))
+        for r, brain in enumerate(self._brains):
+            nav = brain.nav
+            self._nf[r] = nav.fst
+            self._ni[r] = nav.ist
+            self._nrev[r] = nav.rev_at
+            nav.fst, nav.ist, nav.rev_at = self._nf[r], self._ni[r], self._nrev[r]  # views: one state
+        self._npar = self._brains[0].nav._par
+        self._ngeo = self._brains[0].nav._geo
+        self._laser = self._brains[0].nav.laser
+        self._last_step = np.zeros(n, dtype=np.int64)
+        self._par_all = np.ascontiguousarray(np.stack(self._par))
+        self._hint = np.zeros((n, 4))
+        self._init_state()
+        for r in range(n):
+            self._from_brain(r)
+        self.robots = [_TeamView(self, r) for r in range(n)]
+
+    def _step_team(self, obs: GroupObservation) -> GroupAction:
+        n = self._n
+        outbox: list = []
+        events = obs.events
+        t = float(obs.time_s)
+        step = int(obs.step)
+        v = np.zeros(n)
+        w = np.zeros(n)
+        active = np.ones(n, dtype=np.bool_) if obs.waiting is None else ~obs.waiting
+        slow = self._team_due(active, t)  # the reference brain's own step: these, and those with task events
+        if events is not None:
+            for r, ev in enumerate(events):
+                if ev and active[r]:
+                    slow[r] = True
+        for r in np.flatnonzero(slow).tolist():  # robot order: the messages go out in it
+            self._to_brain(r)
+            self._reference_step(self._brains[r], obs, r, v, w, outbox)
+            self._from_brain(r)
+            self._last_step[r] = step
+        rows = np.flatnonzero(active & ~slow)
+        if rows.size:
+            self._before_team(obs, rows, t)
+            ranges = np.ascontiguousarray(obs.ranges_m[self._laser])
+            poses = np.ascontiguousarray(obs.odom_pose)
+            stalled = np.ascontiguousarray(obs.stalled, dtype=np.bool_)
+            out_v = np.zeros(n)
+            out_w = np.zeros(n)
+            hint = self._hint
+            self._team_kernel(rows, ranges, poses, t, stalled, out_v, out_w, hint)
+            self._last_step[rows] = step
+            for r in rows[np.isnan(out_v[rows])].tolist():
+                x, y, th = poses[r, :3].tolist()
+                has_pref, pref, allow, ignore = hint[r].tolist()
+                out_v[r], out_w[r] = self._draw(self._brains[r].nav, ranges[r], x, y, th, t, bool(stalled[r]),
+                                                bool(has_pref), pref, bool(allow), bool(ignore))
+            v[rows] = out_v[rows]
+            w[rows] = out_w[rows]
+        return GroupAction(v, w, np.full(n, math.nan), outbox)
+
+
+class BlazingTrailGroup(_TrailGroup):
+    """``blazing-trail-v1`` teams (module docstring). A robot's step without task events (nearly
+    all of them) is the reference's inbox rule (received crumbs appended to the global list; the
+    crumb dropping that precedes it in the reference touches only the private list) and one
+    compiled call (:func:`blazing_row_step`: crumbs, the trail's hint and Navigate); a step with
+    events, and every step of a robot whose global crumbs expire (``global_crumb_ttl_s``) or
+    whose Navigate is the reference's, runs the reference brain's own step."""
+
+    controller = "teamnav.papers.trails.brains.blazing_trail:BlazingTrail"
+
+    @staticmethod
+    def _param_row(p: Any) -> np.ndarray:
+        b = np.zeros(N_B)
+        b[B_MIN_MOVE] = p.crumb_min_move_m
+        b[B_INTERVAL] = p.crumb_interval_s
+        b[B_REV_CARRIED] = 1.0 if p.reverse_carried_crumbs else 0.0
+        b[B_PRUNE] = 1.0 if p.prune_loops else 0.0
+        b[B_PRUNE_R] = p.prune_radius_m
+        b[B_PRUNE_LOOP] = p.prune_min_loop_m
+        b[B_LOOK] = p.lookahead_m
+        b[B_RADIUS] = p.radius_m
+        b[B_REV_MIN] = p.reverse_min_crumbs
+        b[B_RECOVER] = p.recover_radius_m
+        return b
+
+    @staticmethod
+    def _fast_brain(brain: Any) -> bool:
+        return brain.params.global_crumb_ttl_s is None
+
+    @staticmethod
+    def _take_inbox(brain: Any, box: Sequence[Any], t: float) -> bool:
+        """The reference's inbox rule (:meth:`BlazingTrail.step
+        <teamnav.papers.trails.brains.blazing_trail.BlazingTrail.step>`): received crumbs
+        appended to the global list (it touches only that list, and the crumb dropping before it
+        in the reference only the private one). Whether the robot communicates."""
+        if not brain.params.communicate:
+            return False
+        me = brain.info.robot_id
+        for msg in box:
+            if msg.kind == "crumbs" and isinstance(msg.body, CrumbBatch) and msg.sender != me:
+                brain._add_global(msg.body, t)
+        return True
+
+    def _row_step(self, brain, r, box, ranges, x, y, th, t, stalled, step) -> tuple:
+        if box:
+            self._take_inbox(brain, box, t)
+        nav = brain.nav
+        priv = brain.private
+        priv._reserve(1)
+        glob = brain.global_crumbs
+        last = brain._last_xy
+        crumb = brain._crumb_xy
+        out = blazing_row_step(
+            brain._path_m, last is not None, last[0] if last is not None else 0.0,
+            last[1] if last is not None else 0.0, crumb is not None, crumb[0] if crumb is not None else 0.0,
+            crumb[1] if crumb is not None else 0.0, brain._next_crumb_s, brain.carrying, priv._buf, priv._n,
+            glob._buf, glob._n, self._par[r], nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t,
+            stalled, *nav._geo)
+        (vr, wr, brain._path_m, has_crumb, cx, cy, brain._next_crumb_s, priv._n, cut, brain._following,
+         brain._recovering, has_pref, pref, allow) = out
+        brain._step = step
+        brain._last_xy = (x, y)
+        if has_crumb:
+            brain._crumb_xy = (cx, cy)
+        brain.loops_cut += cut
+        return vr, wr, has_pref, pref, allow, False
+
+    # ------------------------------------------------------------------ the team in one call
+    def _init_state(self) -> None:
+        """The brains' scalars (``BS_*``), crumb counts, the private lists' capacities, what
+        they carry; the crumb buffers (the reference's own) as typed lists
+        (:func:`blazing_team_step`)."""
+        n = self._n
+        self._bs = np.zeros((n, N_BS))
+        self._pn = np.zeros(n, dtype=np.int64)
+        self._gn = np.zeros(n, dtype=np.int64)
+        self._cap = np.zeros(n, dtype=np.int64)
+        self._carry = np.zeros(n, dtype=np.bool_)
+        self._privs = _Buffers([b.private._buf for b in self._brains])
+        self._globs = _Buffers([b.global_crumbs._buf for b in self._brains])
+
+    def _from_brain(self, r: int) -> None:
+        b = self._brains[r]
+        row = self._bs[r]
+        row[BS_PATH] = b._path_m
+        last, crumb = b._last_xy, b._crumb_xy
+        row[BS_HAS_LAST] = 0.0 if last is None else 1.0
+        row[BS_LX], row[BS_LY] = (0.0, 0.0) if last is None else last
+        row[BS_HAS_CRUMB] = 0.0 if crumb is None else 1.0
+        row[BS_CX], row[BS_CY] = (0.0, 0.0) if crumb is None else crumb
+        row[BS_NEXT] = b._next_crumb_s
+        row[BS_CUT] = b.loops_cut
+        row[BS_FOLLOW] = 1.0 if b._following else 0.0
+        row[BS_RECOVER] = 1.0 if b._recovering else 0.0
+        self._pn[r] = b.private._n
+        self._sync_buffers(r)
+        self._carry[r] = b.carrying
+        self._last_step[r] = b._step
+
+    def _sync_buffers(self, r: int) -> None:
+        """Robot r's crumb buffers, the private list's capacity and the global list's count."""
+        b = self._brains[r]
+        self._privs.sync(r, b.private._buf)
+        self._cap[r] = b.private._buf.shape[0]
+        g = b.global_crumbs
+        self._globs.sync(r, g._buf)
+        self._gn[r] = g._n
+
+    def _to_brain(self, r: int) -> None:
+        b = self._brains[r]
+        row = self._bs[r].tolist()
+        b._path_m = row[BS_PATH]
+        b._last_xy = (row[BS_LX], row[BS_LY]) if row[BS_HAS_LAST] else None
+        b._crumb_xy = (row[BS_CX], row[BS_CY]) if row[BS_HAS_CRUMB] else None
+        b._next_crumb_s = row[BS_NEXT]
+        b.loops_cut = int(row[BS_CUT])
+        b._following = bool(row[BS_FOLLOW])
+        b._recovering = bool(row[BS_RECOVER])
+        b.private._n = int(self._pn[r])
+        b._step = int(self._last_step[r])
+
+    def _before_team(self, obs, rows, t) -> None:
+        inbox = obs.inbox
+        for r in rows.tolist():
+            if inbox[r] and self._take_inbox(self._brains[r], inbox[r], t):
+                self._sync_buffers(r)
+        full = rows[self._pn[rows] + 1 > self._cap[rows]]
+        for r in full.tolist():  # room for one more private crumb
+            priv = self._brains[r].private
+            priv._n = int(self._pn[r])
+            priv._reserve(1)
+            self._sync_buffers(r)
+
+    def _team_kernel(self, rows, ranges, poses, t, stalled, out_v, out_w, hint) -> None:
+        blazing_team_step(rows, self._bs, self._pn, self._privs.typed, self._gn, self._globs.typed, self._par_all,
+                          self._carry, self._nf, self._ni, self._npar, self._nrev, ranges, poses, t, stalled,
+                          *self._ngeo, out_v, out_w, hint)
 
     @classmethod
     def _probe_params(cls, params: Any):
@@ -854,62 +928,70 @@ class TrailShareGroup(_TrailGroup):
 
     controller = "teamnav.papers.trails.brains.trail_share:TrailShare"
 
-    def __init__(self, params, rngs, infos) -> None:
-        super().__init__(params, rngs, infos)
-        self._spar = []
-        self._fast = []
-        for brain in self.robots:
-            p = brain.params
-            sp = np.zeros(N_S)
-            sp[S_DESCEND] = 1.0 if p.descend_only else 0.0
-            sp[S_REACH] = p.reach_m
-            sp[S_LOOK] = p.lookahead_m
-            sp[S_RADIUS] = p.radius_m
-            sp[S_RECOVER] = p.recover_radius_m
-            sp[S_RECOVER_REV] = 1.0 if p.recover_reverse else 0.0
-            self._spar.append(sp)
-            self._fast.append(isinstance(brain.nav, NC.CompiledNavigate) and not brain._tell_bold)
-        navs = [brain.nav for brain in self.robots]
-        self._team = len(navs) >= self.TEAM_MIN and all(self._fast) and all(
-            nav._par is navs[0]._par and nav.laser == navs[0].laser for nav in navs)
-        if self._team:
-            self._init_team()
+    @staticmethod
+    def _param_row(p: Any) -> np.ndarray:
+        sp = np.zeros(N_S)
+        sp[S_DESCEND] = 1.0 if p.descend_only else 0.0
+        sp[S_REACH] = p.reach_m
+        sp[S_LOOK] = p.lookahead_m
+        sp[S_RADIUS] = p.radius_m
+        sp[S_RECOVER] = p.recover_radius_m
+        sp[S_RECOVER_REV] = 1.0 if p.recover_reverse else 0.0
+        return sp
+
+    @staticmethod
+    def _fast_brain(brain: Any) -> bool:
+        return not brain._tell_bold
+
+    @staticmethod
+    def _due(brain: Any, t: float) -> bool:
+        """A robot's first step, and one with a broadcast due."""
+        return not brain._started or t >= brain._next_broadcast_s
+
+    @staticmethod
+    def _take_inbox(brain: Any, box: Sequence[Any]) -> bool:
+        """§2.2 step 3, the reference's rule (:meth:`TrailShare.step
+        <teamnav.papers.trails.brains.trail_share.TrailShare.step>`): each received Trail
+        combined into the robot's own. Whether the robot communicates."""
+        p = brain.params
+        if not p.communicate:
+            return False
+        me = brain.info.robot_id
+        trail = brain.trail
+        for msg in box:
+            if msg.kind == "trail" and isinstance(msg.body, TrailMessage) and msg.sender != me:
+                if trail.combine(msg.body, p.policy, use_transforms=p.use_place_transforms) is None:
+                    brain.refused += 1
+                else:
+                    brain.combined += 1
+        return True
+
+    def _row_step(self, brain, r, box, ranges, x, y, th, t, stalled, step) -> tuple:
+        brain._step = step
+        trail = brain.trail
+        if box:
+            self._take_inbox(brain, box)
+        trail.expire(t, brain.params.crumb_max_age_s)  # §2.3 step 2 (the reference's own)
+        code = trail._codes.get(brain.round.goal)
+        nav = brain.nav
+        vr, wr, brain._bound_s, brain._bound_t, brain._following, brain._recovering, has_pref, pref, ignore = \
+            share_row_step(brain._bound_s, brain._bound_t, -1 if code is None else code, trail._xys, trail._p,
+                           trail._n, self._par[r], nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t,
+                           stalled, *nav._geo)
+        return vr, wr, has_pref, pref, True, ignore
 
     # ------------------------------------------------------------------ the team in one call
-    def _init_team(self) -> None:
-        """As :meth:`BlazingTrailGroup._init_team`: Navigate's states and the brains' scalars in
-        arrays, the Trails' buffers (the reference's own) as typed lists."""
-        from numba.typed import List
-
+    def _init_state(self) -> None:
+        """The brains' scalars (``SS_*``), goal codes, Trail counts, broadcast times; the Trails'
+        buffers (the reference's own) as typed lists (:func:`share_team_step`)."""
         n = self._n
-        self._brains = list(self.robots)
-        self._nf = np.zeros((n, NC.N_F))
-        self._ni = np.zeros((n, NC.N_I), dtype=np.int64)
-        self._nrev = np.zeros((n, NC.REV_AT, 2))
-        for r, brain in enumerate(self._brains):
-            nav = brain.nav
-            self._nf[r] = nav.fst
-            self._ni[r] = nav.ist
-            self._nrev[r] = nav.rev_at
-            nav.fst, nav.ist, nav.rev_at = self._nf[r], self._ni[r], self._nrev[r]
-        self._npar = self._brains[0].nav._par
-        self._ngeo = self._brains[0].nav._geo
-        self._laser = self._brains[0].nav.laser
         self._ss = np.zeros((n, N_SS))
         self._code = np.full(n, -1, dtype=np.int64)
         self._tn = np.zeros(n, dtype=np.int64)
         self._started = np.zeros(n, dtype=np.bool_)
         self._next_b = np.zeros(n)
-        self._last_step = np.zeros(n, dtype=np.int64)
-        self._spar_all = np.ascontiguousarray(np.stack(self._spar))
-        self._xys_obj = [b.trail._xys for b in self._brains]
-        self._p_obj = [b.trail._p for b in self._brains]
-        self._xyss = List(self._xys_obj)
-        self._ps = List(self._p_obj)
-        self._out_pref = np.zeros((n, 3))
-        for r in range(n):
-            self._from_brain(r)
-        self.robots = [_ShareView(self, r) for r in range(n)]
+        self._xyss = _Buffers([b.trail._xys for b in self._brains])
+        self._ps = _Buffers([b.trail._p for b in self._brains])
 
     def _from_brain(self, r: int) -> None:
         b = self._brains[r]
@@ -924,17 +1006,11 @@ class TrailShareGroup(_TrailGroup):
         self._sync_trail(r)
 
     def _sync_trail(self, r: int) -> None:
-        """Robot r's Trail buffers, count and goal code (a Trail that grew has new buffers: the
-        typed lists are built again, as in :meth:`BlazingTrailGroup._sync_buffers`)."""
-        from numba.typed import List
-
+        """Robot r's Trail buffers, count and goal code."""
         b = self._brains[r]
         tr = b.trail
-        if tr._xys is not self._xys_obj[r] or tr._p is not self._p_obj[r]:
-            self._xys_obj[r] = tr._xys
-            self._p_obj[r] = tr._p
-            self._xyss = List(self._xys_obj)
-            self._ps = List(self._p_obj)
+        self._xyss.sync(r, tr._xys)
+        self._ps.sync(r, tr._p)
         self._tn[r] = tr._n
         code = tr._codes.get(b.round.goal)
         self._code[r] = -1 if code is None else code
@@ -948,127 +1024,26 @@ class TrailShareGroup(_TrailGroup):
         b._recovering = bool(row[SS_RECOVER])
         b._step = int(self._last_step[r])
 
-    def _step_team(self, obs: GroupObservation) -> GroupAction:
-        n = self._n
-        outbox: list = []
-        waiting = obs.waiting
-        events = obs.events
+    def _team_due(self, active, t) -> np.ndarray:
+        return active & ((~self._started) | (t >= self._next_b))
+
+    def _before_team(self, obs, rows, t) -> None:
         inbox = obs.inbox
-        t = float(obs.time_s)
-        step = int(obs.step)
-        v = np.zeros(n)
-        w = np.zeros(n)
-        active = np.ones(n, dtype=np.bool_) if waiting is None else ~waiting
-        # the reference brain's own step: a robot's first, one with task events, one with a broadcast due
-        slow = active & ((~self._started) | (t >= self._next_b))
-        if events is not None:
-            for r, ev in enumerate(events):
-                if ev and active[r]:
-                    slow[r] = True
-        for r in np.flatnonzero(slow).tolist():  # robot order: the messages go out in it
-            self._to_brain(r)
-            action, msgs = self._brains[r].step(_row_observation(obs, r))
-            self._from_brain(r)
-            self._last_step[r] = step
-            v[r] = action.v_mps
-            w[r] = action.omega_radps
-            if msgs:
-                rid = int(obs.robot_ids[r])
-                outbox.extend((rid, m) for m in msgs)
-        rows = np.flatnonzero(active & ~slow)
-        if rows.size == 0:
-            return GroupAction(v, w, np.full(n, math.nan), outbox)
         for r in rows.tolist():
             b = self._brains[r]
-            p = b.params
             tr = b.trail
-            box = inbox[r]
-            if box and p.communicate:  # §2.2 step 3, the reference's rule (TrailShare.step)
-                me = b.info.robot_id
-                for msg in box:
-                    if msg.kind == "trail" and isinstance(msg.body, TrailMessage) and msg.sender != me:
-                        if tr.combine(msg.body, p.policy, use_transforms=p.use_place_transforms) is None:
-                            b.refused += 1
-                        else:
-                            b.combined += 1
-                tr.expire(t, p.crumb_max_age_s)  # §2.3 step 2
+            age = b.params.crumb_max_age_s
+            if inbox[r] and self._take_inbox(b, inbox[r]):
+                tr.expire(t, age)  # §2.3 step 2
                 self._sync_trail(r)
-            elif tr._n and tr._t_min < t - p.crumb_max_age_s:  # expire() has crumbs to remove
-                tr.expire(t, p.crumb_max_age_s)
+            elif tr._n and tr._t_min < t - age:  # expire() has crumbs to remove
+                tr.expire(t, age)
                 self._tn[r] = tr._n
-        ranges = np.ascontiguousarray(obs.ranges_m[self._laser])
-        poses = np.ascontiguousarray(obs.odom_pose)
-        stalled = np.ascontiguousarray(obs.stalled, dtype=np.bool_)
-        out_v = np.zeros(n)
-        out_w = np.zeros(n)
-        pref = self._out_pref
-        share_team_step(rows, self._ss, self._code, self._xyss, self._ps, self._tn, self._spar_all, self._nf,
-                        self._ni, self._npar, self._nrev, ranges, poses, t, stalled, *self._ngeo, out_v, out_w, pref)
-        self._last_step[rows] = step
-        for r in rows[np.isnan(out_v[rows])].tolist():  # Navigate must draw: with the Generator
-            x, y, th = poses[r, :3].tolist()
-            nav = self._brains[r].nav
-            out_v[r], out_w[r] = NC.nav_step_rng(
-                nav.fst, nav.ist, nav._par, nav.rev_at, ranges[r], x, y, th, t, bool(stalled[r]),
-                bool(pref[r, 0]), float(pref[r, 1]), True, bool(pref[r, 2]), nav.rng, *nav._geo)
-        v[rows] = out_v[rows]
-        w[rows] = out_w[rows]
-        return GroupAction(v, w, np.full(n, math.nan), outbox)
 
-    def step_group(self, obs: GroupObservation) -> GroupAction:
-        """Every robot's step (class docstring); a waiting robot's brain is off."""
-        if self._team:
-            return self._step_team(obs)
-        n = self._n
-        v = np.zeros(n)
-        w = np.zeros(n)
-        d = np.full(n, math.nan)
-        outbox: list = []
-        waiting = obs.waiting
-        events = obs.events
-        inbox = obs.inbox
-        poses = obs.odom_pose.tolist()
-        stalled = obs.stalled.tolist()
-        t = float(obs.time_s)
-        step = int(obs.step)
-        for r, brain in enumerate(self.robots):
-            if waiting is not None and waiting[r]:
-                continue
-            if (not self._fast[r] or not brain._started or t >= brain._next_broadcast_s
-                    or (events is not None and events[r])):
-                action, msgs = brain.step(_row_observation(obs, r))
-                v[r] = action.v_mps
-                w[r] = action.omega_radps
-                if msgs:
-                    rid = int(obs.robot_ids[r])
-                    outbox.extend((rid, m) for m in msgs)
-                continue
-            x, y, th = poses[r][:3]
-            brain._step = step
-            trail = brain.trail
-            p = brain.params
-            if inbox[r] and p.communicate:  # §2.2 step 3, the reference's rule (TrailShare.step)
-                me = brain.info.robot_id
-                for msg in inbox[r]:
-                    if msg.kind == "trail" and isinstance(msg.body, TrailMessage) and msg.sender != me:
-                        if trail.combine(msg.body, p.policy, use_transforms=p.use_place_transforms) is None:
-                            brain.refused += 1
-                        else:
-                            brain.combined += 1
-            trail.expire(t, brain.params.crumb_max_age_s)  # §2.3 step 2 (the reference's own)
-            code = trail._codes.get(brain.round.goal)
-            nav = brain.nav
-            ranges = obs.ranges_m[brain.params.sensor][r]
-            vr, wr, brain._bound_s, brain._bound_t, brain._following, brain._recovering, has_pref, pref, ignore = \
-                share_row_step(brain._bound_s, brain._bound_t, -1 if code is None else code, trail._xys, trail._p,
-                               trail._n, self._spar[r], nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t,
-                               stalled[r], *nav._geo)
-            if vr != vr:  # Navigate must draw: its step again, with the robot's Generator
-                vr, wr = NC.nav_step_rng(nav.fst, nav.ist, nav._par, nav.rev_at, ranges, x, y, th, t, stalled[r],
-                                         has_pref, pref, True, ignore, nav.rng, *nav._geo)
-            v[r] = vr
-            w[r] = wr
-        return GroupAction(v, w, d, outbox)
+    def _team_kernel(self, rows, ranges, poses, t, stalled, out_v, out_w, hint) -> None:
+        share_team_step(rows, self._ss, self._code, self._xyss.typed, self._ps.typed, self._tn, self._par_all,
+                        self._nf, self._ni, self._npar, self._nrev, ranges, poses, t, stalled, *self._ngeo, out_v,
+                        out_w, hint)
 
     @classmethod
     def _probe_params(cls, params: Any):
