@@ -20,9 +20,12 @@ run, as the script writes them; ``docs/report/blazing-gap-fill-study.jsonl`` and
 ``blazing-drift-study.jsonl`` hold the same lines; a test checks that they agree). The ``breakdown`` part
 (the 2000 paper column as judged since 2026-11-29, 1 h at the papers' drift with and without a
 heading random walk, tuning seeds 1000-1019) is stored in the same file. The same
-``gapfills`` part for the 2002 brain (``--system try``: trail-share-v1 on ``try-to-see-it-my-way``,
-1-h runs) is ``try-gap-fill-study.json`` / ``docs/report/try-gap-fill-study.jsonl``, shown in the
-try-to-see-it-my-way section.
+``gapfills`` part for the 2002 brain (``--system try``: trail-share-v1 on ``try-to-see-it-my-way``)
+is ``try-gap-fill-study.json`` / ``docs/report/try-gap-fill-study.jsonl``, shown in the
+try-to-see-it-my-way section: 30-min runs on paired seeds 100-107 with the 180° rule's turns
+counted, on the set-up of 2026-11-29 (2da9eba: 361 beams, the one-at-a-time start, crumb radius
+4 m; 176 runs, 28 CPU-min). Its first version (1-h runs, seeds 100-103, on 2026-11-27's set-up,
+turns not counted) is kept as ``docs/report/try-gap-fill-study-2026-11-27.jsonl``, history only.
 """
 
 from __future__ import annotations
