@@ -259,12 +259,13 @@ def failure_cause_text(paper_verdicts: dict, share_rows, k0_rows, drift_dur_s: f
     return (head + f"the paper's robots drove {PAPER_M_PER_TRIP:.1f} m a trip (Table 1: 8211 m in 262 trips), the "
             f"route's length; ours, under the paper's rules at the paper's drift, drive {m:.1f} m a trip (median of "
             f"{per_trip.size} runs, {m / PAPER_M_PER_TRIP:.1f}x), something the paper's robots cannot have done at "
-            "92 % efficiency." + without + counted + " How often the 180° rule (Blazing §4.2: \"If the robot is "
-            "heading in approximately the opposite direction to the trail it makes a sharp 180° right turn\") fires "
-            "rests on values the 2002 paper does not give: the radius of the crumbs a robot follows "
-            f"({TrailShareParams().radius_m:g} m, a fill in the ledger) and what \"approximately opposite\" means "
-            "(Navigate's reverse_threshold_deg, 150°, the library default, untuned). So these verdicts are "
-            "measured, but their cause is not shown to be the paper's.")
+            "92 % efficiency." + without + counted + " How far a robot drives a trip rests on values the 2002 "
+            "paper does not give: the radius of the crumbs a robot follows "
+            f"({TrailShareParams().radius_m:g} m, a fill in the ledger), what \"approximately opposite\" means in "
+            "the 180° rule (Blazing §4.2: \"If the robot is heading in approximately the opposite direction to the "
+            "trail it makes a sharp 180° right turn\"; Navigate's reverse_threshold_deg, 150°, the library default, "
+            "untuned), and Navigate's other settings, chosen at 0.4 m/s, not at the paper's 0.25 (the speed probe "
+            "below). So these verdicts are measured, but their cause is not shown to be the paper's.")
 
 
 #: the run length each claim's min_duration_s is read against: the drift runs' or the long runs'
