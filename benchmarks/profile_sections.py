@@ -62,7 +62,7 @@ def _category(filename: str) -> str | None:
         return None
     if "/teamnav/control/" in f or "/teamnav/localization/" in f:
         return "brains"
-    if f.endswith("/teamnav/world/raycast.py") or f.endswith("/teamnav/world/los.py"):
+    if f.endswith(("/teamnav/world/raycast.py", "/teamnav/world/raycast_stretched.py", "/teamnav/world/los.py")):
         return None  # shared geometry kernels: counted where they are called from (a sensor or a brain)
     if "/teamnav/sim/sensors/" in f:
         return "sensing"

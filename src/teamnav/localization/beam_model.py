@@ -47,7 +47,11 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from scipy.special import ndtr
 
 from teamnav.localization._checks import array, positive
-from teamnav.world.raycast import _POSES_PER_WAVE_ST, _cast_group_st, _scratch_st
+from teamnav.world.raycast_stretched import (
+    _POSES_PER_WAVE_ST,
+    _cast_group_st,
+    _scratch_st,
+)
 
 __all__ = [
     "BeamModelParams", "BeamTable", "beam_density", "beam_table_kernel", "beam_probability", "beam_log_table", "beam_loglik_kernel",
