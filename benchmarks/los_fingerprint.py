@@ -61,9 +61,10 @@ on another CPU), and a second run reproduced all 48. Check on this kind of machi
     python benchmarks/los_fingerprint.py --paper-rules --check benchmarks/los_fingerprints_paper.json
 
 ``--group-brains`` runs the compiled group brains wherever they exist
-(``docs/concepts/group-brains.md``) and must match the same files. On 2026-11-29 they run the
-12 runs of R1 alone of each file, VisBug-21's 4 included (the summary's ``compiled robots``);
-the team runs keep their per-robot brains. Both files matched, 24 of 24 runs each.
+(``docs/concepts/group-brains.md``) and must match the same files. Since 2026-11-29 every run
+of each file steps compiled robots (the summary's ``compiled robots``): the 12 runs of R1 alone,
+VisBug-21's 4 included, and the 12 team runs with all 4 robots in one group call. Both files
+matched, 24 of 24 runs each.
 """
 
 from __future__ import annotations
