@@ -188,6 +188,10 @@ class _Group:
     # the first group of a team: {sensor name: index into SharedSensing.scan_sets} whose block
     # is the team's concatenated readings of that sensor (Simulation._step_team)
     team_blocks: dict = field(default_factory=dict)
+    # set on every group of a team whose whole observation comes from arrays (every sensor a
+    # shared cast's block, detections padded or none): the team's first group, its slice and,
+    # per sensor in order, (name, scan set index, angles, max range); None: the general path
+    team_fast: Any = None
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -457,8 +461,10 @@ class Simulation:
         self._padded_sets: dict | None = None
         if self.faults is None and not self._rec_sensing and not any(g.whole for g in self._groups):
             for _team, _start, _stop, members in self.group_teams:
-                for j, (_det, dmembers) in enumerate(self._sharing.det_sets):
-                    if tuple(g.index for g in dmembers) == tuple(members):
+                for j, (det, dmembers) in enumerate(self._sharing.det_sets):
+                    # (false negatives or positives: Detector._detect_groups_padded declines)
+                    if (tuple(g.index for g in dmembers) == tuple(members) and det.cfg.p_false_negative == 0.0
+                            and det.cfg.p_false_positive == 0.0):
                         self._padded_sets = {**(self._padded_sets or {}), j: None}
                         for gi in members:
                             self._groups[gi].padded_det = j
@@ -471,6 +477,19 @@ class Simulation:
                     names = {g.sensors[k].name for g, k in smembers}
                     if len(names) == 1:
                         self._groups[members[0]].team_blocks[names.pop()] = j
+            for _team, start, stop, members in self.group_teams:
+                grps = [self._groups[gi] for gi in members]
+                first = grps[0]
+                names = [sn.name for sn in first.sensors]
+                dets = {g.detector is not None for g in grps}
+                if (len(grps) > 1 and names and len(set(names)) == len(names) and all(n in first.team_blocks for n in names)
+                        and all([sn.name for sn in g.sensors] == names for g in grps)
+                        and (dets == {False} or (dets == {True} and first.padded_det >= 0))):
+                    order = tuple((sn.name, first.team_blocks[sn.name], a, float(sn.max_range_m))
+                                  for sn, a in zip(first.sensors, first.angles))
+                    fast = (first, slice(start, stop), order)
+                    for g in grps:
+                        g.team_fast = fast
         self._n_track = 0
         if self.places.moving:  # replays and exports draw moving places where they are, not at their start
             self.recorder.declare_layer("moving_places", "markers", hold=True,
@@ -770,6 +789,11 @@ class Simulation:
         timer = self._brain_timer
         team_readings: list = []
         for grp in self._groups:
+            fast = grp.team_fast
+            if fast is not None:  # the team's observation is all arrays (no per-group readings)
+                if grp.team_last:
+                    self._step_team_fast(grp.team, fast, step, t, odom, delta, inboxes, events, outgoing, padded)
+                continue
             sl = grp.sl
             gx, gy, gth = xs[sl], ys[sl], ths[sl]
             if grp.batched:
@@ -972,6 +996,35 @@ class Simulation:
                 if any(d is not None for _, _, d in members):
                     dets = [row for grp, _, d in members for row in (d if d is not None else ((),) * grp.cfg.count)]
             count, ids, rng, brg = api.pad_detections(dets, n)
+        self._call_team(api, team, first, sl, n, ranges, angles, max_range, count, ids, rng, brg, step, t, odom, delta,
+                        inboxes, events, outgoing)
+
+    def _step_team_fast(self, team, fast: tuple, step: int, t: float, odom, delta, inboxes, events, outgoing: list,
+                        padded: dict | None) -> None:
+        """:meth:`_step_team` for a team whose observation is all arrays (``_Group.team_fast``):
+        each sensor's readings are its shared cast's block, the detections come padded (or
+        there is no detector); the same observation, built without the per-group readings."""
+        first, sl, order = fast
+        n = sl.stop - sl.start
+        blocks = self._sharing.blocks
+        ranges, angles, max_range = {}, {}, {}
+        for name, j, a, m in order:
+            ranges[name] = blocks[j]
+            angles[name] = a
+            max_range[name] = m
+        api = _group_api()
+        pj = first.padded_det
+        got = padded[pj] if pj >= 0 and padded is not None else None
+        if got is not None:
+            count, ids, rng, brg = got
+        else:
+            count, ids, rng, brg = api.pad_detections(None, n)
+        self._call_team(api, team, first, sl, n, ranges, angles, max_range, count, ids, rng, brg, step, t, odom, delta,
+                        inboxes, events, outgoing)
+
+    def _call_team(self, api, team, first: _Group, sl: slice, n: int, ranges, angles, max_range, count, ids, rng, brg,
+                   step: int, t: float, odom, delta, inboxes, events, outgoing: list) -> None:
+        """The group brain's call with its observation; its commands and messages stored."""
         obs = api.GroupObservation(
             np.arange(sl.start, sl.stop, dtype=np.int64), step, t, odom[sl], delta[sl], self.state.stalled[sl].copy(),
             ranges, angles, max_range, count, ids, rng, brg,
