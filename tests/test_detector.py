@@ -309,6 +309,45 @@ def test_detect_groups_equals_one_detect_per_group(seed, n, which, n_groups):
     assert [r.bit_generator.state for r in one] == [r.bit_generator.state for r in many]
 
 
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 12), st.sampled_from(range(len(_CFGS))), st.integers(1, 4),
+       st.booleans())
+def test_detect_groups_padded_equals_padded_tuples(seed, n, which, n_groups, far):
+    """The padded arrays a team's group brain gets straight from the detector are, byte for
+    byte, ``pad_detections`` of the concatenated groups' Detection tuples, with the same draws
+    from every group's stream; a detector with false negatives or positives declines (None)
+    and draws nothing."""
+    from teamnav.control.group import pad_detections
+
+    g = np.random.default_rng(seed)
+    det = RobotDetector(_CFGS[which], _walled())
+    xs, ys = g.uniform(0.3, 15.7, n), g.uniform(0.3, 11.7, n)
+    if far:  # spread out: often nobody sees anybody (the empty arrays)
+        xs = np.arange(n) * 7.0 + 0.5
+        ys = np.where(np.arange(n) % 2 == 0, 1.0, 10.0)
+    elif n > 2:
+        xs[2], ys[2] = xs[1], ys[1]
+    ths = g.uniform(-np.pi, np.pi, n)
+    radii = g.uniform(0.1, 0.3, n)
+    ids = np.arange(n, dtype=np.int64) + 10
+    cuts = np.unique(np.concatenate([[0, n], g.integers(1, n, n_groups - 1)]))
+    groups = [np.arange(cuts[k], cuts[k + 1], dtype=np.int64) for k in range(cuts.shape[0] - 1)]
+    one = [np.random.default_rng([seed, k]) for k in range(len(groups))]
+    many = [np.random.default_rng([seed, k]) for k in range(len(groups))]
+    before = [r.bit_generator.state for r in many]
+    got = det._detect_groups_padded(xs, ys, ths, radii, groups, many, ids)
+    if det.cfg.p_false_negative or det.cfg.p_false_positive:
+        assert got is None
+        assert [r.bit_generator.state for r in many] == before
+        return
+    tuples = [row for d in det._detect_groups(xs, ys, ths, radii, groups, one, ids) for row in d]
+    expected = pad_detections(tuples, n)
+    assert [r.bit_generator.state for r in one] == [r.bit_generator.state for r in many]
+    for a, b in zip(got, expected):
+        assert a.dtype == b.dtype and a.shape == b.shape and a.flags.c_contiguous
+        assert a.tobytes() == b.tobytes()
+
+
 @settings(max_examples=30, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(2, 40), st.sampled_from([0, 1, 3, 4]))
 def test_small_team_kernel_equals_spatial_hash(seed, n, which):

@@ -182,6 +182,16 @@ class _Group:
     extras_last: bool = False  # last step's observations carried an inbox, events or detections
     team: Any = None  # the group brain that steps its robots (``group_brains``), None: per-robot brains
     team_last: bool = False  # the last group of its team: the team steps after its readings
+    # index into SharedSensing.det_sets whose detections its team takes as padded arrays
+    # (Simulation._padded_sets), -1: as Detection tuples
+    padded_det: int = -1
+    # the first group of a team: {sensor name: index into SharedSensing.scan_sets} whose block
+    # is the team's concatenated readings of that sensor (Simulation._step_team)
+    team_blocks: dict = field(default_factory=dict)
+    # set on every group of a team whose whole observation comes from arrays (every sensor a
+    # shared cast's block, detections padded or none): the team's first group, its slice and,
+    # per sensor in order, (name, scan set index, angles, max range); None: the general path
+    team_fast: Any = None
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -444,6 +454,42 @@ class Simulation:
         if self.radio is not None:
             self.recorder.comm_counts = self.radio.counts
         self._rec_sensing = bool(config.record_scans)
+        # speed: a team whose groups are exactly one set of the shared detector, in order, gets
+        # its detections straight as its observation's padded arrays (no Detection objects
+        # built and read back: the same values and draws). Only where nothing else reads the
+        # tuples: no faults, no recorded detections, no controller reading Simulation.observed.
+        self._padded_sets: dict | None = None
+        if self.faults is None and not self._rec_sensing and not any(g.whole for g in self._groups):
+            for _team, _start, _stop, members in self.group_teams:
+                for j, (det, dmembers) in enumerate(self._sharing.det_sets):
+                    # (false negatives or positives: Detector._detect_groups_padded declines)
+                    if (tuple(g.index for g in dmembers) == tuple(members) and det.cfg.p_false_negative == 0.0
+                            and det.cfg.p_false_positive == 0.0):
+                        self._padded_sets = {**(self._padded_sets or {}), j: None}
+                        for gi in members:
+                            self._groups[gi].padded_det = j
+            # likewise a team whose groups are exactly one shared cast's members, in order, for
+            # a sensor: its concatenated readings of that sensor are the cast's block
+            for _team, _start, _stop, members in self.group_teams:
+                for j, (_sensor, smembers, _idx, _bodies, starts) in enumerate(self._sharing.scan_sets):
+                    if starts is None or tuple(g.index for g, _ in smembers) != tuple(members):
+                        continue
+                    names = {g.sensors[k].name for g, k in smembers}
+                    if len(names) == 1:
+                        self._groups[members[0]].team_blocks[names.pop()] = j
+            for _team, start, stop, members in self.group_teams:
+                grps = [self._groups[gi] for gi in members]
+                first = grps[0]
+                names = [sn.name for sn in first.sensors]
+                dets = {g.detector is not None for g in grps}
+                if (len(grps) > 1 and names and len(set(names)) == len(names) and all(n in first.team_blocks for n in names)
+                        and all([sn.name for sn in g.sensors] == names for g in grps)
+                        and (dets == {False} or (dets == {True} and first.padded_det >= 0))):
+                    order = tuple((sn.name, first.team_blocks[sn.name], a, float(sn.max_range_m))
+                                  for sn, a in zip(first.sensors, first.angles))
+                    fast = (first, slice(start, stop), order)
+                    for g in grps:
+                        g.team_fast = fast
         self._n_track = 0
         if self.places.moving:  # replays and exports draw moving places where they are, not at their start
             self.recorder.declare_layer("moving_places", "markers", hold=True,
@@ -733,7 +779,8 @@ class Simulation:
         xs, ys, ths = s.x_m, s.y_m, s.theta_rad
         sharing = self._sharing
         shared = sharing.readings(s) if sharing.scan_sets else None
-        dets_of = sharing.detections(s, self._ids_all) if sharing.det_sets else None
+        padded = None if self._padded_sets is None else dict(self._padded_sets)
+        dets_of = sharing.detections(s, self._ids_all, padded) if sharing.det_sets else None
         delta = self.odometry.delta.copy() if self._any_per_robot else None  # fresh, one copy for all groups
         scans_of: dict[int, list] = {}
         self.observed = (step, odom, delta, scans_of, inboxes, events, dets_of)
@@ -742,6 +789,11 @@ class Simulation:
         timer = self._brain_timer
         team_readings: list = []
         for grp in self._groups:
+            fast = grp.team_fast
+            if fast is not None:  # the team's observation is all arrays (no per-group readings)
+                if grp.team_last:
+                    self._step_team_fast(grp.team, fast, step, t, odom, delta, inboxes, events, outgoing, padded)
+                continue
             sl = grp.sl
             gx, gy, gth = xs[sl], ys[sl], ths[sl]
             if grp.batched:
@@ -771,7 +823,8 @@ class Simulation:
                  angles, float(sensor.max_range_m))
                 for k, (sensor, rng, angles, bodies) in enumerate(zip(grp.sensors, grp.rngs, grp.angles, grp.bodies))
             ]
-            dets = dets_of[grp.index] if grp.detector is not None else None
+            # (None for a team group whose detections come padded: dets_of leaves it out)
+            dets = dets_of.get(grp.index) if grp.detector is not None else None
             if fx is not None:
                 readings, omit = fx.readings(grp.index, sl.start, readings)
                 if dets is not None:
@@ -784,7 +837,8 @@ class Simulation:
             if grp.team is not None:  # stepped by its group brain once its team's last group is sensed
                 team_readings.append((grp, readings, dets))
                 if grp.team_last:
-                    self._step_team(grp.team, team_readings, step, t, odom, delta, inboxes, events, outgoing)
+                    self._step_team(grp.team, team_readings, step, t, odom, delta, inboxes, events, outgoing,
+                                    padded)
                     team_readings = []
                 continue
             stalled = s.stalled[sl].tolist()
@@ -907,7 +961,8 @@ class Simulation:
                 self.radio.send(outgoing, xs, ys, muted=fx.radio_off if fx.any_radio_off else None, blocked=fx.blackout,
                                 step=step)
 
-    def _step_team(self, team, members: list, step: int, t: float, odom, delta, inboxes, events, outgoing: list) -> None:
+    def _step_team(self, team, members: list, step: int, t: float, odom, delta, inboxes, events, outgoing: list,
+                   padded: dict | None = None) -> None:
         """One call of a group brain for its team: each robot's own readings, odometry,
         detections, inbox and events as arrays (:class:`~teamnav.control.group.GroupObservation`),
         its commands into the command arrays, its messages to the radio (robot order)."""
@@ -921,19 +976,55 @@ class Simulation:
         elif len(members) == 1:
             ranges = {name: r for name, r, _, _ in readings}
         else:
-            ranges = {name: np.concatenate([dict((nm, rr) for nm, rr, _, _ in rd)[name] for _, rd, _ in members])
+            blocks = first.team_blocks
+            ranges = {name: self._sharing.blocks[blocks[name]] if name in blocks else
+                      np.concatenate([dict((nm, rr) for nm, rr, _, _ in rd)[name] for _, rd, _ in members])
                       for name, _, _, _ in members[0][1]}
         if not (len(members) == 1 and len(readings) == 1):
             angles = {name: a for name, _, a, _ in readings}
             max_range = {name: m for name, _, _, m in readings}
-        if len(members) == 1:
-            dets = members[0][2]
-        else:
-            dets = None
-            if any(d is not None for _, _, d in members):
-                dets = [row for grp, _, d in members for row in (d if d is not None else ((),) * grp.cfg.count)]
-        count, ids, rng, brg = _group_api().pad_detections(dets, n)
         api = _group_api()
+        pj = first.padded_det
+        got = padded[pj] if pj >= 0 and padded is not None else None
+        if got is not None:  # the team's detections, padded by the detector (Simulation._padded_sets)
+            count, ids, rng, brg = got
+        else:
+            if len(members) == 1:
+                dets = members[0][2]
+            else:
+                dets = None
+                if any(d is not None for _, _, d in members):
+                    dets = [row for grp, _, d in members for row in (d if d is not None else ((),) * grp.cfg.count)]
+            count, ids, rng, brg = api.pad_detections(dets, n)
+        self._call_team(api, team, first, sl, n, ranges, angles, max_range, count, ids, rng, brg, step, t, odom, delta,
+                        inboxes, events, outgoing)
+
+    def _step_team_fast(self, team, fast: tuple, step: int, t: float, odom, delta, inboxes, events, outgoing: list,
+                        padded: dict | None) -> None:
+        """:meth:`_step_team` for a team whose observation is all arrays (``_Group.team_fast``):
+        each sensor's readings are its shared cast's block, the detections come padded (or
+        there is no detector); the same observation, built without the per-group readings."""
+        first, sl, order = fast
+        n = sl.stop - sl.start
+        blocks = self._sharing.blocks
+        ranges, angles, max_range = {}, {}, {}
+        for name, j, a, m in order:
+            ranges[name] = blocks[j]
+            angles[name] = a
+            max_range[name] = m
+        api = _group_api()
+        pj = first.padded_det
+        got = padded[pj] if pj >= 0 and padded is not None else None
+        if got is not None:
+            count, ids, rng, brg = got
+        else:
+            count, ids, rng, brg = api.pad_detections(None, n)
+        self._call_team(api, team, first, sl, n, ranges, angles, max_range, count, ids, rng, brg, step, t, odom, delta,
+                        inboxes, events, outgoing)
+
+    def _call_team(self, api, team, first: _Group, sl: slice, n: int, ranges, angles, max_range, count, ids, rng, brg,
+                   step: int, t: float, odom, delta, inboxes, events, outgoing: list) -> None:
+        """The group brain's call with its observation; its commands and messages stored."""
         obs = api.GroupObservation(
             np.arange(sl.start, sl.stop, dtype=np.int64), step, t, odom[sl], delta[sl], self.state.stalled[sl].copy(),
             ranges, angles, max_range, count, ids, rng, brg,

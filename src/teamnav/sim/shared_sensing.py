@@ -51,6 +51,9 @@ class SharedSensing:
         (all noise in one kernel call, each with its own key).
     shared_scan : set of (group index, sensor k)
         The sensors whose readings come from a shared cast.
+    blocks : list of ndarray or None
+        Per scan set, the last :meth:`readings`' array of all its rows (fresh each step) when
+        its noise took one call, else None.
     """
 
     def __init__(self, groups: Sequence[Any], state: Any) -> None:
@@ -96,6 +99,9 @@ class SharedSensing:
             starts = np.cumsum([0] + [g.cfg.count for g, _ in members]).astype(np.int64)
             self.scan_sets.append((g0.sensors[k0], members, idx, bodies, starts if len(noise) == 1 else None))
         self.shared_scan = {(g.index, k) for _, members, _, _, _ in self.scan_sets for g, k in members}
+        #: per scan set, the last step's ranges of all its rows when its noise took one kernel
+        #: call (the members' readings are row blocks of it), else None
+        self.blocks: list[np.ndarray | None] = [None] * len(self.scan_sets)
 
     def readings(self, state: Any) -> dict:
         """This step's ranges of the shared casts: ``{(group index, sensor k): (n, B) array}``."""
@@ -103,13 +109,14 @@ class SharedSensing:
 
         s = state
         out = {}
-        for sensor, members, idx, bodies, starts in self.scan_sets:
+        for j, (sensor, members, idx, bodies, starts) in enumerate(self.scan_sets):
             true = sensor._true_ranges(s.x_m[idx], s.y_m[idx], s.theta_rad[idx], bodies)
             if starts is not None:
                 keys = np.array([draw_noise_key(grp.rngs[k]) for grp, k in members], dtype=np.uint64)
                 ranges = np.empty(true.shape)  # fresh this step; each group reads its own rows
                 _counter_noise_blocks(true, keys, starts, sensor.noise_std_m, sensor.p_max, sensor.p_short,
                                       sensor.max_range_m, ranges)
+                self.blocks[j] = ranges
                 sl = starts.tolist()
                 for j, (grp, k) in enumerate(members):
                     out[(grp.index, k)] = ranges[sl[j]:sl[j + 1]]
@@ -124,11 +131,22 @@ class SharedSensing:
                 r0 = r1
         return out
 
-    def detections(self, state: Any, ids_all: np.ndarray) -> dict:
-        """This step's detections, ``{group index: list of tuples of Detection}``."""
+    def detections(self, state: Any, ids_all: np.ndarray, padded: dict | None = None) -> dict:
+        """This step's detections, ``{group index: list of tuples of Detection}``.
+
+        ``padded`` (optional): ``{index into det_sets: None}``; each of those sets whose
+        detector has rule 4 only is instead filled in with its groups' detections in a group
+        brain's padded arrays (:meth:`Detector._detect_groups_padded`), and its groups are left
+        out of the result (the same draws either way)."""
         s = state
         out = {}
-        for det, members in self.det_sets:
+        for j, (det, members) in enumerate(self.det_sets):
+            if padded is not None and j in padded:
+                got = det._detect_groups_padded(s.x_m, s.y_m, s.theta_rad, s.radius_m, [g.ids for g in members],
+                                                [g.detector_rng for g in members], ids_all)
+                if got is not None:
+                    padded[j] = got
+                    continue
             found = det._detect_groups(s.x_m, s.y_m, s.theta_rad, s.radius_m, [g.ids for g in members],
                                        [g.detector_rng for g in members], ids_all)
             for grp, d in zip(members, found):

@@ -416,8 +416,75 @@ class RobotDetector:
             out.append(_as_tuples(self._finish(truth, n_all, radii, o, rng, ids), sizes[g]))
         return out
 
+    def _detect_groups_padded(self, xs, ys, thetas, radii, observers, rngs, ids):
+        """:meth:`_detect_groups` for a detector with rule 4 only (no false negatives or
+        positives), its result already in the padded form of a group brain's observation
+        (:func:`teamnav.control.group.pad_detections` of the concatenated groups' tuples):
+        ``(count (n,), id (n, k), range_m (n, k), bearing_rad (n, k))`` over every observer of
+        ``observers`` in order, ``k`` the most detections of one observer, empty slots -1 and
+        NaN. The same draws from each group's stream and the same values bit for bit as the
+        tuples (which only carried these float64 values as Python floats); no
+        :class:`Detection` object is built. Returns None (nothing drawn) for a detector with
+        false negatives or positives: the caller takes :meth:`_detect_groups` then.
+        """
+        cfg = self.cfg
+        if cfg.p_false_negative != 0.0 or cfg.p_false_positive != 0.0:
+            return None
+        key = tuple(map(id, observers))
+        memo = getattr(self, "_groups_memo", None)
+        if memo is None or memo[0] != key or any(x is not y for x, y in zip(memo[1], observers)):
+            obs = observers[0] if len(observers) == 1 else np.concatenate(observers)
+            sizes = [o.shape[0] for o in observers]
+            offs = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+            self._groups_memo = memo = (key, list(observers), obs, sizes, offs, offs.tolist())
+        obs, offs = memo[2], memo[4]
+        n = obs.shape[0]
+        row, a, b, d_r, a_r = self._visible(xs, ys, thetas, obs)
+        m = row.shape[0]
+        if m == 0:
+            for rng in rngs:
+                self._draw_noise(0, rng)
+            return np.zeros(n, dtype=np.int64), np.empty((n, 0), dtype=np.int64), np.empty((n, 0)), np.empty((n, 0))
+        cut = np.searchsorted(row, offs).tolist()
+        draws = [self._draw_noise(cut[g + 1] - cut[g], rng) for g, rng in enumerate(rngs)]
+        u = None if draws[0] is None else draws[0] if len(draws) == 1 else np.concatenate(draws, axis=1)
+        d_p, a_p = self._apply_noise(d_r, a_r, 2.0 * radii[b], u)
+        return _pad_rows(row, b, ids, cfg.report_identity, np.asarray(d_p, np.float64), np.asarray(a_p, np.float64), n)
+
 
 # ---------------------------------------------------------------------------- helpers
+@njit(cache=True)
+def _pad_rows(row, b, ids, report_identity, d_p, a_p, n):
+    """The padded arrays of :meth:`Detector._detect_groups_padded` from the sorted detections
+    (``row`` ascending; each row's detections in order): per row its count, and its
+    detections' ids (``ids[b]``, -1 without identities or for a negative id), ranges and
+    bearings in slots 0..count-1, the rest -1 / NaN (as ``pad_detections`` fills them)."""
+    m = row.shape[0]
+    count = np.zeros(n, dtype=np.int64)
+    for j in range(m):
+        count[row[j]] += 1
+    k = 0
+    for r in range(n):
+        if count[r] > k:
+            k = count[r]
+    det_id = np.full((n, k), -1, dtype=np.int64)
+    rng_m = np.full((n, k), np.nan)
+    brg = np.full((n, k), np.nan)
+    col = 0
+    for j in range(m):
+        r = row[j]
+        if j > 0 and row[j - 1] == r:
+            col += 1
+        else:
+            col = 0
+        if report_identity:
+            v = ids[b[j]]
+            det_id[r, col] = v if v >= 0 else -1
+        rng_m[r, col] = d_p[j]
+        brg[r, col] = a_p[j]
+    return count, det_id, rng_m, brg
+
+
 #: Teams up to this size find their visible pairs by testing every pair in one kernel;
 #: larger ones use the spatial hash (:func:`teamnav.world.los.pairs_within`).
 _BRUTE_MAX_ROBOTS = 64
