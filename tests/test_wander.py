@@ -104,6 +104,33 @@ def test_compiled_kernel_matches_its_python_execution(seed, use_prox):
         np.testing.assert_allclose(st_c, st_py, rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.parametrize("chunk", [1, 7, 64, 5000])
+def test_rows_spread_over_threads_are_the_serial_kernels_bit_for_bit(chunk):
+    """wander_step_parallel (rows in chunks over numba's threads) against wander_step: the same
+    commands and states, byte for byte, for any chunk size (a chunk larger than the team too)."""
+    import numba
+
+    rng = np.random.default_rng(chunk)
+    n, nb = 300, LASER.angles_rad.size
+    p = kernel_params(WanderParams(p_turn_at_opening=0.5), LASER.max_range_m, 0.1)
+    keys = rng.integers(0, 2**63, n, dtype=np.uint64)
+    st_s, st_p = K.initial_state(n), K.initial_state(n)
+    threads = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(2, numba.config.NUMBA_NUM_THREADS)))
+    try:
+        for step in range(20):
+            r = np.minimum(rng.uniform(0.0, 1.0, (n, nb)) ** 2 * LASER.max_range_m * 1.2, LASER.max_range_m)
+            stalled = rng.random(n) < 0.1
+            out_s, out_p = (np.zeros(n), np.zeros(n)), (np.zeros(n), np.zeros(n))
+            K.wander_step(r, LASER.angles_rad, LASER.max_range_m, stalled, keys, np.int64(step), p, st_s, *out_s)
+            K.wander_step_parallel(r, LASER.angles_rad, LASER.max_range_m, stalled, keys, np.int64(step), p, st_p,
+                                   *out_p, np.int64(chunk))
+            assert np.array_equal(out_s[0], out_p[0]) and np.array_equal(out_s[1], out_p[1])
+            assert st_s.tobytes() == st_p.tobytes()
+    finally:
+        numba.set_num_threads(threads)
+
+
 def test_rows_do_not_depend_on_their_neighbours():
     params = WanderParams()
     infos = [info(i, 3) for i in range(3)]

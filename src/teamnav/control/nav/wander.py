@@ -37,6 +37,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numba
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -324,8 +325,13 @@ class WanderBatched:
             raise ValueError(f"obs.ranges_m must have shape ({n}, n_beams), got {ranges.shape}")
         stalled = np.ascontiguousarray(obs.stalled, dtype=np.bool_)
         angles = np.ascontiguousarray(obs.angles_rad, dtype=np.float64)
-        K.wander_step(ranges, angles, float(obs.max_range_m), stalled, self._keys,
-                      np.int64(obs.step), self._p, self._state, self._v, self._w)
+        threads = numba.get_num_threads()
+        if n >= K.PARALLEL_MIN_ROWS and threads > 1:  # rows are independent: the same on any thread count
+            K.wander_step_parallel(ranges, angles, float(obs.max_range_m), stalled, self._keys, np.int64(obs.step),
+                                   self._p, self._state, self._v, self._w, np.int64(min(512, n // (4 * threads))))
+        else:
+            K.wander_step(ranges, angles, float(obs.max_range_m), stalled, self._keys,
+                          np.int64(obs.step), self._p, self._state, self._v, self._w)
         return BatchAction(self._v.copy(), self._w.copy())
 
     def log(self) -> dict[str, Any]:

@@ -24,7 +24,7 @@ parameters in a float64 vector of length N_PARAMS with the entries ``P_*`` (buil
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 # ----------------------------------------------------------------- parameter vector layout
 P_CRUISE_MPS = 0  # forward speed in open space [m/s]
@@ -408,6 +408,32 @@ def wander_step(
     """
     cls, perp_l, perp_r = beam_classes(angles_rad, p)  # once per call
     _wander_rows(ranges_m, cls[C_FRONT], cls[C_SIDE_L], cls[C_SIDE_R], cls[C_HALF_L], cls[C_HALF_R], perp_l, perp_r, max_range_m, stalled, keys, step, p, state, v_out, omega_out)
+
+
+#: Fewest rows for which :class:`~teamnav.control.nav.wander.WanderBatched` spreads them over
+#: numba's threads (:func:`wander_step_parallel`): a row takes ~0.5 µs, so below ~1 ms of work
+#: waking the threads costs more than it saves.
+PARALLEL_MIN_ROWS = 2048
+
+
+@njit(cache=True, parallel=True)
+def wander_step_parallel(ranges_m, angles_rad, max_range_m, stalled, keys, step, p, state, v_out, omega_out,
+                         chunk) -> None:
+    """:func:`wander_step` with chunks of ``chunk`` rows spread over numba's threads.
+
+    Exact by construction: a row reads only its own ranges, stall flag, key and state, and its
+    random draws are ``uniform01(key, step, k)`` (module docstring), so its command and state are
+    the same on any thread count and in any chunk.
+    """
+    cls, perp_l, perp_r = beam_classes(angles_rad, p)  # once per call
+    n = ranges_m.shape[0]
+    nchunks = (n + chunk - 1) // chunk
+    for c in prange(nchunks):
+        a = c * chunk
+        b = min(n, a + chunk)
+        _wander_rows(ranges_m[a:b], cls[C_FRONT], cls[C_SIDE_L], cls[C_SIDE_R], cls[C_HALF_L], cls[C_HALF_R], perp_l,
+                     perp_r, max_range_m, stalled[a:b], keys[a:b], step, p, state[a:b], v_out[a:b],
+                     omega_out[a:b])
 
 
 def initial_state(n: int) -> np.ndarray:
