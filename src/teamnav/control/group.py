@@ -163,6 +163,18 @@ def empty_inbox(n: int) -> tuple:
 
 
 
+def renew_module_caches(module_name: str, callees: Sequence[Any]) -> bool:
+    """:func:`renew_stale_caches` for every cached numba kernel defined in the module
+    ``module_name``, against the source files of the modules ``callees`` (each compiled module
+    calls this once at import, naming the modules whose numba functions it calls)."""
+    import sys
+
+    here = sys.modules[module_name]
+    kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
+               and f.py_func.__module__ == module_name]
+    return renew_stale_caches(kernels, [m.__file__ for m in callees])
+
+
 def renew_stale_caches(dispatchers: Sequence[Any], sources: Sequence[str | Path]) -> bool:
     """Empty the numba caches of ``dispatchers`` when a module they call has changed.
 

@@ -825,16 +825,11 @@ def _renew_caches() -> None:
     """This module's kernels call the reference's kernels (the openings' quick test) and CPython's
     hypot (``local/compiled.py``): renew their numba caches when one of those changes
     (:func:`~teamnav.control.group.renew_stale_caches`)."""
-    import sys
-
-    from teamnav.control.group import renew_stale_caches
+    from teamnav.control.group import renew_module_caches
     from teamnav.control.nav import openings
     from teamnav.control.nav.local import compiled as local_compiled
 
-    here = sys.modules[__name__]
-    kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
-               and f.py_func.__module__ == __name__]
-    renew_stale_caches(kernels, [m.__file__ for m in (openings, local_compiled)])
+    renew_module_caches(__name__, (openings, local_compiled))
 
 
 _renew_caches()

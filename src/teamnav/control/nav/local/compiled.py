@@ -410,15 +410,10 @@ def direction(par, fst, ist, grid, normals, r, px, py, th, ranges, angles, max_r
 def _renew_caches() -> None:
     """This module's kernels call the reference's kernels in base, potential_field and
     avoid_past: renew their numba caches when those change (:func:`~teamnav.control.group.renew_stale_caches`)."""
-    import sys
-
-    from teamnav.control.group import renew_stale_caches
+    from teamnav.control.group import renew_module_caches
     from teamnav.control.nav.local import avoid_past, base, potential_field
 
-    here = sys.modules[__name__]
-    kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
-               and f.py_func.__module__ == __name__]
-    renew_stale_caches(kernels, [m.__file__ for m in (avoid_past, base, potential_field)])
+    renew_module_caches(__name__, (avoid_past, base, potential_field))
 
 
 _renew_caches()

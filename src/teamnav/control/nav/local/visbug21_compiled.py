@@ -707,15 +707,10 @@ def _renew_caches() -> None:
     """This module's kernels call the reference's kernels (base, visbug21_geometry) and the
     compiled navigators' helpers: renew their numba caches when one of those changes
     (:func:`~teamnav.control.group.renew_stale_caches`)."""
-    import sys
-
-    from teamnav.control.group import renew_stale_caches
+    from teamnav.control.group import renew_module_caches
     from teamnav.control.nav.local import base, visbug21, visbug21_geometry
 
-    here = sys.modules[__name__]
-    kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
-               and f.py_func.__module__ == __name__]
-    renew_stale_caches(kernels, [m.__file__ for m in (N, base, visbug21, visbug21_geometry)])
+    renew_module_caches(__name__, (N, base, visbug21, visbug21_geometry))
 
 
 _renew_caches()

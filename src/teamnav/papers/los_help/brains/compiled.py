@@ -525,17 +525,11 @@ def _renew_caches() -> None:
     """This module's kernels call the compiled navigators and the reference's kernels (base,
     goal_sharing, the navigators'): renew their numba caches when one of those changes
     (:func:`~teamnav.control.group.renew_stale_caches`)."""
-    import sys
-
-    from teamnav.control.group import renew_stale_caches
+    from teamnav.control.group import renew_module_caches
     from teamnav.control.nav.local import avoid_past, base, potential_field, visbug21, visbug21_geometry
     from teamnav.papers.los_help.brains import goal_sharing
 
-    here = sys.modules[__name__]
-    kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
-               and f.py_func.__module__ == __name__]
-    renew_stale_caches(kernels, [m.__file__ for m in (N, V, avoid_past, base, potential_field, visbug21,
-                                                      visbug21_geometry, goal_sharing)])
+    renew_module_caches(__name__, (N, V, avoid_past, base, potential_field, visbug21, visbug21_geometry, goal_sharing))
 
 
 _renew_caches()

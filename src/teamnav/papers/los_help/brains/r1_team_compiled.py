@@ -534,9 +534,7 @@ def _renew_caches() -> None:
     """This module's kernels call the compiled R1's and helpers', the navigators' and goal
     sharing's: renew their numba caches when one of those changes
     (:func:`~teamnav.control.group.renew_stale_caches`)."""
-    import sys
-
-    from teamnav.control.group import renew_stale_caches
+    from teamnav.control.group import renew_module_caches
     from teamnav.control.nav.local import (
         avoid_past,
         base,
@@ -546,11 +544,8 @@ def _renew_caches() -> None:
     )
     from teamnav.papers.los_help.brains import goal_sharing
 
-    here = sys.modules[__name__]
-    kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
-               and f.py_func.__module__ == __name__]
-    renew_stale_caches(kernels, [m.__file__ for m in (N, V, C, GC, HC, avoid_past, base, potential_field, visbug21,
-                                                      visbug21_geometry, goal_sharing)])
+    renew_module_caches(__name__, (N, V, C, GC, HC, avoid_past, base, potential_field, visbug21, visbug21_geometry,
+                                   goal_sharing))
 
 
 _renew_caches()

@@ -1058,16 +1058,11 @@ def _renew_caches() -> None:
     calls: renew their numba caches when one of those changes (a cached kernel of this module
     went on calling an old form of the step, and crashed, 2026-11-29;
     :func:`~teamnav.control.group.renew_stale_caches`)."""
-    import sys
-
-    from teamnav.control.group import renew_stale_caches
+    from teamnav.control.group import renew_module_caches
     from teamnav.control.nav import openings
     from teamnav.control.nav.local import compiled as local_compiled
 
-    here = sys.modules[__name__]
-    kernels = [f for f in vars(here).values() if hasattr(f, "_cache") and hasattr(f, "py_func")
-               and f.py_func.__module__ == __name__]
-    renew_stale_caches(kernels, [m.__file__ for m in (NC, openings, local_compiled)])
+    renew_module_caches(__name__, (NC, openings, local_compiled))
 
 
 _renew_caches()
