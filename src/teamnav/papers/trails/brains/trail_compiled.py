@@ -29,6 +29,7 @@ the per-robot path skips them.
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from typing import Any, Sequence
 
 import numpy as np
@@ -519,7 +520,7 @@ class _TeamView:
         return getattr(g._brains[self._r], name)
 
 
-class _TrailGroup:
+class _TrailGroup(ABC):
     """A team of one trail brain class: each robot its reference brain over a compiled Navigate.
 
     The part both trail brains share: building the brains, the two forms of the step (one
@@ -571,6 +572,7 @@ class _TrailGroup:
         return "; ".join(sorted(set(whys))) or "no robots"
 
     @classmethod
+    @abstractmethod
     def _probe_params(cls, params: Any):
         """The Navigate parameters the reference brain builds for ``params``."""
         raise NotImplementedError
@@ -601,11 +603,13 @@ class _TrailGroup:
 
     # ------------------------------------------------------------------ what each brain says
     @staticmethod
+    @abstractmethod
     def _param_row(p: Any) -> np.ndarray:
         """The brain's parameters ``p`` as its kernels' parameter row."""
         raise NotImplementedError
 
     @staticmethod
+    @abstractmethod
     def _fast_brain(brain: Any) -> bool:
         """Whether a robot with a compiled Navigate takes the compiled step (on steps without task
         events)."""
@@ -617,6 +621,7 @@ class _TrailGroup:
         events."""
         return False
 
+    @abstractmethod
     def _row_step(self, brain: Any, r: int, box: Sequence[Any], ranges: np.ndarray, x: float, y: float, th: float,
                   t: float, stalled: bool, step: int) -> tuple:
         """One call per robot: robot r's compiled step (inbox included), its brain's state
@@ -624,15 +629,18 @@ class _TrailGroup:
         Navigate must draw (:meth:`_draw`)."""
         raise NotImplementedError
 
+    @abstractmethod
     def _init_state(self) -> None:
         """The team in one call: the brains' own state in the team's arrays (allocated here,
         filled by :meth:`_from_brain`)."""
         raise NotImplementedError
 
+    @abstractmethod
     def _from_brain(self, r: int) -> None:
         """Robot r's state, from its reference brain into the team's arrays."""
         raise NotImplementedError
 
+    @abstractmethod
     def _to_brain(self, r: int) -> None:
         """Robot r's state, from the team's arrays into its reference brain."""
         raise NotImplementedError
@@ -642,11 +650,13 @@ class _TrailGroup:
         task events (a new array)."""
         return np.zeros(self._n, dtype=np.bool_)
 
+    @abstractmethod
     def _before_team(self, obs: GroupObservation, rows: np.ndarray, t: float) -> None:
         """The team in one call: the reference's rules the kernel does not run (the inbox), for
         the robots ``rows``, before it."""
         raise NotImplementedError
 
+    @abstractmethod
     def _team_kernel(self, rows: np.ndarray, ranges: np.ndarray, poses: np.ndarray, t: float, stalled: np.ndarray,
                      out_v: np.ndarray, out_w: np.ndarray, hint: np.ndarray) -> None:
         """The team in one call: the brain's team kernel over ``rows``; a robot whose Navigate
